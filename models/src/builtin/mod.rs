@@ -1,0 +1,5 @@
+//! The built-in friction models, one per file.
+
+mod coulomb;
+
+pub use coulomb::Coulomb;

@@ -1,0 +1,15 @@
+//! Friction models for frictionid: the [`FrictionModel`] trait, the typetag-based registry and
+//! the built-in friction laws.
+//!
+//! Models are pure functions of sliding velocity, internal states, normal force and
+//! parameters; they know nothing of solvers, files or the command line.
+
+pub mod builtin;
+pub mod error;
+pub mod model;
+pub mod registry;
+
+pub use builtin::*;
+pub use error::ModelError;
+pub use model::{check_bounds, check_len, sgn, FrictionModel, GuessHint, ParamInfo};
+pub use registry::{build_json, build_toml, default_model, listings, names, Built, ModelListing};

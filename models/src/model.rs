@@ -1,0 +1,209 @@
+//! The friction-model trait and its parameter metadata.
+
+use crate::error::ModelError;
+use serde::Serialize;
+
+/// Metadata of one model parameter.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ParamInfo {
+    /// Parameter name, as used in config files.
+    pub name: String,
+    /// SI unit ("1" for dimensionless coefficients).
+    pub unit: String,
+    /// Default value.
+    pub default: f64,
+    /// Physical lower bound.
+    pub lower: f64,
+    /// Physical upper bound.
+    pub upper: f64,
+    /// When true the lower bound itself is excluded (the value must be strictly greater).
+    pub lower_exclusive: bool,
+    /// One-line meaning.
+    pub description: String,
+}
+
+impl ParamInfo {
+    /// Metadata with an inclusive lower bound.
+    pub fn new(
+        name: &str,
+        unit: &str,
+        default: f64,
+        (lower, upper): (f64, f64),
+        description: &str,
+    ) -> Self {
+        Self {
+            name: name.to_string(),
+            unit: unit.to_string(),
+            default,
+            lower,
+            upper,
+            lower_exclusive: false,
+            description: description.to_string(),
+        }
+    }
+
+    /// Metadata for a strictly positive parameter (lower bound 0, excluded).
+    pub fn positive(name: &str, unit: &str, default: f64, upper: f64, description: &str) -> Self {
+        Self {
+            lower_exclusive: true,
+            ..Self::new(name, unit, default, (0.0, upper), description)
+        }
+    }
+
+    /// Whether `value` lies inside the physical bounds.
+    pub fn admits(&self, value: f64) -> bool {
+        let above = if self.lower_exclusive {
+            value > self.lower
+        } else {
+            value >= self.lower
+        };
+        value.is_finite() && above && value <= self.upper
+    }
+
+    /// The bounds as text, e.g. `(0, inf]` or `[0, 10]`.
+    pub fn bounds_text(&self) -> String {
+        format!(
+            "{}{}, {}]",
+            if self.lower_exclusive { "(" } else { "[" },
+            fmt_bound(self.lower),
+            fmt_bound(self.upper)
+        )
+    }
+}
+
+fn fmt_bound(x: f64) -> String {
+    if x == f64::INFINITY {
+        "inf".into()
+    } else if x == f64::NEG_INFINITY {
+        "-inf".into()
+    } else {
+        format!("{x}")
+    }
+}
+
+/// Data-driven hints for initial parameter values, computed by the identifier from the
+/// measured records (see `FrictionModel::apply_guess`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GuessHint {
+    /// Mean friction force divided by the normal force (from the half-cycle energy estimate).
+    pub mu: f64,
+    /// A typical sliding speed of the records [m/s] (e.g. the RMS velocity).
+    pub typical_velocity: f64,
+    /// The normal force [N].
+    pub normal_force: f64,
+    /// The oscillator stiffness [N/m]; bristle and element stiffnesses are guessed relative to it.
+    pub stiffness: f64,
+}
+
+/// A friction law: a pure function of sliding velocity, internal states and normal force.
+///
+/// Implementors derive `Clone`, `Serialize` and `Deserialize` (with `#[serde(default,
+/// deny_unknown_fields)]` so that missing parameters take their defaults and unknown keys are
+/// rejected) and register with `#[typetag::serde(name = "...")]` on the `impl` block. That is
+/// all it takes for the registry, the engine, the identifier and the CLI to know the model.
+///
+/// Sign convention: the force opposes motion, so a positive velocity gives a positive force in
+/// `m x'' + c x' + k x + F = 0`.
+#[typetag::serde(tag = "type")]
+pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
+    /// The registry name (must equal the typetag name).
+    fn name(&self) -> &'static str;
+
+    /// The friction law in one line, for listings.
+    fn equation(&self) -> String;
+
+    /// Parameter metadata, in the order of `params`/`set_params`.
+    fn param_info(&self) -> Vec<ParamInfo>;
+
+    /// The current parameter values.
+    fn params(&self) -> Vec<f64>;
+
+    /// Sets all parameters at once (same order as `param_info`). The length is checked; the
+    /// bounds are not (the identifier enforces them, `validate` reports them).
+    fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError>;
+
+    /// Number of internal states (0 for static friction laws).
+    fn n_states(&self) -> usize {
+        0
+    }
+
+    /// Time derivative of the internal states at sliding velocity `v`.
+    fn state_derivative(&self, _v: f64, _z: &[f64], _normal: f64, _dz: &mut [f64]) {}
+
+    /// The friction force at velocity `v` with internal states `z`. For static laws `z` is empty
+    /// and sgn(0) = 0.
+    fn force(&self, v: f64, z: &[f64], normal: f64) -> f64;
+
+    /// For static laws with a set-valued force at zero velocity: the breakaway force limit
+    /// used to decide sticking (coulomb: mu N). `None` for smooth laws and dynamic models.
+    fn static_limit(&self, _normal: f64) -> Option<f64> {
+        None
+    }
+
+    /// The force while slipping in `direction` (+1 or -1), for the switched-system treatment
+    /// of static laws. `v` may be zero or of the wrong sign by round-off at a mode boundary:
+    /// the direction of the set-valued part must come from `direction`, never from sgn(v).
+    fn slip_force(&self, v: f64, _direction: f64, normal: f64) -> f64 {
+        self.force(v, &[], normal)
+    }
+
+    /// Steady-state friction curve F_ss(v) (the force at constant sliding velocity).
+    fn steady_state(&self, v: f64, normal: f64) -> f64;
+
+    /// Energy stored in the internal states (bristle deflection), 0 for static laws. Used by
+    /// the engine's energy checks: KE + PE + stored never increases for a passive model.
+    fn stored_energy(&self, _z: &[f64], _normal: f64) -> f64 {
+        0.0
+    }
+
+    /// Sets data-driven initial values (levels from the energy estimate). Default: keep.
+    fn apply_guess(&mut self, _hint: &GuessHint) {}
+
+    /// Checks every parameter against its physical bounds; returns warnings for values that
+    /// are admissible but unusual (e.g. mu_s < mu_c).
+    fn validate(&self) -> Result<Vec<String>, ModelError> {
+        check_bounds(self.name(), &self.param_info(), &self.params())?;
+        Ok(Vec::new())
+    }
+}
+
+dyn_clone::clone_trait_object!(FrictionModel);
+
+/// Checks `values` against the bounds in `info`; the error names the model and parameter.
+pub fn check_bounds(model: &str, info: &[ParamInfo], values: &[f64]) -> Result<(), ModelError> {
+    for (p, &v) in info.iter().zip(values) {
+        if !p.admits(v) {
+            return Err(ModelError::OutOfBounds {
+                model: model.to_string(),
+                param: p.name.clone(),
+                value: v,
+                bounds: p.bounds_text(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Checks the length of a parameter vector passed to `set_params`.
+pub fn check_len(model: &str, expected: usize, got: usize) -> Result<(), ModelError> {
+    if expected == got {
+        Ok(())
+    } else {
+        Err(ModelError::ParamCount {
+            model: model.to_string(),
+            expected,
+            got,
+        })
+    }
+}
+
+/// Sign with sgn(0) = 0 (and sgn(NaN) = 0).
+pub fn sgn(v: f64) -> f64 {
+    if v > 0.0 {
+        1.0
+    } else if v < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
