@@ -7,6 +7,7 @@ pub mod error;
 pub mod exact;
 pub mod oscillator;
 pub mod record;
+pub mod synthetic;
 
 pub use error::EngineError;
 pub use oscillator::Oscillator;
