@@ -93,6 +93,8 @@ pub struct GuessHint {
     pub normal_force: f64,
     /// The oscillator stiffness [N/m]; bristle and element stiffnesses are guessed relative to it.
     pub stiffness: f64,
+    /// The oscillator mass [kg] (for damping-like parameters such as LuGre's sigma1).
+    pub mass: f64,
 }
 
 /// A friction law: a pure function of sliding velocity, internal states and normal force.
