@@ -7,8 +7,13 @@ pub mod error;
 pub mod exact;
 pub mod oscillator;
 pub mod record;
+pub mod simulate;
 pub mod synthetic;
 
 pub use error::EngineError;
 pub use oscillator::Oscillator;
 pub use record::Record;
+pub use simulate::{
+    simulate, simulate_velocity, Event, EventKind, Initial, Integrator, Rest, SimOptions, SimStats,
+    Trajectory,
+};
