@@ -465,3 +465,44 @@ fn options_and_events_serialise_with_their_tags() {
         "turning_point"
     );
 }
+
+#[test]
+fn euler_converges_to_the_adaptive_solution_for_every_model() {
+    // Two independent integrators with the same mode logic: the first-order Euler error must
+    // shrink tenfold from n = 1e4 to n = 1e5 steps per period.
+    let osc = Oscillator::fmm();
+    let times = uniform_times(1.0, 1000.0);
+    for name in names() {
+        let model = default_model(&name).unwrap();
+        let reference = fmm_run(model.as_ref(), 0.022, 1.0);
+        let err = |n: f64| {
+            let opts = SimOptions {
+                integrator: Integrator::Euler {
+                    steps_per_period: n,
+                },
+                ..SimOptions::default()
+            };
+            let sim = simulate(
+                &osc,
+                model.as_ref(),
+                &Initial::at_rest(0.022),
+                1.0,
+                &times,
+                &opts,
+            )
+            .unwrap_or_else(|e| panic!("{name}, Euler n = {n}: {e}"));
+            sim.x
+                .iter()
+                .zip(&reference.x)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max)
+        };
+        let (e4, e5) = (err(1e4), err(1e5));
+        eprintln!("{name}: Euler max |x - x_dopri5|: n = 1e4 {e4:.2e} m, n = 1e5 {e5:.2e} m");
+        assert!(e5 < 2e-5, "{name}: {e5}");
+        assert!(
+            e5 < 0.2 * e4,
+            "{name}: {e4} -> {e5} is not first-order convergence"
+        );
+    }
+}

@@ -327,7 +327,13 @@ impl Recorder for FullRecorder<'_> {
         self.kinetic.push(ke);
         self.potential.push(pe);
         self.energy.push(ke + pe);
-        self.stored.push(self.model.stored_energy(z, self.normal));
+        // Static laws store nothing: skip the call.
+        let stored = if z.is_empty() {
+            0.0
+        } else {
+            self.model.stored_energy(z, self.normal)
+        };
+        self.stored.push(stored);
     }
 }
 
