@@ -5,6 +5,7 @@
 
 pub mod error;
 pub mod exact;
+pub mod identify;
 pub mod oscillator;
 pub mod record;
 pub mod synthetic;
