@@ -8,8 +8,13 @@ pub mod exact;
 pub mod identify;
 pub mod oscillator;
 pub mod record;
+pub mod simulate;
 pub mod synthetic;
 
 pub use error::EngineError;
 pub use oscillator::Oscillator;
 pub use record::Record;
+pub use simulate::{
+    simulate, simulate_velocity, Event, EventKind, Initial, Integrator, Rest, SimOptions, SimStats,
+    Trajectory,
+};
