@@ -33,9 +33,9 @@ pub enum Differentiator {
 
 impl Default for Differentiator {
     /// Savitzky-Golay with a 31-sample window and a quartic: at 1 kHz the fit spans 30 ms,
-    /// about 1/15 of the FMM's 0.455 s period, so the quartic follows the sine to ~1e-6
-    /// relative while averaging white noise over 31 samples (see the module docs for the
-    /// measured figures that fixed this choice).
+    /// about 1/15 of the FMM's 0.455 s period, so the quartic follows its sine to 4e-6
+    /// relative (3e-5 with the one-sided fits at the ends) while averaging white noise over
+    /// 31 samples (see the `energy` module docs for the measured figures behind this choice).
     fn default() -> Self {
         Differentiator::SavitzkyGolay {
             window: 31,
