@@ -4,6 +4,7 @@
 use crate::error::EngineError;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
+use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 
 /// The moving-average span of the paper's recipe (section 5: "a moving average filter with a
@@ -185,24 +186,26 @@ pub fn savitzky_golay_derivative(
         for i in seg[0]..seg[1] {
             let lo = i.saturating_sub(w / 2).clamp(s, e - w);
             let hi = lo + w;
-            let weights = match uniform_dt {
+            let fresh;
+            let weights: &[f64] = match uniform_dt {
                 Some(dt) => {
                     let key = (i - lo, w, p);
-                    if let Some(wts) = cache.get(&key) {
-                        wts.clone()
-                    } else {
-                        let offsets: Vec<f64> = (lo..hi).map(|j| j as f64 - i as f64).collect();
-                        let wts: Vec<f64> = derivative_weights(&offsets, p)?
-                            .into_iter()
-                            .map(|x| x / dt)
-                            .collect();
-                        cache.insert(key, wts.clone());
-                        wts
+                    match cache.entry(key) {
+                        Entry::Occupied(e) => e.into_mut().as_slice(),
+                        Entry::Vacant(e) => {
+                            let offsets: Vec<f64> = (lo..hi).map(|j| j as f64 - i as f64).collect();
+                            let wts: Vec<f64> = derivative_weights(&offsets, p)?
+                                .into_iter()
+                                .map(|x| x / dt)
+                                .collect();
+                            e.insert(wts).as_slice()
+                        }
                     }
                 }
                 None => {
                     let offsets: Vec<f64> = (lo..hi).map(|j| time[j] - time[i]).collect();
-                    derivative_weights(&offsets, p)?
+                    fresh = derivative_weights(&offsets, p)?;
+                    &fresh
                 }
             };
             out[i] = weights.iter().zip(&v[lo..hi]).map(|(w, y)| w * y).sum();
