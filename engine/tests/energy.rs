@@ -193,6 +193,37 @@ fn non_uniform_time_grid() {
     assert!(percent_difference(an.half_cycle_mean, mu_n()).abs() < 0.1);
 }
 
+/// Records that start or end mid-motion: a start with a velocity is not a turning point, so
+/// the first half-cycle begins at the first reversal; a record cut before the stop keeps only
+/// its complete half-cycles and analyses Eq. 7 up to its last sample.
+#[test]
+fn partial_records() {
+    let osc = Oscillator::fmm();
+    let ex = exact(0.022);
+    // Starts 100 ms after release, in the first half-cycle, with the known state there.
+    let mut late = Record::new(
+        "late",
+        ex.time[100..].to_vec(),
+        ex.v[100..].to_vec(),
+        ex.x[100],
+    );
+    late.v0 = ex.v[100];
+    let an = analyze_record(&late, &osc, &Default::default()).expect("ok");
+    assert_eq!(an.half_cycles.len(), ex.half_cycles() - 1);
+    assert!((an.half_cycles[0].t_start - ex.turning_times[0]).abs() <= 1e-3);
+    assert!(percent_difference(an.mean_abs_force, mu_n()).abs() < 0.5);
+    assert!(percent_difference(an.half_cycle_mean, mu_n()).abs() < 0.1);
+    // Ends at 0.8 s, between the third and fourth turning points.
+    let n = 801;
+    let early = Record::new("early", ex.time[..n].to_vec(), ex.v[..n].to_vec(), 0.022);
+    let an = analyze_record(&early, &osc, &Default::default()).expect("ok");
+    let complete = ex.turning_times.iter().filter(|&&t| t < 0.8).count();
+    assert_eq!(an.half_cycles.len(), complete);
+    assert!(!an.friction[n - 1].is_nan());
+    assert!(percent_difference(an.mean_abs_force, mu_n()).abs() < 0.5);
+    assert!(percent_difference(an.half_cycle_mean, mu_n()).abs() < 0.1);
+}
+
 // ---------------------------------------------------------------- series and masking
 
 /// Energies and Eq. 4 are the textbook formulas of the integrated displacement; the
@@ -311,6 +342,8 @@ fn savitzky_golay_breaks_isolate_kinks() {
         let exact = if i < 100 { -1.0 } else { 1.0 };
         assert!((d[i] - exact).abs() < 1e-9, "t = {t}: {}", d[i]);
     }
+    let unsorted = savitzky_golay_derivative(&time, &v, 21, 2, &[500, 100, 0]).expect("sg");
+    assert_eq!(unsorted, d);
     let smeared = savitzky_golay_derivative(&time, &v, 21, 2, &[]).expect("sg");
     assert!((smeared[99] + 1.0).abs() > 0.5);
 }

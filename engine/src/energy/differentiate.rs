@@ -143,7 +143,8 @@ pub fn paper_derivative(time: &[f64], v: &[f64]) -> Vec<f64> {
 ///
 /// At each sample the polynomial of degree `order` is fitted by least squares to `window`
 /// samples and its slope at that sample is returned. The samples are split into segments at
-/// the indices in `breaks` (each the first sample of a new segment, ascending); a fit never
+/// the indices in `breaks` (each the first sample of a new segment; out-of-range indices are
+/// ignored); a fit never
 /// reaches across a break. Inside a segment the window is centred where it fits and slides
 /// inwards near the segment ends (a one-sided fit of the same size, evaluated at the end
 /// sample). A segment shorter than `window` is fitted whole with the degree reduced to its
@@ -172,6 +173,7 @@ pub fn savitzky_golay_derivative(
     bounds.push(0);
     bounds.extend(breaks.iter().copied().filter(|&b| b > 0 && b < n));
     bounds.push(n);
+    bounds.sort_unstable();
     bounds.dedup();
     for seg in bounds.windows(2) {
         let (s, e) = (seg[0], seg[1]);

@@ -38,17 +38,17 @@ const NOISE_FACTOR: f64 = 5.0;
 /// points.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct HalfCycle {
-    /// Time of the turning point that starts the half-cycle [s].
+    /// Time of the turning point that starts the half-cycle \[s\].
     pub t_start: f64,
-    /// Time of the turning point that ends it [s].
+    /// Time of the turning point that ends it \[s\].
     pub t_end: f64,
-    /// Distance travelled, int |v| dt [m].
+    /// Distance travelled, int |v| dt \[m\].
     pub distance: f64,
-    /// Mechanical energy at the start minus at the end [J].
+    /// Mechanical energy at the start minus at the end \[J\].
     pub energy_lost: f64,
-    /// Viscous loss c int v^2 dt [J].
+    /// Viscous loss c int v^2 dt \[J\].
     pub viscous_loss: f64,
-    /// Mean friction force (energy_lost - viscous_loss) / distance [N].
+    /// Mean friction force (energy_lost - viscous_loss) / distance \[N\].
     pub force: f64,
 }
 
@@ -77,11 +77,11 @@ pub(crate) struct Samples<'a> {
 /// A turning point (velocity zero) or the release.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Turning {
-    /// Time [s].
+    /// Time \[s\].
     pub time: f64,
     /// Index i of the sample interval [t_i, t_i+1] that holds it.
     pub interval: usize,
-    /// Displacement there [m].
+    /// Displacement there \[m\].
     pub x: f64,
     /// Velocity there [m/s] (0 except at a release with a velocity).
     pub v: f64,

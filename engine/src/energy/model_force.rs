@@ -28,11 +28,11 @@ const MAX_SUBSTEPS: u64 = 20_000_000;
 /// The model force along a record against the energy-based force.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ForceResiduals {
-    /// The model's friction force at every sample [N].
+    /// The model's friction force at every sample \[N\].
     pub model_force: Vec<f64>,
-    /// Energy-based force minus model force [N]; NaN where the energy-based force is masked.
+    /// Energy-based force minus model force \[N\]; NaN where the energy-based force is masked.
     pub residual: Vec<f64>,
-    /// Root mean square of the residual over the samples used [N].
+    /// Root mean square of the residual over the samples used \[N\].
     pub rms: f64,
     /// Number of samples used (not masked).
     pub used: usize,
