@@ -64,7 +64,8 @@ impl Differentiator {
             }
             if window % 2 == 0 || window <= order {
                 return Err(EngineError::InvalidInput(format!(
-                    "savitzky_golay `window` must be odd and greater than `order` = {order}, got {window}"
+                    "savitzky_golay `window` must be odd and greater than `order` = {order}, \
+                     got {window}"
                 )));
             }
         }

@@ -23,8 +23,8 @@
 //! # Masking and the oscillating interval
 //! Eq. 7 divides by v, so samples with |v| <= `velocity_threshold` are masked (NaN, counted in
 //! `masked`). So are samples after the mass has come to rest (the final turning point found
-//! by the hysteresis detector described in [`halfcycle`]): the equation of motion with a sliding
-//! friction force no longer holds there, and a noisy record would otherwise contribute noise
+//! by the hysteresis detector described in [`halfcycle`]): the equation of motion with a
+//! sliding friction force no longer holds there, and a noisy record would otherwise contribute noise
 //! spikes. `mean_abs_force` is the mean of |F| over the unmasked samples, i.e. over the
 //! oscillating interval, the quantity the paper compares with mu N (1.9 %, 8.0 % and -4.3 %
 //! for its three records).
@@ -41,18 +41,20 @@
 //! # Choice of the default differentiator
 //! The Coulomb acceleration jumps by 2 mu N / m at every reversal, and any smoothing window
 //! that straddles the jump smears it over the samples on both sides, pulling |F| down on
-//! both. With the paper's recipe applied across reversals this bias is of the order of a few
-//! percent. The Savitzky-Golay default therefore fits each half-cycle separately (the breaks
+//! both. With the paper's recipe applied across reversals this bias is about -0.5 to -1.4 %
+//! on the records below. The Savitzky-Golay default therefore fits each half-cycle separately (the breaks
 //! are the robust turning points) and uses one-sided fits of the same size at the ends of a
 //! half-cycle. Measured on the FMM acceptance records (exact Coulomb solution, mu = 0.24,
 //! x0 = 10, 14, 22 mm, 2 s at 1 kHz; `tests/energy.rs`), mean |Eq. 7| against mu N:
 //!
-//! | differentiation | noise-free | 2e-4 m/s noise, RMS over 20 seeds |
+//! | differentiation | noise-free | 2e-4 m/s noise |
 //! |---|---|---|
-//! | paper (central difference + 10-point average, across reversals) | -0.57, -1.00, -1.39 % | similar |
-//! | SG 21 samples, quadratic, per half-cycle | +0.002, +0.011, +0.011 % | 0.13, 0.12, 0.12 % |
-//! | SG 31 samples, quartic, per half-cycle (default) | +0.0018, +0.0008, +0.0007 % | 0.12, 0.13, 0.14 % |
-//! | SG 51 samples, quartic, per half-cycle | +0.0017, +0.0005, +0.0004 % | 0.12, 0.11, 0.10 % |
+//! | paper, across reversals | -0.57, -1.00, -1.39 % | -0.57, -0.96, -1.28 % (1 seed) |
+//! | SG 21, quadratic | +0.002, +0.011, +0.011 % | 0.13, 0.12, 0.12 % (RMS, 20 seeds) |
+//! | SG 31, quartic (default) | +0.0018, +0.0008, +0.0007 % | 0.12, 0.13, 0.14 % (idem) |
+//! | SG 51, quartic | +0.0017, +0.0005, +0.0004 % | 0.12, 0.11, 0.10 % (idem) |
+//!
+//! (SG n = Savitzky-Golay over n samples, fitted per half-cycle.)
 //!
 //! With noise the error is dominated by the displacement drift, not by the window, so the
 //! default takes the middle window: 30 ms is 1/15 of the FMM period, short enough for stages
