@@ -24,8 +24,8 @@
 //! Eq. 7 divides by v, so samples with |v| <= `velocity_threshold` are masked (NaN, counted in
 //! `masked`). So are samples after the mass has come to rest (the final turning point found
 //! by the hysteresis detector described in [`halfcycle`]): the equation of motion with a
-//! sliding friction force no longer holds there, and a noisy record would otherwise contribute noise
-//! spikes. `mean_abs_force` is the mean of |F| over the unmasked samples, i.e. over the
+//! sliding friction force no longer holds there, and a noisy record would otherwise
+//! contribute noise spikes. `mean_abs_force` is the mean of |F| over the unmasked samples, i.e. over the
 //! oscillating interval, the quantity the paper compares with mu N (1.9 %, 8.0 % and -4.3 %
 //! for its three records).
 //!
@@ -42,9 +42,9 @@
 //! The Coulomb acceleration jumps by 2 mu N / m at every reversal, and any smoothing window
 //! that straddles the jump smears it over the samples on both sides, pulling |F| down on
 //! both. With the paper's recipe applied across reversals this bias is about -0.5 to -1.4 %
-//! on the records below. The Savitzky-Golay default therefore fits each half-cycle separately (the breaks
-//! are the robust turning points) and uses one-sided fits of the same size at the ends of a
-//! half-cycle. Measured on the FMM acceptance records (exact Coulomb solution, mu = 0.24,
+//! on the records below. The Savitzky-Golay default therefore fits each half-cycle
+//! separately (the breaks are the robust turning points) and uses one-sided fits of the same
+//! size at the ends of a half-cycle. Measured on the FMM acceptance records (exact Coulomb solution, mu = 0.24,
 //! x0 = 10, 14, 22 mm, 2 s at 1 kHz; `tests/energy.rs`), mean |Eq. 7| against mu N:
 //!
 //! | differentiation | noise-free | 2e-4 m/s noise |
