@@ -659,6 +659,60 @@ fn lugre_settles_on_its_steady_state() {
     }
 }
 
+/// LuGre with a constant Stribeck level (mu_s = mu_c, sigma1 = sigma2 = 0) and Dahl with
+/// alpha = 1 share z' = v (1 - sigma0 z sgn(v) / (mu N)), which is linear in the distance s
+/// travelled: z = sgn(v) mu N / sigma0 + (z_start - sgn(v) mu N / sigma0) exp(-sigma0 s / (mu N))
+/// on every stretch of constant sign. Along the Coulomb motion's velocity (reversals included,
+/// v linear between samples, so s is exact per interval) the stiff integration (sigma0 = 1e5,
+/// up to 3 relaxation times per sample) follows this closed form.
+#[test]
+fn bristle_models_follow_the_distance_closed_form() {
+    let osc = Oscillator::fmm();
+    let ex = exact(0.014);
+    let (fc, sigma0) = (mu_n(), 1e5);
+    let mut expected = vec![0.0];
+    let mut z: f64 = 0.0;
+    let mut relax = |z: &mut f64, sign: f64, s: f64| {
+        let target = sign * fc / sigma0;
+        *z = target + (*z - target) * (-sigma0 * s / fc).exp();
+    };
+    for i in 1..ex.time.len() {
+        let (v0, v1, h) = (ex.v[i - 1], ex.v[i], ex.time[i] - ex.time[i - 1]);
+        if v0 * v1 >= 0.0 {
+            relax(&mut z, (v0 + v1).signum(), h * (v0 + v1).abs() / 2.0);
+        } else {
+            let tau = h * v0 / (v0 - v1);
+            relax(&mut z, v0.signum(), tau * v0.abs() / 2.0);
+            relax(&mut z, v1.signum(), (h - tau) * v1.abs() / 2.0);
+        }
+        expected.push(sigma0 * z);
+    }
+    let lugre = LuGre {
+        sigma0,
+        sigma1: 0.0,
+        sigma2: 0.0,
+        mu_c: MU,
+        mu_s: MU,
+        v_s: 0.01,
+    };
+    let dahl = Dahl {
+        sigma0,
+        mu_c: MU,
+        alpha: 1.0,
+    };
+    for model in [&lugre as &dyn FrictionModel, &dahl] {
+        let f = model_force_along(model, &osc, &ex.time, &ex.v).expect("force");
+        for (i, (fi, e)) in f.iter().zip(&expected).enumerate() {
+            assert!(
+                (fi - e).abs() < 1e-6 * fc,
+                "{} at t = {}: {fi} vs {e}",
+                model.name(),
+                ex.time[i]
+            );
+        }
+    }
+}
+
 /// Static models are evaluated sample by sample: Coulomb gives mu N sgn(v) exactly.
 #[test]
 fn coulomb_force_along_is_exact() {

@@ -25,9 +25,9 @@
 //! `masked`). So are samples after the mass has come to rest (the final turning point found
 //! by the hysteresis detector described in [`halfcycle`]): the equation of motion with a
 //! sliding friction force no longer holds there, and a noisy record would otherwise
-//! contribute noise spikes. `mean_abs_force` is the mean of |F| over the unmasked samples, i.e. over the
-//! oscillating interval, the quantity the paper compares with mu N (1.9 %, 8.0 % and -4.3 %
-//! for its three records).
+//! contribute noise spikes. `mean_abs_force` is the mean of |F| over the unmasked samples,
+//! i.e. over the oscillating interval, the quantity the paper compares with mu N (1.9 %,
+//! 8.0 % and -4.3 % for its three records).
 //!
 //! # Displacement drift
 //! Integrating a velocity with white noise of standard deviation sigma_v at spacing dt adds a
@@ -44,8 +44,9 @@
 //! both. With the paper's recipe applied across reversals this bias is about -0.5 to -1.4 %
 //! on the records below. The Savitzky-Golay default therefore fits each half-cycle
 //! separately (the breaks are the robust turning points) and uses one-sided fits of the same
-//! size at the ends of a half-cycle. Measured on the FMM acceptance records (exact Coulomb solution, mu = 0.24,
-//! x0 = 10, 14, 22 mm, 2 s at 1 kHz; `tests/energy.rs`), mean |Eq. 7| against mu N:
+//! size at the ends of a half-cycle. Measured on the FMM acceptance records (exact Coulomb
+//! solution, mu = 0.24, x0 = 10, 14, 22 mm, 2 s at 1 kHz; `tests/energy.rs`), mean |Eq. 7|
+//! against mu N:
 //!
 //! | differentiation | noise-free | 2e-4 m/s noise |
 //! |---|---|---|
