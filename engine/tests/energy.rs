@@ -672,7 +672,7 @@ fn bristle_models_follow_the_distance_closed_form() {
     let (fc, sigma0) = (mu_n(), 1e5);
     let mut expected = vec![0.0];
     let mut z: f64 = 0.0;
-    let mut relax = |z: &mut f64, sign: f64, s: f64| {
+    let relax = |z: &mut f64, sign: f64, s: f64| {
         let target = sign * fc / sigma0;
         *z = target + (*z - target) * (-sigma0 * s / fc).exp();
     };
