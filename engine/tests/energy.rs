@@ -157,7 +157,10 @@ fn engine_simulated_records_and_states() {
             let an = analyze_record(&rec, &osc, &Default::default()).expect("record");
             let e7 = percent_difference(an.mean_abs_force, mu_n());
             let hc = percent_difference(an.half_cycle_mean, mu_n());
-            eprintln!("x0 = {x0}, noise {noise}: simulated record, Eq. 7 {e7:+.4} %, half-cycles {hc:+.4} %");
+            eprintln!(
+                "x0 = {x0}, noise {noise}: simulated record, Eq. 7 {e7:+.4} %, \
+                 half-cycles {hc:+.4} %"
+            );
             assert!(
                 e7.abs() < eq7_bound,
                 "x0 = {x0}, noise {noise}: Eq. 7 {e7} %"
