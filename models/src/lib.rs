@@ -11,5 +11,5 @@ pub mod registry;
 
 pub use builtin::*;
 pub use error::ModelError;
-pub use model::{check_bounds, check_len, sgn, FrictionModel, GuessHint, ParamInfo};
+pub use model::{check_bounds, check_len, clone_model, sgn, FrictionModel, GuessHint, ParamInfo};
 pub use registry::{build_json, build_toml, default_model, listings, names, Built, ModelListing};

@@ -221,3 +221,8 @@ pub fn sgn(v: f64) -> f64 {
         0.0
     }
 }
+
+/// A boxed copy of a model behind a reference.
+pub fn clone_model(model: &(dyn FrictionModel + 'static)) -> Box<dyn FrictionModel> {
+    dyn_clone::clone_box(model)
+}

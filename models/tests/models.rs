@@ -308,3 +308,18 @@ fn set_params_checks_the_length() {
         }
     );
 }
+
+#[test]
+fn only_the_stribeck_exponent_is_fixed_by_default() {
+    for l in listings() {
+        for p in &l.parameters {
+            assert_eq!(
+                p.fixed_by_default,
+                l.name == "stribeck" && p.name == "delta",
+                "{}.{}",
+                l.name,
+                p.name
+            );
+        }
+    }
+}

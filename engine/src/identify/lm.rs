@@ -34,6 +34,9 @@ pub struct LevenbergMarquardt {
     pub ftol: f64,
     /// Initial damping relative to the largest diagonal entry of JᵀJ.
     pub tau: f64,
+    /// Largest change of any parameter in one step (a trust-region cap: a step that would
+    /// move further is shortened along its direction).
+    pub max_step: f64,
     mu: f64,
     nu: f64,
     residuals: DVector<f64>,
@@ -49,9 +52,10 @@ impl LevenbergMarquardt {
             lower,
             upper,
             gtol: 1e-10,
-            xtol: 1e-10,
-            ftol: 1e-12,
+            xtol: 1e-8,
+            ftol: 1e-9,
             tau: 1e-3,
+            max_step: f64::INFINITY,
             mu: 0.0,
             nu: 2.0,
             residuals: DVector::zeros(0),
@@ -184,6 +188,10 @@ where
         let mut delta = DVector::zeros(n);
         for (r, &i) in free.iter().enumerate() {
             delta[i] = reduced[r];
+        }
+        let longest = delta.amax();
+        if longest > self.max_step {
+            delta *= self.max_step / longest;
         }
         let trial = self.project(&(&p + &delta));
         let step = &trial - &p;

@@ -144,9 +144,11 @@ impl FrictionModel for LuGre {
         let v = hint.typical_velocity.max(1e-6);
         self.mu_c = 0.9 * hint.mu;
         self.mu_s = 1.2 * hint.mu;
-        self.v_s = 0.2 * v;
+        // Stribeck velocities are typically a few percent of the sliding speeds of a free
+        // vibration; bristle damping a fraction of the critical damping of the bristle mode.
+        self.v_s = 0.05 * v;
         self.sigma0 = (hint.mu * hint.normal_force / 2e-5).max(1.0);
-        self.sigma1 = 0.5 * (self.sigma0 * hint.mass).sqrt();
+        self.sigma1 = 0.25 * (self.sigma0 * hint.mass).sqrt();
         self.sigma2 = 0.05 * hint.mu * hint.normal_force / v;
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {

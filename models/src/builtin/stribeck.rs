@@ -86,7 +86,8 @@ impl FrictionModel for Stribeck {
                 2.0,
                 10.0,
                 "Stribeck shape exponent (usually fixed)",
-            ),
+            )
+            .fixed(),
             ParamInfo::new(
                 "viscous",
                 "N s/m",

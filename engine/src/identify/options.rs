@@ -1,0 +1,146 @@
+//! What a fit varies and how.
+
+use crate::energy::EnergyOptions;
+use crate::simulate::SimOptions;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// An oscillator property that a fit may vary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OscillatorParam {
+    /// m [kg].
+    Mass,
+    /// c [N s/m].
+    Damping,
+    /// k [N/m].
+    Stiffness,
+}
+
+impl OscillatorParam {
+    /// Config name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Mass => "mass",
+            Self::Damping => "damping",
+            Self::Stiffness => "stiffness",
+        }
+    }
+    /// SI unit.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Self::Mass => "kg",
+            Self::Damping => "N s/m",
+            Self::Stiffness => "N/m",
+        }
+    }
+    /// Parses a config name.
+    pub fn parse(name: &str) -> Option<Self> {
+        match name {
+            "mass" => Some(Self::Mass),
+            "damping" => Some(Self::Damping),
+            "stiffness" => Some(Self::Stiffness),
+            _ => None,
+        }
+    }
+}
+
+/// Progress of a running fit, reported after every solver iteration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Progress {
+    /// Model being fitted.
+    pub model: String,
+    /// Index of the start (multi-start).
+    pub start: usize,
+    /// Number of starts.
+    pub starts: usize,
+    /// Iterations of this start so far.
+    pub iteration: u64,
+    /// Iteration limit.
+    pub max_iterations: u64,
+    /// Best cost (half the weighted sum of squares) of this start so far.
+    pub cost: f64,
+}
+
+/// A progress callback (e.g. the CLI's progress bar). Called from worker threads.
+pub type ProgressFn = Arc<dyn Fn(&Progress) + Send + Sync>;
+
+/// The step limit of each simulation during a fit. Trial parameters that make a model so
+/// stiff that a record needs more steps are rejected quickly instead of being integrated
+/// for seconds (the engine's own default allows 2e7 steps).
+pub const FIT_MAX_STEPS: u64 = 200_000;
+
+/// Options of a fit.
+#[derive(Clone)]
+pub struct FitOptions {
+    /// Model parameters to fit, by name; `None`: every parameter not fixed by default.
+    pub free: Option<Vec<String>>,
+    /// Bounds by parameter name (model parameters, `mass`, `damping`, `stiffness`, `offset`,
+    /// `shift`); default: the model's physical bounds.
+    pub bounds: BTreeMap<String, (f64, f64)>,
+    /// Data-driven initial values for the free model parameters (from the half-cycle energy
+    /// estimate), except those named in `keep_initial`.
+    pub guess: bool,
+    /// Free parameters whose initial value is the model's current value even when guessing.
+    pub keep_initial: Vec<String>,
+    /// Oscillator properties to fit.
+    pub oscillator: Vec<OscillatorParam>,
+    /// Fit a velocity offset per record.
+    pub velocity_offset: bool,
+    /// Fit a release-time shift per record.
+    pub time_shift: bool,
+    /// Number of starts; `None`: 1 when at most two model parameters are free, else
+    /// [`super::fit::DEFAULT_STARTS`].
+    pub multistart: Option<usize>,
+    /// Iteration limit of each start.
+    pub max_iterations: u64,
+    /// Simulation options.
+    pub sim: SimOptions,
+    /// Energy-analysis options (for the energy-based force residuals).
+    pub energy: EnergyOptions,
+    /// Use several cores (records, Jacobian columns, starts, models).
+    pub parallel: bool,
+    /// Progress callback.
+    pub progress: Option<ProgressFn>,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        Self {
+            free: None,
+            bounds: BTreeMap::new(),
+            guess: true,
+            keep_initial: Vec::new(),
+            oscillator: Vec::new(),
+            velocity_offset: false,
+            time_shift: false,
+            multistart: None,
+            max_iterations: 200,
+            sim: SimOptions {
+                max_steps: FIT_MAX_STEPS,
+                ..SimOptions::default()
+            },
+            energy: EnergyOptions::default(),
+            parallel: true,
+            progress: None,
+        }
+    }
+}
+
+impl std::fmt::Debug for FitOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FitOptions")
+            .field("free", &self.free)
+            .field("bounds", &self.bounds)
+            .field("guess", &self.guess)
+            .field("keep_initial", &self.keep_initial)
+            .field("oscillator", &self.oscillator)
+            .field("velocity_offset", &self.velocity_offset)
+            .field("time_shift", &self.time_shift)
+            .field("multistart", &self.multistart)
+            .field("max_iterations", &self.max_iterations)
+            .field("parallel", &self.parallel)
+            .finish_non_exhaustive()
+    }
+}

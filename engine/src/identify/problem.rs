@@ -1,0 +1,293 @@
+//! The fitting problem: parameters in, weighted velocity residuals of every record out.
+//!
+//! Implements argmin's [`Operator`] (residuals) and [`Jacobian`] (forward differences), so
+//! any argmin least-squares solver can drive it; ours is [`super::lm::LevenbergMarquardt`].
+
+use super::layout::{FreeParam, ParamKind};
+use crate::error::EngineError;
+use crate::oscillator::Oscillator;
+use crate::record::Record;
+use crate::simulate::{simulate_velocity, Initial, SimOptions};
+use argmin::core::{Error, Jacobian, Operator};
+use frictionid_models::FrictionModel;
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+
+/// Relative forward-difference step in internal coordinates. The ODE engine's default
+/// tolerances (rtol 1e-10) leave ~1e-10 relative noise in the residuals, so a step of 1e-6
+/// balances truncation against that noise (error ~ 1e-4 of the derivative).
+pub const FD_STEP: f64 = 1e-6;
+
+/// Step budget of a simulation per sample of its record. Friction dynamics so fast that the
+/// integrator needs more than this many steps per sample interval are far beyond what the
+/// record resolves (a bristle that relaxes within a twentieth of a sample looks rigid), so
+/// trial parameters that demand it are rejected as infeasible instead of integrated for
+/// seconds: this keeps the cost of a fit bounded when a bristle stiffness runs away.
+pub const STEPS_PER_SAMPLE: u64 = 20;
+
+/// The residual function of a fit.
+pub struct FitProblem {
+    /// The oscillator with its fixed values.
+    pub oscillator: Oscillator,
+    /// The model with its fixed values.
+    pub model: Box<dyn FrictionModel>,
+    /// The records.
+    pub records: Vec<Record>,
+    /// The free parameters.
+    pub layout: Vec<FreeParam>,
+    /// Simulation options.
+    pub sim: SimOptions,
+    /// Simulate records (and Jacobian columns) in parallel.
+    pub parallel: bool,
+    simulations: AtomicU64,
+    last_error: Mutex<Option<String>>,
+    /// The last point `apply` evaluated, reused by `jacobian` at the same point.
+    cache: Mutex<Option<(DVector<f64>, DVector<f64>)>>,
+}
+
+/// The state of the world for one parameter vector.
+pub struct Realised {
+    /// The oscillator.
+    pub oscillator: Oscillator,
+    /// The model.
+    pub model: Box<dyn FrictionModel>,
+    /// Velocity offset per record.
+    pub offsets: Vec<f64>,
+    /// Release-time shift per record.
+    pub shifts: Vec<f64>,
+}
+
+impl FitProblem {
+    /// A problem over `layout`; the model and oscillator carry the fixed values.
+    pub fn new(
+        oscillator: Oscillator,
+        model: Box<dyn FrictionModel>,
+        records: Vec<Record>,
+        layout: Vec<FreeParam>,
+        sim: SimOptions,
+        parallel: bool,
+    ) -> Self {
+        Self {
+            oscillator,
+            model,
+            records,
+            layout,
+            sim,
+            parallel,
+            simulations: AtomicU64::new(0),
+            last_error: Mutex::new(None),
+            cache: Mutex::new(None),
+        }
+    }
+
+    /// Number of residuals (samples over all records).
+    pub fn n_residuals(&self) -> usize {
+        self.records.iter().map(Record::len).sum()
+    }
+
+    /// Simulations run so far.
+    pub fn simulations(&self) -> u64 {
+        self.simulations.load(Ordering::Relaxed)
+    }
+
+    /// The last simulation failure, if any.
+    pub fn last_error(&self) -> Option<String> {
+        self.last_error.lock().ok().and_then(|g| g.clone())
+    }
+
+    /// Physical values of the free parameters at internal coordinates `u`.
+    pub fn physical(&self, u: &DVector<f64>) -> Vec<f64> {
+        self.layout
+            .iter()
+            .zip(u.iter())
+            .map(|(f, &x)| f.to_physical(x))
+            .collect()
+    }
+
+    /// Internal coordinates of physical values.
+    pub fn internal(&self, p: &[f64]) -> DVector<f64> {
+        DVector::from_iterator(
+            p.len(),
+            self.layout.iter().zip(p).map(|(f, &x)| f.to_internal(x)),
+        )
+    }
+
+    /// Builds the oscillator, model and nuisance values for physical parameters `p`.
+    pub fn realise(&self, p: &[f64]) -> Result<Realised, EngineError> {
+        let mut osc = self.oscillator;
+        let mut model = self.model.clone();
+        let mut values = model.params();
+        let mut offsets = vec![0.0; self.records.len()];
+        let mut shifts = vec![0.0; self.records.len()];
+        for (f, &x) in self.layout.iter().zip(p) {
+            match f.kind {
+                ParamKind::Model(i) => {
+                    if let Some(v) = values.get_mut(i) {
+                        *v = x;
+                    }
+                }
+                ParamKind::Mass => osc.mass = x,
+                ParamKind::Damping => osc.damping = x,
+                ParamKind::Stiffness => osc.stiffness = x,
+                ParamKind::Offset(r) => {
+                    if let Some(o) = offsets.get_mut(r) {
+                        *o = x;
+                    }
+                }
+                ParamKind::Shift(r) => {
+                    if let Some(s) = shifts.get_mut(r) {
+                        *s = x;
+                    }
+                }
+            }
+        }
+        model.set_params(&values)?;
+        osc.validate()?;
+        Ok(Realised {
+            oscillator: osc,
+            model,
+            offsets,
+            shifts,
+        })
+    }
+
+    /// The simulated velocity of record `r` at its time stamps (without offset).
+    pub fn simulate_record(&self, world: &Realised, r: usize) -> Result<Vec<f64>, EngineError> {
+        let rec = self
+            .records
+            .get(r)
+            .ok_or_else(|| EngineError::InvalidInput(format!("no record {r}")))?;
+        let t0 = rec.time.first().copied().unwrap_or(0.0);
+        let release = t0 + world.shifts[r];
+        // Sample times on the simulation clock; samples before the release see the initial state.
+        let first = rec.time.partition_point(|&t| t < release);
+        let times: Vec<f64> = rec.time[first..].iter().map(|&t| t - release).collect();
+        let mut v = vec![rec.v0; first];
+        if let Some(&t_end) = times.last() {
+            self.simulations.fetch_add(1, Ordering::Relaxed);
+            let init = Initial {
+                x0: rec.x0,
+                v0: rec.v0,
+                z0: None,
+            };
+            let mut sim = Vec::with_capacity(times.len());
+            let mut opts = self.sim;
+            opts.max_steps = opts
+                .max_steps
+                .min(STEPS_PER_SAMPLE * (rec.len() as u64).max(100));
+            simulate_velocity(
+                &world.oscillator,
+                world.model.as_ref(),
+                &init,
+                t_end,
+                &times,
+                &opts,
+                &mut sim,
+            )?;
+            v.extend_from_slice(&sim);
+        }
+        Ok(v)
+    }
+
+    /// Weighted residuals sqrt(w) (v_sim + offset - v_measured) of every record, concatenated.
+    pub fn residuals_at(&self, p: &[f64]) -> Result<DVector<f64>, EngineError> {
+        let world = self.realise(p)?;
+        let run = |r: usize| -> Result<Vec<f64>, EngineError> {
+            let rec = &self.records[r];
+            let sim = self.simulate_record(&world, r)?;
+            let w = rec.weight.sqrt();
+            Ok(sim
+                .iter()
+                .zip(&rec.velocity)
+                .map(|(s, m)| w * (s + world.offsets[r] - m))
+                .collect())
+        };
+        let parts: Vec<Result<Vec<f64>, EngineError>> = if self.parallel && self.records.len() > 1 {
+            (0..self.records.len()).into_par_iter().map(run).collect()
+        } else {
+            (0..self.records.len()).map(run).collect()
+        };
+        let mut out = Vec::with_capacity(self.n_residuals());
+        for part in parts {
+            out.extend(part?);
+        }
+        Ok(DVector::from_vec(out))
+    }
+
+    fn residuals_or_nan(&self, u: &DVector<f64>) -> DVector<f64> {
+        match self.residuals_at(&self.physical(u)) {
+            Ok(r) => r,
+            Err(e) => {
+                if let Ok(mut g) = self.last_error.lock() {
+                    *g = Some(e.to_string());
+                }
+                DVector::from_element(self.n_residuals(), f64::NAN)
+            }
+        }
+    }
+
+    /// Forward-difference Jacobian of the residuals in internal coordinates, stepping
+    /// inwards at an upper bound.
+    pub fn jacobian_internal(&self, u: &DVector<f64>, r0: &DVector<f64>) -> DMatrix<f64> {
+        let n = self.layout.len();
+        let column = |j: usize| -> DVector<f64> {
+            let (_, hi) = self.layout[j].internal_bounds();
+            let mut h = FD_STEP * u[j].abs().max(1.0);
+            if u[j] + h > hi {
+                h = -h;
+            }
+            let mut up = u.clone();
+            up[j] += h;
+            (self.residuals_or_nan(&up) - r0) / h
+        };
+        let cols: Vec<DVector<f64>> = if self.parallel && n > 1 {
+            (0..n).into_par_iter().map(column).collect()
+        } else {
+            (0..n).map(column).collect()
+        };
+        DMatrix::from_columns(&cols)
+    }
+
+    /// The Jacobian with respect to the physical parameters (for the statistics).
+    pub fn jacobian_physical(
+        &self,
+        p: &[f64],
+    ) -> Result<(DMatrix<f64>, DVector<f64>), EngineError> {
+        let r0 = self.residuals_at(p)?;
+        let u = self.internal(p);
+        let mut j = self.jacobian_internal(&u, &r0);
+        for (c, f) in self.layout.iter().enumerate() {
+            let d = f.internal_derivative(p[c]);
+            j.column_mut(c).scale_mut(d);
+        }
+        Ok((j, r0))
+    }
+}
+
+impl Operator for FitProblem {
+    type Param = DVector<f64>;
+    type Output = DVector<f64>;
+    fn apply(&self, u: &DVector<f64>) -> Result<DVector<f64>, Error> {
+        let r = self.residuals_or_nan(u);
+        if let Ok(mut c) = self.cache.lock() {
+            *c = Some((u.clone(), r.clone()));
+        }
+        Ok(r)
+    }
+}
+
+impl Jacobian for FitProblem {
+    type Param = DVector<f64>;
+    type Jacobian = DMatrix<f64>;
+    fn jacobian(&self, u: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+        let cached = self
+            .cache
+            .lock()
+            .ok()
+            .and_then(|c| c.as_ref().filter(|(cu, _)| cu == u).map(|(_, r)| r.clone()));
+        let r0 = cached.unwrap_or_else(|| self.residuals_or_nan(u));
+        Ok(self.jacobian_internal(u, &r0))
+    }
+}
