@@ -6,6 +6,7 @@
 
 pub mod builtin;
 pub mod error;
+pub mod formula;
 pub mod model;
 pub mod registry;
 
