@@ -30,9 +30,9 @@
 //! eps = 1e-4 m/s (a smoothed Coulomb law; `params`, `bounds` and `units` then override its
 //! defaults).
 //!
-//! Switched laws: a formula containing `sign(v)` (or `sgn(v)`, `sign(-v)`) whose force at
-//! v -> 0+ is nonzero has a set-valued force at rest, like Coulomb's. Then `static_limit` is
-//! |F(0+)| and `slip_force(v, direction, N)` evaluates a second compiled form of the formula
+//! Switched laws: a formula containing `sign(v)` (or `sgn(v)`, `sign(-v)`) has a set-valued
+//! force at rest, like Coulomb's. Then `static_limit` is |F(0+)| (also when that is 0, e.g.
+//! mu = 0, exactly as coulomb's mu N) and `slip_force(v, direction, N)` evaluates a second compiled form of the formula
 //! in which `sign(v)` is replaced by `direction` itself, while every other occurrence of `v`
 //! keeps its (possibly zero or round-off-signed) value. So `mu * N * sign(v)` is exactly
 //! `coulomb` in the engine's switched treatment, and no velocity is nudged (which would bias
@@ -146,7 +146,7 @@ impl Expression {
     fn breakaway(&self, normal: f64) -> Option<f64> {
         let f = self.switched.as_ref()?;
         let f0 = self.eval(f, 0.0, normal, Some(1.0));
-        (f0.is_finite() && f0 != 0.0).then_some(f0.abs())
+        f0.is_finite().then_some(f0.abs())
     }
 }
 

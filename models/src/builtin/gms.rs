@@ -4,7 +4,7 @@
 //! damping sigma_i; every element slides at its share of the Stribeck curve
 //!
 //! s(v) = N (mu_c + (mu_s - mu_c) exp(-|v / v_s|^delta)),   rho_i = k_i z_i / (w_i s(v)),
-//! dz_i/dt = v (1 - sgn(v) sgn(rho_i) |rho_i|^m),
+//! dz_i/dt = v (1 - max(0, sgn(v) rho_i)^m),
 //! F = sum_i (k_i z_i + sigma_i dz_i/dt) + viscous v.
 //!
 //! | parameter | unit | default | bounds | meaning |
@@ -47,21 +47,30 @@
 //! (adaptive Dormand-Prince with zero-velocity events only) does not have, and a hidden
 //! switch in the right-hand side would make the step-size control fail around each switch.
 //!
-//! So each element here follows a smooth rate law in (v, z) alone, a LuGre/Dahl element with
-//! a sharpness exponent m: it is exactly stick (dz/dt = v) at z = 0, nearly stick while
-//! |rho| is well below 1, and saturates at its sliding force w_i s(v) (dz/dt = 0 at
-//! k_i z_i = w_i s(v) sgn(v)); a velocity reversal unloads it elastically at first. At
-//! constant velocity from rest the element force follows its virgin curve
-//! F_i(x) = w_i s (1 - exp(-k_i x / (w_i s))) for m = 1 (LuGre) and
-//! w_i s tanh(k_i x / (w_i s)) for m = 2; m -> infinity recovers the paper's ideal
-//! elastic-then-slipping element. Presliding stiffness sum k_i and sliding level s(v) are the
-//! paper's in every case. The right-hand side is continuous (Lipschitz in z), so the adaptive
-//! solver handles it without events; its stiffness near saturation, m k_i |v| / (w_i s), sets
-//! the step size, as sigma0 does for LuGre.
+//! So each element here follows a smooth rate law in (v, z) alone, an elasto-plastic
+//! element with a sharpness exponent m:
+//! - unloading (motion against the element's deflection, sgn(v) rho_i <= 0) is exactly stick,
+//!   dz_i/dt = v: the element unloads and reloads elastically with its stiffness k_i, as the
+//!   paper's element does after a velocity reversal;
+//! - loading (sgn(v) rho_i > 0) is nearly stick while rho_i is well below 1 and saturates at
+//!   the element's sliding force: dz_i/dt = 0 at k_i z_i = w_i s(v) sgn(v), and beyond it
+//!   (when s(v) drops with speed) z_i is pulled back to it, like the paper's slip law.
+//!
+//! Loaded at constant velocity from rest, the element force follows the virgin curve
+//! F_i(x) = w_i s (1 - exp(-k_i x / (w_i s))) for m = 1 and w_i s tanh(k_i x / (w_i s)) for
+//! m = 2; m -> infinity recovers the paper's ideal elastic-then-slipping element. The
+//! presliding stiffness sum k_i and the sliding level s(v) are the paper's for every m. A plain
+//! LuGre element (dz/dt = v - k |v| z / (w s)) would unload with up to twice its stiffness just
+//! after a reversal; the max(0, .) keeps unloading elastic. The right-hand side is continuous
+//! and Lipschitz in z (with a kink in v at v = 0 only, where the engine stops at its
+//! zero-velocity events anyway), so the adaptive solver handles it without per-element
+//! events; its stiffness near saturation, m k_i |v| / (w_i s), sets the step size, as sigma0
+//! does for LuGre.
 //!
 //! Energy: the elements store sum_i k_i z_i^2 / 2 and dissipate
-//! |v| w_i s |rho_i|^(m+1) >= 0 each, so with sigma_i = 0 the model is passive.
-//! An element whose sliding force w_i s(v) is zero (w_i = 0 or N = 0) is frozen (dz_i/dt = 0).
+//! k_i z_i (v - dz_i/dt) = |v| w_i s max(0, sgn(v) rho_i)^(m+1) >= 0 each, so with
+//! sigma_i = 0 the model is passive. An element whose sliding force w_i s(v) is zero (w_i = 0
+//! or N = 0) is frozen (dz_i/dt = 0).
 //!
 //! Reference: F. Al-Bender, V. Lampaert, J. Swevers, "The generalized Maxwell-slip model: a
 //! novel model for friction simulation and compensation", IEEE Trans. Automatic Control
@@ -90,7 +99,7 @@ pub struct GmsElement {
     pub damping: f64,
 }
 
-/// The generalized Maxwell-slip model with smooth (LuGre-like) elements.
+/// The generalized Maxwell-slip model with smooth elasto-plastic elements.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "GmsConfig", into = "GmsConfig")]
 pub struct Gms {
@@ -143,18 +152,26 @@ impl Gms {
             * (self.mu_c + (self.mu_s - self.mu_c) * (-(v / self.v_s).abs().powf(self.delta)).exp())
     }
 
+    /// The element law dz/dt = v (1 - max(0, sgn(v) rho)^m).
     fn z_dot(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
         let limit = e.weight * s;
-        if limit > 0.0 {
-            let rho = e.stiffness * z / limit;
-            let r = if self.sharpness == 1.0 {
-                rho
+        if limit <= 0.0 {
+            // No sliding force: the element is frozen.
+            return 0.0;
+        }
+        let rho = e.stiffness * z / limit;
+        // How far the motion loads the element towards its sliding force in the direction of
+        // motion; unloading (v against the deflection) is purely elastic.
+        let load = if v >= 0.0 { rho } else { -rho };
+        if load > 0.0 {
+            let p = if self.sharpness == 1.0 {
+                load
             } else {
-                rho * rho.abs().powf(self.sharpness - 1.0)
+                load.powf(self.sharpness)
             };
-            v - v.abs() * r
+            v * (1.0 - p)
         } else {
-            0.0
+            v
         }
     }
 }
@@ -365,7 +382,7 @@ impl FrictionModel for Gms {
         MODEL
     }
     fn equation(&self) -> String {
-        "dz_i/dt = v (1 - sgn(v) sgn(rho_i) |rho_i|^sharpness), rho_i = k_i z_i / (w_i s(v)), s(v) = N (mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta)), F = sum_i (k_i z_i + sigma_i dz_i/dt) + viscous v".into()
+        "dz_i/dt = v (1 - max(0, sgn(v) rho_i)^sharpness), rho_i = k_i z_i / (w_i s(v)), s(v) = N (mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta)), F = sum_i (k_i z_i + sigma_i dz_i/dt) + viscous v".into()
     }
     fn param_info(&self) -> Vec<ParamInfo> {
         let n = self.elements.len();
