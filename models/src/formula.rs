@@ -809,6 +809,106 @@ impl Formula {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// Direct evaluation of the syntax tree: the meaning the parser gave the text.
+    fn reference(n: &Node, x: f64, y: f64) -> f64 {
+        match n {
+            Node::Num(c) => *c,
+            Node::Var(name) => match name.as_str() {
+                "x" => x,
+                "y" => y,
+                _ => f64::NAN,
+            },
+            Node::Neg(a) => -reference(a, x, y),
+            Node::Bin(k, a, b) => {
+                let (a, b) = (reference(a, x, y), reference(b, x, y));
+                match k {
+                    BinKind::Add => a + b,
+                    BinKind::Sub => a - b,
+                    BinKind::Mul => a * b,
+                    BinKind::Div => a / b,
+                    BinKind::Pow => a.powf(b),
+                }
+            }
+            Node::Call(f, args) => {
+                let a = args.first().map_or(f64::NAN, |a| reference(a, x, y));
+                let b = args.get(1).map_or(f64::NAN, |b| reference(b, x, y));
+                match f {
+                    Func::Sign => crate::model::sgn(a),
+                    Func::Abs => a.abs(),
+                    Func::Exp => a.exp(),
+                    Func::Ln => a.ln(),
+                    Func::Log10 => a.log10(),
+                    Func::Sqrt => a.sqrt(),
+                    Func::Sin => a.sin(),
+                    Func::Cos => a.cos(),
+                    Func::Tan => a.tan(),
+                    Func::Asin => a.asin(),
+                    Func::Acos => a.acos(),
+                    Func::Atan => a.atan(),
+                    Func::Sinh => a.sinh(),
+                    Func::Cosh => a.cosh(),
+                    Func::Tanh => a.tanh(),
+                    Func::Min => a.min(b),
+                    Func::Max => a.max(b),
+                    Func::Atan2 => a.atan2(b),
+                }
+            }
+        }
+    }
+
+    /// Valid formulas of x and y mixing every operator without parentheses, so that the
+    /// precedence rules decide.
+    fn formula_text() -> impl Strategy<Value = String> {
+        let leaf = prop_oneof![
+            (0u32..40).prop_map(|i| format!("{}", f64::from(i) / 4.0)),
+            Just("x".to_string()),
+            Just("y".to_string()),
+            Just("pi".to_string()),
+            Just("2.5e-1".to_string()),
+        ];
+        leaf.prop_recursive(5, 40, 2, |inner| {
+            prop_oneof![
+                (
+                    inner.clone(),
+                    prop::sample::select(vec!["+", "-", "*", "/", "^", "**"]),
+                    inner.clone()
+                )
+                    .prop_map(|(a, op, b)| format!("{a} {op} {b}")),
+                inner.clone().prop_map(|a| format!("-{a}")),
+                inner.clone().prop_map(|a| format!("({a})")),
+                (
+                    prop::sample::select(FUNCTIONS.iter().map(|(n, _)| *n).collect::<Vec<_>>()),
+                    inner.clone(),
+                    inner
+                )
+                    .prop_map(|(f, a, b)| match Func::lookup(f).map(Func::arity) {
+                        Some(2) => format!("{f}({a}, {b})"),
+                        _ => format!("{f}({a})"),
+                    }),
+            ]
+        })
+    }
+
+    proptest! {
+        /// exmex evaluates the canonical text exactly as the parsed tree reads.
+        #[test]
+        fn compiled_formula_matches_the_syntax_tree(
+            text in formula_text(),
+            x in -3.0f64..3.0,
+            y in prop_oneof![Just(0.0), -2.0f64..2.0],
+        ) {
+            let parsed = parse(&text).map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let f = parsed.compile(&["x", "y"]).map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let got = f.eval(&[x, y]);
+            let want = reference(&parsed.root, x, y);
+            prop_assert!(
+                got == want || (got.is_nan() && want.is_nan()),
+                "{} at x = {}, y = {}: exmex {} vs tree {}", text, x, y, got, want
+            );
+        }
+    }
 
     fn eval(text: &str, vars: &[&str], values: &[f64]) -> f64 {
         parse(text).unwrap().compile(vars).unwrap().eval(values)
