@@ -366,7 +366,7 @@ fn gms_config_per_element_lists_and_scalars() {
     // `elements` with defaults: geometric stiffnesses, equal weights.
     let b = toml_model("type = \"gms\"\nelements = 4\ndamping = 1.5").unwrap();
     let p = b.model.params();
-    assert_eq!(p[..4], [3e5, 1e5, 3e5 / 9.0, 3e5 / 27.0]);
+    assert_eq!(p[..4], [1e5, 1e5 / 3.0, 1e5 / 9.0, 1e5 / 27.0]);
     assert_eq!(p[4..8], [0.25; 4]);
     assert_eq!(p[8..12], [1.5; 4]);
     // The default model: three elements.
