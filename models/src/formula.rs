@@ -796,13 +796,26 @@ impl Formula {
     /// The value at `values` (indexed like the `variables` of the compilation). A missing
     /// value reads as NaN, so does any evaluation error; nothing panics.
     pub fn eval(&self, values: &[f64]) -> f64 {
-        self.expr
-            .eval_iter(
-                self.slots
-                    .iter()
-                    .map(|&i| values.get(i).copied().unwrap_or(f64::NAN)),
-            )
-            .unwrap_or(f64::NAN)
+        self.eval_by(|i| values.get(i).copied().unwrap_or(f64::NAN))
+    }
+
+    /// The value with variable `i` (index into the `variables` of the compilation) read from
+    /// `value(i)`: the caller's values go straight into exmex's order, with no intermediate
+    /// buffer (and no allocation for up to 16 variables).
+    pub fn eval_by(&self, value: impl Fn(usize) -> f64) -> f64 {
+        const STACK: usize = 16;
+        let n = self.slots.len();
+        let result = if n <= STACK {
+            let mut buf = [0.0; STACK];
+            for (b, &i) in buf.iter_mut().zip(&self.slots) {
+                *b = value(i);
+            }
+            self.expr.eval(buf.get(..n).unwrap_or_default())
+        } else {
+            let buf: Vec<f64> = self.slots.iter().map(|&i| value(i)).collect();
+            self.expr.eval(&buf)
+        };
+        result.unwrap_or(f64::NAN)
     }
 }
 

@@ -117,29 +117,17 @@ impl Expression {
     }
 
     fn eval(&self, f: &Formula, v: f64, normal: f64, direction: Option<f64>) -> f64 {
-        // Values in the order v, N, params..., [direction], without allocating for the
-        // usual handful of parameters.
-        const STACK: usize = 16;
-        let n = self.params.len() + 3;
-        let fill = |buf: &mut [f64]| {
-            for (slot, value) in buf.iter_mut().zip(
-                [v, normal]
-                    .into_iter()
-                    .chain(self.params.iter().map(|p| p.value))
-                    .chain(direction),
-            ) {
-                *slot = value;
-            }
-        };
-        if n <= STACK {
-            let mut buf = [0.0; STACK];
-            fill(&mut buf);
-            f.eval(&buf)
-        } else {
-            let mut buf = vec![0.0; n];
-            fill(&mut buf);
-            f.eval(&buf)
-        }
+        // Variables in the order v, N, params..., direction (see `try_from`).
+        f.eval_by(|i| match i {
+            0 => v,
+            1 => normal,
+            _ => self
+                .params
+                .get(i - 2)
+                .map(|p| p.value)
+                .or(direction)
+                .unwrap_or(f64::NAN),
+        })
     }
 
     /// The force at v -> 0+ in the switched form (sign(v) = +1).
