@@ -148,7 +148,7 @@ impl Gms {
         }
     }
 
-    /// The Stribeck curve s(v) [N] (the total sliding force for weights summing to 1).
+    /// The Stribeck curve s(v) \[N\] (the total sliding force for weights summing to 1).
     pub fn s(&self, v: f64, normal: f64) -> f64 {
         normal
             * (self.mu_c + (self.mu_s - self.mu_c) * (-(v / self.v_s).abs().powf(self.delta)).exp())

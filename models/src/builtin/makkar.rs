@@ -33,13 +33,13 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Makkar {
-    /// Stribeck amplitude [N].
+    /// Stribeck amplitude \[N\].
     pub g1: f64,
     /// Stribeck rise rate [s/m].
     pub g2: f64,
     /// Stribeck decay rate [s/m].
     pub g3: f64,
-    /// Coulomb level [N].
+    /// Coulomb level \[N\].
     pub g4: f64,
     /// Coulomb steepness [s/m].
     pub g5: f64,
