@@ -40,6 +40,22 @@ pub enum ModelError {
         expected: usize,
         got: usize,
     },
+    /// A key of a model table whose value is inconsistent with the rest of the table (e.g. a
+    /// per-element list of the wrong length).
+    #[error("model `{model}`, key `{key}`: {message}")]
+    BadKey {
+        model: String,
+        key: String,
+        message: String,
+    },
+    /// A formula (of the `expression` model) that does not parse or names an unknown variable;
+    /// `column` counts characters from 1.
+    #[error("expression model: {message} at column {column} of `{formula}`")]
+    Formula {
+        message: String,
+        column: usize,
+        formula: String,
+    },
     /// Any other malformed model table (wrong value type, ...).
     #[error("invalid model table: {0}")]
     Invalid(String),

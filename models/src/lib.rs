@@ -2,10 +2,12 @@
 //! the built-in friction laws.
 //!
 //! Models are pure functions of sliding velocity, internal states, normal force and
-//! parameters; they know nothing of solvers, files or the command line.
+//! parameters; they know nothing of solvers, files or the command line. The [`formula`]
+//! module parses and compiles the formulas of the `expression` model.
 
 pub mod builtin;
 pub mod error;
+pub mod formula;
 pub mod model;
 pub mod registry;
 

@@ -101,11 +101,11 @@ pub struct GuessHint {
     pub mu: f64,
     /// A typical sliding speed of the records [m/s] (e.g. the RMS velocity).
     pub typical_velocity: f64,
-    /// The normal force [N].
+    /// The normal force \[N\].
     pub normal_force: f64,
     /// The oscillator stiffness [N/m]; bristle and element stiffnesses are guessed relative to it.
     pub stiffness: f64,
-    /// The oscillator mass [kg] (for damping-like parameters such as LuGre's sigma1).
+    /// The oscillator mass \[kg\] (for damping-like parameters such as LuGre's sigma1).
     pub mass: f64,
 }
 

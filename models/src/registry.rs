@@ -142,6 +142,11 @@ fn translate(model: &str, msg: &str) -> ModelError {
             },
         };
     }
+    // A model's own checks run while deserialising (serde `try_from`); their messages already
+    // name the model.
+    if msg.starts_with(&format!("model `{model}`")) || msg.starts_with(&format!("{model} model:")) {
+        return ModelError::Invalid(msg.to_string());
+    }
     ModelError::Invalid(format!("model `{model}`: {msg}"))
 }
 

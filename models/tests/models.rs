@@ -16,7 +16,10 @@ fn registry_lists_the_built_in_models() {
         vec![
             "coulomb",
             "dahl",
+            "expression",
+            "gms",
             "lugre",
+            "makkar",
             "none",
             "stribeck",
             "viscous_coulomb"

@@ -54,7 +54,7 @@ impl Default for LuGre {
 }
 
 impl LuGre {
-    /// The Stribeck level g(v) [N].
+    /// The Stribeck level g(v) \[N\].
     pub fn g(&self, v: f64, normal: f64) -> f64 {
         let r = v / self.v_s;
         normal * (self.mu_c + (self.mu_s - self.mu_c) * (-r * r).exp())

@@ -1,0 +1,326 @@
+//! A static friction law written as a formula in the config.
+//!
+//! F = f(v, N; p_1, ..., p_n), e.g. `mu * N * tanh(v / eps) + b * v`
+//!
+//! ```toml
+//! [model]
+//! type = "expression"
+//! force = "mu * N * tanh(v / eps) + b * v"
+//! params = { mu = 0.2, eps = 1.0e-4, b = 0.5 }
+//! bounds = { mu = [0, 1], eps = [1e-9, 1] }      # optional, inclusive; default (-inf, inf)
+//! units = { mu = "1", eps = "m/s", b = "N s/m" } # optional, for listings and reports
+//! ```
+//!
+//! | key | meaning |
+//! |---|---|
+//! | `force` | the friction force [N] as a formula of `v` [m/s], `N` [N] and the parameters |
+//! | `params` | every other name in the formula with its value (SI units) |
+//! | `bounds` | physical bounds `[lower, upper]` of some parameters |
+//! | `units` | units of some parameters (text) |
+//!
+//! The parameters are the names of `params`, ordered by their first appearance in the
+//! formula (stable for a given formula); they are fitted like any model's. A parameter that
+//! the formula does not use, or a name in the formula that is neither `v`, `N` nor a
+//! parameter, is an error naming it. Syntax and functions: see [`crate::formula`] (usual
+//! precedence, `^` or `**` for powers, `sign`/`sgn` with sign(0) = 0, `abs`, `exp`, `ln`,
+//! `sqrt`, `tanh`, `sin`, `cos`, `atan`, `min`, `max`, ...). The formula is parsed once, when
+//! the model is built, into an exmex flat expression; evaluation does not parse.
+//!
+//! Without `force`, the model is the default law `mu * N * tanh(v / eps)` with mu = 0.2,
+//! eps = 1e-4 m/s (a smoothed Coulomb law; `params`, `bounds` and `units` then override its
+//! defaults).
+//!
+//! Switched laws: a formula containing `sign(v)` (or `sgn(v)`, `sign(-v)`) has a set-valued
+//! force at rest, like Coulomb's. Then `static_limit` is |F(0+)| (also when that is 0, e.g.
+//! mu = 0, exactly as coulomb's mu N) and `slip_force(v, direction, N)` evaluates a second compiled form of the formula
+//! in which `sign(v)` is replaced by `direction` itself, while every other occurrence of `v`
+//! keeps its (possibly zero or round-off-signed) value. So `mu * N * sign(v)` is exactly
+//! `coulomb` in the engine's switched treatment, and no velocity is nudged (which would bias
+//! the smooth parts of the law by the nudge). `sign` of any other argument (`sign(v - 1)`) is
+//! evaluated as written.
+
+use crate::error::ModelError;
+use crate::formula::{self, Formula, Parsed};
+use crate::model::{check_bounds, check_len, FrictionModel, GuessHint, ParamInfo};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+const MODEL: &str = "expression";
+/// The variable standing for the slip direction in the switched form (not writable by users).
+const DIRECTION: &str = "#direction";
+const DEFAULT_FORCE: &str = "mu * N * tanh(v / eps)";
+
+/// The table of the `expression` model as written in a config file.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ExpressionConfig {
+    /// The force formula; `None` selects the default law.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub force: Option<String>,
+    /// Parameter values.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub params: BTreeMap<String, f64>,
+    /// Physical bounds `[lower, upper]` of some parameters.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub bounds: BTreeMap<String, [f64; 2]>,
+    /// Units of some parameters.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub units: BTreeMap<String, String>,
+}
+
+/// One fittable parameter of a formula.
+#[derive(Debug, Clone, PartialEq)]
+struct Param {
+    name: String,
+    value: f64,
+    bounds: Option<[f64; 2]>,
+    unit: Option<String>,
+}
+
+/// A static friction law given as a formula, compiled once when the model is built.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(try_from = "ExpressionConfig", into = "ExpressionConfig")]
+pub struct Expression {
+    force: String,
+    params: Vec<Param>,
+    /// F(v, N, params...).
+    compiled: Formula,
+    /// F with sign(v) replaced by the slip direction: (v, N, params..., direction); `None`
+    /// when the formula has no sign(v).
+    switched: Option<Formula>,
+}
+
+impl Expression {
+    /// Builds the model from a formula and its parameter values (no bounds, no units).
+    pub fn new(force: &str, params: &[(&str, f64)]) -> Result<Self, ModelError> {
+        Self::try_from(ExpressionConfig {
+            force: Some(force.to_string()),
+            params: params.iter().map(|(n, v)| (n.to_string(), *v)).collect(),
+            ..ExpressionConfig::default()
+        })
+    }
+
+    /// The formula as written.
+    pub fn formula(&self) -> &str {
+        &self.force
+    }
+
+    /// The parameter names, in the order of `params`/`set_params`.
+    pub fn param_names(&self) -> Vec<&str> {
+        self.params.iter().map(|p| p.name.as_str()).collect()
+    }
+
+    /// Whether the law is switched (has sign(v)), so that `slip_force` substitutes the
+    /// direction.
+    pub fn is_switched(&self) -> bool {
+        self.switched.is_some()
+    }
+
+    fn eval(&self, f: &Formula, v: f64, normal: f64, direction: Option<f64>) -> f64 {
+        // Variables in the order v, N, params..., direction (see `try_from`).
+        f.eval_by(|i| match i {
+            0 => v,
+            1 => normal,
+            _ => self
+                .params
+                .get(i - 2)
+                .map(|p| p.value)
+                .or(direction)
+                .unwrap_or(f64::NAN),
+        })
+    }
+
+    /// The force at v -> 0+ in the switched form (sign(v) = +1).
+    fn breakaway(&self, normal: f64) -> Option<f64> {
+        let f = self.switched.as_ref()?;
+        let f0 = self.eval(f, 0.0, normal, Some(1.0));
+        f0.is_finite().then_some(f0.abs())
+    }
+}
+
+impl TryFrom<ExpressionConfig> for Expression {
+    type Error = ModelError;
+
+    fn try_from(cfg: ExpressionConfig) -> Result<Self, ModelError> {
+        let bad = |key: &str, message: String| ModelError::BadKey {
+            model: MODEL.into(),
+            key: key.into(),
+            message,
+        };
+        let (force, mut values, mut bounds, mut units) = match cfg.force {
+            Some(f) => (f, cfg.params, cfg.bounds, cfg.units),
+            None => {
+                // The default law, with any given values overriding its defaults.
+                let mut p = BTreeMap::from([("mu".to_string(), 0.2), ("eps".to_string(), 1e-4)]);
+                let mut b = BTreeMap::from([
+                    ("mu".to_string(), [0.0, 10.0]),
+                    ("eps".to_string(), [1e-9, 1.0]),
+                ]);
+                let mut u = BTreeMap::from([
+                    ("mu".to_string(), "1".to_string()),
+                    ("eps".to_string(), "m/s".to_string()),
+                ]);
+                p.extend(cfg.params);
+                b.extend(cfg.bounds);
+                u.extend(cfg.units);
+                (DEFAULT_FORCE.to_string(), p, b, u)
+            }
+        };
+        let parsed: Parsed = formula::parse(&force)?;
+        for name in values.keys() {
+            if name == "v" || name == "N" || formula::is_reserved(name) {
+                return Err(bad(
+                    "params",
+                    format!("`{name}` is reserved (v, N and function names cannot be parameters)"),
+                ));
+            }
+            if !formula::is_identifier(name) {
+                return Err(bad(
+                    "params",
+                    format!("`{name}` is not a valid name (a letter or `_`, then letters, digits or `_`)"),
+                ));
+            }
+            if !parsed.variables().iter().any(|(n, _)| n == name) {
+                return Err(bad(
+                    "params",
+                    format!("parameter `{name}` does not appear in the formula `{force}`"),
+                ));
+            }
+        }
+        for (key, names) in [
+            ("bounds", bounds.keys().collect::<Vec<_>>()),
+            ("units", units.keys().collect::<Vec<_>>()),
+        ] {
+            if let Some(name) = names.into_iter().find(|n| !values.contains_key(*n)) {
+                return Err(bad(
+                    key,
+                    format!("`{name}` is not a parameter of the formula"),
+                ));
+            }
+        }
+        for (name, [lo, hi]) in &bounds {
+            if lo.is_nan() || hi.is_nan() || lo > hi {
+                return Err(bad(
+                    "bounds",
+                    format!("bounds of `{name}` must be [lower, upper] with lower <= upper, got [{lo}, {hi}]"),
+                ));
+            }
+        }
+        // Parameters in order of first appearance in the formula.
+        let mut params = Vec::new();
+        for (name, _) in parsed.variables() {
+            if name == "v" || name == "N" {
+                continue;
+            }
+            if let Some(value) = values.remove(name) {
+                params.push(Param {
+                    name: name.clone(),
+                    value,
+                    bounds: bounds.remove(name),
+                    unit: units.remove(name),
+                });
+            }
+        }
+        let mut variables = vec!["v", "N"];
+        variables.extend(params.iter().map(|p| p.name.as_str()));
+        let compiled = parsed.compile(&variables)?;
+        let switched = if parsed.has_sign_of("v") {
+            variables.push(DIRECTION);
+            Some(
+                parsed
+                    .with_sign_of_replaced("v", DIRECTION)
+                    .compile(&variables)?,
+            )
+        } else {
+            None
+        };
+        Ok(Self {
+            force,
+            params,
+            compiled,
+            switched,
+        })
+    }
+}
+
+impl From<Expression> for ExpressionConfig {
+    fn from(m: Expression) -> Self {
+        let mut cfg = ExpressionConfig {
+            force: Some(m.force),
+            ..ExpressionConfig::default()
+        };
+        for p in m.params {
+            if let Some(b) = p.bounds {
+                cfg.bounds.insert(p.name.clone(), b);
+            }
+            if let Some(u) = p.unit {
+                cfg.units.insert(p.name.clone(), u);
+            }
+            cfg.params.insert(p.name, p.value);
+        }
+        cfg
+    }
+}
+
+#[typetag::serde(name = "expression")]
+impl FrictionModel for Expression {
+    fn name(&self) -> &'static str {
+        MODEL
+    }
+    fn equation(&self) -> String {
+        format!("F = {}", self.force)
+    }
+    fn param_info(&self) -> Vec<ParamInfo> {
+        self.params
+            .iter()
+            .map(|p| {
+                let [lo, hi] = p.bounds.unwrap_or([f64::NEG_INFINITY, f64::INFINITY]);
+                ParamInfo::new(
+                    &p.name,
+                    p.unit.as_deref().unwrap_or("?"),
+                    p.value,
+                    (lo, hi),
+                    "parameter of the formula",
+                )
+            })
+            .collect()
+    }
+    fn params(&self) -> Vec<f64> {
+        self.params.iter().map(|p| p.value).collect()
+    }
+    fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
+        check_len(self.name(), self.params.len(), values.len())?;
+        for (p, &v) in self.params.iter_mut().zip(values) {
+            p.value = v;
+        }
+        Ok(())
+    }
+    fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
+        self.eval(&self.compiled, v, normal, None)
+    }
+    fn static_limit(&self, normal: f64) -> Option<f64> {
+        self.breakaway(normal)
+    }
+    fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
+        match &self.switched {
+            Some(f) => self.eval(f, v, normal, Some(direction)),
+            None => self.force(v, &[], normal),
+        }
+    }
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        self.force(v, &[], normal)
+    }
+    fn apply_guess(&mut self, hint: &GuessHint) {
+        // Only the conventional name is guessed: a parameter `mu` is the mean coefficient.
+        for p in &mut self.params {
+            if p.name == "mu" && hint.mu.is_finite() {
+                let [lo, hi] = p.bounds.unwrap_or([f64::NEG_INFINITY, f64::INFINITY]);
+                p.value = hint.mu.clamp(lo, hi);
+            }
+        }
+    }
+    fn validate(&self) -> Result<Vec<String>, ModelError> {
+        check_bounds(self.name(), &self.param_info(), &self.params())?;
+        Ok(Vec::new())
+    }
+}
