@@ -6,8 +6,7 @@ use rand_distr::{Distribution, Normal};
 
 /// Sample times 0, 1/rate, ... up to and including `duration` (to round-off).
 pub fn uniform_times(duration: f64, sample_rate: f64) -> Vec<f64> {
-    if !(duration.is_finite() && sample_rate.is_finite() && duration >= 0.0 && sample_rate > 0.0)
-    {
+    if !(duration.is_finite() && sample_rate.is_finite() && duration >= 0.0 && sample_rate > 0.0) {
         return Vec::new();
     }
     let n = (duration * sample_rate + 1e-9).floor() as usize + 1;
