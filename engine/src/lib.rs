@@ -6,6 +6,7 @@
 pub mod data;
 pub mod error;
 pub mod exact;
+pub mod identify;
 pub mod oscillator;
 pub mod record;
 pub mod synthetic;

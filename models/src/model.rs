@@ -20,6 +20,9 @@ pub struct ParamInfo {
     pub lower_exclusive: bool,
     /// One-line meaning.
     pub description: String,
+    /// Whether the identifier keeps this parameter fixed unless the user frees it by name
+    /// (e.g. the Stribeck shape exponent).
+    pub fixed_by_default: bool,
 }
 
 impl ParamInfo {
@@ -39,6 +42,7 @@ impl ParamInfo {
             upper,
             lower_exclusive: false,
             description: description.to_string(),
+            fixed_by_default: false,
         }
     }
 
@@ -47,6 +51,14 @@ impl ParamInfo {
         Self {
             lower_exclusive: true,
             ..Self::new(name, unit, default, (0.0, upper), description)
+        }
+    }
+
+    /// The same metadata, marked as fixed unless freed by name.
+    pub fn fixed(self) -> Self {
+        Self {
+            fixed_by_default: true,
+            ..self
         }
     }
 
@@ -93,6 +105,8 @@ pub struct GuessHint {
     pub normal_force: f64,
     /// The oscillator stiffness [N/m]; bristle and element stiffnesses are guessed relative to it.
     pub stiffness: f64,
+    /// The oscillator mass [kg] (for damping-like parameters such as LuGre's sigma1).
+    pub mass: f64,
 }
 
 /// A friction law: a pure function of sliding velocity, internal states and normal force.

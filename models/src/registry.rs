@@ -148,15 +148,23 @@ fn translate(model: &str, msg: &str) -> ModelError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
     #[test]
-    fn probe() {
-        println!("{:?}", names());
-        let e = build_json(&serde_json::json!({"type": "coulomb", "mux": 1.0})).unwrap_err();
-        println!("{e}");
-        let e = build_json(&serde_json::json!({"type": "colomb"})).unwrap_err();
-        println!("{e}");
-        let b = build_toml(&toml::from_str::<toml::Value>("type = 'coulomb'\nmu = 0.3").unwrap())
-            .unwrap();
-        println!("{:?} {}", b.model, serde_json::to_string(&b.model).unwrap());
+    fn parses_serde_expected_lists() {
+        let msg = "unknown variant `x`, expected one of `a`, `b_c`, `d`";
+        assert_eq!(parse_expected(msg), vec!["a", "b_c", "d"]);
+        assert_eq!(
+            parse_expected("unknown field `q`, expected `mu`"),
+            vec!["mu"]
+        );
+        assert!(parse_expected("unknown field `q`, there are no fields").is_empty());
+    }
+
+    #[test]
+    fn nearest_names_only_close_matches() {
+        let c = ["coulomb", "lugre", "stribeck"];
+        assert_eq!(nearest("colomb", c), Some("coulomb"));
+        assert_eq!(nearest("lugree", c), Some("lugre"));
+        assert_eq!(nearest("xyzzy", c), None);
     }
 }

@@ -1,0 +1,378 @@
+//! A bounded Levenberg-Marquardt least-squares solver, written as an argmin [`Solver`].
+//!
+//! argmin ships no Levenberg-Marquardt. This one follows Marquardt's scaled form as presented
+//! by Madsen, Nielsen and Tingleff ("Methods for non-linear least squares problems", 2004):
+//! solve (JᵀJ + μ D) δ = -Jᵀr with D = diag(JᵀJ) (Marquardt's scaling, which makes the step
+//! invariant to the units of the parameters), accept the step when the actual reduction is a
+//! positive fraction of the reduction the linear model predicts, and update μ by Nielsen's rule.
+//! Box bounds are kept by projecting each trial point onto the box (a projected LM step); the
+//! predicted reduction is evaluated for the projected step, so the gain ratio stays honest.
+//!
+//! The problem supplies the residual vector through argmin's [`Operator`] and its Jacobian
+//! through [`Jacobian`]. A residual vector with a non-finite entry (e.g. a simulation that
+//! failed for the trial parameters) is treated as an infinitely bad trial and rejected.
+
+use argmin::core::{
+    Error, IterState, Jacobian, Operator, Problem, Solver, State, TerminationReason,
+    TerminationStatus, KV,
+};
+use nalgebra::{DMatrix, DVector};
+
+/// The argmin state used by [`LevenbergMarquardt`].
+pub type LmState = IterState<DVector<f64>, (), DMatrix<f64>, (), DVector<f64>, f64>;
+
+/// Bounded Levenberg-Marquardt.
+#[derive(Debug, Clone)]
+pub struct LevenbergMarquardt {
+    lower: DVector<f64>,
+    upper: DVector<f64>,
+    /// Stop when the largest scaled gradient component falls below this.
+    pub gtol: f64,
+    /// Stop when a step changes no parameter by more than xtol relative.
+    pub xtol: f64,
+    /// Stop when an accepted step reduces the cost by less than ftol relative.
+    pub ftol: f64,
+    /// Initial damping relative to the largest diagonal entry of JᵀJ.
+    pub tau: f64,
+    mu: f64,
+    nu: f64,
+    residuals: DVector<f64>,
+    jacobian: DMatrix<f64>,
+    cost: f64,
+    converged: Option<String>,
+}
+
+impl LevenbergMarquardt {
+    /// A solver for parameters in the box [lower, upper] (use ±inf for no bound).
+    pub fn new(lower: DVector<f64>, upper: DVector<f64>) -> Self {
+        Self {
+            lower,
+            upper,
+            gtol: 1e-10,
+            xtol: 1e-10,
+            ftol: 1e-12,
+            tau: 1e-3,
+            mu: 0.0,
+            nu: 2.0,
+            residuals: DVector::zeros(0),
+            jacobian: DMatrix::zeros(0, 0),
+            cost: f64::INFINITY,
+            converged: None,
+        }
+    }
+
+    fn project(&self, p: &DVector<f64>) -> DVector<f64> {
+        DVector::from_iterator(
+            p.len(),
+            p.iter()
+                .zip(self.lower.iter().zip(self.upper.iter()))
+                .map(|(&x, (&lo, &hi))| x.max(lo).min(hi)),
+        )
+    }
+
+    /// The largest component of the projected gradient, scaled by the diagonal of JᵀJ, so
+    /// that a parameter held at a bound by a gradient pushing outwards does not count.
+    fn scaled_gradient_norm(&self, p: &DVector<f64>, g: &DVector<f64>, diag: &[f64]) -> f64 {
+        let mut worst: f64 = 0.0;
+        for i in 0..p.len() {
+            let at_lower = p[i] <= self.lower[i] && g[i] > 0.0;
+            let at_upper = p[i] >= self.upper[i] && g[i] < 0.0;
+            if at_lower || at_upper {
+                continue;
+            }
+            let s = diag[i].sqrt().max(1e-300);
+            worst = worst.max(g[i].abs() / s);
+        }
+        worst / (2.0 * self.cost).sqrt().max(1e-300)
+    }
+}
+
+fn half_sq(r: &DVector<f64>) -> f64 {
+    if r.iter().all(|x| x.is_finite()) {
+        0.5 * r.norm_squared()
+    } else {
+        f64::INFINITY
+    }
+}
+
+impl<O> Solver<O, LmState> for LevenbergMarquardt
+where
+    O: Operator<Param = DVector<f64>, Output = DVector<f64>>
+        + Jacobian<Param = DVector<f64>, Jacobian = DMatrix<f64>>,
+{
+    fn name(&self) -> &str {
+        "Levenberg-Marquardt (bounded, Nielsen damping)"
+    }
+
+    fn init(
+        &mut self,
+        problem: &mut Problem<O>,
+        mut state: LmState,
+    ) -> Result<(LmState, Option<KV>), Error> {
+        let p0 = state
+            .take_param()
+            .ok_or_else(|| Error::msg("Levenberg-Marquardt needs an initial parameter vector"))?;
+        if p0.len() != self.lower.len() || p0.len() != self.upper.len() {
+            return Err(Error::msg("parameter and bound vectors differ in length"));
+        }
+        let p0 = self.project(&p0);
+        let r = problem.apply(&p0)?;
+        let cost = half_sq(&r);
+        if !cost.is_finite() {
+            return Err(Error::msg(
+                "the residuals at the initial parameters are not finite",
+            ));
+        }
+        let j = problem.jacobian(&p0)?;
+        let a = j.transpose() * &j;
+        let max_diag = a.diagonal().iter().cloned().fold(0.0, f64::max);
+        self.mu = self.tau * max_diag.max(1e-300);
+        self.nu = 2.0;
+        self.residuals = r;
+        self.jacobian = j;
+        self.cost = cost;
+        self.converged = None;
+        Ok((state.param(p0).cost(cost), None))
+    }
+
+    fn next_iter(
+        &mut self,
+        problem: &mut Problem<O>,
+        mut state: LmState,
+    ) -> Result<(LmState, Option<KV>), Error> {
+        let p = state
+            .take_param()
+            .ok_or_else(|| Error::msg("Levenberg-Marquardt lost its parameter vector"))?;
+        let j = &self.jacobian;
+        let a = j.transpose() * j;
+        let g = j.transpose() * &self.residuals;
+        let n = p.len();
+        let diag: Vec<f64> = (0..n)
+            .map(|i| a[(i, i)].max(1e-12 * (1.0 + a[(i, i)])))
+            .collect();
+
+        if self.scaled_gradient_norm(&p, &g, &diag) < self.gtol {
+            self.converged = Some("gradient below tolerance".into());
+            return Ok((state.param(p).cost(self.cost), None));
+        }
+
+        // Parameters held at a bound by a gradient pointing outwards stay put; the damped
+        // normal equations are solved for the others only.
+        let free: Vec<usize> = (0..n)
+            .filter(|&i| {
+                !((p[i] <= self.lower[i] && g[i] > 0.0) || (p[i] >= self.upper[i] && g[i] < 0.0))
+            })
+            .collect();
+        let m = free.len();
+        let mut lhs = DMatrix::zeros(m, m);
+        let mut rhs = DVector::zeros(m);
+        for (r, &i) in free.iter().enumerate() {
+            rhs[r] = -g[i];
+            for (c, &k) in free.iter().enumerate() {
+                lhs[(r, c)] = a[(i, k)];
+            }
+            lhs[(r, r)] += self.mu * diag[i];
+        }
+        let reduced = match lhs.cholesky() {
+            Some(ch) => ch.solve(&rhs),
+            None => {
+                self.mu *= self.nu;
+                self.nu *= 2.0;
+                return Ok((state.param(p).cost(self.cost), None));
+            }
+        };
+        let mut delta = DVector::zeros(n);
+        for (r, &i) in free.iter().enumerate() {
+            delta[i] = reduced[r];
+        }
+        let trial = self.project(&(&p + &delta));
+        let step = &trial - &p;
+        let small_step = step
+            .iter()
+            .zip(p.iter())
+            .all(|(s, x)| s.abs() <= self.xtol * (x.abs() + self.xtol));
+        if small_step {
+            self.converged = Some("step below tolerance".into());
+            return Ok((state.param(p).cost(self.cost), None));
+        }
+        let r_new = problem.apply(&trial)?;
+        let cost_new = half_sq(&r_new);
+        // Predicted reduction of the linear model for the projected step.
+        let predicted = -(step.dot(&g)) - 0.5 * step.dot(&(&a * &step));
+        let actual = self.cost - cost_new;
+        let rho = if predicted > 0.0 {
+            actual / predicted
+        } else {
+            -1.0
+        };
+        if cost_new.is_finite() && rho > 0.0 {
+            let old = self.cost;
+            self.residuals = r_new;
+            self.cost = cost_new;
+            self.jacobian = problem.jacobian(&trial)?;
+            self.mu *= (1.0_f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
+            self.nu = 2.0;
+            if actual <= self.ftol * old {
+                self.converged = Some("relative cost reduction below tolerance".into());
+            }
+            Ok((state.param(trial).cost(cost_new), None))
+        } else {
+            self.mu *= self.nu;
+            self.nu *= 2.0;
+            if self.mu > 1e20 {
+                self.converged = Some("no further decrease possible (damping limit)".into());
+            }
+            Ok((state.param(p).cost(self.cost), None))
+        }
+    }
+
+    fn terminate(&mut self, _state: &LmState) -> TerminationStatus {
+        match &self.converged {
+            Some(why) => TerminationStatus::Terminated(TerminationReason::SolverExit(format!(
+                "converged: {why}"
+            ))),
+            None => TerminationStatus::NotTerminated,
+        }
+    }
+}
+
+/// Whether an argmin termination status means the solver converged.
+pub fn is_converged(status: &TerminationStatus) -> bool {
+    match status {
+        TerminationStatus::Terminated(TerminationReason::SolverExit(s)) => {
+            s.starts_with("converged")
+        }
+        TerminationStatus::Terminated(TerminationReason::SolverConverged)
+        | TerminationStatus::Terminated(TerminationReason::TargetCostReached) => true,
+        _ => false,
+    }
+}
+
+/// Reads the state's best parameter and cost.
+pub fn best(state: &LmState) -> Option<(DVector<f64>, f64)> {
+    state
+        .get_best_param()
+        .map(|p| (p.clone(), state.get_best_cost()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use argmin::core::Executor;
+
+    /// Rosenbrock as least squares: r = (10 (y - x^2), 1 - x), minimum at (1, 1).
+    struct Rosenbrock;
+    impl Operator for Rosenbrock {
+        type Param = DVector<f64>;
+        type Output = DVector<f64>;
+        fn apply(&self, p: &DVector<f64>) -> Result<DVector<f64>, Error> {
+            Ok(DVector::from_vec(vec![
+                10.0 * (p[1] - p[0] * p[0]),
+                1.0 - p[0],
+            ]))
+        }
+    }
+    impl Jacobian for Rosenbrock {
+        type Param = DVector<f64>;
+        type Jacobian = DMatrix<f64>;
+        fn jacobian(&self, p: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+            Ok(DMatrix::from_row_slice(
+                2,
+                2,
+                &[-20.0 * p[0], 10.0, -1.0, 0.0],
+            ))
+        }
+    }
+
+    fn run<O>(problem: O, p0: Vec<f64>, lo: Vec<f64>, hi: Vec<f64>) -> LmState
+    where
+        O: Operator<Param = DVector<f64>, Output = DVector<f64>>
+            + Jacobian<Param = DVector<f64>, Jacobian = DMatrix<f64>>,
+    {
+        let solver = LevenbergMarquardt::new(DVector::from_vec(lo), DVector::from_vec(hi));
+        Executor::new(problem, solver)
+            .configure(|s| s.param(DVector::from_vec(p0)).max_iters(500))
+            .run()
+            .unwrap()
+            .state()
+            .clone()
+    }
+
+    #[test]
+    fn finds_the_rosenbrock_minimum() {
+        let inf = f64::INFINITY;
+        let s = run(Rosenbrock, vec![-1.2, 1.0], vec![-inf; 2], vec![inf; 2]);
+        let (p, cost) = best(&s).unwrap();
+        assert!(
+            (p[0] - 1.0).abs() < 1e-8 && (p[1] - 1.0).abs() < 1e-8,
+            "{p}"
+        );
+        assert!(cost < 1e-20);
+        assert!(
+            is_converged(&s.termination_status),
+            "{:?}",
+            s.termination_status
+        );
+    }
+
+    #[test]
+    fn respects_bounds() {
+        // The unconstrained minimum (1, 1) is outside x <= 0.5: the bounded minimum of
+        // 100 (y - x^2)^2 + (1 - x)^2 on x <= 0.5 is at x = 0.5, y = 0.25.
+        let inf = f64::INFINITY;
+        let s = run(Rosenbrock, vec![-1.2, 1.0], vec![-inf; 2], vec![0.5, inf]);
+        let (p, _) = best(&s).unwrap();
+        assert!((p[0] - 0.5).abs() < 1e-12, "{p}");
+        assert!((p[1] - 0.25).abs() < 1e-8, "{p}");
+        assert!(
+            is_converged(&s.termination_status),
+            "{:?}",
+            s.termination_status
+        );
+    }
+
+    /// Exponential decay y = a exp(-b t) from exact data: recovers a and b exactly.
+    struct Decay {
+        t: Vec<f64>,
+        y: Vec<f64>,
+    }
+    impl Operator for Decay {
+        type Param = DVector<f64>;
+        type Output = DVector<f64>;
+        fn apply(&self, p: &DVector<f64>) -> Result<DVector<f64>, Error> {
+            Ok(DVector::from_iterator(
+                self.t.len(),
+                self.t
+                    .iter()
+                    .zip(&self.y)
+                    .map(|(t, y)| p[0] * (-p[1] * t).exp() - y),
+            ))
+        }
+    }
+    impl Jacobian for Decay {
+        type Param = DVector<f64>;
+        type Jacobian = DMatrix<f64>;
+        fn jacobian(&self, p: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+            let mut j = DMatrix::zeros(self.t.len(), 2);
+            for (i, t) in self.t.iter().enumerate() {
+                let e = (-p[1] * t).exp();
+                j[(i, 0)] = e;
+                j[(i, 1)] = -p[0] * t * e;
+            }
+            Ok(j)
+        }
+    }
+
+    #[test]
+    fn fits_an_exponential_decay_exactly() {
+        let t: Vec<f64> = (0..50).map(|i| i as f64 * 0.1).collect();
+        let y = t.iter().map(|t| 3.0 * (-0.7 * t).exp()).collect();
+        let inf = f64::INFINITY;
+        let s = run(Decay { t, y }, vec![1.0, 3.0], vec![0.0; 2], vec![inf; 2]);
+        let (p, _) = best(&s).unwrap();
+        assert!(
+            (p[0] - 3.0).abs() < 1e-9 && (p[1] - 0.7).abs() < 1e-9,
+            "{p}"
+        );
+    }
+}

@@ -1,0 +1,171 @@
+//! Least-squares statistics: covariance from the Jacobian at the optimum, confidence
+//! intervals, correlations and information criteria.
+
+use nalgebra::DMatrix;
+
+/// Two-sided 95 % quantile of Student's t distribution with `dof` degrees of freedom.
+///
+/// Exact values up to 4 degrees of freedom; beyond, the Cornish-Fisher expansion of t about
+/// the normal quantile (Abramowitz & Stegun 26.7.5), accurate to better than 5e-4 from 5 dof.
+pub fn t_quantile_975(dof: usize) -> f64 {
+    match dof {
+        0 => f64::INFINITY,
+        1 => 12.706_204_736_174_7,
+        2 => 4.302_652_729_749_46,
+        3 => 3.182_446_305_284_26,
+        4 => 2.776_445_105_197_8,
+        _ => {
+            let z: f64 = 1.959_963_984_540_054;
+            let n = dof as f64;
+            let z3 = z.powi(3);
+            let z5 = z.powi(5);
+            let z7 = z.powi(7);
+            let z9 = z.powi(9);
+            z + (z3 + z) / (4.0 * n)
+                + (5.0 * z5 + 16.0 * z3 + 3.0 * z) / (96.0 * n * n)
+                + (3.0 * z7 + 19.0 * z5 + 17.0 * z3 - 15.0 * z) / (384.0 * n.powi(3))
+                + (79.0 * z9 + 776.0 * z7 + 1482.0 * z5 - 1920.0 * z3 - 945.0 * z)
+                    / (92160.0 * n.powi(4))
+        }
+    }
+}
+
+/// Covariance, standard errors and correlations of a least-squares estimate.
+#[derive(Debug, Clone)]
+pub struct Covariance {
+    /// Covariance matrix s^2 (JᵀJ)^-1 (NaN where JᵀJ is singular).
+    pub matrix: DMatrix<f64>,
+    /// Standard errors.
+    pub std_errors: Vec<f64>,
+    /// Correlation matrix.
+    pub correlation: DMatrix<f64>,
+    /// Residual variance s^2 = SSR / (n - p).
+    pub residual_variance: f64,
+    /// Degrees of freedom n - p.
+    pub dof: usize,
+    /// Whether JᵀJ was numerically singular (parameters not separately identifiable).
+    pub singular: bool,
+}
+
+/// Covariance from the (weighted) Jacobian `j` (n x p) at the optimum and the sum of squared
+/// (weighted) residuals `ssr`.
+pub fn covariance(j: &DMatrix<f64>, ssr: f64) -> Covariance {
+    let (n, p) = j.shape();
+    let dof = n.saturating_sub(p);
+    let s2 = if dof > 0 { ssr / dof as f64 } else { f64::NAN };
+    let jtj = j.transpose() * j;
+    // Scale to unit diagonal before inverting, so the condition test is unit-free.
+    let d: Vec<f64> = (0..p).map(|i| jtj[(i, i)].max(0.0).sqrt()).collect();
+    let mut scaled = jtj.clone();
+    for r in 0..p {
+        for c in 0..p {
+            let den = d[r] * d[c];
+            scaled[(r, c)] = if den > 0.0 { jtj[(r, c)] / den } else { 0.0 };
+        }
+    }
+    let svd = scaled.clone().svd(false, false);
+    let (smax, smin) = svd
+        .singular_values
+        .iter()
+        .fold((0.0f64, f64::INFINITY), |(a, b), &s| (a.max(s), b.min(s)));
+    let singular = p > 0 && (d.iter().any(|&x| x == 0.0) || smin <= 1e-12 * smax);
+    let matrix = match (singular, scaled.try_inverse()) {
+        (false, Some(inv)) => {
+            let mut m = inv;
+            for r in 0..p {
+                for c in 0..p {
+                    m[(r, c)] *= s2 / (d[r] * d[c]);
+                }
+            }
+            m
+        }
+        _ => DMatrix::from_element(p, p, f64::NAN),
+    };
+    let std_errors: Vec<f64> = (0..p).map(|i| matrix[(i, i)].max(0.0).sqrt()).collect();
+    let mut correlation = DMatrix::from_element(p, p, f64::NAN);
+    for r in 0..p {
+        for c in 0..p {
+            let den = std_errors[r] * std_errors[c];
+            if den > 0.0 {
+                correlation[(r, c)] = matrix[(r, c)] / den;
+            }
+        }
+    }
+    Covariance {
+        matrix,
+        std_errors,
+        correlation,
+        residual_variance: s2,
+        dof,
+        singular,
+    }
+}
+
+/// Akaike's information criterion for Gaussian least squares: n ln(SSR/n) + 2 p.
+pub fn aic(n: usize, ssr: f64, p: usize) -> f64 {
+    let n = n as f64;
+    n * (ssr / n).ln() + 2.0 * p as f64
+}
+
+/// The Bayesian (Schwarz) information criterion: n ln(SSR/n) + p ln(n).
+pub fn bic(n: usize, ssr: f64, p: usize) -> f64 {
+    let nf = n as f64;
+    nf * (ssr / nf).ln() + p as f64 * nf.ln()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn t_quantiles_match_tables() {
+        // Tabulated two-sided 95 % values.
+        for (dof, t) in [
+            (1, 12.706),
+            (2, 4.303),
+            (3, 3.182),
+            (5, 2.571),
+            (10, 2.228),
+            (30, 2.042),
+            (120, 1.980),
+        ] {
+            assert!((t_quantile_975(dof) - t).abs() < 2e-3, "dof {dof}");
+        }
+        assert!((t_quantile_975(100_000) - 1.95996).abs() < 1e-4);
+    }
+
+    /// Straight line y = a + b x: the covariance equals the textbook formulas.
+    #[test]
+    fn straight_line_covariance_matches_the_closed_form() {
+        let x: Vec<f64> = (0..20).map(|i| i as f64 * 0.5).collect();
+        let n = x.len() as f64;
+        let j = DMatrix::from_fn(x.len(), 2, |r, c| if c == 0 { 1.0 } else { x[r] });
+        let ssr = 3.6;
+        let cov = covariance(&j, ssr);
+        let s2 = ssr / (n - 2.0);
+        let mean = x.iter().sum::<f64>() / n;
+        let sxx: f64 = x.iter().map(|v| (v - mean).powi(2)).sum();
+        let var_b = s2 / sxx;
+        let var_a = s2 * (1.0 / n + mean * mean / sxx);
+        assert!((cov.std_errors[1] - var_b.sqrt()).abs() < 1e-12);
+        assert!((cov.std_errors[0] - var_a.sqrt()).abs() < 1e-12);
+        let rho = -mean * s2 / sxx / (var_a.sqrt() * var_b.sqrt());
+        assert!((cov.correlation[(0, 1)] - rho).abs() < 1e-12);
+        assert!(!cov.singular);
+    }
+
+    #[test]
+    fn collinear_columns_are_flagged_singular() {
+        let j = DMatrix::from_fn(10, 2, |r, c| (r as f64 + 1.0) * (c as f64 + 1.0));
+        let cov = covariance(&j, 1.0);
+        assert!(cov.singular);
+        assert!(cov.std_errors.iter().all(|s| s.is_nan() || *s == 0.0));
+    }
+
+    #[test]
+    fn information_criteria_by_hand() {
+        let (n, ssr) = (100, 2.5);
+        assert!((aic(n, ssr, 3) - (100.0 * (0.025f64).ln() + 6.0)).abs() < 1e-12);
+        assert!((bic(n, ssr, 3) - (100.0 * (0.025f64).ln() + 3.0 * (100f64).ln())).abs() < 1e-12);
+    }
+}

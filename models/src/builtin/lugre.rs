@@ -1,0 +1,156 @@
+//! The LuGre model.
+//!
+//! dz/dt = v - sigma0 |v| z / g(v),  g(v) = N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)),
+//! F = sigma0 z + sigma1 dz/dt + sigma2 v
+//!
+//! | parameter | unit | default | bounds | meaning |
+//! |---|---|---|---|---|
+//! | `sigma0` | N/m | 1e5 | (0, 1e12] | bristle stiffness |
+//! | `sigma1` | N s/m | 300 | [0, inf) | bristle damping |
+//! | `sigma2` | N s/m | 0.5 | [0, inf) | viscous friction coefficient |
+//! | `mu_c` | 1 | 0.2 | (0, 10] | Coulomb friction coefficient |
+//! | `mu_s` | 1 | 0.3 | (0, 10] | static friction coefficient |
+//! | `v_s` | m/s | 0.01 | (0, 100] | Stribeck velocity |
+//!
+//! Stored energy: sigma0 z^2 / 2. mu_s < mu_c is admissible but reported as a warning.
+//!
+//! Reference: C. Canudas de Wit, H. Olsson, K. J. Åström, P. Lischinsky, "A new model for
+//! control of systems with friction", IEEE Trans. Automatic Control 40(3), 419-425, 1995.
+
+use crate::builtin::stribeck::mu_s_warning;
+use crate::error::ModelError;
+use crate::model::{check_bounds, check_len, sgn, FrictionModel, GuessHint, ParamInfo};
+use serde::{Deserialize, Serialize};
+
+/// The LuGre bristle model with the Stribeck curve of Canudas de Wit et al. (1995).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LuGre {
+    /// Bristle stiffness [N/m].
+    pub sigma0: f64,
+    /// Bristle damping [N s/m].
+    pub sigma1: f64,
+    /// Viscous coefficient [N s/m].
+    pub sigma2: f64,
+    /// Coulomb coefficient.
+    pub mu_c: f64,
+    /// Static coefficient.
+    pub mu_s: f64,
+    /// Stribeck velocity [m/s].
+    pub v_s: f64,
+}
+
+impl Default for LuGre {
+    fn default() -> Self {
+        Self {
+            sigma0: 1e5,
+            sigma1: 300.0,
+            sigma2: 0.5,
+            mu_c: 0.2,
+            mu_s: 0.3,
+            v_s: 0.01,
+        }
+    }
+}
+
+impl LuGre {
+    /// The Stribeck level g(v) [N].
+    pub fn g(&self, v: f64, normal: f64) -> f64 {
+        let r = v / self.v_s;
+        normal * (self.mu_c + (self.mu_s - self.mu_c) * (-r * r).exp())
+    }
+
+    fn z_dot(&self, v: f64, z: f64, normal: f64) -> f64 {
+        let g = self.g(v, normal);
+        if g > 0.0 {
+            v - self.sigma0 * v.abs() * z / g
+        } else {
+            // No normal load: the bristles carry no force.
+            0.0
+        }
+    }
+}
+
+#[typetag::serde(name = "lugre")]
+impl FrictionModel for LuGre {
+    fn name(&self) -> &'static str {
+        "lugre"
+    }
+    fn equation(&self) -> String {
+        "dz/dt = v - sigma0 |v| z / g(v), g(v) = N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)), F = sigma0 z + sigma1 dz/dt + sigma2 v".into()
+    }
+    fn param_info(&self) -> Vec<ParamInfo> {
+        vec![
+            ParamInfo::positive("sigma0", "N/m", 1e5, 1e12, "bristle stiffness"),
+            ParamInfo::new(
+                "sigma1",
+                "N s/m",
+                300.0,
+                (0.0, f64::INFINITY),
+                "bristle damping",
+            ),
+            ParamInfo::new(
+                "sigma2",
+                "N s/m",
+                0.5,
+                (0.0, f64::INFINITY),
+                "viscous friction coefficient",
+            ),
+            ParamInfo::positive("mu_c", "1", 0.2, 10.0, "Coulomb friction coefficient"),
+            ParamInfo::positive("mu_s", "1", 0.3, 10.0, "static friction coefficient"),
+            ParamInfo::positive("v_s", "m/s", 0.01, 100.0, "Stribeck velocity"),
+        ]
+    }
+    fn params(&self) -> Vec<f64> {
+        vec![
+            self.sigma0,
+            self.sigma1,
+            self.sigma2,
+            self.mu_c,
+            self.mu_s,
+            self.v_s,
+        ]
+    }
+    fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
+        check_len(self.name(), 6, values.len())?;
+        self.sigma0 = values[0];
+        self.sigma1 = values[1];
+        self.sigma2 = values[2];
+        self.mu_c = values[3];
+        self.mu_s = values[4];
+        self.v_s = values[5];
+        Ok(())
+    }
+    fn n_states(&self) -> usize {
+        1
+    }
+    fn state_derivative(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) {
+        if let (Some(&z0), Some(d)) = (z.first(), dz.first_mut()) {
+            *d = self.z_dot(v, z0, normal);
+        }
+    }
+    fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
+        let z0 = z.first().copied().unwrap_or(0.0);
+        self.sigma0 * z0 + self.sigma1 * self.z_dot(v, z0, normal) + self.sigma2 * v
+    }
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        self.g(v, normal) * sgn(v) + self.sigma2 * v
+    }
+    fn stored_energy(&self, z: &[f64], _normal: f64) -> f64 {
+        let z0 = z.first().copied().unwrap_or(0.0);
+        0.5 * self.sigma0 * z0 * z0
+    }
+    fn apply_guess(&mut self, hint: &GuessHint) {
+        let v = hint.typical_velocity.max(1e-6);
+        self.mu_c = 0.9 * hint.mu;
+        self.mu_s = 1.2 * hint.mu;
+        self.v_s = 0.2 * v;
+        self.sigma0 = (hint.mu * hint.normal_force / 2e-5).max(1.0);
+        self.sigma1 = 0.5 * (self.sigma0 * hint.mass).sqrt();
+        self.sigma2 = 0.05 * hint.mu * hint.normal_force / v;
+    }
+    fn validate(&self) -> Result<Vec<String>, ModelError> {
+        check_bounds(self.name(), &self.param_info(), &self.params())?;
+        Ok(mu_s_warning(self.name(), self.mu_s, self.mu_c))
+    }
+}

@@ -1,0 +1,145 @@
+//! Stribeck friction with viscous term.
+//!
+//! F = N (mu_c + (mu_s - mu_c) exp(-|v / v_s|^delta)) sgn(v) + b v
+//!
+//! | parameter | unit | default | bounds | meaning |
+//! |---|---|---|---|---|
+//! | `mu_c` | 1 | 0.2 | [0, 10] | Coulomb (kinetic) friction coefficient |
+//! | `mu_s` | 1 | 0.3 | [0, 10] | static (breakaway) friction coefficient |
+//! | `v_s` | m/s | 0.01 | (0, 100] | Stribeck velocity |
+//! | `delta` | 1 | 2 | (0, 10] | Stribeck shape exponent (usually fixed) |
+//! | `viscous` | N s/m | 0.5 | [0, inf) | viscous friction coefficient b |
+//!
+//! The breakaway limit used to decide sticking is mu_s N. mu_s < mu_c is admissible but
+//! reported as a warning.
+//!
+//! Reference: R. Stribeck, "Die wesentlichen Eigenschaften der Gleit- und Rollenlager",
+//! Z. VDI 46, 1902; the exponential form as in Armstrong-Hélouvry et al., Automatica 30(7), 1994.
+
+use crate::error::ModelError;
+use crate::model::{check_bounds, check_len, sgn, FrictionModel, GuessHint, ParamInfo};
+use serde::{Deserialize, Serialize};
+
+/// Static friction law with a Stribeck dip between static and Coulomb levels.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Stribeck {
+    /// Coulomb coefficient.
+    pub mu_c: f64,
+    /// Static coefficient.
+    pub mu_s: f64,
+    /// Stribeck velocity [m/s].
+    pub v_s: f64,
+    /// Shape exponent.
+    pub delta: f64,
+    /// Viscous coefficient [N s/m].
+    pub viscous: f64,
+}
+
+impl Default for Stribeck {
+    fn default() -> Self {
+        Self {
+            mu_c: 0.2,
+            mu_s: 0.3,
+            v_s: 0.01,
+            delta: 2.0,
+            viscous: 0.5,
+        }
+    }
+}
+
+impl Stribeck {
+    /// The velocity-dependent coefficient mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta).
+    pub fn coefficient(&self, v: f64) -> f64 {
+        self.mu_c + (self.mu_s - self.mu_c) * (-(v / self.v_s).abs().powf(self.delta)).exp()
+    }
+}
+
+#[typetag::serde(name = "stribeck")]
+impl FrictionModel for Stribeck {
+    fn name(&self) -> &'static str {
+        "stribeck"
+    }
+    fn equation(&self) -> String {
+        "F = N (mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta)) sgn(v) + viscous v".into()
+    }
+    fn param_info(&self) -> Vec<ParamInfo> {
+        vec![
+            ParamInfo::new(
+                "mu_c",
+                "1",
+                0.2,
+                (0.0, 10.0),
+                "Coulomb (kinetic) friction coefficient",
+            ),
+            ParamInfo::new(
+                "mu_s",
+                "1",
+                0.3,
+                (0.0, 10.0),
+                "static (breakaway) friction coefficient",
+            ),
+            ParamInfo::positive("v_s", "m/s", 0.01, 100.0, "Stribeck velocity"),
+            ParamInfo::positive(
+                "delta",
+                "1",
+                2.0,
+                10.0,
+                "Stribeck shape exponent (usually fixed)",
+            ),
+            ParamInfo::new(
+                "viscous",
+                "N s/m",
+                0.5,
+                (0.0, f64::INFINITY),
+                "viscous friction coefficient",
+            ),
+        ]
+    }
+    fn params(&self) -> Vec<f64> {
+        vec![self.mu_c, self.mu_s, self.v_s, self.delta, self.viscous]
+    }
+    fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
+        check_len(self.name(), 5, values.len())?;
+        self.mu_c = values[0];
+        self.mu_s = values[1];
+        self.v_s = values[2];
+        self.delta = values[3];
+        self.viscous = values[4];
+        Ok(())
+    }
+    fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
+        normal * self.coefficient(v) * sgn(v) + self.viscous * v
+    }
+    fn static_limit(&self, normal: f64) -> Option<f64> {
+        Some(self.mu_s * normal)
+    }
+    fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
+        normal * self.coefficient(v) * direction + self.viscous * v
+    }
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        self.force(v, &[], normal)
+    }
+    fn apply_guess(&mut self, hint: &GuessHint) {
+        let v = hint.typical_velocity.max(1e-6);
+        self.mu_c = 0.9 * hint.mu;
+        self.mu_s = 1.2 * hint.mu;
+        self.v_s = 0.2 * v;
+        self.viscous = 0.05 * hint.mu * hint.normal_force / v;
+    }
+    fn validate(&self) -> Result<Vec<String>, ModelError> {
+        check_bounds(self.name(), &self.param_info(), &self.params())?;
+        Ok(mu_s_warning(self.name(), self.mu_s, self.mu_c))
+    }
+}
+
+/// The warning for a static coefficient below the kinetic one.
+pub(crate) fn mu_s_warning(model: &str, mu_s: f64, mu_c: f64) -> Vec<String> {
+    if mu_s < mu_c {
+        vec![format!(
+            "model `{model}`: mu_s = {mu_s} is below mu_c = {mu_c} (friction rises with speed near zero)"
+        )]
+    } else {
+        Vec::new()
+    }
+}

@@ -1,0 +1,310 @@
+//! Built-in models against hand-computed values, odd symmetry, serde round trips and the
+//! registry's error messages.
+
+use frictionid_models::*;
+
+const N: f64 = 14.5;
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * (1.0 + b.abs())
+}
+
+#[test]
+fn registry_lists_the_built_in_models() {
+    assert_eq!(
+        names(),
+        vec![
+            "coulomb",
+            "dahl",
+            "lugre",
+            "none",
+            "stribeck",
+            "viscous_coulomb"
+        ]
+    );
+    for l in listings() {
+        let m = default_model(&l.name).unwrap();
+        assert_eq!(m.name(), l.name);
+        assert_eq!(l.parameters.len(), m.params().len());
+        // Defaults in the metadata are the defaults of the built instance, inside the bounds.
+        for (p, v) in l.parameters.iter().zip(m.params()) {
+            assert_eq!(p.default, v, "{}.{}", l.name, p.name);
+            assert!(p.admits(v));
+        }
+    }
+}
+
+#[test]
+fn coulomb_forces_by_hand() {
+    let m = Coulomb { mu: 0.24 };
+    assert_eq!(m.force(0.3, &[], N), 0.24 * 14.5);
+    assert_eq!(m.force(-1e-300, &[], N), -3.48);
+    assert_eq!(m.force(0.0, &[], N), 0.0);
+    assert_eq!(m.static_limit(N), Some(3.48));
+    // In a slip phase the direction comes from the mode, not from sgn(v).
+    assert_eq!(m.slip_force(0.0, -1.0, N), -3.48);
+    assert_eq!(m.slip_force(1e-18, -1.0, N), -3.48);
+}
+
+#[test]
+fn viscous_coulomb_forces_by_hand() {
+    let m = ViscousCoulomb {
+        mu: 0.2,
+        viscous: 3.0,
+    };
+    assert!(close(m.force(0.1, &[], N), 2.9 + 0.3, 1e-15));
+    assert!(close(m.force(-0.02, &[], N), -2.9 - 0.06, 1e-15));
+    assert_eq!(m.force(0.0, &[], N), 0.0);
+    assert!(close(m.force(1e-12, &[], N), 2.9 + 3e-12, 1e-15));
+    assert_eq!(m.static_limit(N), Some(0.2 * 14.5));
+    assert!(close(m.slip_force(0.0, 1.0, N), 2.9, 1e-15));
+}
+
+#[test]
+fn stribeck_forces_by_hand() {
+    let m = Stribeck {
+        mu_c: 0.2,
+        mu_s: 0.28,
+        v_s: 0.02,
+        delta: 2.0,
+        viscous: 3.0,
+    };
+    // v = v_s: N (0.2 + 0.08 e^-1) + 3 * 0.02
+    let f = 14.5 * (0.2 + 0.08 * (-1.0f64).exp()) + 0.06;
+    assert!(close(m.force(0.02, &[], N), f, 1e-14));
+    // v = 2 v_s: e^-4
+    let f2 = 14.5 * (0.2 + 0.08 * (-4.0f64).exp()) + 0.12;
+    assert!(close(m.force(0.04, &[], N), f2, 1e-14));
+    // tiny |v|: the static level mu_s N
+    assert!(close(m.force(-1e-9, &[], N), -0.28 * 14.5 - 3e-9, 1e-12));
+    assert_eq!(m.force(0.0, &[], N), 0.0);
+    assert_eq!(m.static_limit(N), Some(0.28 * 14.5));
+    // high speed: Coulomb level plus viscous
+    assert!(close(m.force(1.0, &[], N), 2.9 + 3.0, 1e-14));
+    // delta = 1: exp(-|v/v_s|)
+    let m1 = Stribeck { delta: 1.0, ..m };
+    let f3 = 14.5 * (0.2 + 0.08 * (-0.5f64).exp()) + 0.03;
+    assert!(close(m1.force(0.01, &[], N), f3, 1e-14));
+}
+
+#[test]
+fn dahl_state_derivative_by_hand() {
+    let m = Dahl {
+        sigma0: 1e5,
+        mu_c: 0.2,
+        alpha: 1.0,
+    };
+    let fc = 0.2 * 14.5;
+    let mut dz = [0.0];
+    // F = 0: dF/dt = sigma0 v
+    m.state_derivative(0.01, &[0.0], N, &mut dz);
+    assert!(close(dz[0], 1e3, 1e-15));
+    // F = Fc/2, v > 0: sigma0 v (1 - 1/2)
+    m.state_derivative(0.01, &[fc / 2.0], N, &mut dz);
+    assert!(close(dz[0], 500.0, 1e-14));
+    // F = Fc/2, v < 0: sigma0 v (1 + 1/2)
+    m.state_derivative(-0.01, &[fc / 2.0], N, &mut dz);
+    assert!(close(dz[0], -1500.0, 1e-14));
+    // saturated: no change
+    m.state_derivative(0.5, &[fc], N, &mut dz);
+    assert_eq!(dz[0], 0.0);
+    // v = 0: no change
+    m.state_derivative(0.0, &[1.0], N, &mut dz);
+    assert_eq!(dz[0], 0.0);
+    // alpha = 2, beyond saturation: r = 1 - 1.5 = -0.5 -> sigma0 v 0.25 * (-1)
+    let m2 = Dahl { alpha: 2.0, ..m };
+    m2.state_derivative(0.01, &[1.5 * fc], N, &mut dz);
+    assert!(close(dz[0], -250.0, 1e-14));
+    assert_eq!(m.force(0.3, &[1.25], N), 1.25);
+    assert!(close(m.stored_energy(&[2.0], N), 4.0 / 2e5, 1e-15));
+}
+
+#[test]
+fn lugre_by_hand() {
+    let m = LuGre::default();
+    // g(0) = mu_s N, g(v_s) = N (mu_c + (mu_s - mu_c)/e)
+    assert!(close(m.g(0.0, N), 0.3 * 14.5, 1e-15));
+    let gvs = 14.5 * (0.2 + 0.1 * (-1.0f64).exp());
+    assert!(close(m.g(0.01, N), gvs, 1e-15));
+    let z = 1e-5;
+    let v = 0.01;
+    let zd = v - 1e5 * v * z / gvs;
+    let mut dz = [0.0];
+    m.state_derivative(v, &[z], N, &mut dz);
+    assert!(close(dz[0], zd, 1e-14));
+    assert!(close(
+        m.force(v, &[z], N),
+        1e5 * z + 300.0 * zd + 0.5 * v,
+        1e-14
+    ));
+    // v = 0: dz/dt = 0, F = sigma0 z
+    m.state_derivative(0.0, &[z], N, &mut dz);
+    assert_eq!(dz[0], 0.0);
+    assert!(close(m.force(0.0, &[z], N), 1.0, 1e-14));
+    // tiny v: dz/dt ~ v
+    m.state_derivative(1e-12, &[0.0], N, &mut dz);
+    assert_eq!(dz[0], 1e-12);
+    // steady state: z = g/sigma0 sgn(v), F = g sgn(v) + sigma2 v
+    let zss = gvs / 1e5;
+    m.state_derivative(v, &[zss], N, &mut dz);
+    assert!(dz[0].abs() < 1e-15);
+    assert!(close(m.force(v, &[zss], N), m.steady_state(v, N), 1e-12));
+    assert!(close(m.stored_energy(&[z], N), 0.5 * 1e5 * z * z, 1e-15));
+}
+
+#[test]
+fn none_is_zero() {
+    let m = NoFriction {};
+    assert_eq!(m.force(1.0, &[], N), 0.0);
+    assert_eq!(m.steady_state(-1.0, N), 0.0);
+    assert!(m.params().is_empty());
+}
+
+/// F(-v, -z) = -F(v, z) and dz(-v, -z) = -dz(v, z) for every registered model.
+#[test]
+fn every_model_is_odd() {
+    let velocities = [0.0, 1e-15, 1e-9, 1e-4, 0.003, 0.01, 0.05, 0.4, 3.0];
+    for name in names() {
+        let m = default_model(&name).unwrap();
+        let ns = m.n_states();
+        for &v in &velocities {
+            for zs in [0.0, 1e-6, -3e-5, 2.0] {
+                let z = vec![zs; ns];
+                let zneg: Vec<f64> = z.iter().map(|x| -x).collect();
+                let f = m.force(v, &z, N);
+                let fneg = m.force(-v, &zneg, N);
+                assert!(
+                    close(fneg, -f, 1e-14),
+                    "{name}: F({v}) = {f}, F(-v) = {fneg}"
+                );
+                let (mut d, mut dneg) = (vec![0.0; ns], vec![0.0; ns]);
+                m.state_derivative(v, &z, N, &mut d);
+                m.state_derivative(-v, &zneg, N, &mut dneg);
+                for (a, b) in d.iter().zip(&dneg) {
+                    assert!(close(*b, -a, 1e-14), "{name}: dz");
+                }
+            }
+            let s = m.steady_state(v, N);
+            assert!(close(m.steady_state(-v, N), -s, 1e-14), "{name}: F_ss");
+            if m.static_limit(N).is_some() {
+                let sp = m.slip_force(v, 1.0, N);
+                assert!(close(m.slip_force(-v, -1.0, N), -sp, 1e-14), "{name}: slip");
+            }
+        }
+    }
+}
+
+/// The steady state of a dynamic model equals its force at the state where dz/dt = 0.
+#[test]
+fn dynamic_steady_state_matches_the_fixed_point() {
+    let m = Dahl::default();
+    let v = 0.05;
+    let fc = 0.2 * N;
+    assert!(close(m.force(v, &[fc], N), m.steady_state(v, N), 1e-15));
+}
+
+#[test]
+fn every_model_round_trips_through_json_and_toml() {
+    for name in names() {
+        let mut m = default_model(&name).unwrap();
+        // Perturb every parameter so the defaults cannot hide a lost field.
+        let p: Vec<f64> = m.params().iter().map(|x| x * 1.1 + 0.001).collect();
+        m.set_params(&p).unwrap();
+        let json = serde_json::to_string(&m).unwrap();
+        let back: Box<dyn FrictionModel> = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.name(), name);
+        assert_eq!(back.params(), p, "{name} JSON");
+        let text = toml::to_string(&m).unwrap();
+        let table: toml::Value = toml::from_str(&text).unwrap();
+        let built = build_toml(&table).unwrap();
+        assert_eq!(built.model.params(), p, "{name} TOML: {text}");
+        let back2: Box<dyn FrictionModel> = toml::from_str(&text).unwrap();
+        assert_eq!(back2.params(), p);
+    }
+}
+
+#[test]
+fn missing_parameters_take_their_defaults() {
+    let t: toml::Value = toml::from_str("type = \"lugre\"\nsigma0 = 2.0e5\nmu_c = 0.22\n").unwrap();
+    let b = build_toml(&t).unwrap();
+    let d = LuGre::default();
+    assert_eq!(
+        b.model.params(),
+        vec![2.0e5, d.sigma1, d.sigma2, 0.22, d.mu_s, d.v_s]
+    );
+    assert!(b.warnings.is_empty());
+}
+
+#[test]
+fn unknown_type_lists_the_registered_names() {
+    let t: toml::Value = toml::from_str("type = \"lugra\"").unwrap();
+    let e = build_toml(&t).unwrap_err().to_string();
+    assert!(e.contains("unknown friction model `lugra`"), "{e}");
+    assert!(e.contains("did you mean `lugre`"), "{e}");
+    for n in names() {
+        assert!(e.contains(&n), "{e} lacks {n}");
+    }
+    let e = build_json(&serde_json::json!({"mu": 1.0}))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no `type`"), "{e}");
+}
+
+#[test]
+fn unknown_parameter_is_named_with_the_models_parameters() {
+    let t: toml::Value = toml::from_str("type = \"stribeck\"\nmu_k = 0.2").unwrap();
+    let e = build_toml(&t).unwrap_err().to_string();
+    assert!(e.contains("unknown parameter `mu_k`"), "{e}");
+    assert!(e.contains("stribeck"), "{e}");
+    for p in ["mu_c", "mu_s", "v_s", "delta", "viscous"] {
+        assert!(e.contains(p), "{e}");
+    }
+}
+
+#[test]
+fn out_of_bounds_values_are_errors() {
+    for (text, param) in [
+        ("type = \"coulomb\"\nmu = -0.1", "mu"),
+        ("type = \"lugre\"\nsigma0 = 0.0", "sigma0"),
+        ("type = \"dahl\"\nsigma0 = -5.0", "sigma0"),
+        ("type = \"stribeck\"\nv_s = 0.0", "v_s"),
+        ("type = \"viscous_coulomb\"\nviscous = -1.0", "viscous"),
+    ] {
+        let t: toml::Value = toml::from_str(text).unwrap();
+        let e = build_toml(&t).unwrap_err();
+        assert!(
+            matches!(&e, ModelError::OutOfBounds { param: p, .. } if p == param),
+            "{text}: {e}"
+        );
+        assert!(e.to_string().contains("outside its physical bounds"));
+    }
+    let e = build_json(&serde_json::json!({"type": "coulomb", "mu": "high"}))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("coulomb"), "{e}");
+}
+
+#[test]
+fn mu_s_below_mu_c_is_a_warning_not_an_error() {
+    for ty in ["stribeck", "lugre"] {
+        let t: toml::Value =
+            toml::from_str(&format!("type = \"{ty}\"\nmu_c = 0.3\nmu_s = 0.2")).unwrap();
+        let b = build_toml(&t).unwrap();
+        assert_eq!(b.warnings.len(), 1, "{ty}");
+        assert!(b.warnings[0].contains("mu_s"));
+    }
+}
+
+#[test]
+fn set_params_checks_the_length() {
+    let mut m = default_model("stribeck").unwrap();
+    let e = m.set_params(&[0.1, 0.2]).unwrap_err();
+    assert_eq!(
+        e,
+        ModelError::ParamCount {
+            model: "stribeck".into(),
+            expected: 5,
+            got: 2
+        }
+    );
+}
