@@ -78,7 +78,8 @@ pub struct ModelConfig {
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FitConfig {
-    /// Names of the parameters to fit; `None` means every parameter of the model.
+    /// Names of the parameters to fit; `None` means every parameter of the model that is not
+    /// fixed by default.
     pub free: Option<Vec<String>>,
     /// Search bounds [lower, upper] per parameter (default: the model's physical bounds).
     pub bounds: BTreeMap<String, [f64; 2]>,
@@ -120,11 +121,17 @@ impl FitConfig {
         Ok(())
     }
 
-    /// The free parameter names for `model` (all of them when `free` is absent).
+    /// The free parameter names for `model`: `free` as written, or else every parameter not
+    /// marked fixed by default (such as the Stribeck shape exponent).
     pub fn free_names(&self, model: &dyn FrictionModel) -> Vec<String> {
         match &self.free {
             Some(list) => list.clone(),
-            None => model.param_info().into_iter().map(|p| p.name).collect(),
+            None => model
+                .param_info()
+                .into_iter()
+                .filter(|p| !p.fixed_by_default)
+                .map(|p| p.name)
+                .collect(),
         }
     }
 }

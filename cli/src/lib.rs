@@ -36,12 +36,18 @@ pub const EXIT_ERROR: u8 = 1;
 pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
         Command::Models { json } => commands::models::run(json).map(|_| Outcome::Done),
-        Command::Simulate { .. }
-        | Command::Fit { .. }
-        | Command::Compare { .. }
-        | Command::Energy { .. } => Err(anyhow::anyhow!(
-            "this command is not available in this build of frictionid yet"
+        Command::Simulate { .. } => Err(anyhow::anyhow!(
+            "`simulate` is not available in this build of frictionid yet"
         )),
+        Command::Fit { config, .. }
+        | Command::Compare { config, .. }
+        | Command::Energy { config, .. } => {
+            // The inputs are checked in full before the (not yet wired) analysis.
+            commands::load_inputs(&config, "this command")?;
+            Err(anyhow::anyhow!(
+                "this command is not available in this build of frictionid yet"
+            ))
+        }
     }
 }
 

@@ -106,7 +106,18 @@ pub fn fmt_num(x: f64) -> String {
         let s = s.trim_end_matches('0').trim_end_matches('.');
         s.to_string()
     } else {
-        format!("{x:.4e}")
+        let s = format!("{x:.4e}");
+        match s.split_once('e') {
+            Some((mant, exp)) => {
+                let mant = if mant.contains('.') {
+                    mant.trim_end_matches('0').trim_end_matches('.')
+                } else {
+                    mant
+                };
+                format!("{mant}e{exp}")
+            }
+            None => s,
+        }
     }
 }
 
@@ -241,7 +252,8 @@ mod tests {
     #[test]
     fn numbers_are_compact() {
         assert_eq!(fmt_num(0.24), "0.24");
-        assert_eq!(fmt_num(100000.0), "1.0000e5");
+        assert_eq!(fmt_num(100000.0), "1e5");
+        assert_eq!(fmt_num(-1.25e-7), "-1.25e-7");
         assert_eq!(fmt_num(-0.009297), "-0.009297");
         assert_eq!(fmt_num(0.0), "0");
     }

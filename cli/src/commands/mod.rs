@@ -34,3 +34,28 @@ pub fn print_json(output: &OutputArgs, report: &serde_json::Value) -> anyhow::Re
     }
     Ok(())
 }
+
+/// A checked configuration with its records read, for `fit`, `compare` and `energy`.
+#[derive(Debug, Clone)]
+pub struct Inputs {
+    /// The configuration.
+    pub config: crate::config::Config,
+    /// The `[[records]]`, read and checked, in file order.
+    pub records: Vec<frictionid_engine::Record>,
+}
+
+/// Loads `config`, prints the model's warnings to stderr and reads every record; `purpose`
+/// (the command name) appears in the message when something it needs is missing.
+pub fn load_inputs(config: &std::path::Path, purpose: &str) -> anyhow::Result<Inputs> {
+    let cfg = crate::config::Config::load(config)?;
+    if let Some(m) = &cfg.model {
+        for w in &m.warnings {
+            warn(&format!("{}: [model]: {w}", config.display()));
+        }
+    }
+    let records = cfg.load_records(purpose)?;
+    Ok(Inputs {
+        config: cfg,
+        records,
+    })
+}

@@ -5,7 +5,7 @@ use frictionid_models::{listings, ModelListing};
 use std::io::Write;
 
 /// The listing as JSON: a list of {name, equation, states, parameters [{name, unit, default,
-/// lower, upper, lower_exclusive, description, ...}]}.
+/// lower, upper, lower_exclusive, description, fixed_by_default}]}.
 pub fn listing_json(list: &[ModelListing]) -> anyhow::Result<serde_json::Value> {
     Ok(serde_json::to_value(list)?)
 }
@@ -35,13 +35,19 @@ pub fn listing_text(list: &[ModelListing]) -> String {
                     p.name.clone(),
                     p.unit.clone(),
                     fmt_num(p.default),
-                    p.bounds_text(),
+                    format!(
+                        "{}{}, {}]",
+                        if p.lower_exclusive { "(" } else { "[" },
+                        fmt_num(p.lower),
+                        fmt_num(p.upper)
+                    ),
+                    if p.fixed_by_default { "fixed" } else { "free" }.to_string(),
                     p.description.clone(),
                 ]
             })
             .collect();
         for line in text_table(
-            &["parameter", "unit", "default", "bounds", "meaning"],
+            &["parameter", "unit", "default", "bounds", "fit", "meaning"],
             &rows,
         )
         .lines()
