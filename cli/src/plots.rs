@@ -35,6 +35,8 @@ pub struct Series<'a> {
     pub y: &'a [f64],
     /// Draw dashed instead of solid.
     pub dashed: bool,
+    /// Line width in pixels.
+    pub width: u32,
 }
 
 impl<'a> Series<'a> {
@@ -45,7 +47,13 @@ impl<'a> Series<'a> {
             x,
             y,
             dashed: false,
+            width: 2,
         }
+    }
+
+    /// The same line drawn `width` pixels wide.
+    pub fn width(self, width: u32) -> Self {
+        Self { width, ..self }
     }
 
     /// A dashed line.
@@ -127,16 +135,30 @@ fn axis_text(label: &str, unit: &str) -> String {
     }
 }
 
-/// Compact tick labels.
-fn tick(v: f64) -> String {
-    let a = v.abs();
-    if v == 0.0 {
-        "0".into()
-    } else if !(1e-3..1e4).contains(&a) {
-        format!("{v:.1e}")
+/// Tick label for `v` on an axis spanning `span`: round-off next to zero shows as 0, and the
+/// number of decimals follows the span.
+fn tick(v: f64, span: f64) -> String {
+    let span = if span.is_finite() && span > 0.0 {
+        span
     } else {
-        let s = format!("{v:.4}");
+        1.0
+    };
+    if v.abs() < 1e-9 * span {
+        return "0".into();
+    }
+    if !(1e-3..1e5).contains(&span) {
+        let s = format!("{v:.2e}");
+        return match s.split_once('e') {
+            Some((m, e)) => format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.')),
+            None => s,
+        };
+    }
+    let decimals = (2.0 - (span / 10.0).log10().floor()).clamp(0.0, 8.0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
         s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
     }
 }
 
@@ -184,7 +206,7 @@ fn draw_panel(
     x_range: (f64, f64),
     is_last: bool,
 ) -> PlotResult<()> {
-    let y_range = range(
+    let mut y_range = range(
         panel
             .series
             .iter()
@@ -192,6 +214,19 @@ fn draw_panel(
             .chain(panel.reference.iter().map(|r| r.y)),
         true,
     );
+    // A legend for more than one line (or any reference line), in the upper right corner:
+    // extend the y range upwards so that it covers no data.
+    let entries = panel.series.iter().filter(|s| !s.label.is_empty()).count()
+        + panel
+            .reference
+            .iter()
+            .filter(|r| !r.label.is_empty())
+            .count();
+    let show_legend = entries > 1 || !panel.reference.is_empty();
+    if show_legend {
+        y_range.1 += (0.04 + 0.075 * entries as f64) * (y_range.1 - y_range.0);
+    }
+    let (x_span, y_span) = (x_range.1 - x_range.0, y_range.1 - y_range.0);
     let mut chart = ChartBuilder::on(area)
         .margin(12)
         .x_label_area_size(if is_last { 45 } else { 30 })
@@ -200,10 +235,12 @@ fn draw_panel(
         .map_err(|e| e.to_string())?;
     let x_desc = axis_text(&fig.x_label, &fig.x_unit);
     let y_desc = axis_text(&panel.y_label, &panel.y_unit);
+    let x_fmt = |v: &f64| tick(*v, x_span);
+    let y_fmt = |v: &f64| tick(*v, y_span);
     let mut mesh = chart.configure_mesh();
     mesh.y_desc(y_desc)
-        .x_label_formatter(&|v| tick(*v))
-        .y_label_formatter(&|v| tick(*v))
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 16))
         .light_line_style(RGBColor(235, 235, 235));
@@ -212,10 +249,10 @@ fn draw_panel(
     }
     mesh.draw().map_err(|e| e.to_string())?;
 
-    let mut any_label = false;
     for (i, s) in panel.series.iter().enumerate() {
         let color = COLORS[i % COLORS.len()];
-        let style = color.stroke_width(2);
+        let style = color.stroke_width(s.width);
+        let width = s.width;
         for (k, seg) in segments(s.x, s.y).into_iter().enumerate() {
             let anno = if s.dashed {
                 chart
@@ -227,9 +264,8 @@ fn draw_panel(
                     .map_err(|e| e.to_string())?
             };
             if k == 0 && !s.label.is_empty() {
-                any_label = true;
                 anno.label(s.label.clone()).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 22, y)], color.stroke_width(2))
+                    PathElement::new(vec![(x, y), (x + 22, y)], color.stroke_width(width))
                 });
             }
         }
@@ -246,13 +282,12 @@ fn draw_panel(
             .draw_series(DashedLineSeries::new(line, 6, 4, style))
             .map_err(|e| e.to_string())?;
         if !r.label.is_empty() {
-            any_label = true;
             anno.label(r.label.clone()).legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 8, y), (x + 14, y), (x + 22, y)], style)
             });
         }
     }
-    if any_label {
+    if show_legend {
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperRight)
@@ -439,14 +474,22 @@ pub fn steady_state_curves(
             )
         })
         .collect();
+    // Earlier curves are drawn wider and later ones dashed, so that coinciding curves
+    // stay visible.
     let mut panel = Panel::new("steady-state friction force F_ss", "N");
-    for (name, f) in &curves {
-        panel = panel.with(Series::solid(name.clone(), &v, f));
+    for (i, (name, f)) in curves.iter().enumerate() {
+        let width = 5u32.saturating_sub(i as u32).max(2);
+        let s = if i >= 3 {
+            Series::dashed(name.clone(), &v, f)
+        } else {
+            Series::solid(name.clone(), &v, f)
+        };
+        panel = panel.with(s.width(width));
     }
     let fig = Figure {
         title: format!(
             "Steady-state friction curves (N = {} N)",
-            tick(normal_force)
+            crate::report::fmt_num(normal_force)
         ),
         x_label: "sliding velocity".into(),
         x_unit: "m/s".into(),
@@ -467,6 +510,14 @@ mod tests {
             segments(&x, &y),
             vec![vec![(0.0, 1.0)], vec![(2.0, 2.0), (3.0, 3.0)]]
         );
+    }
+
+    #[test]
+    fn ticks_hide_round_off_and_follow_the_span() {
+        assert_eq!(tick(-5.6e-17, 0.5), "0");
+        assert_eq!(tick(0.25, 0.5), "0.25");
+        assert_eq!(tick(1.5, 20.0), "1.5");
+        assert_eq!(tick(2e-5, 1e-4), "2e-5");
     }
 
     #[test]
