@@ -4,13 +4,23 @@
 //! Library code: values in, values out; no printing.
 
 pub mod data;
+pub mod energy;
 pub mod error;
 pub mod exact;
 pub mod identify;
 pub mod oscillator;
 pub mod record;
+pub mod simulate;
 pub mod synthetic;
 
+pub use energy::{
+    analyze_record, analyze_states, force_residuals, model_force_along, percent_difference,
+    Differentiator, EnergyAnalysis, EnergyOptions, ForceResiduals, HalfCycle,
+};
 pub use error::EngineError;
 pub use oscillator::Oscillator;
 pub use record::Record;
+pub use simulate::{
+    simulate, simulate_velocity, Event, EventKind, Initial, Integrator, Rest, SimOptions, SimStats,
+    Trajectory,
+};

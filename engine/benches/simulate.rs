@@ -1,0 +1,90 @@
+//! Criterion benchmarks of the simulation engine: one run per registered model for the FMM case
+//! (N = 14.5 N, x0 = 22 mm, 2 s sampled at 1 kHz), the paper's 140 mm Coulomb case (N = m g,
+//! mu = 0.24) with Dopri5 and with the paper's Euler (T_n / 1e6). The RHS counts are printed once
+//! per case (stderr) for the README's performance table.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use frictionid_engine::synthetic::uniform_times;
+use frictionid_engine::{simulate, Initial, Integrator, Oscillator, SimOptions};
+use frictionid_models::{default_model, names, Coulomb, FrictionModel};
+use std::hint::black_box;
+use std::time::Duration;
+
+fn run(
+    osc: &Oscillator,
+    model: &dyn FrictionModel,
+    x0: f64,
+    t_end: f64,
+    times: &[f64],
+    opts: &SimOptions,
+) -> u64 {
+    match simulate(osc, model, &Initial::at_rest(x0), t_end, times, opts) {
+        Ok(sim) => sim.stats.rhs_evaluations,
+        Err(e) => {
+            eprintln!("simulation failed: {e}");
+            0
+        }
+    }
+}
+
+fn fmm_models(c: &mut Criterion) {
+    let osc = Oscillator::fmm();
+    let times = uniform_times(2.0, 1000.0);
+    let opts = SimOptions::default();
+    let mut group = c.benchmark_group("fmm_22mm_2s_1kHz");
+    for name in names() {
+        let Ok(model) = default_model(&name) else {
+            continue;
+        };
+        let rhs = run(&osc, model.as_ref(), 0.022, 2.0, &times, &opts);
+        eprintln!("fmm_22mm_2s_1kHz/{name}: {rhs} RHS evaluations");
+        group.bench_function(name.as_str(), |b| {
+            b.iter(|| {
+                run(
+                    &osc,
+                    black_box(model.as_ref()),
+                    black_box(0.022),
+                    2.0,
+                    &times,
+                    &opts,
+                )
+            })
+        });
+    }
+    group.finish();
+}
+
+fn paper_140mm(c: &mut Criterion) {
+    let mut osc = Oscillator::fmm();
+    osc.normal_force = osc.mass * 9.81;
+    let model = Coulomb { mu: 0.24 };
+    let times = uniform_times(2.0, 1000.0);
+    let opts = SimOptions::default();
+    let euler = SimOptions {
+        integrator: Integrator::Euler {
+            steps_per_period: 1e6,
+        },
+        ..SimOptions::default()
+    };
+    let mut group = c.benchmark_group("paper_140mm_coulomb");
+    let cases: [(&str, &[f64], &SimOptions); 3] = [
+        ("dopri5_events_only", &[], &opts),
+        ("dopri5_2s_1kHz", &times, &opts),
+        ("euler_1e6_2s_1kHz", &times, &euler),
+    ];
+    for (label, t, o) in cases {
+        let rhs = run(&osc, &model, 0.140, 2.0, t, o);
+        eprintln!("paper_140mm_coulomb/{label}: {rhs} RHS evaluations");
+        if label.starts_with("euler") {
+            group.sample_size(10);
+            group.measurement_time(Duration::from_secs(5));
+        }
+        group.bench_function(label, |b| {
+            b.iter(|| run(&osc, &model, black_box(0.140), 2.0, t, o))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, fmm_models, paper_140mm);
+criterion_main!(benches);

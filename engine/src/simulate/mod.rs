@@ -1,0 +1,704 @@
+//! The event-detecting simulation of the paper's Eq. (1), m x'' + c x' + k x + F_f = 0, with any
+//! registered friction model.
+//!
+//! # Method
+//! The motion is integrated in *segments* between zero-velocity events (turning points). In each
+//! segment the sliding direction d = +1 or -1 is fixed, the event function is g = d v, and the
+//! segment stops at the first accepted step where g <= 0; the crossing is located on the
+//! integrator's dense output by the Illinois method to about 1e-12 s, the transition is applied
+//! and a fresh segment is started from the event.
+//!
+//! - **Static laws with a set-valued force at v = 0** (`static_limit` is `Some`, e.g. coulomb,
+//!   viscous_coulomb, stribeck) form a switched system with modes slip+, slip- and stick. Inside
+//!   a slip segment the force is `slip_force(v, d, N)`: its set-valued part takes its sign from
+//!   the mode, never from the (exactly or numerically zero) velocity. At a turning point the mass
+//!   sticks when |k x| <= the static limit; in free vibration it then stays at rest for good.
+//!   Otherwise it slips on in the direction -sgn(k x).
+//! - **Smooth static laws** (`static_limit` is `None`, no internal states) and **dynamic models**
+//!   (internal states z integrated with x and v) have no mode switch; the turning points are
+//!   still located and the integration restarted there, so that no step straddles the kink of
+//!   |v|. A motion whose swing between two turning points has fallen below `REST_SWING_ATOLS`
+//!   times the absolute tolerance is declared at rest (the integrator cannot resolve it).
+//!
+//! Two integrators: ode_solvers' adaptive Dormand-Prince 5(4) with its dense output
+//! ([`Integrator::Dopri5`], the default), and the paper's fixed-step explicit Euler with step
+//! T_n / n ([`Integrator::Euler`]), linearly interpolated between steps.
+
+mod dopri;
+mod euler;
+mod root;
+
+use crate::error::EngineError;
+use crate::oscillator::Oscillator;
+use frictionid_models::{sgn, FrictionModel};
+use serde::{Deserialize, Serialize};
+
+/// A motion whose swing between consecutive turning points is below this many absolute
+/// tolerances is declared at rest (smooth and dynamic models only).
+pub const REST_SWING_ATOLS: f64 = 10.0;
+
+/// The time integrator.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(tag = "method", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Integrator {
+    /// Adaptive Dormand-Prince 5(4) (ode_solvers) with dense output and event location.
+    #[default]
+    Dopri5,
+    /// The paper's fixed-step explicit Euler with step T_n / `steps_per_period` (paper: 1e6).
+    Euler {
+        /// Steps per undamped natural period T_n.
+        steps_per_period: f64,
+    },
+}
+
+/// Options of [`simulate`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SimOptions {
+    /// The integrator.
+    pub integrator: Integrator,
+    /// Relative tolerance of the adaptive integrator (>= 1e-14).
+    pub rtol: f64,
+    /// Absolute tolerance of the adaptive integrator [m, m/s, state units] (> 0).
+    pub atol: f64,
+    /// Maximum number of steps (accepted and rejected) over the whole simulation.
+    pub max_steps: u64,
+    /// Maximum number of events (turning points and stick) over the whole simulation.
+    pub max_events: usize,
+}
+
+impl Default for SimOptions {
+    /// Dopri5 with rtol = 1e-10 and atol = 1e-12: the exact Coulomb solution is reproduced to
+    /// better than 1e-9 m.
+    fn default() -> Self {
+        Self {
+            integrator: Integrator::Dopri5,
+            rtol: 2e-9,
+            atol: 1e-11,
+            max_steps: 20_000_000,
+            max_events: 100_000,
+        }
+    }
+}
+
+/// The initial state at t = 0.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Initial {
+    /// Initial displacement [m].
+    pub x0: f64,
+    /// Initial velocity [m/s].
+    #[serde(default)]
+    pub v0: f64,
+    /// Initial internal states (default: all zero). Must have the model's `n_states` entries.
+    #[serde(default)]
+    pub z0: Option<Vec<f64>>,
+}
+
+impl Initial {
+    /// Released from rest at `x0` with relaxed internal states.
+    pub fn at_rest(x0: f64) -> Self {
+        Self {
+            x0,
+            v0: 0.0,
+            z0: None,
+        }
+    }
+
+    /// Displacement `x0` and velocity `v0`, relaxed internal states.
+    pub fn new(x0: f64, v0: f64) -> Self {
+        Self { x0, v0, z0: None }
+    }
+}
+
+/// The kind of an event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EventKind {
+    /// The velocity crossed zero.
+    TurningPoint,
+    /// The mass stuck for good (free vibration: it stays at rest).
+    Stick,
+}
+
+/// An event of the simulation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Event {
+    /// Time [s].
+    pub time: f64,
+    /// What happened.
+    pub kind: EventKind,
+    /// Displacement at the event [m].
+    pub displacement: f64,
+}
+
+/// The end of the motion.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Rest {
+    /// Time at which the mass came to rest [s].
+    pub time: f64,
+    /// Final displacement [m].
+    pub displacement: f64,
+}
+
+/// Integration statistics, summed over all segments.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct SimStats {
+    /// Right-hand-side evaluations of the integrator.
+    pub rhs_evaluations: u64,
+    /// Accepted steps.
+    pub steps: u64,
+    /// Rejected steps.
+    pub rejected_steps: u64,
+    /// Number of events.
+    pub events: usize,
+}
+
+/// A simulated trajectory sampled at the requested times.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Trajectory {
+    /// Sample times [s].
+    pub time: Vec<f64>,
+    /// Displacement [m].
+    pub x: Vec<f64>,
+    /// Velocity [m/s].
+    pub v: Vec<f64>,
+    /// Acceleration [m/s^2] (0 at rest).
+    pub a: Vec<f64>,
+    /// `states[j][i]`: internal state j at sample i.
+    pub states: Vec<Vec<f64>>,
+    /// Friction force [N] (at rest: the static force balancing the spring, -k x).
+    pub friction: Vec<f64>,
+    /// Kinetic energy m v^2 / 2 [J].
+    pub kinetic: Vec<f64>,
+    /// Potential energy k x^2 / 2 [J].
+    pub potential: Vec<f64>,
+    /// Mechanical energy E = KE + PE [J] (the paper's E; without `stored`).
+    pub energy: Vec<f64>,
+    /// Energy stored in the friction model's internal states [J].
+    pub stored: Vec<f64>,
+    /// Events in time order.
+    pub events: Vec<Event>,
+    /// The rest time and final displacement, if the motion stopped before the end time.
+    pub rest: Option<Rest>,
+    /// Integration statistics.
+    pub stats: SimStats,
+}
+
+impl Trajectory {
+    /// Number of slip phases (half-cycles): the turning points, plus one if the simulation
+    /// ended while still moving (no rest and a non-zero velocity at the last sample).
+    pub fn half_cycles(&self) -> usize {
+        let turning = self
+            .events
+            .iter()
+            .filter(|e| e.kind == EventKind::TurningPoint)
+            .count();
+        let moving = self.rest.is_none() && self.v.last().is_some_and(|&v| v != 0.0);
+        turning + usize::from(moving)
+    }
+}
+
+/// Simulates the free vibration of `osc` with friction `model` from `init` up to `t_end`,
+/// returning the states at `sample_times` (sorted, within [0, t_end]) from the dense output.
+pub fn simulate(
+    osc: &Oscillator,
+    model: &dyn FrictionModel,
+    init: &Initial,
+    t_end: f64,
+    sample_times: &[f64],
+    opts: &SimOptions,
+) -> Result<Trajectory, EngineError> {
+    let n_states = model.n_states();
+    let mut rec = FullRecorder::new(osc, model, sample_times.len(), n_states);
+    let out = run(osc, model, init, t_end, sample_times, opts, &mut rec)?;
+    let FullRecorder {
+        time,
+        x,
+        v,
+        a,
+        states,
+        friction,
+        kinetic,
+        potential,
+        energy,
+        stored,
+        ..
+    } = rec;
+    Ok(Trajectory {
+        time,
+        x,
+        v,
+        a,
+        states,
+        friction,
+        kinetic,
+        potential,
+        energy,
+        stored,
+        events: out.events,
+        rest: out.rest,
+        stats: out.stats,
+    })
+}
+
+/// The cheap variant for fitting: only the velocity at `sample_times`, written into `v_out`
+/// (cleared first, so a buffer can be reused across calls). Same method and errors as
+/// [`simulate`]; returns the statistics.
+pub fn simulate_velocity(
+    osc: &Oscillator,
+    model: &dyn FrictionModel,
+    init: &Initial,
+    t_end: f64,
+    sample_times: &[f64],
+    opts: &SimOptions,
+    v_out: &mut Vec<f64>,
+) -> Result<SimStats, EngineError> {
+    v_out.clear();
+    v_out.reserve(sample_times.len());
+    let mut rec = VelocityRecorder { v: v_out };
+    Ok(run(osc, model, init, t_end, sample_times, opts, &mut rec)?.stats)
+}
+
+/// Events, rest and statistics of a run.
+pub(crate) struct RunOutput {
+    pub events: Vec<Event>,
+    pub rest: Option<Rest>,
+    pub stats: SimStats,
+}
+
+/// Receives the samples.
+pub(crate) trait Recorder {
+    /// One sample: time, state, acceleration and friction force.
+    fn sample(&mut self, t: f64, x: f64, v: f64, z: &[f64], a: f64, friction: f64);
+}
+
+struct FullRecorder<'a> {
+    model: &'a dyn FrictionModel,
+    mass: f64,
+    stiffness: f64,
+    normal: f64,
+    time: Vec<f64>,
+    x: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+    states: Vec<Vec<f64>>,
+    friction: Vec<f64>,
+    kinetic: Vec<f64>,
+    potential: Vec<f64>,
+    energy: Vec<f64>,
+    stored: Vec<f64>,
+}
+
+impl<'a> FullRecorder<'a> {
+    fn new(osc: &Oscillator, model: &'a dyn FrictionModel, n: usize, n_states: usize) -> Self {
+        let col = || Vec::with_capacity(n);
+        Self {
+            model,
+            mass: osc.mass,
+            stiffness: osc.stiffness,
+            normal: osc.normal_force,
+            time: col(),
+            x: col(),
+            v: col(),
+            a: col(),
+            states: (0..n_states).map(|_| col()).collect(),
+            friction: col(),
+            kinetic: col(),
+            potential: col(),
+            energy: col(),
+            stored: col(),
+        }
+    }
+}
+
+impl Recorder for FullRecorder<'_> {
+    fn sample(&mut self, t: f64, x: f64, v: f64, z: &[f64], a: f64, friction: f64) {
+        let ke = 0.5 * self.mass * v * v;
+        let pe = 0.5 * self.stiffness * x * x;
+        self.time.push(t);
+        self.x.push(x);
+        self.v.push(v);
+        self.a.push(a);
+        for (col, &zj) in self.states.iter_mut().zip(z) {
+            col.push(zj);
+        }
+        self.friction.push(friction);
+        self.kinetic.push(ke);
+        self.potential.push(pe);
+        self.energy.push(ke + pe);
+        // Static laws store nothing: skip the call.
+        let stored = if z.is_empty() {
+            0.0
+        } else {
+            self.model.stored_energy(z, self.normal)
+        };
+        self.stored.push(stored);
+    }
+}
+
+struct VelocityRecorder<'a> {
+    v: &'a mut Vec<f64>,
+}
+
+impl Recorder for VelocityRecorder<'_> {
+    fn sample(&mut self, _t: f64, _x: f64, v: f64, _z: &[f64], _a: f64, _friction: f64) {
+        self.v.push(v);
+    }
+}
+
+/// How the friction law is treated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Law {
+    /// Static law with a set-valued force at v = 0: switched system (slip+, slip-, stick).
+    Switched { limit: f64 },
+    /// Smooth static law: no mode switch, restart at turning points.
+    Smooth,
+    /// Dynamic model with internal states integrated alongside x and v.
+    Dynamic,
+}
+
+/// The equation of motion with its friction law.
+#[derive(Clone, Copy)]
+pub(crate) struct Dynamics<'a> {
+    pub mass: f64,
+    pub damping: f64,
+    pub stiffness: f64,
+    pub normal: f64,
+    pub model: &'a dyn FrictionModel,
+    pub law: Law,
+}
+
+/// What happens at a state with (possibly) zero velocity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Start {
+    /// Slip in this direction (+1 or -1).
+    Slip(f64),
+    /// The mass stays at rest.
+    Rest,
+}
+
+impl Dynamics<'_> {
+    /// The friction force in slip direction `dir` (static laws) or from the states (dynamic).
+    #[inline]
+    pub fn force(&self, v: f64, z: &[f64], dir: f64) -> f64 {
+        match self.law {
+            Law::Dynamic => self.model.force(v, z, self.normal),
+            _ => self.model.slip_force(v, dir, self.normal),
+        }
+    }
+
+    /// The acceleration for friction force `f`.
+    #[inline]
+    pub fn accel(&self, x: f64, v: f64, f: f64) -> f64 {
+        -(self.damping * v + self.stiffness * x + f) / self.mass
+    }
+
+    /// The right-hand side of the first-order system y = [x, v, z...] in direction `dir`.
+    #[inline]
+    pub fn rhs(&self, y: &[f64], dy: &mut [f64], dir: f64) {
+        let ([x, v, z @ ..], [dx, dv, dz @ ..]) = (y, dy) else {
+            return;
+        };
+        let f = match self.law {
+            Law::Dynamic => {
+                self.model.state_derivative(*v, z, self.normal, dz);
+                self.model.force(*v, z, self.normal)
+            }
+            _ => self.model.slip_force(*v, dir, self.normal),
+        };
+        *dx = *v;
+        *dv = self.accel(*x, *v, f);
+    }
+
+    /// The mode at the start of a segment from state (x, v, z).
+    pub fn start(&self, x: f64, v: f64, z: &[f64]) -> Start {
+        if v != 0.0 {
+            return Start::Slip(sgn(v));
+        }
+        match self.law {
+            Law::Switched { limit } => {
+                let spring = self.stiffness * x;
+                if spring.abs() <= limit {
+                    return Start::Rest;
+                }
+                let dir = -sgn(spring);
+                let a = self.accel(x, 0.0, self.model.slip_force(0.0, dir, self.normal));
+                if dir * a > 0.0 {
+                    Start::Slip(dir)
+                } else {
+                    Start::Rest
+                }
+            }
+            Law::Smooth | Law::Dynamic => {
+                let a = self.accel(x, 0.0, self.force(0.0, z, 0.0));
+                if a == 0.0 || !a.is_finite() {
+                    Start::Rest
+                } else {
+                    Start::Slip(sgn(a))
+                }
+            }
+        }
+    }
+}
+
+/// Book-keeping shared by the integrators: sample cursor, events, rest and statistics.
+pub(crate) struct Driver<'s, R: Recorder> {
+    pub dynamics: Dynamics<'s>,
+    pub samples: &'s [f64],
+    pub next: usize,
+    pub rec: &'s mut R,
+    pub events: Vec<Event>,
+    pub rest: Option<Rest>,
+    pub stats: SimStats,
+    pub max_events: usize,
+    pub max_steps: u64,
+    /// Displacement at the previous turning point (or the release from rest).
+    pub last_turn: Option<f64>,
+    /// Swing below which smooth and dynamic motions are declared at rest.
+    pub rest_swing: f64,
+}
+
+impl<R: Recorder> Driver<'_, R> {
+    /// Samples not yet written whose time is <= `t`.
+    pub fn pending_until(&self, t: f64) -> usize {
+        self.samples
+            .get(self.next..)
+            .map_or(0, |rest| rest.iter().take_while(|&&ts| ts <= t).count())
+    }
+
+    /// Writes one sample of a moving state in direction `dir`.
+    pub fn write_moving(&mut self, t: f64, y: &[f64], dir: f64) {
+        if let [x, v, z @ ..] = y {
+            let f = self.dynamics.force(*v, z, dir);
+            let a = self.dynamics.accel(*x, *v, f);
+            self.rec.sample(t, *x, *v, z, a, f);
+        }
+        self.next += 1;
+    }
+
+    /// Fills every remaining sample with the state at rest `y` (v = 0, a = 0).
+    pub fn fill_rest(&mut self, y: &[f64]) {
+        if let [x, _, z @ ..] = y {
+            let f = -self.dynamics.stiffness * x;
+            while let Some(&ts) = self.samples.get(self.next) {
+                self.rec.sample(ts, *x, 0.0, z, 0.0, f);
+                self.next += 1;
+            }
+        }
+    }
+
+    /// Fills every remaining sample with the (moving) state `y` at the end time.
+    pub fn fill_end(&mut self, y: &[f64], dir: f64) {
+        while let Some(&ts) = self.samples.get(self.next) {
+            self.write_moving(ts, y, dir);
+        }
+    }
+
+    fn push_event(&mut self, time: f64, kind: EventKind, x: f64) -> Result<(), EngineError> {
+        if self.events.len() >= self.max_events {
+            return Err(EngineError::Integration {
+                time,
+                reason: format!(
+                    "more than max_events = {} events (the velocity keeps crossing zero; \
+                     raise max_events or end the simulation earlier)",
+                    self.max_events
+                ),
+            });
+        }
+        self.events.push(Event {
+            time,
+            kind,
+            displacement: x,
+        });
+        self.stats.events = self.events.len();
+        Ok(())
+    }
+
+    /// Records a turning point at (t, x).
+    pub fn turning_point(&mut self, t: f64, x: f64) -> Result<(), EngineError> {
+        self.push_event(t, EventKind::TurningPoint, x)
+    }
+
+    /// Decides the mode at time `t` for state `y` (a turning point or the start): returns the
+    /// slip direction, or `None` after recording the rest and filling the remaining samples.
+    pub fn decide(&mut self, t: f64, y: &[f64]) -> Result<Option<f64>, EngineError> {
+        let [x, v, z @ ..] = y else {
+            return Ok(None);
+        };
+        let mut start = self.dynamics.start(*x, *v, z);
+        if *v == 0.0 && !matches!(self.dynamics.law, Law::Switched { .. }) {
+            if let Some(prev) = self.last_turn {
+                if (x - prev).abs() < self.rest_swing {
+                    start = Start::Rest;
+                }
+            }
+        }
+        if *v == 0.0 {
+            self.last_turn = Some(*x);
+        }
+        match start {
+            Start::Slip(d) => Ok(Some(d)),
+            Start::Rest => {
+                self.push_event(t, EventKind::Stick, *x)?;
+                self.rest = Some(Rest {
+                    time: t,
+                    displacement: *x,
+                });
+                self.fill_rest(y);
+                Ok(None)
+            }
+        }
+    }
+
+    /// The error for a non-finite state.
+    pub fn non_finite(t: f64, y: &[f64]) -> EngineError {
+        EngineError::Integration {
+            time: t,
+            reason: format!("the state became non-finite ([x, v, z...] = {y:?})"),
+        }
+    }
+}
+
+/// Validates the inputs and runs the chosen integrator.
+pub(crate) fn run<R: Recorder>(
+    osc: &Oscillator,
+    model: &dyn FrictionModel,
+    init: &Initial,
+    t_end: f64,
+    sample_times: &[f64],
+    opts: &SimOptions,
+    rec: &mut R,
+) -> Result<RunOutput, EngineError> {
+    osc.validate()?;
+    model.validate()?;
+    let y0 = initial_state(model, init)?;
+    check_times(t_end, sample_times)?;
+    check_options(opts)?;
+    let law = if model.n_states() > 0 {
+        Law::Dynamic
+    } else {
+        match model.static_limit(osc.normal_force) {
+            Some(limit) if limit.is_finite() && limit >= 0.0 => Law::Switched { limit },
+            Some(limit) => {
+                return Err(EngineError::InvalidInput(format!(
+                    "model `{}` reports a static limit of {limit} N",
+                    model.name()
+                )))
+            }
+            None => Law::Smooth,
+        }
+    };
+    let dynamics = Dynamics {
+        mass: osc.mass,
+        damping: osc.damping,
+        stiffness: osc.stiffness,
+        normal: osc.normal_force,
+        model,
+        law,
+    };
+    let mut driver = Driver {
+        dynamics,
+        samples: sample_times,
+        next: 0,
+        rec,
+        events: Vec::new(),
+        rest: None,
+        stats: SimStats::default(),
+        max_events: opts.max_events,
+        max_steps: opts.max_steps,
+        last_turn: None,
+        rest_swing: REST_SWING_ATOLS * opts.atol,
+    };
+    match opts.integrator {
+        Integrator::Dopri5 => dopri::run(&mut driver, &y0, t_end, opts, osc.natural_period())?,
+        Integrator::Euler { steps_per_period } => euler::run(
+            &mut driver,
+            y0,
+            t_end,
+            osc.natural_period() / steps_per_period,
+        )?,
+    }
+    Ok(RunOutput {
+        events: driver.events,
+        rest: driver.rest,
+        stats: driver.stats,
+    })
+}
+
+fn initial_state(model: &dyn FrictionModel, init: &Initial) -> Result<Vec<f64>, EngineError> {
+    if !init.x0.is_finite() || !init.v0.is_finite() {
+        return Err(EngineError::InvalidInput(format!(
+            "initial conditions must be finite (x0 = {}, v0 = {})",
+            init.x0, init.v0
+        )));
+    }
+    let n = model.n_states();
+    let mut y = Vec::with_capacity(2 + n);
+    y.push(init.x0);
+    y.push(init.v0);
+    match &init.z0 {
+        None => y.resize(2 + n, 0.0),
+        Some(z0) => {
+            if z0.len() != n {
+                return Err(EngineError::InvalidInput(format!(
+                    "model `{}` has {n} internal states, z0 has {}",
+                    model.name(),
+                    z0.len()
+                )));
+            }
+            if let Some(bad) = z0.iter().find(|z| !z.is_finite()) {
+                return Err(EngineError::InvalidInput(format!(
+                    "initial internal states must be finite, got {bad}"
+                )));
+            }
+            y.extend_from_slice(z0);
+        }
+    }
+    Ok(y)
+}
+
+fn check_times(t_end: f64, times: &[f64]) -> Result<(), EngineError> {
+    if !(t_end.is_finite() && t_end >= 0.0) {
+        return Err(EngineError::InvalidInput(format!(
+            "the end time must be finite and >= 0, got {t_end}"
+        )));
+    }
+    for (i, &t) in times.iter().enumerate() {
+        if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
+            return Err(EngineError::InvalidInput(format!(
+                "sample time {i} (t = {t} s) lies outside [0, {t_end}] s"
+            )));
+        }
+    }
+    if let Some(i) = times.windows(2).position(|w| w[1] < w[0]) {
+        return Err(EngineError::InvalidInput(format!(
+            "sample times are not sorted at index {} ({} s after {} s)",
+            i + 1,
+            times.get(i + 1).copied().unwrap_or(f64::NAN),
+            times.get(i).copied().unwrap_or(f64::NAN)
+        )));
+    }
+    Ok(())
+}
+
+fn check_options(opts: &SimOptions) -> Result<(), EngineError> {
+    let bad = |what: String| Err(EngineError::InvalidInput(what));
+    if !(opts.rtol.is_finite() && opts.rtol >= 1e-14 && opts.rtol < 1.0) {
+        return bad(format!("rtol must lie in [1e-14, 1), got {}", opts.rtol));
+    }
+    if !(opts.atol.is_finite() && opts.atol > 0.0) {
+        return bad(format!("atol must be finite and > 0, got {}", opts.atol));
+    }
+    if opts.max_steps == 0 {
+        return bad("max_steps must be >= 1".into());
+    }
+    if let Integrator::Euler { steps_per_period } = opts.integrator {
+        if !(steps_per_period.is_finite() && steps_per_period >= 1.0) {
+            return bad(format!(
+                "Euler steps_per_period must be finite and >= 1, got {steps_per_period}"
+            ));
+        }
+    }
+    Ok(())
+}

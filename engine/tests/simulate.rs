@@ -1,0 +1,508 @@
+//! Acceptance tests of the event-detecting engine (issue 3). Oracles: the exact piecewise
+//! Coulomb solution, the energy balance of a passive system, and mirror symmetry.
+
+#![allow(clippy::needless_range_loop)]
+
+use frictionid_engine::exact::coulomb_free_vibration;
+use frictionid_engine::synthetic::uniform_times;
+use frictionid_engine::{
+    simulate, simulate_velocity, EngineError, EventKind, Initial, Integrator, Oscillator,
+    SimOptions, Trajectory,
+};
+use frictionid_models::{default_model, names, Coulomb, FrictionModel};
+
+/// The paper's Fig. 2/3 oscillator: N = m g.
+fn paper_osc() -> Oscillator {
+    let mut osc = Oscillator::fmm();
+    osc.normal_force = osc.mass * 9.81;
+    osc
+}
+
+fn paper_coulomb() -> Coulomb {
+    Coulomb { mu: 0.24 }
+}
+
+/// Compares the default Dopri5 run with the exact piecewise solution.
+fn check_against_exact(x0: f64, paper_final_mm: f64, paper_half_cycles: usize) {
+    let osc = paper_osc();
+    let model = paper_coulomb();
+    let t_end = 2.0;
+    let times = uniform_times(t_end, 1000.0);
+    let exact = coulomb_free_vibration(&osc, model.mu * osc.normal_force, x0, &times).unwrap();
+    let sim = simulate(
+        &osc,
+        &model,
+        &Initial::at_rest(x0),
+        t_end,
+        &times,
+        &SimOptions::default(),
+    )
+    .unwrap();
+    let rest = sim.rest.expect("the mass must come to rest");
+    assert!(
+        (rest.displacement - exact.final_displacement).abs() < 1e-9,
+        "final displacement {} vs exact {}",
+        rest.displacement,
+        exact.final_displacement
+    );
+    assert!(
+        (rest.time - exact.rest_time).abs() < 1e-9,
+        "rest time {} vs exact {}",
+        rest.time,
+        exact.rest_time
+    );
+    assert!((rest.displacement * 1e3 - paper_final_mm).abs() < 5e-4);
+    assert_eq!(sim.half_cycles(), paper_half_cycles);
+    assert_eq!(exact.half_cycles(), paper_half_cycles);
+    let turning: Vec<_> = sim
+        .events
+        .iter()
+        .filter(|e| e.kind == EventKind::TurningPoint)
+        .collect();
+    assert_eq!(turning.len(), exact.turning_times.len());
+    for (e, (&te, &xe)) in turning
+        .iter()
+        .zip(exact.turning_times.iter().zip(&exact.turning_displacements))
+    {
+        assert!(
+            (e.time - te).abs() < 1e-9,
+            "turning time {} vs {te}",
+            e.time
+        );
+        assert!((e.displacement - xe).abs() < 1e-9);
+    }
+    assert_eq!(sim.events.last().map(|e| e.kind), Some(EventKind::Stick));
+    let (mut ex, mut ev) = (0.0f64, 0.0f64);
+    for i in 0..times.len() {
+        ex = ex.max((sim.x[i] - exact.x[i]).abs());
+        ev = ev.max((sim.v[i] - exact.v[i]).abs());
+    }
+    assert!(ex < 1e-8, "max |x - exact| = {ex}");
+    assert!(ev < 1e-8, "max |v - exact| = {ev}");
+    eprintln!(
+        "x0 = {x0}: |dx|max = {ex:.2e}, |dv|max = {ev:.2e}, final err {:.2e}, rest-time err {:.2e}, stats {:?}",
+        (rest.displacement - exact.final_displacement).abs(),
+        (rest.time - exact.rest_time).abs(),
+        sim.stats
+    );
+}
+
+#[test]
+fn coulomb_140mm_matches_the_exact_solution() {
+    check_against_exact(0.140, -9.297, 6);
+}
+
+#[test]
+fn coulomb_110mm_matches_the_exact_solution() {
+    check_against_exact(0.110, 10.529, 4);
+}
+
+/// FMM case: the paper's stage with the PTFE pin (N = 14.5 N).
+fn fmm_run(model: &dyn FrictionModel, x0: f64, t_end: f64) -> Trajectory {
+    let times = uniform_times(t_end, 1000.0);
+    simulate(
+        &Oscillator::fmm(),
+        model,
+        &Initial::at_rest(x0),
+        t_end,
+        &times,
+        &SimOptions::default(),
+    )
+    .unwrap_or_else(|e| panic!("model {} from {x0}: {e}", model.name()))
+}
+
+#[test]
+fn release_from_a_moving_state_continues_the_exact_solution() {
+    // Start mid-slip from the exact state at t1 and compare with the exact solution shifted by t1.
+    let osc = paper_osc();
+    let model = paper_coulomb();
+    let f = model.mu * osc.normal_force;
+    let t1 = 0.3;
+    let start = coulomb_free_vibration(&osc, f, 0.140, &[t1]).unwrap();
+    let (x1, v1) = (start.x[0], start.v[0]);
+    assert!(v1 != 0.0);
+    let tau = uniform_times(1.5, 1000.0);
+    let shifted: Vec<f64> = tau.iter().map(|t| t + t1).collect();
+    let exact = coulomb_free_vibration(&osc, f, 0.140, &shifted).unwrap();
+    let sim = simulate(
+        &osc,
+        &model,
+        &Initial::new(x1, v1),
+        1.5,
+        &tau,
+        &SimOptions::default(),
+    )
+    .unwrap();
+    for i in 0..tau.len() {
+        assert!((sim.x[i] - exact.x[i]).abs() < 1e-8, "x at {}", tau[i]);
+        assert!((sim.v[i] - exact.v[i]).abs() < 1e-8, "v at {}", tau[i]);
+    }
+    let rest = sim.rest.unwrap();
+    assert!((rest.displacement - exact.final_displacement).abs() < 1e-9);
+    assert!((rest.time + t1 - exact.rest_time).abs() < 1e-9);
+}
+
+#[test]
+fn release_inside_the_stick_band_stays_at_rest() {
+    let osc = paper_osc();
+    let model = paper_coulomb();
+    let x_lim = model.mu * osc.normal_force / osc.stiffness;
+    let times = uniform_times(0.5, 100.0);
+    let sim = simulate(
+        &osc,
+        &model,
+        &Initial::at_rest(0.9 * x_lim),
+        0.5,
+        &times,
+        &SimOptions::default(),
+    )
+    .unwrap();
+    let rest = sim.rest.unwrap();
+    assert_eq!((rest.time, rest.displacement), (0.0, 0.9 * x_lim));
+    assert_eq!(sim.half_cycles(), 0);
+    assert!(sim.x.iter().all(|&x| x == 0.9 * x_lim));
+    assert!(sim.v.iter().chain(&sim.a).all(|&v| v == 0.0));
+    // The static friction force balances the spring.
+    assert!(sim
+        .friction
+        .iter()
+        .all(|&f| (f + osc.stiffness * 0.9 * x_lim).abs() < 1e-12));
+    assert_eq!(sim.stats.rhs_evaluations, 0);
+}
+
+#[test]
+fn paper_euler_reproduces_the_final_displacement() {
+    let osc = paper_osc();
+    let model = paper_coulomb();
+    let exact = coulomb_free_vibration(&osc, model.mu * osc.normal_force, 0.140, &[]).unwrap();
+    let opts = SimOptions {
+        integrator: Integrator::Euler {
+            steps_per_period: 1e6,
+        },
+        ..SimOptions::default()
+    };
+    let times = uniform_times(2.0, 100.0);
+    let sim = simulate(&osc, &model, &Initial::at_rest(0.140), 2.0, &times, &opts).unwrap();
+    let rest = sim.rest.unwrap();
+    assert!(
+        (rest.displacement - exact.final_displacement).abs() < 1e-5,
+        "Euler final {} vs exact {}",
+        rest.displacement,
+        exact.final_displacement
+    );
+    assert_eq!(sim.half_cycles(), 6);
+    // One RHS evaluation per step, T_n / 1e6 per step.
+    let expected_steps = exact.rest_time / (osc.natural_period() / 1e6);
+    assert!((sim.stats.steps as f64 / expected_steps - 1.0).abs() < 1e-3);
+    eprintln!(
+        "Euler: final error {:.2e} m, {} RHS",
+        (rest.displacement - exact.final_displacement).abs(),
+        sim.stats.rhs_evaluations
+    );
+}
+
+#[test]
+fn adaptive_uses_far_fewer_rhs_evaluations_than_the_papers_euler() {
+    let osc = paper_osc();
+    let sim = simulate(
+        &osc,
+        &paper_coulomb(),
+        &Initial::at_rest(0.140),
+        2.0,
+        &[],
+        &SimOptions::default(),
+    )
+    .unwrap();
+    let rest = sim.rest.unwrap();
+    let euler_steps = rest.time / (osc.natural_period() / 1e6);
+    let ratio = euler_steps / sim.stats.rhs_evaluations as f64;
+    eprintln!(
+        "Dopri5: {} RHS, paper Euler {euler_steps:.0}: {ratio:.0}x",
+        sim.stats.rhs_evaluations
+    );
+    assert!(ratio >= 1000.0, "only {ratio:.0}x fewer RHS evaluations");
+}
+
+#[test]
+fn energy_never_increases_for_any_built_in_model() {
+    for name in names() {
+        let model = default_model(&name).unwrap();
+        for x0 in [0.022, 0.014, -0.010, 0.003] {
+            let sim = fmm_run(model.as_ref(), x0, 2.0);
+            let total: Vec<f64> = sim
+                .energy
+                .iter()
+                .zip(&sim.stored)
+                .map(|(e, s)| e + s)
+                .collect();
+            let scale = total[0];
+            for i in 1..total.len() {
+                assert!(
+                    total[i] - total[i - 1] <= 1e-9 * scale,
+                    "{name} from {x0}: energy rises by {:e} J ({:e} relative) at t = {}",
+                    total[i] - total[i - 1],
+                    (total[i] - total[i - 1]) / scale,
+                    sim.time[i]
+                );
+            }
+            // Sanity of the columns: E = KE + PE.
+            for i in 0..total.len() {
+                let e = 0.5 * 10.391 * sim.v[i].powi(2) + 0.5 * 1982.0 * sim.x[i].powi(2);
+                assert!((sim.energy[i] - e).abs() <= 1e-12 * scale.max(1.0));
+            }
+        }
+    }
+}
+
+#[test]
+fn mirror_symmetry_for_every_built_in_model() {
+    for name in names() {
+        let model = default_model(&name).unwrap();
+        let a = fmm_run(model.as_ref(), 0.022, 2.0);
+        let b = fmm_run(model.as_ref(), -0.022, 2.0);
+        for i in 0..a.x.len() {
+            assert!(
+                (a.x[i] + b.x[i]).abs() < 1e-12 && (a.v[i] + b.v[i]).abs() < 1e-12,
+                "{name}: x(t) = {} but the mirrored run gives {} at t = {}",
+                a.x[i],
+                b.x[i],
+                a.time[i]
+            );
+            assert!((a.friction[i] + b.friction[i]).abs() < 1e-9);
+        }
+        assert_eq!(a.events.len(), b.events.len(), "{name}");
+        assert_eq!(a.rest.is_some(), b.rest.is_some(), "{name}");
+    }
+}
+
+/// Half the peak-to-peak displacement over the last `n` samples.
+fn tail_amplitude(x: &[f64], n: usize) -> f64 {
+    let tail = &x[x.len() - n..];
+    let hi = tail.iter().copied().fold(f64::MIN, f64::max);
+    let lo = tail.iter().copied().fold(f64::MAX, f64::min);
+    0.5 * (hi - lo)
+}
+
+#[test]
+fn bristle_models_complete_over_four_decades_of_stiffness() {
+    for name in ["lugre", "dahl"] {
+        for sigma0 in [1e3, 1e5, 1e7] {
+            let built =
+                frictionid_models::build_json(&serde_json::json!({"type": name, "sigma0": sigma0}))
+                    .unwrap();
+            // The FMM case (2 s) completes ...
+            let short = fmm_run(built.model.as_ref(), 0.022, 2.0);
+            // ... and a longer run comes to rest or decays below 1e-6 m.
+            let long = fmm_run(built.model.as_ref(), 0.022, 20.0);
+            let (a2, a20) = (tail_amplitude(&short.x, 200), tail_amplitude(&long.x, 200));
+            eprintln!(
+                "{name} sigma0 = {sigma0:e}: 2 s: amplitude {a2:.2e} m, {:?}; 20 s: rest {:?}, amplitude {a20:.2e} m",
+                short.stats, long.rest
+            );
+            if name == "dahl" && sigma0 == 1e3 {
+                // Dahl has no static friction: with a bristle compliance mu_c N / sigma0 = 2.9 mm
+                // the small-amplitude loss falls as the amplitude cubed and the decay is
+                // algebraic, so 1e-6 m is out of reach in 20 s; the amplitude must still fall.
+                assert!(a20 < 0.1 * a2, "{name} sigma0 = {sigma0}: {a2} -> {a20}");
+            } else {
+                assert!(
+                    long.rest.is_some() || a20 < 1e-6,
+                    "{name} sigma0 = {sigma0}: still moving with amplitude {a20}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn velocity_only_variant_matches_the_full_trajectory() {
+    let times = uniform_times(2.0, 1000.0);
+    let mut buf = vec![1.0; 3];
+    for name in names() {
+        let model = default_model(&name).unwrap();
+        let full = fmm_run(model.as_ref(), 0.022, 2.0);
+        let stats = simulate_velocity(
+            &Oscillator::fmm(),
+            model.as_ref(),
+            &Initial::at_rest(0.022),
+            2.0,
+            &times,
+            &SimOptions::default(),
+            &mut buf,
+        )
+        .unwrap();
+        assert_eq!(buf, full.v, "{name}");
+        assert_eq!(stats, full.stats, "{name}");
+    }
+}
+
+fn integration_time(e: EngineError) -> f64 {
+    match e {
+        EngineError::Integration { time, .. } => time,
+        other => panic!("expected an integration error, got {other}"),
+    }
+}
+
+#[test]
+fn failures_are_errors_not_panics() {
+    let osc = Oscillator::fmm();
+    let model = paper_coulomb();
+    let opts = SimOptions::default();
+    let t = uniform_times(1.0, 100.0);
+    let run = |osc: &Oscillator,
+               m: &dyn FrictionModel,
+               init: &Initial,
+               t_end: f64,
+               times: &[f64],
+               o: &SimOptions| { simulate(osc, m, init, t_end, times, o) };
+    let at = Initial::at_rest(0.02);
+    // Invalid oscillator and model.
+    let bad_osc = Oscillator { mass: 0.0, ..osc };
+    assert!(matches!(
+        run(&bad_osc, &model, &at, 1.0, &t, &opts),
+        Err(EngineError::InvalidOscillator(_))
+    ));
+    assert!(matches!(
+        run(&osc, &Coulomb { mu: -1.0 }, &at, 1.0, &t, &opts),
+        Err(EngineError::Model(_))
+    ));
+    // Invalid initial conditions and sample times.
+    for init in [Initial::at_rest(f64::NAN), Initial::new(0.0, f64::INFINITY)] {
+        assert!(matches!(
+            run(&osc, &model, &init, 1.0, &t, &opts),
+            Err(EngineError::InvalidInput(_))
+        ));
+    }
+    let lugre = default_model("lugre").unwrap();
+    let wrong_z = Initial {
+        x0: 0.01,
+        v0: 0.0,
+        z0: Some(vec![0.0, 0.0]),
+    };
+    assert!(matches!(
+        run(&osc, lugre.as_ref(), &wrong_z, 1.0, &t, &opts),
+        Err(EngineError::InvalidInput(_))
+    ));
+    for times in [
+        vec![0.0, 0.2, 0.1],
+        vec![0.0, 1.5],
+        vec![-0.1, 0.0],
+        vec![f64::NAN],
+    ] {
+        let e = run(&osc, &model, &at, 1.0, &times, &opts).unwrap_err();
+        assert!(matches!(e, EngineError::InvalidInput(_)), "{e}");
+    }
+    assert!(run(&osc, &model, &at, f64::NAN, &[], &opts).is_err());
+    for bad in [
+        SimOptions { rtol: 0.0, ..opts },
+        SimOptions { atol: -1.0, ..opts },
+        SimOptions {
+            max_steps: 0,
+            ..opts
+        },
+        SimOptions {
+            integrator: Integrator::Euler {
+                steps_per_period: f64::NAN,
+            },
+            ..opts
+        },
+    ] {
+        assert!(matches!(
+            run(&osc, &model, &at, 1.0, &t, &bad),
+            Err(EngineError::InvalidInput(_))
+        ));
+    }
+    // Too many steps: the error says how far the integration got.
+    let few = SimOptions {
+        max_steps: 50,
+        ..opts
+    };
+    let time = integration_time(run(&osc, &model, &at, 1.0, &t, &few).unwrap_err());
+    assert!(time > 0.0 && time < 1.0, "{time}");
+    let few_euler = SimOptions {
+        max_steps: 1000,
+        integrator: Integrator::Euler {
+            steps_per_period: 1e4,
+        },
+        ..opts
+    };
+    let time = integration_time(run(&osc, &model, &at, 1.0, &t, &few_euler).unwrap_err());
+    assert!(
+        (time - 1000.0 * osc.natural_period() / 1e4).abs() < 1e-9,
+        "{time}"
+    );
+    // Too many events.
+    let none = default_model("none").unwrap();
+    let few_events = SimOptions {
+        max_events: 3,
+        ..opts
+    };
+    let time = integration_time(run(&osc, none.as_ref(), &at, 1.0, &t, &few_events).unwrap_err());
+    assert!((time - 2.0 * osc.natural_period()).abs() < 0.01, "{time}");
+    let msg = run(&osc, none.as_ref(), &at, 1.0, &t, &few_events)
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("max_events"), "{msg}");
+}
+
+#[test]
+fn options_and_events_serialise_with_their_tags() {
+    let o = SimOptions {
+        integrator: Integrator::Euler {
+            steps_per_period: 1e6,
+        },
+        ..SimOptions::default()
+    };
+    let j = serde_json::to_value(o).unwrap();
+    assert_eq!(j["integrator"]["method"], "euler");
+    assert_eq!(j["integrator"]["steps_per_period"], 1e6);
+    let back: SimOptions = serde_json::from_value(j).unwrap();
+    assert_eq!(back, o);
+    let d: SimOptions = serde_json::from_str(r#"{"integrator": {"method": "dopri5"}}"#).unwrap();
+    assert_eq!(d, SimOptions::default());
+    assert_eq!(
+        serde_json::to_value(EventKind::TurningPoint).unwrap(),
+        "turning_point"
+    );
+}
+
+#[test]
+fn euler_converges_to_the_adaptive_solution_for_every_model() {
+    // Two independent integrators with the same mode logic: the first-order Euler error must
+    // shrink tenfold from n = 1e4 to n = 1e5 steps per period.
+    let osc = Oscillator::fmm();
+    let times = uniform_times(1.0, 1000.0);
+    for name in names() {
+        let model = default_model(&name).unwrap();
+        let reference = fmm_run(model.as_ref(), 0.022, 1.0);
+        let err = |n: f64| {
+            let opts = SimOptions {
+                integrator: Integrator::Euler {
+                    steps_per_period: n,
+                },
+                ..SimOptions::default()
+            };
+            let sim = simulate(
+                &osc,
+                model.as_ref(),
+                &Initial::at_rest(0.022),
+                1.0,
+                &times,
+                &opts,
+            )
+            .unwrap_or_else(|e| panic!("{name}, Euler n = {n}: {e}"));
+            sim.x
+                .iter()
+                .zip(&reference.x)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max)
+        };
+        let (e4, e5) = (err(1e4), err(1e5));
+        eprintln!("{name}: Euler max |x - x_dopri5|: n = 1e4 {e4:.2e} m, n = 1e5 {e5:.2e} m");
+        assert!(e5 < 2e-5, "{name}: {e5}");
+        assert!(
+            e5 < 0.2 * e4,
+            "{name}: {e4} -> {e5} is not first-order convergence"
+        );
+    }
+}
