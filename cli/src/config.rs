@@ -190,7 +190,7 @@ pub struct SimulationConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum DifferentiatorMethod {
-    /// The paper's differentiation (central differences).
+    /// The paper's differentiation (central differences and a moving average).
     Paper,
     /// Savitzky-Golay smoothing differentiator.
     SavitzkyGolay,

@@ -36,12 +36,9 @@ pub const EXIT_ERROR: u8 = 1;
 pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
         Command::Models { json } => commands::models::run(json).map(|_| Outcome::Done),
-        Command::Simulate { .. } => Err(anyhow::anyhow!(
-            "`simulate` is not available in this build of frictionid yet"
-        )),
-        Command::Fit { config, .. }
-        | Command::Compare { config, .. }
-        | Command::Energy { config, .. } => {
+        Command::Simulate { config, output } => commands::simulate::run(&config, &output),
+        Command::Energy { config, output } => commands::energy::run(&config, &output),
+        Command::Fit { config, .. } | Command::Compare { config, .. } => {
             // The inputs are checked in full before the (not yet wired) analysis.
             commands::load_inputs(&config, "this command")?;
             Err(anyhow::anyhow!(

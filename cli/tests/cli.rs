@@ -229,7 +229,12 @@ fn unknown_key_suggests_the_nearest() {
         e.contains("c.toml:11:1: unknown key `velocity_colum` in [[records]] (did you mean `velocity_column`?)"),
         "{e}"
     );
-    let e = fails("key2", "fit", &format!("{OSC}[simulaton]\nx0 = 0.1\n"), &[]);
+    let e = fails(
+        "key2",
+        "simulate",
+        &format!("{OSC}[simulaton]\nx0 = 0.1\n"),
+        &[],
+    );
     assert!(
         e.contains("unknown key `simulaton` at the top level (did you mean `simulation`?)"),
         "{e}"
@@ -268,7 +273,7 @@ fn missing_x0_is_named() {
         "{e}"
     );
     let cfg = format!("{OSC}[model]\ntype = \"coulomb\"\n[simulation]\nduration = 1.0\n");
-    let e = fails("x0-sim", "fit", &cfg, &[]);
+    let e = fails("x0-sim", "simulate", &cfg, &[]);
     assert!(e.contains("[simulation]: missing `x0`"), "{e}");
 }
 
@@ -301,4 +306,35 @@ fn fixture_configs_parse() {
         let c = frictionid_cli::Config::load(&fixtures().join(f)).unwrap();
         assert!(c.oscillator.mass > 0.0, "{f}");
     }
+}
+
+#[test]
+fn simulate_and_energy_name_what_they_need() {
+    let e = fails(
+        "no-sim",
+        "simulate",
+        &format!("{OSC}[model]\ntype = \"coulomb\"\n"),
+        &[],
+    );
+    assert!(e.contains("simulate needs a [simulation] table"), "{e}");
+    let e = fails(
+        "no-model",
+        "simulate",
+        &format!("{OSC}[simulation]\nx0 = 0.01\nduration = 1.0\n"),
+        &[],
+    );
+    assert!(e.contains("simulate needs a [model] table"), "{e}");
+    let cfg = format!("{OSC}[[records]]\nfile = \"r.csv\"\nx0 = 0.014\n");
+    let e = fails("no-ref", "energy", &cfg, &[("r.csv", &csv(20))]);
+    assert!(e.contains("energy needs a reference friction force"), "{e}");
+    let e = fails(
+        "no-records",
+        "energy",
+        &format!("{OSC}[model]\ntype = \"coulomb\"\n"),
+        &[],
+    );
+    assert!(
+        e.contains("energy needs at least one [[records]] entry"),
+        "{e}"
+    );
 }

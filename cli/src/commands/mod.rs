@@ -1,6 +1,8 @@
 //! The subcommands. Each returns an [`Outcome`]; errors propagate as `anyhow` to the edge.
 
+pub mod energy;
 pub mod models;
+pub mod simulate;
 
 use crate::args::OutputArgs;
 use std::io::Write;

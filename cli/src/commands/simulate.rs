@@ -147,8 +147,16 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
             panels: vec![
                 plots::Panel::new("energy", "J")
                     .with(plots::Series::solid("kinetic", &traj.time, &traj.kinetic))
-                    .with(plots::Series::solid("potential", &traj.time, &traj.potential))
-                    .with(plots::Series::solid("E = KE + PE", &traj.time, &traj.energy)),
+                    .with(plots::Series::solid(
+                        "potential",
+                        &traj.time,
+                        &traj.potential,
+                    ))
+                    .with(plots::Series::solid(
+                        "E = KE + PE",
+                        &traj.time,
+                        &traj.energy,
+                    )),
                 plots::Panel::new("dE/dt", "W").with(plots::Series::solid(
                     "dE/dt = -(c v + F) v",
                     &traj.time,
@@ -196,7 +204,11 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
             "s".into(),
         ],
         vec!["half-cycles".into(), half_cycles.to_string(), String::new()],
-        vec!["events".into(), traj.events.len().to_string(), String::new()],
+        vec![
+            "events".into(),
+            traj.events.len().to_string(),
+            String::new(),
+        ],
         vec![
             "steps (rejected)".into(),
             format!("{} ({})", traj.stats.steps, traj.stats.rejected_steps),
@@ -215,7 +227,7 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
         .map(|e| {
             vec![
                 fmt_num(e.time),
-                serde_json::to_value(&e.kind)
+                serde_json::to_value(e.kind)
                     .ok()
                     .and_then(|k| k.as_str().map(str::to_string))
                     .unwrap_or_default(),

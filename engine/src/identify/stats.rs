@@ -68,7 +68,7 @@ pub fn covariance(j: &DMatrix<f64>, ssr: f64) -> Covariance {
         .singular_values
         .iter()
         .fold((0.0f64, f64::INFINITY), |(a, b), &s| (a.max(s), b.min(s)));
-    let singular = p > 0 && (d.iter().any(|&x| x == 0.0) || smin <= 1e-12 * smax);
+    let singular = p > 0 && (d.contains(&0.0) || smin <= 1e-12 * smax);
     let matrix = match (singular, scaled.try_inverse()) {
         (false, Some(inv)) => {
             let mut m = inv;
