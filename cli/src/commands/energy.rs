@@ -207,3 +207,38 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
     print_json(output, &report)?;
     Ok(Outcome::Done)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn energy_config_maps_onto_engine_options() {
+        let d = EnergyOptions::default();
+        assert_eq!(energy_options(&EnergyConfig::default()), d);
+        let o = energy_options(&EnergyConfig {
+            method: Some(DifferentiatorMethod::Paper),
+            velocity_threshold: Some(2e-3),
+            ..EnergyConfig::default()
+        });
+        assert_eq!(o.differentiator, Differentiator::Paper);
+        assert_eq!(o.velocity_threshold, 2e-3);
+        let o = energy_options(&EnergyConfig {
+            window: Some(41),
+            ..EnergyConfig::default()
+        });
+        match (o.differentiator, d.differentiator) {
+            (
+                Differentiator::SavitzkyGolay { window, order },
+                Differentiator::SavitzkyGolay { order: order0, .. },
+            ) => assert_eq!((window, order), (41, order0)),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn plot_stems_come_from_file_names() {
+        assert_eq!(plot_stem("data/x14mm.csv"), "x14mm");
+        assert_eq!(plot_stem("x14mm.uff"), "x14mm");
+    }
+}

@@ -263,3 +263,52 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
     print_json(output, &report)?;
     Ok(Outcome::Done)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use frictionid_engine::exact::coulomb_free_vibration;
+    use frictionid_engine::Oscillator;
+
+    #[test]
+    fn integrator_config_maps_onto_engine_options() {
+        let d = SimOptions::default();
+        assert_eq!(sim_options(&IntegratorConfig::default()), d);
+        let o = sim_options(&IntegratorConfig {
+            method: IntegratorMethod::Euler,
+            steps_per_period: Some(1e5),
+            rtol: Some(1e-6),
+            max_events: Some(7),
+            ..IntegratorConfig::default()
+        });
+        assert_eq!(
+            o.integrator,
+            Integrator::Euler {
+                steps_per_period: 1e5
+            }
+        );
+        assert_eq!((o.rtol, o.atol, o.max_events), (1e-6, d.atol, 7));
+    }
+
+    /// The energy rate from the states equals the power of the dissipative forces,
+    /// -(c v + mu N sgn v) v, on the exact Coulomb solution.
+    #[test]
+    fn energy_rate_is_the_dissipated_power() {
+        let osc = Oscillator::fmm();
+        let f = 0.24 * osc.normal_force;
+        let t: Vec<f64> = (0..500).map(|i| i as f64 * 1e-3 + 1e-4).collect();
+        let s = coulomb_free_vibration(&osc, f, 0.014, &t).unwrap();
+        let rate = energy_rate(osc.mass, osc.stiffness, &s.x, &s.v, &s.a);
+        for i in 0..t.len() {
+            let v = s.v[i];
+            let expect = -(osc.damping * v + f * v.signum()) * v;
+            let expect = if v == 0.0 { 0.0 } else { expect };
+            assert!(
+                (rate[i] - expect).abs() < 1e-9,
+                "t = {}: {} vs {expect}",
+                t[i],
+                rate[i]
+            );
+        }
+    }
+}
