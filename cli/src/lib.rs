@@ -5,7 +5,8 @@
 //! same line; its models then appear in `frictionid models` and can be named in configs.
 //!
 //! Modules: [`args`] (clap), [`config`] (TOML), [`commands`] (one per subcommand), [`report`]
-//! (atomic output files and tables), [`plots`] (SVG charts), [`error`] (typed errors).
+//! (atomic output files and tables), [`plots`] (SVG charts), [`progress`] (progress bars),
+//! [`error`] (typed errors).
 //!
 //! Exit codes: 0 success, 1 error (one line on stderr), 2 a fit that did not converge (its
 //! report is written).
@@ -15,6 +16,7 @@ pub mod commands;
 pub mod config;
 pub mod error;
 pub mod plots;
+pub mod progress;
 pub mod report;
 
 use args::{Cli, Command};
