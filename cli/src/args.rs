@@ -41,7 +41,7 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Simulate a free vibration from [oscillator], [model] and [simulation].
+    /// Simulate a free vibration from the config's oscillator, model and simulation tables.
     #[command(
         after_help = "Example:\n  frictionid simulate fixtures/paper-140mm.toml --out sim-140mm/\n\nWrites trajectory.csv, report.json, report.md and SVG plots; with `noise` in\n[simulation] also record.csv, a noisy velocity record usable in [[records]]."
     )]
@@ -51,7 +51,7 @@ pub enum Command {
         #[command(flatten)]
         output: OutputArgs,
     },
-    /// Fit the [model] to the [[records]].
+    /// Fit the config's model to its records.
     #[command(after_help = "Example:\n  frictionid fit fixtures/fmm-fit.toml --out fit/")]
     Fit {
         /// The TOML configuration file.
@@ -59,7 +59,7 @@ pub enum Command {
         #[command(flatten)]
         output: OutputArgs,
     },
-    /// Fit several models to the same [[records]] and rank them by AIC.
+    /// Fit several models to the same records and rank them by AIC.
     #[command(
         after_help = "Examples:\n  frictionid compare fixtures/fmm-compare.toml\n  frictionid compare fixtures/fmm-compare.toml --models coulomb,stribeck,lugre"
     )]

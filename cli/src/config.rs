@@ -168,15 +168,15 @@ pub struct IntegratorConfig {
 /// `[simulation]`: the release state, the time grid and optional synthetic noise.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimulationConfig {
-    /// Release displacement [m].
+    /// Release displacement \[m\].
     pub x0: f64,
     /// Release velocity [m/s].
     pub v0: f64,
     /// Initial internal states of the model (default: the model's own).
     pub z0: Option<Vec<f64>>,
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     pub duration: f64,
-    /// Output sample rate [Hz].
+    /// Output sample rate \[Hz\].
     pub sample_rate: f64,
     /// Standard deviation of the Gaussian velocity noise of `record.csv` [m/s]; `None`: no record.
     pub noise: Option<f64>,
@@ -208,7 +208,7 @@ pub struct EnergyConfig {
     pub order: Option<usize>,
     /// Speeds below this are masked in the friction-force estimate [m/s].
     pub velocity_threshold: Option<f64>,
-    /// Reference friction force for the comparison [N] (default: from `[model]`).
+    /// Reference friction force for the comparison \[N\] (default: from `[model]`).
     pub reference_force: Option<f64>,
 }
 
@@ -219,7 +219,7 @@ pub struct RecordConfig {
     pub file: PathBuf,
     /// The file as written in the config (for messages and reports).
     pub file_as_written: String,
-    /// Release displacement [m].
+    /// Release displacement \[m\].
     pub x0: f64,
     /// Release velocity [m/s].
     pub v0: f64,

@@ -1,5 +1,5 @@
-//! `frictionid simulate CONFIG`: one free vibration from [oscillator], [model] and
-//! [simulation]; writes trajectory.csv, optional record.csv (noisy velocity), plots,
+//! `frictionid simulate CONFIG`: one free vibration from `[oscillator]`, `[model]` and
+//! `[simulation]`; writes trajectory.csv, optional record.csv (noisy velocity), plots,
 //! report.md and report.json.
 
 use super::{print_json, say, warn, Outcome};
