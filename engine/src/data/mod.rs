@@ -39,7 +39,7 @@ pub enum DataFormat {
 pub struct ReadOptions {
     /// File format.
     pub format: DataFormat,
-    /// Header name of the time column [s] (delimited text only).
+    /// Header name of the time column \[s\] (delimited text only).
     pub time_column: String,
     /// Header name of the velocity column (delimited text only).
     pub velocity_column: String,
