@@ -1,7 +1,8 @@
 //! Criterion benchmarks of the simulation engine: one run per registered model for the FMM case
 //! (N = 14.5 N, x0 = 22 mm, 2 s sampled at 1 kHz), the paper's 140 mm Coulomb case (N = m g,
-//! mu = 0.24) with Dopri5 and with the paper's Euler (T_n / 1e6). The RHS counts are printed once
-//! per case (stderr) for the README's performance table.
+//! mu = 0.24) with Dopri5 and with the paper's Euler (T_n / 1e6), and the stiff bristle models
+//! (sigma0 = 1e7 N/m). The RHS counts are printed once per case (stderr) for the README's
+//! performance table.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use frictionid_engine::synthetic::uniform_times;
@@ -54,6 +55,29 @@ fn fmm_models(c: &mut Criterion) {
     group.finish();
 }
 
+/// The stiff end of the bristle models (sigma0 = 1e7 N/m) with the explicit integrator.
+fn fmm_stiff(c: &mut Criterion) {
+    let osc = Oscillator::fmm();
+    let times = uniform_times(2.0, 1000.0);
+    let opts = SimOptions::default();
+    let mut group = c.benchmark_group("fmm_22mm_2s_1kHz_sigma0_1e7");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(3));
+    for name in ["lugre", "dahl"] {
+        let json = serde_json::json!({ "type": name, "sigma0": 1e7 });
+        let Ok(built) = frictionid_models::build_json(&json) else {
+            continue;
+        };
+        let model = built.model;
+        let rhs = run(&osc, model.as_ref(), 0.022, 2.0, &times, &opts);
+        eprintln!("fmm_22mm_2s_1kHz_sigma0_1e7/{name}: {rhs} RHS evaluations");
+        group.bench_function(name, |b| {
+            b.iter(|| run(&osc, model.as_ref(), black_box(0.022), 2.0, &times, &opts))
+        });
+    }
+    group.finish();
+}
+
 fn paper_140mm(c: &mut Criterion) {
     let mut osc = Oscillator::fmm();
     osc.normal_force = osc.mass * 9.81;
@@ -86,5 +110,5 @@ fn paper_140mm(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, fmm_models, paper_140mm);
+criterion_group!(benches, fmm_models, fmm_stiff, paper_140mm);
 criterion_main!(benches);

@@ -1,5 +1,5 @@
 //! Energy analysis (issue 4) against known truth: the exact Coulomb solution of the FMM case,
-//! closed-form derivatives and closed-form state trajectories.
+//! engine-simulated Coulomb motion, closed-form derivatives and closed-form state trajectories.
 
 use frictionid_engine::energy::{
     central_difference, cumulative_trapezoid, derivative_weights, moving_average, paper_derivative,
@@ -9,7 +9,7 @@ use frictionid_engine::exact::{coulomb_free_vibration, ExactCoulomb};
 use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
 use frictionid_engine::{
     analyze_record, analyze_states, force_residuals, model_force_along, percent_difference,
-    Differentiator, EnergyOptions, EngineError, Oscillator, Record,
+    simulate, Differentiator, EnergyOptions, EngineError, Initial, Oscillator, Record, SimOptions,
 };
 use frictionid_models::{Coulomb, Dahl, FrictionModel, LuGre, ModelError, ParamInfo};
 use serde::{Deserialize, Serialize};
@@ -114,6 +114,62 @@ fn exact_states_give_mu_n_to_one_part_per_million() {
                     "{f} at v = {v}"
                 );
             }
+        }
+    }
+}
+
+/// The same acceptance on records and states simulated by the engine (Coulomb, Dopri5 with
+/// the default tolerances) instead of the exact solution.
+#[test]
+fn engine_simulated_records_and_states() {
+    let osc = Oscillator::fmm();
+    let times = uniform_times(2.0, 1000.0);
+    for x0 in X0S {
+        let traj = simulate(
+            &osc,
+            &Coulomb { mu: MU },
+            &Initial::at_rest(x0),
+            2.0,
+            &times,
+            &SimOptions::default(),
+        )
+        .expect("simulation");
+        let an = analyze_states(
+            &osc,
+            &traj.time,
+            &traj.x,
+            &traj.v,
+            &traj.a,
+            &Default::default(),
+        )
+        .expect("states");
+        let (e7, hc) = (
+            an.mean_abs_force / mu_n() - 1.0,
+            an.half_cycle_mean / mu_n() - 1.0,
+        );
+        eprintln!("x0 = {x0}: simulated states, Eq. 7 {e7:+.2e}, half-cycles {hc:+.2e}");
+        assert!(e7.abs() < 1e-6 && hc.abs() < 1e-6, "x0 = {x0}: {e7}, {hc}");
+        assert_eq!(an.half_cycles.len(), traj.half_cycles());
+        for (noise, seed, eq7_bound, hc_bound) in [(0.0, 0, 0.5, 0.1), (NOISE, 5, 3.0, 1.0)] {
+            let mut v = traj.v.clone();
+            add_gaussian_noise(&mut v, noise, seed);
+            let rec = Record::new("simulated", traj.time.clone(), v, x0);
+            let an = analyze_record(&rec, &osc, &Default::default()).expect("record");
+            let e7 = percent_difference(an.mean_abs_force, mu_n());
+            let hc = percent_difference(an.half_cycle_mean, mu_n());
+            eprintln!(
+                "x0 = {x0}, noise {noise}: simulated record, Eq. 7 {e7:+.4} %, \
+                 half-cycles {hc:+.4} %"
+            );
+            assert!(
+                e7.abs() < eq7_bound,
+                "x0 = {x0}, noise {noise}: Eq. 7 {e7} %"
+            );
+            assert!(
+                hc.abs() < hc_bound,
+                "x0 = {x0}, noise {noise}: half-cycles {hc} %"
+            );
+            assert_eq!(an.half_cycles.len(), traj.half_cycles());
         }
     }
 }
@@ -757,6 +813,60 @@ fn coulomb_residuals_are_exact() {
     for (r, f) in wrong.residual.iter().zip(&an.friction) {
         assert_eq!(r.is_nan(), f.is_nan());
     }
+}
+
+/// A LuGre motion simulated by the engine: the energy-based force of its exact states is the
+/// simulated friction force, and the same model integrated along the sampled velocity
+/// reproduces it (small residual RMS), while a 10 % wrong mu_c leaves a residual of about
+/// 10 % of mu_c N.
+#[test]
+fn lugre_residuals_on_a_simulated_motion() {
+    let osc = Oscillator::fmm();
+    let model = LuGre {
+        mu_c: MU,
+        mu_s: 0.3,
+        ..LuGre::default()
+    };
+    let times = uniform_times(1.0, 1000.0);
+    let traj = simulate(
+        &osc,
+        &model,
+        &Initial::at_rest(0.014),
+        1.0,
+        &times,
+        &SimOptions::default(),
+    )
+    .expect("simulation");
+    let an = analyze_states(
+        &osc,
+        &traj.time,
+        &traj.x,
+        &traj.v,
+        &traj.a,
+        &Default::default(),
+    )
+    .expect("states");
+    for (f, g) in an.friction.iter().zip(&traj.friction) {
+        if !f.is_nan() {
+            assert!((f - g).abs() < 1e-6 * mu_n(), "{f} vs {g}");
+        }
+    }
+    let right = force_residuals(&an, &model, &osc).expect("residuals");
+    let wrong_model = LuGre {
+        mu_c: 1.1 * MU,
+        ..model.clone()
+    };
+    let wrong = force_residuals(&an, &wrong_model, &osc).expect("residuals");
+    eprintln!(
+        "LuGre on its own motion: residual RMS {:.2e} N; with mu_c +10 %: {:.3} N",
+        right.rms, wrong.rms
+    );
+    assert!(right.rms < 1e-3 * mu_n(), "{}", right.rms);
+    assert!(
+        wrong.rms > 0.05 * mu_n() && wrong.rms < 0.15 * mu_n(),
+        "{}",
+        wrong.rms
+    );
 }
 
 /// A stiffer LuGre (mu_s = mu_c, no damping terms) is closer to Coulomb: its residual RMS
