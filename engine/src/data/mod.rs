@@ -242,7 +242,7 @@ fn finish(
     }
     let mut steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
     steps.sort_by(f64::total_cmp);
-    let median = steps[steps.len() / 2];
+    let median = steps.get(steps.len() / 2).copied().unwrap_or(0.0);
     for (i, w) in time.windows(2).enumerate() {
         let step = w[1] - w[0];
         if (step - median).abs() > opts.sampling_tolerance * median {

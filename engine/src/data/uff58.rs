@@ -178,13 +178,13 @@ fn parse_dataset(
     }
 
     let (l7, r7) = record(7)?;
-    let r7v = header_numbers(r7, &[10, 10, 10, 13, 13, 13]).ok_or_else(|| {
-        err(
+    let r7v = header_numbers(r7, &[10, 10, 10, 13, 13, 13]).unwrap_or_default();
+    let [data_type, n_points, even, x_min, dx, ..] = r7v[..] else {
+        return Err(err(
             l7,
             "record 7: expected 3 integers and 3 reals (data type, points, spacing, start, increment, z)".into(),
-        )
-    })?;
-    let (data_type, n_points, even, x_min, dx) = (r7v[0], r7v[1], r7v[2], r7v[3], r7v[4]);
+        ));
+    };
     let double = match data_type as i64 {
         2 => false,
         4 => true,
