@@ -1,1 +1,99 @@
+//! The frictionid command line as a library.
+//!
+//! The `frictionid` binary is one line: `frictionid_cli::main_with_args(std::env::args_os())`.
+//! A crate that registers its own friction models (typetag) builds its own binary with the
+//! same line; its models then appear in `frictionid models` and can be named in configs.
+//!
+//! Modules: [`args`] (clap), [`config`] (TOML), [`commands`] (one per subcommand), [`report`]
+//! (atomic output files and tables), [`plots`] (SVG charts), [`progress`] (progress bars),
+//! [`error`] (typed errors).
+//!
+//! Exit codes: 0 success, 1 error (one line on stderr), 2 a fit that did not converge (its
+//! report is written).
 
+pub mod args;
+pub mod commands;
+pub mod config;
+pub mod error;
+pub mod plots;
+pub mod progress;
+pub mod report;
+
+use args::{Cli, Command};
+use clap::Parser;
+use commands::Outcome;
+use std::ffi::OsString;
+use std::io::Write;
+use std::process::ExitCode;
+
+pub use config::Config;
+pub use error::CliError;
+
+/// Exit code of a fit that ran but did not converge.
+pub const EXIT_NOT_CONVERGED: u8 = 2;
+/// Exit code of any error.
+pub const EXIT_ERROR: u8 = 1;
+
+/// Runs parsed arguments.
+pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
+    match cli.command {
+        Command::Models { json } => commands::models::run(json).map(|_| Outcome::Done),
+        Command::Simulate { config, output } => commands::simulate::run(&config, &output),
+        Command::Energy { config, output } => commands::energy::run(&config, &output),
+        Command::Fit { config, .. } | Command::Compare { config, .. } => {
+            // The inputs are checked in full before the (not yet wired) analysis.
+            commands::load_inputs(&config, "this command")?;
+            Err(anyhow::anyhow!(
+                "this command is not available in this build of frictionid yet"
+            ))
+        }
+    }
+}
+
+/// Collapses a message to one line.
+fn one_line(msg: &str) -> String {
+    msg.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// Parses `args` (the first is the program name), runs the command and returns the exit code.
+/// Errors are printed as one line on stderr; a panic is reported as one line too.
+pub fn main_with_args<I, T>(args: I) -> ExitCode
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { EXIT_ERROR } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    std::panic::set_hook(Box::new(|info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        let at = info
+            .location()
+            .map(|l| format!(" at {}:{}", l.file(), l.line()))
+            .unwrap_or_default();
+        let _ = writeln!(
+            std::io::stderr(),
+            "error: internal error{at}: {} (please report this)",
+            one_line(&msg)
+        );
+    }));
+    match std::panic::catch_unwind(|| run(cli)) {
+        Ok(Ok(Outcome::Done)) => ExitCode::SUCCESS,
+        Ok(Ok(Outcome::NotConverged)) => ExitCode::from(EXIT_NOT_CONVERGED),
+        Ok(Err(e)) => {
+            let _ = writeln!(std::io::stderr(), "error: {}", one_line(&format!("{e:#}")));
+            ExitCode::from(EXIT_ERROR)
+        }
+        Err(_) => ExitCode::from(EXIT_ERROR),
+    }
+}

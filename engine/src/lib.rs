@@ -3,6 +3,7 @@
 //!
 //! Library code: values in, values out; no printing.
 
+pub mod data;
 pub mod energy;
 pub mod error;
 pub mod exact;

@@ -1,0 +1,299 @@
+//! Readers for measured velocity records: delimited text (CSV, whitespace-separated) and the
+//! universal file format's dataset 58 (ASCII), as exported by laser vibrometers and modal-test
+//! software.
+//!
+//! Every reader returns an engine [`Record`] released from rest at x0 = 0 with unit weight; the
+//! caller sets `x0`, `v0` and `weight` from its configuration. Every error is a [`DataError`] whose
+//! message is one line naming the file and, where there is one, the line and the reason.
+
+mod delimited;
+mod uff58;
+
+pub use delimited::read_delimited;
+pub use uff58::read_uff58;
+
+use crate::record::Record;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// The format of a record file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DataFormat {
+    /// Chosen from the file extension (`.uff`, `.unv`, `.58` are UFF; anything else is
+    /// delimited text with the delimiter taken from the header row).
+    #[default]
+    Auto,
+    /// Comma-, semicolon- or tab-separated text with a header row.
+    Csv,
+    /// Text whose columns are separated by runs of spaces or tabs, with a header row.
+    Whitespace,
+    /// Universal file format, dataset 58, ASCII.
+    Uff58,
+}
+
+/// How to read a record file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ReadOptions {
+    /// File format.
+    pub format: DataFormat,
+    /// Header name of the time column \[s\] (delimited text only).
+    pub time_column: String,
+    /// Header name of the velocity column (delimited text only).
+    pub velocity_column: String,
+    /// Factor that turns the file's velocity unit into m/s (1e-3 for mm/s, 1e-6 for um/s).
+    pub velocity_scale: f64,
+    /// Fewest samples accepted.
+    pub min_samples: usize,
+    /// Largest accepted deviation of one time step from the median step, relative to the
+    /// median step (the analyses assume even sampling).
+    pub sampling_tolerance: f64,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        Self {
+            format: DataFormat::Auto,
+            time_column: "time".into(),
+            velocity_column: "velocity".into(),
+            velocity_scale: 1.0,
+            min_samples: 10,
+            sampling_tolerance: 0.01,
+        }
+    }
+}
+
+/// Errors of the record readers. Each names the file; most name the line.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum DataError {
+    /// The file cannot be opened or read.
+    #[error("{file}: cannot read the file: {reason}")]
+    Io { file: PathBuf, reason: String },
+    /// The file has no header row or no data.
+    #[error("{file}: {reason}")]
+    Empty { file: PathBuf, reason: String },
+    /// A named column is not in the header row.
+    #[error("{file}: line {line}: no column `{column}`{hint}; the header has: {available}")]
+    MissingColumn {
+        file: PathBuf,
+        line: usize,
+        column: String,
+        hint: String,
+        available: String,
+    },
+    /// A line does not have as many fields as the header.
+    #[error("{file}: line {line}: {found} fields, but the header has {expected}")]
+    ColumnCount {
+        file: PathBuf,
+        line: usize,
+        found: usize,
+        expected: usize,
+    },
+    /// A field is not a number.
+    #[error("{file}: line {line}: column `{column}`: `{text}` is not a number")]
+    BadNumber {
+        file: PathBuf,
+        line: usize,
+        column: String,
+        text: String,
+    },
+    /// A value is NaN or infinite.
+    #[error("{file}: line {line}: column `{column}` is {value} (values must be finite)")]
+    NonFinite {
+        file: PathBuf,
+        line: usize,
+        column: String,
+        value: f64,
+    },
+    /// The time stamps do not strictly increase.
+    #[error("{file}: line {line}: time {time} s does not increase (previous {previous} s)")]
+    NotIncreasing {
+        file: PathBuf,
+        line: usize,
+        time: f64,
+        previous: f64,
+    },
+    /// One time step deviates from the median step by more than the tolerance.
+    #[error(
+        "{file}: line {line}: uneven sampling: step {step} s differs from the median step {median} s by more than {tolerance_percent}%"
+    )]
+    UnevenSampling {
+        file: PathBuf,
+        line: usize,
+        step: f64,
+        median: f64,
+        tolerance_percent: f64,
+    },
+    /// Fewer samples than required.
+    #[error("{file}: {found} samples, at least {needed} needed")]
+    TooFewSamples {
+        file: PathBuf,
+        found: usize,
+        needed: usize,
+    },
+    /// A malformed or unsupported UFF dataset 58.
+    #[error("{file}: line {line}: {reason}")]
+    Uff {
+        file: PathBuf,
+        line: usize,
+        reason: String,
+    },
+    /// Invalid read options.
+    #[error("{file}: {reason}")]
+    Options { file: PathBuf, reason: String },
+}
+
+/// Reads a record file in the format given by `opts.format` (see [`DataFormat::Auto`]).
+pub fn read_record(path: &Path, opts: &ReadOptions) -> Result<Record, DataError> {
+    if !(opts.velocity_scale.is_finite() && opts.velocity_scale != 0.0) {
+        return Err(DataError::Options {
+            file: path.to_path_buf(),
+            reason: format!(
+                "velocity_scale must be finite and non-zero, got {}",
+                opts.velocity_scale
+            ),
+        });
+    }
+    if !(opts.sampling_tolerance.is_finite() && opts.sampling_tolerance > 0.0) {
+        return Err(DataError::Options {
+            file: path.to_path_buf(),
+            reason: format!(
+                "sampling_tolerance must be > 0, got {}",
+                opts.sampling_tolerance
+            ),
+        });
+    }
+    let text = read_text(path)?;
+    match resolve_format(path, opts.format) {
+        DataFormat::Uff58 => read_uff58(path, &text, opts),
+        fmt => read_delimited(path, &text, fmt, opts),
+    }
+}
+
+/// The concrete format for `path`: `Auto` resolved from the extension.
+pub fn resolve_format(path: &Path, format: DataFormat) -> DataFormat {
+    if format != DataFormat::Auto {
+        return format;
+    }
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    match ext.as_str() {
+        "uff" | "unv" | "58" => DataFormat::Uff58,
+        _ => DataFormat::Auto,
+    }
+}
+
+fn read_text(path: &Path) -> Result<String, DataError> {
+    let bytes = std::fs::read(path).map_err(|e| DataError::Io {
+        file: path.to_path_buf(),
+        reason: io_reason(&e),
+    })?;
+    let text = String::from_utf8_lossy(&bytes).into_owned();
+    Ok(text
+        .strip_prefix('\u{feff}')
+        .map(str::to_string)
+        .unwrap_or(text))
+}
+
+fn io_reason(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".into(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
+        _ => e.to_string(),
+    }
+}
+
+/// A record name for reports: the file name as given.
+fn record_name(path: &Path) -> String {
+    path.display().to_string()
+}
+
+/// Checks time and velocity samples (with the file line of each sample) and builds the record.
+fn finish(
+    path: &Path,
+    time: Vec<f64>,
+    velocity: Vec<f64>,
+    lines: &[usize],
+    opts: &ReadOptions,
+) -> Result<Record, DataError> {
+    let file = || path.to_path_buf();
+    let line_of = |i: usize| lines.get(i).copied().unwrap_or(0);
+    if time.len() < opts.min_samples.max(2) {
+        return Err(DataError::TooFewSamples {
+            file: file(),
+            found: time.len(),
+            needed: opts.min_samples.max(2),
+        });
+    }
+    for (i, w) in time.windows(2).enumerate() {
+        if w[1] <= w[0] {
+            return Err(DataError::NotIncreasing {
+                file: file(),
+                line: line_of(i + 1),
+                time: w[1],
+                previous: w[0],
+            });
+        }
+    }
+    let mut steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+    steps.sort_by(f64::total_cmp);
+    let median = steps.get(steps.len() / 2).copied().unwrap_or(0.0);
+    for (i, w) in time.windows(2).enumerate() {
+        let step = w[1] - w[0];
+        if (step - median).abs() > opts.sampling_tolerance * median {
+            return Err(DataError::UnevenSampling {
+                file: file(),
+                line: line_of(i + 1),
+                step,
+                median,
+                tolerance_percent: opts.sampling_tolerance * 100.0,
+            });
+        }
+    }
+    Ok(Record::new(record_name(path), time, velocity, 0.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn format_from_extension() {
+        assert_eq!(
+            resolve_format(Path::new("a/b.UFF"), DataFormat::Auto),
+            DataFormat::Uff58
+        );
+        assert_eq!(
+            resolve_format(Path::new("a/b.csv"), DataFormat::Auto),
+            DataFormat::Auto
+        );
+        assert_eq!(
+            resolve_format(Path::new("a/b.uff"), DataFormat::Csv),
+            DataFormat::Csv
+        );
+    }
+
+    #[test]
+    fn missing_file_is_an_io_error_naming_it() {
+        let e = read_record(Path::new("/nonexistent/x.csv"), &ReadOptions::default()).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "/nonexistent/x.csv: cannot read the file: no such file"
+        );
+    }
+
+    #[test]
+    fn bad_scale_is_rejected() {
+        let opts = ReadOptions {
+            velocity_scale: 0.0,
+            ..ReadOptions::default()
+        };
+        let e = read_record(Path::new("x.csv"), &opts).unwrap_err();
+        assert!(matches!(e, DataError::Options { .. }), "{e}");
+    }
+}
