@@ -207,3 +207,90 @@ fn simulate_of_the_fixture_truth_dissipates_and_sticks_within_the_static_limit()
     assert!(mean.abs() < 4.0 * 2e-4 / n.sqrt(), "mean {mean}");
     assert!((sd - 2e-4).abs() < 0.05 * 2e-4, "sd {sd}");
 }
+
+/// The parameters `fixtures/sim-*.toml` made the records with.
+const TRUTH: [(&str, f64); 5] = [
+    ("mu_c", 0.2),
+    ("mu_s", 0.3),
+    ("v_s", 0.02),
+    ("viscous", 4.0),
+    ("alpha", 1.6),
+];
+const NOISE: f64 = 2e-4;
+
+/// Checks a fitted `stribeck_power` (a fit's JSON) against the truth: every free parameter
+/// within 3 % and its 95 % interval containing the truth, v_ref fixed, residuals at the noise.
+fn check_recovers_truth(fit: &serde_json::Value) {
+    assert_eq!(fit["model"], "stribeck_power");
+    assert_eq!(fit["converged"], true, "{}", fit["termination"]);
+    let rms = fit["rms_residual"].as_f64().unwrap();
+    assert!((rms - NOISE).abs() < 0.05 * NOISE, "rms {rms}");
+    let params = fit["parameters"].as_array().unwrap();
+    let get = |name: &str| params.iter().find(|p| p["name"] == name).unwrap();
+    for (name, truth) in TRUTH {
+        let p = get(name);
+        assert_eq!(p["free"], true, "{name}");
+        let value = p["value"].as_f64().unwrap();
+        assert!(
+            (value - truth).abs() < 0.03 * truth,
+            "{name} = {value}, truth {truth}"
+        );
+        let ci: Vec<f64> = p["ci95"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        assert!(
+            ci[0] < truth && truth < ci[1],
+            "{name}: 95 % CI {ci:?} vs {truth}"
+        );
+    }
+    assert_eq!(get("v_ref")["free"], false);
+    assert_eq!(get("v_ref")["value"].as_f64(), Some(0.1));
+}
+
+#[test]
+fn fit_recovers_the_parameters_the_fixture_was_made_with() {
+    let out = scratch("fit").join("out");
+    run_ok(&[
+        "fit".as_ref(),
+        fixtures().join("fit.toml").as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--quiet".as_ref(),
+    ]);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["command"], "fit");
+    check_recovers_truth(&report);
+    assert_eq!(report["records"].as_array().unwrap().len(), 3);
+}
+
+#[test]
+fn compare_ranks_the_plugin_model_above_coulomb() {
+    let out = scratch("compare").join("out");
+    run_ok(&[
+        "compare".as_ref(),
+        fixtures().join("compare.toml").as_os_str(),
+        "--models".as_ref(),
+        "coulomb,stribeck_power".as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--quiet".as_ref(),
+    ]);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["failed"].as_array().map(Vec::len), Some(0));
+    let ranking = report["ranking"].as_array().unwrap();
+    let order: Vec<&str> = ranking
+        .iter()
+        .map(|f| f["model"].as_str().unwrap())
+        .collect();
+    assert_eq!(order, ["stribeck_power", "coulomb"]);
+    let aic: Vec<f64> = ranking.iter().map(|f| f["aic"].as_f64().unwrap()).collect();
+    assert!(aic[0] < aic[1], "{aic:?}");
+    // The true model reaches the noise; Coulomb cannot (no Stribeck dip, no drag).
+    check_recovers_truth(&ranking[0]);
+    assert!(ranking[1]["rms_residual"].as_f64().unwrap() > 5.0 * NOISE);
+}
