@@ -212,3 +212,26 @@ fn unknown_fit_option_is_named() {
     );
     assert!(!dir.join("out").join("report.json").exists());
 }
+
+#[test]
+fn energy_without_a_model_takes_its_reference_from_a_coulomb_fit() {
+    let dir = scratch("energy-fit");
+    let text = std::fs::read_to_string(fixtures().join("fmm-compare.toml"))
+        .unwrap()
+        .replace("file = \"", &format!("file = \"{}/", fixtures().display()));
+    let cfg = dir.join("energy.toml");
+    std::fs::write(&cfg, text).unwrap();
+    let out = dir.join("out");
+    let (o, r) = run_json(&["energy", cfg.to_str().unwrap()], &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for rec in r["records"].as_array().unwrap() {
+        let reference = rec["reference"].as_f64().unwrap();
+        // The fitted mu N: the truth 3.48 N within 0.1 %.
+        assert!(
+            (reference / MU_N - 1.0).abs() < 1e-3,
+            "reference {reference}"
+        );
+        let half = rec["half_cycle_mean"].as_f64().unwrap();
+        assert!((half / MU_N - 1.0).abs() < 0.01, "half-cycle mean {half}");
+    }
+}
