@@ -235,3 +235,27 @@ fn energy_without_a_model_takes_its_reference_from_a_coulomb_fit() {
         assert!((half / MU_N - 1.0).abs() < 0.01, "half-cycle mean {half}");
     }
 }
+
+#[test]
+fn expression_sign_law_fits_the_same_mu_as_coulomb() {
+    let dir = scratch("expr");
+    let base = std::fs::read_to_string(fixtures().join("fmm-fit.toml"))
+        .unwrap()
+        .replace("file = \"", &format!("file = \"{}/", fixtures().display()));
+    let expr = base
+        .replace(
+            "type = \"coulomb\"\nmu = 0.2               # initial value",
+            "type = \"expression\"\nforce = \"mu * N * sign(v)\"\nparams = { mu = 0.2 }",
+        );
+    assert_ne!(expr, base, "the fixture's [model] table changed");
+    let mut mus = Vec::new();
+    for (name, text) in [("coulomb", &base), ("expression", &expr)] {
+        let cfg = dir.join(format!("{name}.toml"));
+        std::fs::write(&cfg, text).unwrap();
+        let (o, r) = run_json(&["fit", cfg.to_str().unwrap()], &dir.join(name));
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(r["model"], name);
+        mus.push(r["parameters"][0]["value"].as_f64().unwrap());
+    }
+    assert!((mus[0] - mus[1]).abs() < 1e-6, "{mus:?}");
+}
