@@ -242,11 +242,10 @@ fn expression_sign_law_fits_the_same_mu_as_coulomb() {
     let base = std::fs::read_to_string(fixtures().join("fmm-fit.toml"))
         .unwrap()
         .replace("file = \"", &format!("file = \"{}/", fixtures().display()));
-    let expr = base
-        .replace(
-            "type = \"coulomb\"\nmu = 0.2               # initial value",
-            "type = \"expression\"\nforce = \"mu * N * sign(v)\"\nparams = { mu = 0.2 }",
-        );
+    let expr = base.replace(
+        "type = \"coulomb\"\nmu = 0.2               # initial value",
+        "type = \"expression\"\nforce = \"mu * N * sign(v)\"\nparams = { mu = 0.2 }",
+    );
     assert_ne!(expr, base, "the fixture's [model] table changed");
     let mut mus = Vec::new();
     for (name, text) in [("coulomb", &base), ("expression", &expr)] {
