@@ -3,32 +3,14 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use frictionid_engine::identify::{compare, fit, FitOptions};
-use frictionid_engine::simulate::{simulate, Initial, SimOptions};
-use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
+use frictionid_engine::synthetic::release_records;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{default_model, Coulomb, FrictionModel};
 use std::hint::black_box;
 
 fn records(osc: &Oscillator, model: &dyn FrictionModel) -> Vec<Record> {
-    let times = uniform_times(2.0, 1000.0);
-    [0.010, 0.014, 0.022]
-        .iter()
-        .enumerate()
-        .map(|(i, &x0)| {
-            let t = simulate(
-                osc,
-                model,
-                &Initial::at_rest(x0),
-                2.0,
-                &times,
-                &SimOptions::default(),
-            )
-            .expect("truth simulation");
-            let mut v = t.v;
-            add_gaussian_noise(&mut v, 2e-4, 100 + i as u64);
-            Record::new(format!("x{i}"), times.clone(), v, x0)
-        })
-        .collect()
+    release_records(osc, model, &[0.010, 0.014, 0.022], 2.0, 1000.0, 2e-4, 100)
+        .expect("truth simulation")
 }
 
 fn bench(c: &mut Criterion) {

@@ -28,6 +28,44 @@ pub fn add_gaussian_noise(values: &mut [f64], sigma: f64, seed: u64) {
     }
 }
 
+/// Synthetic measured records: the free vibration of `osc` with `model` released from rest at
+/// each of `releases` [m], simulated for `duration` s, sampled at `sample_rate` Hz, with
+/// Gaussian velocity noise of `noise` m/s (seed `seed + i` for the i-th release). Record
+/// names are `x{mm}mm`.
+pub fn release_records(
+    osc: &crate::Oscillator,
+    model: &dyn frictionid_models::FrictionModel,
+    releases: &[f64],
+    duration: f64,
+    sample_rate: f64,
+    noise: f64,
+    seed: u64,
+) -> Result<Vec<crate::Record>, crate::EngineError> {
+    let times = uniform_times(duration, sample_rate);
+    releases
+        .iter()
+        .enumerate()
+        .map(|(i, &x0)| {
+            let traj = crate::simulate(
+                osc,
+                model,
+                &crate::Initial::at_rest(x0),
+                duration,
+                &times,
+                &crate::SimOptions::default(),
+            )?;
+            let mut v = traj.v;
+            add_gaussian_noise(&mut v, noise, seed + i as u64);
+            Ok(crate::Record::new(
+                format!("x{}mm", (x0 * 1e3).round()),
+                times.clone(),
+                v,
+                x0,
+            ))
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

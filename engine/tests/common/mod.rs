@@ -1,8 +1,7 @@
 //! Synthetic FMM records made by the engine (the identifier issue's acceptance set-up).
 #![allow(dead_code)]
 
-use frictionid_engine::simulate::{simulate, Initial, SimOptions};
-use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
+use frictionid_engine::synthetic::release_records;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::FrictionModel;
 
@@ -14,23 +13,6 @@ pub const NOISE: f64 = 2e-4;
 /// Records of `model` on `osc` from the three releases, 2 s at 1 kHz, with Gaussian noise of
 /// `noise` m/s (seeds `seed`, `seed + 1`, `seed + 2`).
 pub fn records(osc: &Oscillator, model: &dyn FrictionModel, noise: f64, seed: u64) -> Vec<Record> {
-    let times = uniform_times(2.0, 1000.0);
-    RELEASES
-        .iter()
-        .enumerate()
-        .map(|(i, &x0)| {
-            let traj = simulate(
-                osc,
-                model,
-                &Initial::at_rest(x0),
-                2.0,
-                &times,
-                &SimOptions::default(),
-            )
-            .expect("simulation of the truth");
-            let mut v = traj.v.clone();
-            add_gaussian_noise(&mut v, noise, seed + i as u64);
-            Record::new(format!("x{}mm", (x0 * 1e3).round()), times.clone(), v, x0)
-        })
-        .collect()
+    release_records(osc, model, &RELEASES, 2.0, 1000.0, noise, seed)
+        .expect("simulation of the truth")
 }
