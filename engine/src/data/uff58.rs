@@ -109,8 +109,7 @@ pub fn read_uff58(path: &Path, text: &str, opts: &ReadOptions) -> Result<Record,
         reason,
     };
     let mut i = 0;
-    while i < lines.len() {
-        let (_, line) = lines[i];
+    while let Some(&(_, line)) = lines.get(i) {
         if !is_delimiter(line) {
             i += 1;
             continue;
@@ -130,7 +129,7 @@ pub fn read_uff58(path: &Path, text: &str, opts: &ReadOptions) -> Result<Record,
         }
         // Skip another dataset: find its closing delimiter.
         i += 2;
-        while i < lines.len() && !is_delimiter(lines[i].1) {
+        while lines.get(i).is_some_and(|&(_, l)| !is_delimiter(l)) {
             i += 1;
         }
         i += 1;
