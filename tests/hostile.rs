@@ -314,8 +314,7 @@ fn long_formulas_are_refused_and_the_longest_accepted_one_builds() {
     for n in [terms + 1, 100_000, 1_000_000] {
         let force = format!("{head}{}", " + v".repeat(n));
         let e = build_json(&serde_json::json!({ "type": "expression", "force": force }))
-            .err()
-            .expect("over the limit");
+            .expect_err("over the limit");
         assert!(one_line(&e).contains("at most 2000"), "{e}");
     }
     // Deep nesting is refused by the parser's depth limit.
