@@ -40,13 +40,12 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Models { json } => commands::models::run(json).map(|_| Outcome::Done),
         Command::Simulate { config, output } => commands::simulate::run(&config, &output),
         Command::Energy { config, output } => commands::energy::run(&config, &output),
-        Command::Fit { config, .. } | Command::Compare { config, .. } => {
-            // The inputs are checked in full before the (not yet wired) analysis.
-            commands::load_inputs(&config, "this command")?;
-            Err(anyhow::anyhow!(
-                "this command is not available in this build of frictionid yet"
-            ))
-        }
+        Command::Fit { config, output } => commands::fit::run(&config, &output),
+        Command::Compare {
+            config,
+            models,
+            output,
+        } => commands::compare::run(&config, models.as_deref(), &output),
     }
 }
 

@@ -324,9 +324,6 @@ fn simulate_and_energy_name_what_they_need() {
         &[],
     );
     assert!(e.contains("simulate needs a [model] table"), "{e}");
-    let cfg = format!("{OSC}[[records]]\nfile = \"r.csv\"\nx0 = 0.014\n");
-    let e = fails("no-ref", "energy", &cfg, &[("r.csv", &csv(20))]);
-    assert!(e.contains("energy needs a reference friction force"), "{e}");
     let e = fails(
         "no-records",
         "energy",

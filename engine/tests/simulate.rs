@@ -301,9 +301,25 @@ fn bristle_models_complete_over_four_decades_of_stiffness() {
             );
             if name == "dahl" && sigma0 == 1e3 {
                 // Dahl has no static friction: with a bristle compliance mu_c N / sigma0 = 2.9 mm
-                // the small-amplitude loss falls as the amplitude cubed and the decay is
-                // algebraic, so 1e-6 m is out of reach in 20 s; the amplitude must still fall.
+                // the small-amplitude loss falls as the amplitude cubed and the decay is slow
+                // (1.3e-4 m after 20 s), until the viscous damping (zeta = 0.1 %) takes over:
+                // below 1e-6 m within 600 s.
                 assert!(a20 < 0.1 * a2, "{name} sigma0 = {sigma0}: {a2} -> {a20}");
+                let times = uniform_times(600.0, 50.0);
+                let very_long = simulate(
+                    &Oscillator::fmm(),
+                    built.model.as_ref(),
+                    &Initial::at_rest(0.022),
+                    600.0,
+                    &times,
+                    &SimOptions::default(),
+                )
+                .unwrap();
+                let a600 = tail_amplitude(&very_long.x, 100);
+                assert!(
+                    very_long.rest.is_some() || a600 < 1e-6,
+                    "{name} sigma0 = {sigma0}: amplitude {a600} after 600 s"
+                );
             } else {
                 assert!(
                     long.rest.is_some() || a20 < 1e-6,

@@ -51,15 +51,28 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
     let cfg = &inputs.config;
     let osc = &cfg.oscillator;
     let opts = energy_options(&cfg.energy);
-    let model = match (&cfg.model, cfg.energy.reference_force) {
+    // The reference: `[model]` as given, else `reference_force`, else a Coulomb fit to the
+    // same records (the paper's procedure: fit mu, then compare with mu N).
+    let fitted;
+    let model: Option<&dyn frictionid_models::FrictionModel> = match (
+        &cfg.model,
+        cfg.energy.reference_force,
+    ) {
         (Some(m), _) => Some(m.model.as_ref()),
         (None, Some(_)) => None,
-        (None, None) => anyhow::bail!(
-            "{}: energy needs a reference friction force: a [model] table or `reference_force` in [energy]",
-            config.display()
-        ),
+        (None, None) => {
+            let coulomb = frictionid_models::Coulomb::default();
+            let fit_opts = super::fit::fit_options(cfg, &coulomb, None)?;
+            fitted = frictionid_engine::identify::fit(osc, &coulomb, &inputs.records, &fit_opts)
+                    .map_err(|e| {
+                        anyhow::anyhow!(
+                            "{}: no [model] or reference_force, and the Coulomb fit for a reference failed: {e}",
+                            config.display()
+                        )
+                    })?;
+            Some(fitted.fitted_model.as_ref())
+        }
     };
-
     struct One {
         name: String,
         analysis: frictionid_engine::energy::EnergyAnalysis,

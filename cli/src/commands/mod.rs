@@ -1,6 +1,8 @@
 //! The subcommands. Each returns an [`Outcome`]; errors propagate as `anyhow` to the edge.
 
+pub mod compare;
 pub mod energy;
+pub mod fit;
 pub mod models;
 pub mod simulate;
 

@@ -451,6 +451,9 @@ fn run_start(
     // most twice its scale, so a poor linearisation cannot throw a trial point into a region
     // where the simulation is stiff or degenerate.
     solver.max_step = 2.0;
+    if let Some(t) = opts.tolerance {
+        solver.ftol = t;
+    }
     let model_name = problem.model.name().to_string();
     let mut exec = Executor::new(problem, solver)
         .configure(|s| s.param(u0).max_iters(max_iterations))
@@ -565,6 +568,34 @@ pub fn fit(
         let u0 = problem.internal(p);
         run_start(problem, u0, opts, iters, s, n_starts)
     };
+    if layout.is_empty() {
+        // Nothing to vary: evaluate the model as it is.
+        let r = reference.residuals_at(&[])?;
+        let cost = half_sq_norm(&r);
+        return finish(
+            FinishInput {
+                records,
+                opts,
+                layout: &layout,
+                reference: &reference,
+                best: StartOutcome {
+                    u: DVector::zeros(0),
+                    cost,
+                    iterations: 0,
+                    simulations: reference.simulations(),
+                    termination: "converged: no free parameters".into(),
+                    converged: true,
+                },
+                iterations: 0,
+                simulations: 0,
+                n_starts: 1,
+                starts_at_best: 1,
+                n_model_free,
+                warnings: Vec::new(),
+            },
+            clock,
+        );
+    }
     let screened: Vec<Result<StartOutcome, EngineError>> = if opts.parallel && n_starts > 1 {
         points
             .par_iter()
@@ -622,7 +653,7 @@ pub fn fit(
             }
         }
     }
-    let ok: Vec<StartOutcome> = ok.into_iter().map(|(_, o)| o).collect();
+    let mut ok: Vec<StartOutcome> = ok.into_iter().map(|(_, o)| o).collect();
     if ok.is_empty() {
         let why = first_error
             .map(|e| e.to_string())
@@ -635,19 +666,71 @@ pub fn fit(
         return Err(EngineError::Fit(format!("{why}{detail}")));
     }
     let iterations: u64 = ok.iter().map(|o| o.iterations).sum();
-    let mut simulations: u64 = ok.iter().map(|o| o.simulations).sum();
+    let simulations: u64 = ok.iter().map(|o| o.simulations).sum();
     let best_idx = ok
         .iter()
         .enumerate()
         .min_by(|a, b| a.1.cost.total_cmp(&b.1.cost))
         .map(|(i, _)| i)
         .unwrap_or(0);
-    let best = &ok[best_idx];
+    let best_cost = ok[best_idx].cost;
     let starts_at_best = ok
         .iter()
-        .filter(|o| o.cost <= best.cost * (1.0 + 1e-6) + 1e-300)
+        .filter(|o| o.cost <= best_cost * (1.0 + 1e-6) + 1e-300)
         .count();
 
+    let best = ok.swap_remove(best_idx);
+    finish(
+        FinishInput {
+            records,
+            opts,
+            layout: &layout,
+            reference: &reference,
+            best,
+            iterations,
+            simulations,
+            n_starts,
+            starts_at_best,
+            n_model_free,
+            warnings,
+        },
+        clock,
+    )
+}
+
+fn half_sq_norm(r: &DVector<f64>) -> f64 {
+    0.5 * r.norm_squared()
+}
+
+struct FinishInput<'a> {
+    records: &'a [Record],
+    opts: &'a FitOptions,
+    layout: &'a [FreeParam],
+    reference: &'a FitProblem,
+    best: StartOutcome,
+    iterations: u64,
+    simulations: u64,
+    n_starts: usize,
+    starts_at_best: usize,
+    n_model_free: usize,
+    warnings: Vec<String>,
+}
+
+/// Statistics, per-record residuals and the energy check at the best parameters.
+fn finish(input: FinishInput<'_>, clock: Instant) -> Result<FitResult, EngineError> {
+    let FinishInput {
+        records,
+        opts,
+        layout,
+        reference,
+        best,
+        iterations,
+        mut simulations,
+        n_starts,
+        starts_at_best,
+        n_model_free,
+        mut warnings,
+    } = input;
     // Statistics in physical coordinates at the optimum.
     let p_best = reference.physical(&best.u);
     let (jac, r) = reference.jacobian_physical(&p_best)?;
@@ -707,7 +790,7 @@ pub fn fit(
             "velocity alone fixes k/m, c/m and friction/m, not m: with the mass free, scaling m, c, k and the friction level together leaves the motion unchanged; fix the mass (or another of them) to identify the rest".into(),
         );
     }
-    let derived = derived_ratios(&world.oscillator, &layout, &cov.matrix, opts);
+    let derived = derived_ratios(&world.oscillator, layout, &cov.matrix, opts);
 
     // Per-record residuals, fitted series and the energy-based force check.
     let mut record_fits = Vec::new();

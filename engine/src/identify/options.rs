@@ -95,6 +95,8 @@ pub struct FitOptions {
     pub multistart: Option<usize>,
     /// Iteration limit of each start.
     pub max_iterations: u64,
+    /// Convergence tolerance on the relative cost reduction of a step (solver default 1e-9).
+    pub tolerance: Option<f64>,
     /// Simulation options.
     pub sim: SimOptions,
     /// Energy-analysis options (for the energy-based force residuals).
@@ -117,6 +119,7 @@ impl Default for FitOptions {
             time_shift: false,
             multistart: None,
             max_iterations: 200,
+            tolerance: None,
             sim: SimOptions {
                 max_steps: FIT_MAX_STEPS,
                 ..SimOptions::default()

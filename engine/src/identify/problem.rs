@@ -232,6 +232,9 @@ impl FitProblem {
     /// inwards at an upper bound.
     pub fn jacobian_internal(&self, u: &DVector<f64>, r0: &DVector<f64>) -> DMatrix<f64> {
         let n = self.layout.len();
+        if n == 0 {
+            return DMatrix::zeros(r0.len(), 0);
+        }
         let column = |j: usize| -> DVector<f64> {
             let (_, hi) = self.layout[j].internal_bounds();
             let mut h = FD_STEP * u[j].abs().max(1.0);

@@ -53,6 +53,16 @@ pub fn covariance(j: &DMatrix<f64>, ssr: f64) -> Covariance {
     let (n, p) = j.shape();
     let dof = n.saturating_sub(p);
     let s2 = if dof > 0 { ssr / dof as f64 } else { f64::NAN };
+    if p == 0 {
+        return Covariance {
+            matrix: DMatrix::zeros(0, 0),
+            std_errors: Vec::new(),
+            correlation: DMatrix::zeros(0, 0),
+            residual_variance: s2,
+            dof,
+            singular: false,
+        };
+    }
     let jtj = j.transpose() * j;
     // Scale to unit diagonal before inverting, so the condition test is unit-free.
     let d: Vec<f64> = (0..p).map(|i| jtj[(i, i)].max(0.0).sqrt()).collect();
