@@ -323,3 +323,16 @@ fn long_formulas_are_refused_and_the_longest_accepted_one_builds() {
     let deep = format!("{}v", "-".repeat(1500));
     assert!(build_json(&serde_json::json!({ "type": "expression", "force": deep })).is_err());
 }
+
+#[test]
+fn deeply_nested_toml_is_an_error() {
+    for depth in [100usize, 10_000, 1_000_000] {
+        let arrays = format!("x = {}1{}\n", "[".repeat(depth), "]".repeat(depth));
+        let tables = format!("x = {}1{}\n", "{a = ".repeat(depth), "}".repeat(depth));
+        for text in [arrays, tables] {
+            let text = format!("{OSC}{text}");
+            let e = Config::parse(std::path::Path::new("deep.toml"), &text).unwrap_err();
+            one_line(&e);
+        }
+    }
+}
