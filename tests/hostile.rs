@@ -336,3 +336,10 @@ fn deeply_nested_toml_is_an_error() {
         }
     }
 }
+
+#[test]
+fn a_simulation_of_1e18_samples_is_refused_before_allocating() {
+    let text = format!("{OSC}[simulation]\nx0 = 0.01\nduration = 1e9\nsample_rate = 1e9\n");
+    let e = Config::parse(std::path::Path::new("long.toml"), &text).unwrap_err();
+    assert!(one_line(&e).contains("samples"), "{e}");
+}

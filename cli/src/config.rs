@@ -34,7 +34,7 @@
 //! syntax errors name the line and column.
 
 use crate::error::CliError;
-use frictionid_engine::data::{read_record, DataFormat, ReadOptions};
+use frictionid_engine::data::{read_record, DataFormat, ReadOptions, MAX_SAMPLES};
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::registry::nearest;
 use frictionid_models::{build_toml, FrictionModel};
@@ -537,15 +537,24 @@ fn simulation_config(s: RawSimulation) -> Result<SimulationConfig, String> {
         }
         other => other,
     };
+    let duration = positive("[simulation]: `duration`", duration)?;
+    let sample_rate = positive(
+        "[simulation]: `sample_rate`",
+        s.sample_rate.unwrap_or(1000.0),
+    )?;
+    // The output holds duration * sample_rate + 1 samples: bound it before allocating.
+    let samples = duration * sample_rate;
+    if samples >= MAX_SAMPLES as f64 {
+        return Err(format!(
+            "[simulation]: duration * sample_rate = {samples:e} samples; at most {MAX_SAMPLES} are written"
+        ));
+    }
     Ok(SimulationConfig {
         x0: finite("[simulation]: `x0`", x0)?,
         v0: finite("[simulation]: `v0`", s.v0)?,
         z0: s.z0,
-        duration: positive("[simulation]: `duration`", duration)?,
-        sample_rate: positive(
-            "[simulation]: `sample_rate`",
-            s.sample_rate.unwrap_or(1000.0),
-        )?,
+        duration,
+        sample_rate,
         noise,
         seed: s.seed,
         integrator: s.integrator,
