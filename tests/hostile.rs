@@ -343,3 +343,14 @@ fn a_simulation_of_1e18_samples_is_refused_before_allocating() {
     let e = Config::parse(std::path::Path::new("long.toml"), &text).unwrap_err();
     assert!(one_line(&e).contains("samples"), "{e}");
 }
+
+#[test]
+fn an_absurd_number_of_starts_is_refused_before_allocating() {
+    let rec = fmm_record(&Coulomb { mu: 0.2 }, 0.014);
+    let opts = FitOptions {
+        multistart: Some(usize::MAX),
+        ..FitOptions::default()
+    };
+    let e = fit(&Oscillator::fmm(), &Coulomb::default(), &[rec], &opts).unwrap_err();
+    assert!(one_line(&e).contains("multistart"), "{e}");
+}
