@@ -34,13 +34,19 @@
 //! syntax errors name the line and column.
 
 use crate::error::CliError;
-use frictionid_engine::data::{read_record, DataFormat, ReadOptions};
+use frictionid_engine::data::{read_record, DataFormat, ReadOptions, MAX_SAMPLES};
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::registry::nearest;
 use frictionid_models::{build_toml, FrictionModel};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+
+/// Most `[[records]]` entries accepted in one configuration file.
+pub const MAX_RECORDS: usize = 1000;
+
+/// Largest configuration file read \[bytes\] (1 MiB).
+pub const MAX_CONFIG_BYTES: u64 = 1024 * 1024;
 
 /// A loaded and checked configuration file.
 #[derive(Debug, Clone)]
@@ -372,16 +378,34 @@ fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> CliError {
 impl Config {
     /// Reads and checks the configuration file at `path`.
     pub fn load(path: &Path) -> Result<Self, CliError> {
-        let text = std::fs::read_to_string(path).map_err(|e| {
+        use std::io::Read;
+        let io = |e: std::io::Error| {
             CliError::Config(format!(
                 "{}: cannot read the config file: {}",
                 path.display(),
                 match e.kind() {
                     std::io::ErrorKind::NotFound => "no such file".to_string(),
+                    std::io::ErrorKind::InvalidData => "it is not UTF-8 text".to_string(),
                     _ => e.to_string(),
                 }
             ))
-        })?;
+        };
+        // Never read past the limit (also for pipes and devices, whose length is unknown).
+        let mut bytes = Vec::new();
+        std::fs::File::open(path)
+            .map_err(io)?
+            .take(MAX_CONFIG_BYTES + 1)
+            .read_to_end(&mut bytes)
+            .map_err(io)?;
+        if bytes.len() as u64 > MAX_CONFIG_BYTES {
+            return Err(CliError::Config(format!(
+                "{}: the config file is over {} KiB; is it the right file?",
+                path.display(),
+                MAX_CONFIG_BYTES / 1024
+            )));
+        }
+        let text = String::from_utf8(bytes)
+            .map_err(|_| io(std::io::Error::from(std::io::ErrorKind::InvalidData)))?;
         Self::parse(path, &text)
     }
 
@@ -428,6 +452,12 @@ impl Config {
 
         let energy = raw.energy.unwrap_or_default();
 
+        if raw.records.len() > MAX_RECORDS {
+            return Err(cfg_err(format!(
+                "{} [[records]] entries; at most {MAX_RECORDS} are accepted",
+                raw.records.len()
+            )));
+        }
         let records = raw
             .records
             .into_iter()
@@ -507,15 +537,24 @@ fn simulation_config(s: RawSimulation) -> Result<SimulationConfig, String> {
         }
         other => other,
     };
+    let duration = positive("[simulation]: `duration`", duration)?;
+    let sample_rate = positive(
+        "[simulation]: `sample_rate`",
+        s.sample_rate.unwrap_or(1000.0),
+    )?;
+    // The output holds duration * sample_rate + 1 samples: bound it before allocating.
+    let samples = duration * sample_rate;
+    if samples >= MAX_SAMPLES as f64 {
+        return Err(format!(
+            "[simulation]: duration * sample_rate = {samples:e} samples; at most {MAX_SAMPLES} are written"
+        ));
+    }
     Ok(SimulationConfig {
         x0: finite("[simulation]: `x0`", x0)?,
         v0: finite("[simulation]: `v0`", s.v0)?,
         z0: s.z0,
-        duration: positive("[simulation]: `duration`", duration)?,
-        sample_rate: positive(
-            "[simulation]: `sample_rate`",
-            s.sample_rate.unwrap_or(1000.0),
-        )?,
+        duration,
+        sample_rate,
         noise,
         seed: s.seed,
         integrator: s.integrator,

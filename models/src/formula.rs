@@ -165,6 +165,11 @@ const CONSTANTS: &[(&str, f64)] = &[("pi", std::f64::consts::PI)];
 /// Deepest nesting of parentheses and operators accepted (guards the recursive parser).
 const MAX_DEPTH: usize = 256;
 
+/// Longest formula accepted \[characters\]. A chain `a + b + c + ...` is not nested but still
+/// builds a tree as deep as it is long, which every later pass (compilation, drop) walks
+/// recursively; this bound keeps that depth far from the stack limit.
+pub const MAX_FORMULA_CHARS: usize = 2000;
+
 impl Func {
     fn lookup(name: &str) -> Option<Func> {
         FUNCTIONS.iter().find(|(n, _)| *n == name).map(|(_, f)| *f)
@@ -667,6 +672,17 @@ pub fn parse(text: &str) -> Result<Parsed, ModelError> {
         column: e.column,
         formula: text.to_string(),
     };
+    let length = text.chars().count();
+    if length > MAX_FORMULA_CHARS {
+        let head: String = text.chars().take(40).collect();
+        return Err(ModelError::Formula {
+            message: format!(
+                "the formula has {length} characters; at most {MAX_FORMULA_CHARS} are accepted"
+            ),
+            column: MAX_FORMULA_CHARS + 1,
+            formula: format!("{head}..."),
+        });
+    }
     let tokens = lex(text).map_err(locate)?;
     let mut p = Parser {
         tokens,

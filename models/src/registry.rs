@@ -50,6 +50,7 @@ fn parse_expected(msg: &str) -> Vec<String> {
     let Some(pos) = msg.find("expected") else {
         return Vec::new();
     };
+    // `pos` comes from `find` on the same string: a char boundary within it.
     msg[pos..]
         .split('`')
         .skip(1)

@@ -1,7 +1,7 @@
 //! Delimited text records: CSV (comma, semicolon or tab) or whitespace-separated columns with a
 //! header row. Blank lines and lines starting with `#` are skipped anywhere in the file.
 
-use super::{finish, DataError, DataFormat, ReadOptions};
+use super::{finish, quoted, too_many_samples, DataError, DataFormat, ReadOptions, MAX_SAMPLES};
 use crate::record::Record;
 use std::path::Path;
 
@@ -90,11 +90,15 @@ pub fn read_delimited(
         find_column(&header, name).ok_or_else(|| DataError::MissingColumn {
             file: file(),
             line: header_line,
-            column: name.to_string(),
-            hint: frictionid_models::registry::nearest(name, header.iter().copied())
-                .map(|n| format!(" (did you mean `{n}`?)"))
-                .unwrap_or_default(),
-            available: header.join(", "),
+            column: quoted(name),
+            // Only short names are compared (the edit distance costs the product of lengths).
+            hint: frictionid_models::registry::nearest(
+                name,
+                header.iter().copied().filter(|h| h.len() <= 64),
+            )
+            .map(|n| format!(" (did you mean `{n}`?)"))
+            .unwrap_or_default(),
+            available: quoted(&header.join(", ")),
         })
     };
     let ti = column(&opts.time_column)?;
@@ -102,6 +106,9 @@ pub fn read_delimited(
 
     let (mut time, mut velocity, mut line_numbers) = (Vec::new(), Vec::new(), Vec::new());
     for (line, text) in lines {
+        if time.len() >= MAX_SAMPLES {
+            return Err(too_many_samples(path, line));
+        }
         let fields = sep.split(text);
         if fields.len() != header.len() {
             return Err(DataError::ColumnCount {
@@ -117,8 +124,8 @@ pub fn read_delimited(
             let value = raw.parse::<f64>().map_err(|_| DataError::BadNumber {
                 file: file(),
                 line,
-                column: name.to_string(),
-                text: raw.to_string(),
+                column: quoted(name),
+                text: quoted(raw),
             })?;
             if value.is_finite() {
                 Ok(value)
@@ -126,7 +133,7 @@ pub fn read_delimited(
                 Err(DataError::NonFinite {
                     file: file(),
                     line,
-                    column: name.to_string(),
+                    column: quoted(name),
                     value,
                 })
             }

@@ -17,6 +17,28 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+/// Largest record file read \[bytes\] (256 MiB, about six million `time,velocity` lines); a
+/// larger file is refused with [`DataError::TooLarge`] before it is read.
+pub const MAX_FILE_BYTES: u64 = 256 * 1024 * 1024;
+
+/// Most samples accepted in one record (ten million: over two hours at 1 kHz).
+pub const MAX_SAMPLES: usize = 10_000_000;
+
+/// Longest text of a field or header quoted in an error message \[characters\].
+const MAX_QUOTED_CHARS: usize = 60;
+
+/// `text` for an error message: at most [`MAX_QUOTED_CHARS`] characters, with an ellipsis
+/// and the full length when it is cut.
+pub(crate) fn quoted(text: &str) -> String {
+    let n = text.chars().count();
+    if n <= MAX_QUOTED_CHARS {
+        text.to_string()
+    } else {
+        let head: String = text.chars().take(MAX_QUOTED_CHARS).collect();
+        format!("{head}... ({n} characters)")
+    }
+}
+
 /// The format of a record file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -140,6 +162,9 @@ pub enum DataError {
         line: usize,
         reason: String,
     },
+    /// The file or record exceeds a size limit ([`MAX_FILE_BYTES`], [`MAX_SAMPLES`]).
+    #[error("{file}: {reason}")]
+    TooLarge { file: PathBuf, reason: String },
     /// Invalid read options.
     #[error("{file}: {reason}")]
     Options { file: PathBuf, reason: String },
@@ -189,15 +214,44 @@ pub fn resolve_format(path: &Path, format: DataFormat) -> DataFormat {
 }
 
 fn read_text(path: &Path) -> Result<String, DataError> {
-    let bytes = std::fs::read(path).map_err(|e| DataError::Io {
+    use std::io::Read;
+    let io = |e: std::io::Error| DataError::Io {
         file: path.to_path_buf(),
         reason: io_reason(&e),
-    })?;
+    };
+    let too_large = |size: String| DataError::TooLarge {
+        file: path.to_path_buf(),
+        reason: format!(
+            "the file is {size}; records larger than {} MiB are refused",
+            MAX_FILE_BYTES / (1024 * 1024)
+        ),
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let declared = file.metadata().map_err(io)?.len();
+    if declared > MAX_FILE_BYTES {
+        return Err(too_large(format!("{declared} bytes")));
+    }
+    // The metadata length is 0 for pipes and devices: never read past the limit either way.
+    let mut bytes = Vec::new();
+    file.take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(too_large(format!("over {MAX_FILE_BYTES} bytes")));
+    }
     let text = String::from_utf8_lossy(&bytes).into_owned();
     Ok(text
         .strip_prefix('\u{feff}')
         .map(str::to_string)
         .unwrap_or(text))
+}
+
+/// The error for a record with more than [`MAX_SAMPLES`] samples.
+fn too_many_samples(path: &Path, line: usize) -> DataError {
+    DataError::TooLarge {
+        file: path.to_path_buf(),
+        reason: format!("line {line}: more than {MAX_SAMPLES} samples; split the record"),
+    }
 }
 
 fn io_reason(e: &std::io::Error) -> String {
@@ -229,6 +283,19 @@ fn finish(
             found: time.len(),
             needed: opts.min_samples.max(2),
         });
+    }
+    // Values parse as finite, but scaling or an evenly spaced UFF abscissa can overflow.
+    for (i, (&t, &v)) in time.iter().zip(&velocity).enumerate() {
+        for (column, value) in [("time", t), ("velocity", v)] {
+            if !value.is_finite() {
+                return Err(DataError::NonFinite {
+                    file: file(),
+                    line: line_of(i),
+                    column: column.into(),
+                    value,
+                });
+            }
+        }
     }
     for (i, w) in time.windows(2).enumerate() {
         if w[1] <= w[0] {

@@ -17,7 +17,7 @@
 //! skipped. Values are read as whitespace-separated numbers, or by their fixed field widths
 //! when adjacent numbers touch. Binary files (`58b`) are rejected with a message.
 
-use super::{finish, DataError, ReadOptions};
+use super::{finish, quoted, DataError, ReadOptions, MAX_SAMPLES};
 use crate::record::Record;
 use std::path::Path;
 
@@ -109,8 +109,7 @@ pub fn read_uff58(path: &Path, text: &str, opts: &ReadOptions) -> Result<Record,
         reason,
     };
     let mut i = 0;
-    while i < lines.len() {
-        let (_, line) = lines[i];
+    while let Some(&(_, line)) = lines.get(i) {
         if !is_delimiter(line) {
             i += 1;
             continue;
@@ -130,7 +129,7 @@ pub fn read_uff58(path: &Path, text: &str, opts: &ReadOptions) -> Result<Record,
         }
         // Skip another dataset: find its closing delimiter.
         i += 2;
-        while i < lines.len() && !is_delimiter(lines[i].1) {
+        while lines.get(i).is_some_and(|&(_, l)| !is_delimiter(l)) {
             i += 1;
         }
         i += 1;
@@ -199,6 +198,15 @@ fn parse_dataset(
     if !(n_points >= 0.0 && n_points.fract() == 0.0) {
         return Err(err(l7, format!("bad number of points {n_points}")));
     }
+    if n_points > MAX_SAMPLES as f64 {
+        return Err(DataError::TooLarge {
+            file: path.to_path_buf(),
+            reason: format!(
+                "line {l7}: record 7 declares {n_points} points; more than {MAX_SAMPLES} samples are refused"
+            ),
+        });
+    }
+    // In range: a non-negative integer of at most MAX_SAMPLES.
     let n = n_points as usize;
     let even = match even as i64 {
         1 => true,
@@ -254,8 +262,10 @@ fn parse_dataset(
         (true, false) => &[13, 20, 13, 20],
     };
     let expected = if even { n } else { 2 * n };
-    let mut values = Vec::with_capacity(expected);
-    let mut value_lines = Vec::with_capacity(expected);
+    // The declared count is not trusted for the allocation: at most six values fit a line.
+    let room = expected.min(6 * lines.len().saturating_sub(start + 11));
+    let mut values = Vec::with_capacity(room);
+    let mut value_lines = Vec::with_capacity(room);
     let mut end_line = None;
     for &(ln, text) in lines.iter().skip(start + 11) {
         if is_delimiter(text) {
@@ -273,7 +283,7 @@ fn parse_dataset(
         let Some(parsed) = parsed else {
             return Err(err(
                 ln,
-                format!("`{}` is not a list of numbers", text.trim()),
+                format!("`{}` is not a list of numbers", quoted(text.trim())),
             ));
         };
         for v in parsed {

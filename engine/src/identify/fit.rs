@@ -20,6 +20,9 @@ use std::time::Instant;
 /// Starts of a multi-start fit when more than two model parameters are free.
 pub const DEFAULT_STARTS: usize = 4;
 
+/// Most starts of a multi-start fit (each is a full Levenberg-Marquardt run).
+pub const MAX_STARTS: usize = 1000;
+
 /// Iterations every start of a multi-start fit runs before the most promising are continued.
 pub const SCREEN_ITERATIONS: u64 = 25;
 
@@ -529,6 +532,11 @@ pub fn fit(
         .multistart
         .unwrap_or(if n_model_free > 2 { DEFAULT_STARTS } else { 1 })
         .max(1);
+    if n_starts > MAX_STARTS {
+        return Err(EngineError::InvalidInput(format!(
+            "multistart = {n_starts}: at most {MAX_STARTS} starts"
+        )));
+    }
     let make_problem = || {
         FitProblem::new(
             *osc,

@@ -49,6 +49,7 @@ impl FrictionModel for Coulomb {
     }
     fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
         check_len(self.name(), 1, values.len())?;
+        // Indexing below is in range: check_len has just verified the length.
         self.mu = values[0];
         Ok(())
     }

@@ -62,6 +62,7 @@ impl FrictionModel for Dahl {
     }
     fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
         check_len(self.name(), 3, values.len())?;
+        // Indexing below is in range: check_len has just verified the length.
         self.sigma0 = values[0];
         self.mu_c = values[1];
         self.alpha = values[2];

@@ -113,6 +113,7 @@ impl FrictionModel for LuGre {
     }
     fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
         check_len(self.name(), 6, values.len())?;
+        // Indexing below is in range: check_len has just verified the length.
         self.sigma0 = values[0];
         self.sigma1 = values[1];
         self.sigma2 = values[2];

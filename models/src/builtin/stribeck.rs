@@ -102,6 +102,7 @@ impl FrictionModel for Stribeck {
     }
     fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
         check_len(self.name(), 5, values.len())?;
+        // Indexing below is in range: check_len has just verified the length.
         self.mu_c = values[0];
         self.mu_s = values[1];
         self.v_s = values[2];

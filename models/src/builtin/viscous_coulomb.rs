@@ -59,6 +59,7 @@ impl FrictionModel for ViscousCoulomb {
     }
     fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
         check_len(self.name(), 2, values.len())?;
+        // Indexing below is in range: check_len has just verified the length.
         self.mu = values[0];
         self.viscous = values[1];
         Ok(())
