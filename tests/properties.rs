@@ -122,7 +122,7 @@ fn run(
 proptest! {
     #![proptest_config(ProptestConfig {
         cases: 48,
-        rng_seed: RngSeed::Fixed(20_261_121),
+        rng_seed: RngSeed::Fixed(20_261_122),
         ..ProptestConfig::default()
     })]
 
@@ -182,9 +182,12 @@ proptest! {
     ) {
         let mut model = model_from(name, &factors, true);
         if name == "stribeck" {
-            // Keep the kinetic level within a factor of three of the static one so the decay
-            // per half-cycle, 2 mu_c N / k, stops the motion within the simulated time.
+            // A static level at or above the kinetic one (mu_s < mu_c makes the mass creep
+            // by ever smaller slips instead of resting), and the kinetic level within a
+            // factor of three of it so the decay per half-cycle, 2 mu_c N / k, stops the
+            // motion within the simulated time.
             let mut p = model.params();
+            p[1] = p[1].max(p[0]);
             p[0] = p[0].max(p[1] / 3.0);
             model.set_params(&p).expect("five parameters");
         }
