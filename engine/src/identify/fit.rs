@@ -23,11 +23,11 @@ pub const DEFAULT_STARTS: usize = 4;
 /// Most starts of a multi-start fit (each is a full Levenberg-Marquardt run).
 pub const MAX_STARTS: usize = 1000;
 
-/// Iterations every start of a multi-start fit runs before the most promising are continued.
-pub const SCREEN_ITERATIONS: u64 = 25;
+/// Iterations every start of a multi-start fit runs before the most promising is continued.
+pub const SCREEN_ITERATIONS: u64 = 15;
 
-/// Starts continued to convergence after the screening phase.
-pub const PROMOTED_STARTS: usize = 2;
+/// Starts continued to convergence after the screening phase (the best one).
+pub const PROMOTED_STARTS: usize = 1;
 
 /// Correlations above this magnitude are reported as warnings.
 pub const CORRELATION_WARNING: f64 = 0.95;
