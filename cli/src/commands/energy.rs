@@ -8,7 +8,8 @@ use crate::plots;
 use crate::report::{fmt_num, markdown_table, text_table, OutputDir};
 use anyhow::Context;
 use frictionid_engine::energy::{
-    analyze_record, model_force_along, percent_difference, Differentiator, EnergyOptions,
+    analyze_record, mean_abs_where_defined, model_force_along, percent_difference, Differentiator,
+    EnergyOptions,
 };
 use serde_json::json;
 use std::path::Path;
@@ -91,19 +92,7 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
         // estimate uses (mu N for Coulomb friction).
         let reference = match (cfg.energy.reference_force, &model_force) {
             (Some(r), _) => r,
-            (None, Some(f)) => {
-                let used: Vec<f64> = f
-                    .iter()
-                    .zip(&analysis.friction)
-                    .filter(|(_, e)| e.is_finite())
-                    .map(|(m, _)| m.abs())
-                    .collect();
-                if used.is_empty() {
-                    f64::NAN
-                } else {
-                    used.iter().sum::<f64>() / used.len() as f64
-                }
-            }
+            (None, Some(f)) => mean_abs_where_defined(f, &analysis.friction),
             (None, None) => f64::NAN,
         };
         results.push(One {

@@ -146,6 +146,22 @@ pub struct EnergyAnalysis {
     pub half_cycle_std: f64,
 }
 
+/// The mean |F| of a model force series over the samples where the energy-based force
+/// `energy_force` is defined (not masked): the reference the energy estimate is compared
+/// with (exactly mu N for Coulomb friction). NaN when no sample is defined.
+pub fn mean_abs_where_defined(model_force: &[f64], energy_force: &[f64]) -> f64 {
+    let (sum, n) = model_force
+        .iter()
+        .zip(energy_force)
+        .filter(|(m, e)| e.is_finite() && m.is_finite())
+        .fold((0.0, 0usize), |(s, n), (m, _)| (s + m.abs(), n + 1));
+    if n > 0 {
+        sum / n as f64
+    } else {
+        f64::NAN
+    }
+}
+
 /// 100 (value - reference) / reference [%].
 pub fn percent_difference(value: f64, reference: f64) -> f64 {
     100.0 * (value - reference) / reference

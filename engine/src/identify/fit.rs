@@ -5,7 +5,7 @@ use super::lm::{is_converged, LevenbergMarquardt, LmState};
 use super::options::{FitOptions, OscillatorParam, Progress};
 use super::problem::FitProblem;
 use super::stats::{aic, bic, covariance, t_quantile_975};
-use crate::energy::{analyze_record, force_residuals, percent_difference};
+use crate::energy::{analyze_record, force_residuals, mean_abs_where_defined, percent_difference};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -902,19 +902,7 @@ fn energy_check(
     }
     let analysis = analyze_record(&corrected, &world.oscillator, &opts.energy)?;
     let fr = force_residuals(&analysis, world.model.as_ref(), &world.oscillator)?;
-    let mut sum_model = 0.0;
-    let mut used = 0usize;
-    for (m, e) in fr.model_force.iter().zip(&analysis.friction) {
-        if e.is_finite() && m.is_finite() {
-            sum_model += m.abs();
-            used += 1;
-        }
-    }
-    let reference = if used > 0 {
-        sum_model / used as f64
-    } else {
-        f64::NAN
-    };
+    let reference = mean_abs_where_defined(&fr.model_force, &analysis.friction);
     let ef = EnergyForce {
         mean_abs: analysis.mean_abs_force,
         reference,
