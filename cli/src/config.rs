@@ -36,7 +36,6 @@
 use crate::error::CliError;
 use frictionid_engine::data::{read_record, DataFormat, ReadOptions, MAX_SAMPLES};
 use frictionid_engine::{Oscillator, Record};
-use frictionid_models::registry::nearest;
 use frictionid_models::{build_toml, FrictionModel};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -294,11 +293,7 @@ struct RawRecord {
     sampling_tolerance: Option<f64>,
 }
 
-fn hint<'a>(key: &str, candidates: impl IntoIterator<Item = &'a str>) -> String {
-    nearest(key, candidates)
-        .map(|n| format!(" (did you mean `{n}`?)"))
-        .unwrap_or_default()
-}
+use frictionid_models::suggest::did_you_mean as hint;
 
 /// 1-based line and column of byte offset `pos` in `text`.
 fn line_col(text: &str, pos: usize) -> (usize, usize) {

@@ -10,6 +10,7 @@ pub mod error;
 pub mod formula;
 pub mod model;
 pub mod registry;
+pub mod suggest;
 
 pub use builtin::*;
 pub use error::ModelError;

@@ -78,20 +78,10 @@ pub fn listings() -> Vec<ModelListing> {
         .collect()
 }
 
-/// The registered name nearest to `name` (for "did you mean" hints).
-pub fn nearest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    candidates
-        .into_iter()
-        .map(|c| (strsim::damerau_levenshtein(name, c), c))
-        .filter(|(d, c)| *d <= (c.len().max(3) / 2))
-        .min_by_key(|(d, _)| *d)
-        .map(|(_, c)| c)
-}
+pub use crate::suggest::nearest;
 
 fn hint(name: &str, candidates: &[String]) -> String {
-    nearest(name, candidates.iter().map(String::as_str))
-        .map(|n| format!(" (did you mean `{n}`?)"))
-        .unwrap_or_default()
+    crate::suggest::did_you_mean(name, candidates.iter().map(String::as_str))
 }
 
 /// Builds a model from a TOML table (`type` plus parameter values; missing ones default).

@@ -9,7 +9,6 @@ use crate::plots;
 use crate::progress::Progress;
 use crate::report::{fmt_num, markdown_table, text_table, OutputDir};
 use frictionid_engine::identify::{compare, FitOptions};
-use frictionid_models::registry::nearest;
 use frictionid_models::{default_model, names, FrictionModel};
 use serde_json::json;
 use std::path::Path;
@@ -39,9 +38,10 @@ fn models_to_compare(
     for name in &list {
         let name = name.trim();
         if !registered.iter().any(|n| n == name) {
-            let hint = nearest(name, registered.iter().map(String::as_str))
-                .map(|n| format!(" (did you mean `{n}`?)"))
-                .unwrap_or_default();
+            let hint = frictionid_models::suggest::did_you_mean(
+                name,
+                registered.iter().map(String::as_str),
+            );
             return Err(CliError::Config(format!(
                 "unknown model `{name}` in the models to compare{hint}; registered models: {}",
                 registered.join(", ")

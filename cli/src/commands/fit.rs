@@ -10,7 +10,6 @@ use crate::plots;
 use crate::progress::Progress;
 use crate::report::{fmt_num, markdown_table, text_table, OutputDir};
 use frictionid_engine::identify::{FitOptions, FitResult, OscillatorParam};
-use frictionid_models::registry::nearest;
 use frictionid_models::FrictionModel;
 use serde::Deserialize;
 use serde_json::json;
@@ -50,9 +49,7 @@ pub fn extras(cfg: &Config) -> Result<FitExtras, CliError> {
     let table = &cfg.fit.options;
     for key in table.keys() {
         if !EXTRA_KEYS.contains(&key.as_str()) {
-            let hint = nearest(key, EXTRA_KEYS)
-                .map(|n| format!(" (did you mean `{n}`?)"))
-                .unwrap_or_default();
+            let hint = frictionid_models::suggest::did_you_mean(key, EXTRA_KEYS);
             return Err(CliError::Config(format!(
                 "{}: unknown key `{key}` in [fit.options]{hint}; valid keys: {}",
                 cfg.path.display(),

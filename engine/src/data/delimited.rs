@@ -92,12 +92,10 @@ pub fn read_delimited(
             line: header_line,
             column: quoted(name),
             // Only short names are compared (the edit distance costs the product of lengths).
-            hint: frictionid_models::registry::nearest(
+            hint: frictionid_models::suggest::did_you_mean(
                 name,
                 header.iter().copied().filter(|h| h.len() <= 64),
-            )
-            .map(|n| format!(" (did you mean `{n}`?)"))
-            .unwrap_or_default(),
+            ),
             available: quoted(&header.join(", ")),
         })
     };

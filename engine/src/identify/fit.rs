@@ -228,9 +228,7 @@ pub fn guess_hint(osc: &Oscillator, records: &[Record], opts: &FitOptions) -> Gu
 }
 
 fn unknown_name(kind: &str, name: &str, valid: &[String]) -> EngineError {
-    let hint = frictionid_models::registry::nearest(name, valid.iter().map(String::as_str))
-        .map(|n| format!(" (did you mean `{n}`?)"))
-        .unwrap_or_default();
+    let hint = frictionid_models::suggest::did_you_mean(name, valid.iter().map(String::as_str));
     EngineError::InvalidInput(format!(
         "{kind} `{name}` is not a parameter{hint}; valid: {}",
         valid.join(", ")
