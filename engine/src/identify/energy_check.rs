@@ -126,7 +126,11 @@ mod tests {
         let ef = energy_force_check(&a, ForceReference::ModelForce(&fr.model_force)).unwrap();
         let mu_n = 0.24 * osc.normal_force;
         assert!((ef.reference - mu_n).abs() < 1e-12);
-        assert!(ef.percent_difference.abs() < 1e-6, "{}", ef.percent_difference);
+        assert!(
+            ef.percent_difference.abs() < 1e-6,
+            "{}",
+            ef.percent_difference
+        );
         // The independent residual computation of the energy module agrees.
         assert!((ef.residual_rms - fr.rms).abs() < 1e-15);
         assert_eq!(ef.samples, fr.used);
@@ -140,7 +144,10 @@ mod tests {
         let ef = energy_force_check(&a, ForceReference::Level(level)).unwrap();
         assert!((ef.percent_difference - 20.0).abs() < 1e-6);
         assert!(ef.residual_rms.is_nan());
-        assert_eq!(ef.samples, a.friction.iter().filter(|f| f.is_finite()).count());
+        assert_eq!(
+            ef.samples,
+            a.friction.iter().filter(|f| f.is_finite()).count()
+        );
         let short = energy_force_check(&a, ForceReference::ModelForce(&[1.0]));
         assert!(short.is_err());
     }

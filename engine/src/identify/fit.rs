@@ -71,15 +71,18 @@ pub fn fit_with<R: Residuals + 'static>(
     let runs = if layout.params.is_empty() {
         evaluate_as_is(&reference)?
     } else {
-        let points =
-            fit_starting_points(&layout.params, &layout.start, model, opts, n_starts);
+        let points = fit_starting_points(&layout.params, &layout.start, model, opts, n_starts);
         run_starts(make_problem, &reference, &points, opts)?
     };
     let context = FinishContext {
         opts,
         layout: &layout,
         reference: &reference,
-        n_starts: if layout.params.is_empty() { 1 } else { n_starts },
+        n_starts: if layout.params.is_empty() {
+            1
+        } else {
+            n_starts
+        },
     };
     finish(&context, runs, clock)
 }

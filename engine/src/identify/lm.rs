@@ -364,12 +364,7 @@ mod tests {
         }
     }
 
-    fn run<O>(
-        problem: O,
-        p0: Vec<f64>,
-        lo: Vec<f64>,
-        hi: Vec<f64>,
-    ) -> (LmState, TerminationReason)
+    fn run<O>(problem: O, p0: Vec<f64>, lo: Vec<f64>, hi: Vec<f64>) -> (LmState, TerminationReason)
     where
         O: Operator<Param = DVector<f64>, Output = DVector<f64>>
             + Jacobian<Param = DVector<f64>, Jacobian = DMatrix<f64>>,

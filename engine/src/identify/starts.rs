@@ -347,9 +347,8 @@ fn continue_best<R, F>(
         starts: n_starts,
         max_iterations: opts.max_iterations - screen,
     };
-    let finish = |(s, u): &(usize, DVector<f64>)| {
-        (*s, run_start(make_problem(), u.clone(), opts, slot(*s)))
-    };
+    let finish =
+        |(s, u): &(usize, DVector<f64>)| (*s, run_start(make_problem(), u.clone(), opts, slot(*s)));
     let finished: Vec<(usize, Result<StartRun, EngineError>)> = if opts.parallel {
         promoted.par_iter().map(finish).collect()
     } else {
