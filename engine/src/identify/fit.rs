@@ -371,7 +371,7 @@ fn record_fits<R: Residuals>(
             channel: problem.residuals.channel().to_string(),
             rms_residual: (ss / measured.len() as f64).sqrt(),
             energy_force,
-            time: rec.time.clone(),
+            time: rec.time().to_vec(),
             measured: measured.to_vec(),
             fitted,
             energy_based_force: ebf,
@@ -390,7 +390,7 @@ fn energy_check(
 ) -> Result<(EnergyForce, Vec<f64>, Vec<f64>), EngineError> {
     // The energy analysis sees the measured velocity corrected by the fitted offset.
     let mut corrected = rec.clone();
-    for v in &mut corrected.velocity {
+    for v in corrected.velocity_mut() {
         *v -= offset;
     }
     let osc = &world.oscillator;
