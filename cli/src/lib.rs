@@ -4,9 +4,10 @@
 //! A crate that registers its own friction models (typetag) builds its own binary with the
 //! same line; its models then appear in `frictionid models` and can be named in configs.
 //!
-//! Modules: [`args`] (clap), [`config`] (TOML), [`commands`] (one per subcommand), [`report`]
-//! (atomic output files and tables), [`plots`] (SVG charts), [`progress`] (progress bars),
-//! [`error`] (typed errors).
+//! Modules: [`args`] (clap), [`config`] (TOML into the engine's `Spec`), [`commands`] (one per
+//! subcommand: load, run the engine's job, write), [`report`] (atomic output files and
+//! tables), [`terminal`] (the terminal writer of report values), [`plots`] (SVG charts),
+//! [`progress`] (progress bars), [`error`] (typed errors).
 //!
 //! Exit codes: 0 success, 1 error (one line on stderr), 2 a fit that did not converge (its
 //! report is written).
@@ -18,6 +19,7 @@ pub mod error;
 pub mod plots;
 pub mod progress;
 pub mod report;
+pub mod terminal;
 
 use args::{Cli, Command};
 use clap::Parser;

@@ -98,7 +98,7 @@ pub fn simulate_job(spec: &Spec) -> Result<SimulateReport, JobError> {
     Ok(SimulateReport {
         command: "simulate".into(),
         config: String::new(),
-        oscillator: osc.clone(),
+        oscillator: *osc,
         model: model.clone(),
         x0: sim.x0,
         v0: sim.v0,
@@ -109,7 +109,7 @@ pub fn simulate_job(spec: &Spec) -> Result<SimulateReport, JobError> {
         rest_time,
         half_cycles: traj.half_cycles(),
         events: traj.events.clone(),
-        stats: traj.stats.clone(),
+        stats: traj.stats,
         wall_time_s,
         noise: sim.noise,
         seed: sim.noise.map(|_| sim.seed),
@@ -250,7 +250,7 @@ pub fn energy_job(
     Ok(EnergyReport {
         command: "energy".into(),
         config: String::new(),
-        oscillator: spec.oscillator.clone(),
+        oscillator: spec.oscillator,
         model: spec.model.as_ref().map(|m| m.model.clone()),
         options: opts,
         records: analysed,
