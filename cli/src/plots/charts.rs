@@ -14,15 +14,16 @@ pub fn velocity_fit(
     fitted: &[f64],
     model: &str,
 ) -> Result<(), CliError> {
-    let fig = Figure {
-        title: format!("{record}: measured and fitted velocity"),
-        x_label: "time".into(),
-        x_unit: "s".into(),
-        panels: vec![Panel::new("velocity", "m/s")
-            .with(Series::solid("measured", time, measured))
-            .with(Series::dashed(format!("fitted ({model})"), time, fitted))],
-    };
-    draw(path, &fig)
+    let panel = Panel::new("velocity", "m/s")
+        .with(Series::solid("measured", time, measured))
+        .with(Series::dashed(format!("fitted ({model})"), time, fitted));
+    let title = format!("{record}: measured and fitted velocity");
+    draw(path, &Figure::over_time(title, vec![panel]))
+}
+
+/// A panel with one solid line `name` of `y` against `time`; `axis` is (quantity, unit).
+fn line_panel<'a>(axis: (&str, &str), name: &str, time: &'a [f64], y: &'a [f64]) -> Panel<'a> {
+    Panel::new(axis.0, axis.1).with(Series::solid(name, time, y))
 }
 
 /// Displacement and velocity against time (simulations).
@@ -33,16 +34,11 @@ pub fn displacement_velocity(
     x: &[f64],
     v: &[f64],
 ) -> Result<(), CliError> {
-    let fig = Figure {
-        title: title.into(),
-        x_label: "time".into(),
-        x_unit: "s".into(),
-        panels: vec![
-            Panel::new("displacement", "m").with(Series::solid("x", time, x)),
-            Panel::new("velocity", "m/s").with(Series::solid("v", time, v)),
-        ],
-    };
-    draw(path, &fig)
+    let panels = vec![
+        line_panel(("displacement", "m"), "x", time, x),
+        line_panel(("velocity", "m/s"), "v", time, v),
+    ];
+    draw(path, &Figure::over_time(title, panels))
 }
 
 /// Displacement and acceleration derived from a measured velocity (the paper's Figs. 9-10).
@@ -53,16 +49,11 @@ pub fn displacement_acceleration(
     x: &[f64],
     a: &[f64],
 ) -> Result<(), CliError> {
-    let fig = Figure {
-        title: title.into(),
-        x_label: "time".into(),
-        x_unit: "s".into(),
-        panels: vec![
-            Panel::new("displacement", "m").with(Series::solid("x", time, x)),
-            Panel::new("acceleration", "m/s²").with(Series::solid("a", time, a)),
-        ],
-    };
-    draw(path, &fig)
+    let panels = vec![
+        line_panel(("displacement", "m"), "x", time, x),
+        line_panel(("acceleration", "m/s²"), "a", time, a),
+    ];
+    draw(path, &Figure::over_time(title, panels))
 }
 
 /// Mechanical energy and its rate of change (the paper's Figs. 4-5, 11).
@@ -73,16 +64,11 @@ pub fn energy_rate(
     energy: &[f64],
     de_dt: &[f64],
 ) -> Result<(), CliError> {
-    let fig = Figure {
-        title: title.into(),
-        x_label: "time".into(),
-        x_unit: "s".into(),
-        panels: vec![
-            Panel::new("energy E = KE + PE", "J").with(Series::solid("E", time, energy)),
-            Panel::new("dE/dt", "W").with(Series::solid("dE/dt", time, de_dt)),
-        ],
-    };
-    draw(path, &fig)
+    let panels = vec![
+        line_panel(("energy E = KE + PE", "J"), "E", time, energy),
+        line_panel(("dE/dt", "W"), "dE/dt", time, de_dt),
+    ];
+    draw(path, &Figure::over_time(title, panels))
 }
 
 /// Energy-based friction force against the model's force, with dashed levels at +-reference
@@ -106,13 +92,7 @@ pub fn friction_force(
     if let Some((label, r)) = reference {
         panel = panel.with_reference(label, r).with_reference("", -r);
     }
-    let fig = Figure {
-        title: title.into(),
-        x_label: "time".into(),
-        x_unit: "s".into(),
-        panels: vec![panel],
-    };
-    draw(path, &fig)
+    draw(path, &Figure::over_time(title, vec![panel]))
 }
 
 /// The steady-state friction curves F_ss(v) of several models on one chart, for

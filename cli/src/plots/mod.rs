@@ -135,6 +135,18 @@ pub struct Figure<'a> {
     pub panels: Vec<Panel<'a>>,
 }
 
+impl<'a> Figure<'a> {
+    /// A figure of `panels` against time in seconds.
+    pub fn over_time(title: impl Into<String>, panels: Vec<Panel<'a>>) -> Self {
+        Self {
+            title: title.into(),
+            x_label: "time".into(),
+            x_unit: "s".into(),
+            panels,
+        }
+    }
+}
+
 /// Renders `fig` as SVG text.
 pub fn render(fig: &Figure<'_>) -> Result<String, String> {
     let n = fig.panels.len().max(1);

@@ -40,11 +40,9 @@ pub fn simulate_plots(out: &OutputDir, report: &SimulateReport) -> Result<Vec<St
     let t = &traj.time;
     draw(
         &out.path("energy.svg"),
-        &Figure {
-            title: format!("Energy: {title}"),
-            x_label: "time".into(),
-            x_unit: "s".into(),
-            panels: vec![
+        &Figure::over_time(
+            format!("Energy: {title}"),
+            vec![
                 Panel::new("energy", "J")
                     .with(Series::solid("kinetic", t, &traj.kinetic))
                     .with(Series::solid("potential", t, &traj.potential))
@@ -55,7 +53,7 @@ pub fn simulate_plots(out: &OutputDir, report: &SimulateReport) -> Result<Vec<St
                     &report.energy_rate,
                 )),
             ],
-        },
+        ),
     )?;
     Ok(vec![
         "displacement_velocity.svg".into(),
