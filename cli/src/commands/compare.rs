@@ -43,7 +43,7 @@ pub fn run(
     bar.finish();
     report.config = config.display().to_string();
 
-    let out = OutputDir::create(&output.out)?;
+    let out = OutputDir::create(&output.dir_for(config, "compare"))?;
     let ranking = &report.comparison.ranking;
     let mut files = match ranking.first() {
         Some(best) => fit_record_plots(&out, best, "best_")?,

@@ -16,7 +16,7 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
     let mut report =
         energy_job(&cfg.spec, &inputs.records, &Hooks::default()).map_err(|e| cfg.error(e))?;
     report.config = config.display().to_string();
-    let out = OutputDir::create(&output.out)?;
+    let out = OutputDir::create(&output.dir_for(config, "energy"))?;
     let mut files = energy_plots(&out, &report)?;
     files.extend(REPORT_FILES.map(String::from));
     report.files = files;

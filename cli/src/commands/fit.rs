@@ -30,7 +30,7 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
     bar.finish();
     report.config = config.display().to_string();
 
-    let out = OutputDir::create(&output.out)?;
+    let out = OutputDir::create(&output.dir_for(config, "fit"))?;
     let mut files = fit_record_plots(&out, &report.fit, "")?;
     files.extend(steady_state_plot(
         &out,

@@ -65,7 +65,7 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
     let mut report = simulate_job(&cfg.spec).map_err(|e| cfg.error(e))?;
     report.config = config.display().to_string();
     // Everything is computed; now write, report.json last.
-    let out = OutputDir::create(&output.out)?;
+    let out = OutputDir::create(&output.dir_for(config, "simulate"))?;
     let mut files = write_data(&out, &report)?;
     files.extend(simulate_plots(&out, &report)?);
     files.extend(REPORT_FILES.map(String::from));

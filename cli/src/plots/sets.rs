@@ -17,6 +17,41 @@ pub fn plot_stem(record_name: &str) -> String {
         .unwrap_or_else(|| "record".into())
 }
 
+/// Plot stems of the records `names`, one per record and all distinct: the file stem where it
+/// is unique; else the path as written with separators as `_` (`a/data.csv` -> `a_data`);
+/// else that with the record's position appended (`data_2`).
+pub fn unique_stems(names: &[&str]) -> Vec<String> {
+    let stems: Vec<String> = names.iter().map(|n| plot_stem(n)).collect();
+    let count = |list: &[String], s: &String| list.iter().filter(|t| *t == s).count();
+    let with_path: Vec<String> = names
+        .iter()
+        .zip(&stems)
+        .map(|(name, stem)| {
+            if count(&stems, stem) == 1 {
+                return stem.clone();
+            }
+            let parent = Path::new(name)
+                .parent()
+                .map(|p| p.to_string_lossy().into_owned());
+            match parent.filter(|p| !p.is_empty()) {
+                Some(p) => format!("{}_{stem}", p.replace(['/', '\\', ':', '.'], "_")),
+                None => stem.clone(),
+            }
+        })
+        .collect();
+    with_path
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            if count(&with_path, s) == 1 {
+                s.clone()
+            } else {
+                format!("{s}_{}", i + 1)
+            }
+        })
+        .collect()
+}
+
 /// The model force where the energy-based force is defined (not masked), NaN elsewhere.
 pub fn where_defined(model_force: &[f64], energy_force: &[f64]) -> Vec<f64> {
     model_force
@@ -94,8 +129,8 @@ pub fn fit_record_plots(
     prefix: &str,
 ) -> Result<Vec<String>, CliError> {
     let mut files = Vec::new();
-    for r in &fit.records {
-        let stem = plot_stem(&r.file);
+    let names: Vec<&str> = fit.records.iter().map(|r| r.file.as_str()).collect();
+    for (r, stem) in fit.records.iter().zip(unique_stems(&names)) {
         let vf = format!("{prefix}{stem}_velocity_fit.svg");
         super::velocity_fit(
             &out.path(&vf),
@@ -152,9 +187,9 @@ fn energy_record_plots(
     out: &OutputDir,
     report: &EnergyReport,
     r: &EnergyRecord,
+    stem: &str,
 ) -> Result<Vec<String>, CliError> {
     let a = &r.analysis;
-    let stem = plot_stem(&r.file);
     let xa = format!("{stem}_displacement_acceleration.svg");
     super::displacement_acceleration(
         &out.path(&xa),
@@ -195,8 +230,9 @@ fn energy_record_plots(
 /// `energy`: the plots of every record.
 pub fn energy_plots(out: &OutputDir, report: &EnergyReport) -> Result<Vec<String>, CliError> {
     let mut files = Vec::new();
-    for r in &report.records {
-        files.extend(energy_record_plots(out, report, r)?);
+    let names: Vec<&str> = report.records.iter().map(|r| r.file.as_str()).collect();
+    for (r, stem) in report.records.iter().zip(unique_stems(&names)) {
+        files.extend(energy_record_plots(out, report, r, &stem)?);
     }
     Ok(files)
 }
@@ -209,6 +245,22 @@ mod tests {
     fn plot_stems_come_from_file_names() {
         assert_eq!(plot_stem("data/x14mm.csv"), "x14mm");
         assert_eq!(plot_stem("x14mm.uff"), "x14mm");
+    }
+
+    #[test]
+    fn record_stems_stay_distinct_when_file_names_collide() {
+        assert_eq!(
+            unique_stems(&["x10mm.csv", "x14mm.csv"]),
+            ["x10mm", "x14mm"]
+        );
+        assert_eq!(
+            unique_stems(&["a/data.csv", "b/data.csv", "c.csv"]),
+            ["a_data", "b_data", "c"]
+        );
+        assert_eq!(
+            unique_stems(&["data.csv", "data.csv"]),
+            ["data_1", "data_2"]
+        );
     }
 
     #[test]
