@@ -62,6 +62,9 @@ pub enum Command {
         /// Print the listing as JSON.
         #[arg(long)]
         json: bool,
+        /// Print nothing (accepted for symmetry with the other commands).
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Simulate a free vibration from the config's oscillator, model and simulation tables.
     #[command(
@@ -88,7 +91,8 @@ pub enum Command {
     Compare {
         /// The TOML configuration file.
         config: PathBuf,
-        /// Comma-separated model names (default: every registered model).
+        /// Comma-separated model names [default: the config's `[fit.options] models`, else
+        /// every registered model].
         #[arg(long, value_delimiter = ',', value_name = "A,B,...")]
         models: Option<Vec<String>>,
         #[command(flatten)]

@@ -5,8 +5,11 @@ use frictionid_engine::report::json::to_json_text;
 use frictionid_engine::report::ModelsReport;
 use std::io::Write;
 
-/// Runs `frictionid models [--json]`.
-pub fn run(json: bool) -> anyhow::Result<()> {
+/// Runs `frictionid models [--json] [--quiet]`.
+pub fn run(json: bool, quiet: bool) -> anyhow::Result<()> {
+    if quiet && !json {
+        return Ok(());
+    }
     let report = ModelsReport::registered();
     let text = if json {
         to_json_text(&report)?

@@ -1,7 +1,7 @@
 //! The report of `compare`: several models fitted to the same records, ranked by AIC.
 
 use super::fit::{fit_json, parameter_table};
-use super::format::fmt_num;
+use super::format::{fmt_criterion, fmt_num};
 use super::{render_files, Render, Role, Sink, Table};
 use crate::identify::{Comparison, FitResult};
 use serde::ser::SerializeMap;
@@ -59,9 +59,9 @@ impl CompareReport {
                 vec![
                     (i + 1).to_string(),
                     f.model.clone(),
-                    format!("{:.1}", f.aic),
-                    format!("{:.1}", f.aic - best_aic),
-                    format!("{:.1}", f.bic),
+                    fmt_criterion(f.aic),
+                    fmt_criterion(f.aic - best_aic),
+                    fmt_criterion(f.bic),
                     fmt_num(f.rms_residual),
                     f.free_parameters.to_string(),
                     if f.converged { "yes" } else { "no" }.into(),

@@ -1,7 +1,7 @@
 //! The report of `energy`: the energy-based friction force of each record (the paper's
 //! Eq. 7) against a reference force.
 
-use super::format::fmt_num;
+use super::format::{fmt_num, fmt_percent};
 use super::{render_files, Render, Role, Sink, Table};
 use crate::energy::{EnergyAnalysis, EnergyOptions, HalfCycle};
 use crate::oscillator::Oscillator;
@@ -73,7 +73,7 @@ impl EnergyReport {
                     fmt_num(r.mean_abs_force),
                     fmt_num(r.half_cycle_mean),
                     fmt_num(r.reference),
-                    format!("{:.2}", r.percent_difference),
+                    fmt_percent(r.percent_difference),
                     r.half_cycles.len().to_string(),
                 ]
             })

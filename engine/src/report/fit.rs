@@ -1,6 +1,8 @@
 //! The report of `fit`: one model fitted to the records, with the energy-based force check.
 
-use super::format::{fmt_num, fmt_opt};
+use super::format::{
+    fmt_criterion, fmt_estimate, fmt_num, fmt_percent, fmt_std_error, fmt_to_error,
+};
 use super::{render_files, Render, Role, Sink, Table, Verdict};
 use crate::identify::FitResult;
 use serde::{Serialize, Serializer};
@@ -51,10 +53,16 @@ pub fn parameter_table(fit: &FitResult) -> Table {
         .map(|p| {
             vec![
                 p.name.clone(),
-                fmt_num(p.value),
-                fmt_opt(p.std_error),
+                fmt_estimate(p.value, p.std_error),
+                fmt_std_error(p.std_error),
                 p.ci95
-                    .map(|[a, b]| format!("[{}, {}]", fmt_num(a), fmt_num(b)))
+                    .map(|[a, b]| {
+                        format!(
+                            "[{}, {}]",
+                            fmt_to_error(a, p.std_error),
+                            fmt_to_error(b, p.std_error)
+                        )
+                    })
                     .unwrap_or_else(|| "-".into()),
                 p.unit.clone(),
                 if p.free { "fitted" } else { "fixed" }.into(),
@@ -62,7 +70,14 @@ pub fn parameter_table(fit: &FitResult) -> Table {
         })
         .collect();
     Table::new(
-        &["parameter", "value", "std error", "95 % CI", "unit", ""],
+        &[
+            "parameter",
+            "value",
+            "std error",
+            "95 % CI",
+            "unit",
+            "status",
+        ],
         rows,
     )
 }
@@ -77,7 +92,7 @@ pub fn record_table(fit: &FitResult) -> Table {
                 Some(e) => (
                     fmt_num(e.mean_abs),
                     fmt_num(e.reference),
-                    format!("{:.2}", e.percent_difference),
+                    fmt_percent(e.percent_difference),
                 ),
                 None => ("-".into(), "-".into(), "-".into()),
             };
@@ -104,6 +119,47 @@ pub fn record_table(fit: &FitResult) -> Table {
     )
 }
 
+/// The oscillator's derived quantities: k/m, c/m, the undamped natural frequency and the
+/// damping ratio, with standard errors where the fit gives them.
+pub fn oscillator_table(fit: &FitResult) -> Table {
+    let osc = &fit.oscillator;
+    let (m, c, k) = (osc.mass, osc.damping, osc.stiffness);
+    let std_error = |name: &str| {
+        fit.derived
+            .iter()
+            .find(|d| d.name == name)
+            .and_then(|d| d.std_error)
+    };
+    let row = |name: &str, value: f64, se: Option<f64>, unit: &str| {
+        vec![
+            name.to_string(),
+            fmt_estimate(value, se),
+            fmt_std_error(se),
+            unit.to_string(),
+        ]
+    };
+    let omega = (k / m).sqrt();
+    Table::new(
+        &["quantity", "value", "std error", "unit"],
+        vec![
+            row("k/m", k / m, std_error("k/m"), "1/s²"),
+            row("c/m", c / m, std_error("c/m"), "1/s"),
+            row(
+                "natural frequency sqrt(k/m)/2π",
+                omega / (2.0 * std::f64::consts::PI),
+                None,
+                "Hz",
+            ),
+            row(
+                "damping ratio c/(2 sqrt(k m))",
+                c / (2.0 * (k * m).sqrt()),
+                None,
+                "1",
+            ),
+        ],
+    )
+}
+
 impl FitReport {
     /// Done, or not converged.
     pub fn verdict(&self) -> Verdict {
@@ -119,8 +175,8 @@ impl FitReport {
         format!(
             "RMS residual {} m/s; AIC {}; BIC {}; {} iterations, {} simulations, {} s.",
             fmt_num(f.rms_residual),
-            fmt_num(f.aic),
-            fmt_num(f.bic),
+            fmt_criterion(f.aic),
+            fmt_criterion(f.bic),
             f.iterations,
             f.simulations,
             fmt_num(f.wall_time_s)
@@ -134,7 +190,7 @@ impl FitReport {
             f.model,
             f.termination,
             fmt_num(f.rms_residual),
-            fmt_num(f.aic)
+            fmt_criterion(f.aic)
         )
     }
 }
@@ -159,6 +215,8 @@ impl Render for FitReport {
         );
         sink.heading(2, "Parameters", Role::Detail);
         sink.table(&parameter_table(f), Role::Summary);
+        sink.heading(2, "Oscillator", Role::Detail);
+        sink.table(&oscillator_table(f), Role::Detail);
         sink.heading(2, "Records", Role::Detail);
         sink.table(&record_table(f), Role::Summary);
         sink.paragraph(&self.statistics_text(), Role::Detail);

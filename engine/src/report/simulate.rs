@@ -1,6 +1,6 @@
 //! The report of `simulate`: one free vibration.
 
-use super::format::fmt_num;
+use super::format::{fmt_num, fmt_opt};
 use super::{render_files, Render, Role, Sink, Table};
 use crate::oscillator::Oscillator;
 use crate::simulate::{Event, SimStats, Trajectory};
@@ -74,10 +74,8 @@ impl SimulateReport {
                 row("x0", fmt_num(self.x0), "m"),
                 row("final displacement", fmt_num(self.final_displacement), "m"),
                 row(
-                    "rest time",
-                    self.rest_time
-                        .map(fmt_num)
-                        .unwrap_or_else(|| "no rest".into()),
+                    "rest time (- if still moving)",
+                    fmt_opt(self.rest_time),
                     "s",
                 ),
                 row("half-cycles", self.half_cycles.to_string(), ""),
@@ -88,7 +86,7 @@ impl SimulateReport {
                     "",
                 ),
                 row("rhs evaluations", stats.rhs_evaluations.to_string(), ""),
-                row("wall time", format!("{:.4}", self.wall_time_s), "s"),
+                row("wall time", fmt_num(self.wall_time_s), "s"),
             ],
         )
     }
