@@ -193,7 +193,7 @@ def test_ctrl_c_interrupts_a_long_fit():
         " for x0 in (0.01, 0.014, 0.022)]\n"
         "print('ready', flush=True)\n"
         "try:\n"
-        "    frictionid.compare(osc, None, recs, {'options': {'multistart': 8}})\n"
+        "    frictionid.fit(osc, {'type': 'lugre'}, recs, {'options': {'multistart': 8}})\n"
         "    print('finished')\n"
         "except KeyboardInterrupt:\n"
         "    print('interrupted')\n"
@@ -202,6 +202,6 @@ def test_ctrl_c_interrupts_a_long_fit():
     assert proc.stdout.readline().strip() == "ready"
     time.sleep(0.5)
     proc.send_signal(signal.SIGINT)
-    out, _ = proc.communicate(timeout=120)
+    out, _ = proc.communicate(timeout=60)
     assert out.strip() in ("interrupted", "finished")
     assert proc.returncode == 0
