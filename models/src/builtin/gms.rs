@@ -348,68 +348,92 @@ impl Default for GmsConfig {
     }
 }
 
-impl TryFrom<GmsConfig> for Gms {
-    type Error = ModelError;
+fn bad_key(key: &str, message: String) -> ModelError {
+    ModelError::BadKey {
+        model: MODEL.into(),
+        key: key.into(),
+        message,
+    }
+}
 
-    fn try_from(cfg: GmsConfig) -> Result<Self, ModelError> {
-        let bad = |key: &str, message: String| ModelError::BadKey {
-            model: MODEL.into(),
-            key: key.into(),
-            message,
-        };
-        let lists = [
-            ("stiffness", &cfg.stiffness),
-            ("weights", &cfg.weights),
-            ("damping", &cfg.damping),
-        ];
-        // The element count and the key it came from.
-        let (n, source) = match cfg.elements {
+impl GmsConfig {
+    /// The per-element lists with their keys.
+    fn lists(&self) -> [(&'static str, &Option<PerElement>); 3] {
+        [
+            ("stiffness", &self.stiffness),
+            ("weights", &self.weights),
+            ("damping", &self.damping),
+        ]
+    }
+
+    /// The element count and the key it came from (`elements`, else the first list, else
+    /// the default).
+    fn element_count(&self) -> (usize, &'static str) {
+        match self.elements {
             Some(n) => (n, "elements"),
-            None => lists
+            None => self
+                .lists()
                 .iter()
                 .find_map(|(key, l)| l.as_ref().and_then(PerElement::len).map(|n| (n, *key)))
                 .unwrap_or((DEFAULT_ELEMENTS, "the default")),
-        };
+        }
+    }
+
+    /// Checks the element count and that every list has one value per element.
+    fn checked_element_count(&self) -> Result<usize, ModelError> {
+        let (n, source) = self.element_count();
         if n == 0 || n > MAX_ELEMENTS {
-            return Err(bad(
+            return Err(bad_key(
                 source,
                 format!("the model needs 1 to {MAX_ELEMENTS} elements, got {n}"),
             ));
         }
-        for (key, l) in lists {
+        let source = if source == "the default" {
+            source.to_string()
+        } else {
+            format!("`{source}`")
+        };
+        for (key, l) in self.lists() {
             if let Some(len) = l.as_ref().and_then(PerElement::len) {
                 if len != n {
-                    return Err(bad(
+                    return Err(bad_key(
                         key,
                         format!(
-                            "has {len} values but the model has {n} elements (from {}); give one \
-                             value per element or a single number for all",
-                            if source == "the default" {
-                                source.to_string()
-                            } else {
-                                format!("`{source}`")
-                            }
+                            "has {len} values but the model has {n} elements (from {source}); give \
+                             one value per element or a single number for all"
                         ),
                     ));
                 }
             }
         }
-        let defaults = Gms::with_elements(n);
+        Ok(n)
+    }
+
+    /// The `n` elements: the given values, else the defaults of `Gms::with_elements(n)`.
+    fn elements(&self, n: usize) -> Vec<GmsElement> {
         let pick = |l: &Option<PerElement>, i: usize, default: f64| {
             l.as_ref().and_then(|l| l.get(i)).unwrap_or(default)
         };
-        let elements = defaults
+        Gms::with_elements(n)
             .elements
             .iter()
             .enumerate()
             .map(|(i, d)| GmsElement {
-                stiffness: pick(&cfg.stiffness, i, d.stiffness),
-                weight: pick(&cfg.weights, i, d.weight),
-                damping: pick(&cfg.damping, i, d.damping),
+                stiffness: pick(&self.stiffness, i, d.stiffness),
+                weight: pick(&self.weights, i, d.weight),
+                damping: pick(&self.damping, i, d.damping),
             })
-            .collect();
+            .collect()
+    }
+}
+
+impl TryFrom<GmsConfig> for Gms {
+    type Error = ModelError;
+
+    fn try_from(cfg: GmsConfig) -> Result<Self, ModelError> {
+        let n = cfg.checked_element_count()?;
         Ok(Self {
-            elements,
+            elements: cfg.elements(n),
             mu_c: cfg.mu_c,
             mu_s: cfg.mu_s,
             v_s: cfg.v_s,
@@ -563,11 +587,10 @@ impl FrictionModel for Gms {
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         if self.elements.is_empty() {
-            return Err(ModelError::BadKey {
-                model: MODEL.into(),
-                key: "elements".into(),
-                message: "the model needs at least one element".into(),
-            });
+            return Err(bad_key(
+                "elements",
+                "the model needs at least one element".into(),
+            ));
         }
         check_bounds(self.name(), &self.param_info(), &self.params())?;
         let mut warnings = mu_s_warning(self.name(), self.mu_s, self.mu_c);
