@@ -77,28 +77,24 @@ pub fn energy_force_check(
     })
 }
 
-/// RMS of energy minus model force over the samples where the energy force is defined, and
-/// their count.
+/// RMS of energy minus model force over the samples where both are defined, and their count.
 fn residual_rms(energy: &[f64], model: &[f64]) -> Result<(f64, usize), EngineError> {
-    let (sum, used) = energy
+    let residual: Vec<f64> = energy
         .iter()
         .zip(model)
-        .filter(|(e, _)| !e.is_nan())
         .map(|(e, m)| e - m)
         .filter(|r| !r.is_nan())
-        .fold((0.0, 0usize), |(s, n), r| (s + r * r, n + 1));
-    if used == 0 {
-        return Err(EngineError::InvalidInput(
+        .collect();
+    let rms = (residual.iter().map(|r| r * r).sum::<f64>() / residual.len() as f64).sqrt();
+    match (residual.len(), rms.is_finite()) {
+        (0, _) => Err(EngineError::InvalidInput(
             "no unmasked samples to compare the model force with".into(),
-        ));
-    }
-    let rms = (sum / used as f64).sqrt();
-    if !rms.is_finite() {
-        return Err(EngineError::InvalidInput(
+        )),
+        (_, false) => Err(EngineError::InvalidInput(
             "the model gives a non-finite force along the motion".into(),
-        ));
+        )),
+        (used, true) => Ok((rms, used)),
     }
-    Ok((rms, used))
 }
 
 #[cfg(test)]
