@@ -16,6 +16,7 @@
 //!   `energy` command.
 
 pub mod compare;
+pub mod diagnostics;
 pub mod energy_check;
 pub mod fit;
 pub mod layout;
@@ -36,3 +37,4 @@ pub use lm::LevenbergMarquardt;
 pub use options::{FitOptions, OscillatorParam, Progress, ProgressFn};
 pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
 pub use residuals::{Evaluation, NuisanceKind, NuisanceValues, Residuals, VelocityResponse};
+pub use result::Verdict;
