@@ -266,3 +266,37 @@ fn an_unmodelled_offset_or_a_wrong_scale_fails_a_diagnostic() {
     let mu = r.param("mu").unwrap();
     assert!(mu.std_error.is_none() && mu.ci95.is_none(), "{mu:?}");
 }
+
+/// Akaike weights by hand from the AICs; on Coulomb data the nested viscous-Coulomb law is
+/// no better by more than 2, so the verdict names the simplest indistinguishable model,
+/// coulomb.
+#[test]
+fn the_comparison_gives_akaike_weights_and_names_the_simplest_model() {
+    let osc = Oscillator::fmm();
+    let recs = records(&osc, &Coulomb { mu: 0.24 }, NOISE, 101);
+    let models: Vec<Box<dyn FrictionModel>> = ["viscous_coulomb", "coulomb"]
+        .iter()
+        .map(|n| default_model(n).unwrap())
+        .collect();
+    let c = compare(&osc, &models, &recs, &FitOptions::default()).unwrap();
+    let best = c.ranking[0].aic;
+    let by_hand: Vec<f64> = c
+        .ranking
+        .iter()
+        .map(|f| (-(f.aic - best) / 2.0).exp())
+        .collect();
+    let total: f64 = by_hand.iter().sum();
+    let mut sum = 0.0;
+    for (f, l) in c.ranking.iter().zip(&by_hand) {
+        let rank = f.rank.unwrap();
+        assert!((rank.delta_aic - (f.aic - best)).abs() < 1e-12);
+        assert!((rank.akaike_weight - l / total).abs() < 1e-12);
+        sum += rank.akaike_weight;
+        let json = serde_json::to_value(f).unwrap();
+        assert!(json["delta_aic"].is_number() && json["akaike_weight"].is_number());
+    }
+    assert!((sum - 1.0).abs() < 1e-12);
+    let v = c.verdict.unwrap();
+    assert_eq!(v.simplest, "coulomb", "{}", v.message);
+    assert!(c.warnings.is_empty(), "{:?}", c.warnings);
+}

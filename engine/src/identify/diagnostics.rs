@@ -516,7 +516,10 @@ mod tests {
     #[test]
     fn a_parameter_at_its_bound_warns() {
         let mu = FreeParam::linear("mu".into(), "1", ParamKind::Model(0), (0.0, 5.0), 0.3, 1.0);
-        assert_eq!(parameters_at_bounds(std::slice::from_ref(&mu), &[0.24]).len(), 0);
+        assert_eq!(
+            parameters_at_bounds(std::slice::from_ref(&mu), &[0.24]).len(),
+            0
+        );
         let at = parameters_at_bounds(std::slice::from_ref(&mu), &[5.0]);
         assert_eq!(at.len(), 1);
         assert_eq!(at[0].status, Status::Warn);

@@ -21,7 +21,7 @@ use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use super::result::{Derived, FitResult, FittedParam, RecordFit};
+pub use super::result::{Derived, FitResult, FittedParam, Rank, RecordFit};
 pub use super::setup::guess_hint;
 pub use super::starts::{DEFAULT_STARTS, MAX_STARTS, PROMOTED_STARTS, SCREEN_ITERATIONS};
 
@@ -205,6 +205,7 @@ fn finish<R: Residuals>(
         diagnostics: findings,
         warnings,
         wall_time_s: clock.elapsed().as_secs_f64(),
+        rank: None,
         fitted_model: stats.world.model,
         oscillator: stats.world.oscillator,
     })

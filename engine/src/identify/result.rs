@@ -120,6 +120,23 @@ pub struct FitResult {
     pub warnings: Vec<String>,
     /// Wall time of the fit [s].
     pub wall_time_s: f64,
+    /// Its place in a model comparison (set by [`super::compare::compare`]; its keys join the
+    /// fit's in JSON).
+    #[serde(flatten)]
+    pub rank: Option<Rank>,
+}
+
+/// A fit's standing in a model comparison.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Rank {
+    /// AIC minus the best AIC (0 for the best).
+    pub delta_aic: f64,
+    /// exp(-delta_aic / 2), normalised over the ranking: the weight of evidence for this
+    /// model among those compared.
+    pub akaike_weight: f64,
+    /// Within [`super::compare::INDISTINGUISHABLE_DELTA_AIC`] of the best: the data do not
+    /// tell it from the best.
+    pub indistinguishable: bool,
 }
 
 /// What a fit's outcome means for whoever decides an exit status: the CLI maps `Ok` to 0,
