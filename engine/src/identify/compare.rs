@@ -2,6 +2,7 @@
 
 use super::fit::{fit, FitResult};
 use super::options::FitOptions;
+use super::setup::non_model_bound_keys;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -49,10 +50,9 @@ pub fn compare(
             .free
             .as_ref()
             .map(|f| f.iter().filter(|n| names.contains(n)).cloned().collect());
-        o.bounds.retain(|k, _| {
-            names.contains(k)
-                || ["mass", "damping", "stiffness", "offset", "shift"].contains(&k.as_str())
-        });
+        let other_keys = non_model_bound_keys();
+        o.bounds
+            .retain(|k, _| names.contains(k) || other_keys.contains(&k.as_str()));
         o.keep_initial.retain(|k| names.contains(k));
         (m.name().to_string(), fit(osc, m, records, &o))
     };
