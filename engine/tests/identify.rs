@@ -232,7 +232,7 @@ fn an_unmodelled_offset_or_a_wrong_scale_fails_a_diagnostic() {
     let clean = records(&osc, &Coulomb { mu: 0.24 }, NOISE, 91);
     let mut offset = clean.clone();
     for r in &mut offset {
-        for v in &mut r.velocity {
+        for v in r.velocity_mut() {
             *v += 3e-3;
         }
     }
@@ -240,7 +240,7 @@ fn an_unmodelled_offset_or_a_wrong_scale_fails_a_diagnostic() {
     assert_eq!(r.verdict(), Verdict::DiagnosticFailed, "{:?}", r.warnings);
     let mut mm = clean;
     for r in &mut mm {
-        for v in &mut r.velocity {
+        for v in r.velocity_mut() {
             *v *= 1e3;
         }
     }

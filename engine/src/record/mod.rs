@@ -298,7 +298,10 @@ mod tests {
         assert_eq!(r.normal_force().map(|n| n.mean()), Some(5.5));
         let osc = crate::Oscillator::fmm();
         assert_eq!(r.normal_force_with(&osc).at(2), 6.0);
-        assert_eq!(record().normal_force_with(&osc), NormalForce::Constant(14.5));
+        assert_eq!(
+            record().normal_force_with(&osc),
+            NormalForce::Constant(14.5)
+        );
         let tail = r.starting_at(2);
         assert_eq!(tail.time(), &[0.2, 0.3]);
         assert_eq!(tail.channel(Channel::NormalForce), Some(&[6.0, 6.0][..]));
