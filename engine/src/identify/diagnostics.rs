@@ -441,6 +441,7 @@ mod tests {
         RecordFit {
             file: "r".into(),
             x0: 0.014,
+            release_time: None,
             samples: time.len(),
             channel: "velocity".into(),
             rms_residual: 0.0,

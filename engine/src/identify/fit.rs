@@ -387,6 +387,7 @@ fn record_fits<R: Residuals>(
         out.records.push(RecordFit {
             file: rec.name.clone(),
             x0: rec.x0,
+            release_time: rec.release_time,
             samples: rec.len(),
             channel: problem.residuals.channel().to_string(),
             rms_residual: (ss / measured.len() as f64).sqrt(),

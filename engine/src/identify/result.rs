@@ -30,6 +30,9 @@ pub struct RecordFit {
     pub file: String,
     /// Release displacement [m].
     pub x0: f64,
+    /// The release instant the record was cut at (`release = "auto"` or a time) \[s\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub release_time: Option<f64>,
     /// Samples.
     pub samples: usize,
     /// The quantity compared (`velocity`).
