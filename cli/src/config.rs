@@ -153,6 +153,10 @@ pub enum IntegratorMethod {
     /// Adaptive Dormand-Prince 5(4) with dense output and event location.
     #[default]
     Dopri5,
+    /// Closed form for laws affine in v, Dopri5 otherwise.
+    Auto,
+    /// The exact closed-form propagator (coulomb, viscous_coulomb, none).
+    Exact,
     /// Fixed-step explicit Euler (for comparison only).
     Euler,
 }

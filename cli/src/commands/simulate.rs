@@ -18,6 +18,8 @@ use std::time::Instant;
 pub fn sim_options(cfg: &IntegratorConfig) -> SimOptions {
     let mut opts = SimOptions::default();
     match cfg.method {
+        IntegratorMethod::Auto => opts.integrator = Integrator::Auto,
+        IntegratorMethod::Exact => opts.integrator = Integrator::Exact,
         IntegratorMethod::Dopri5 => opts.integrator = Integrator::Dopri5,
         IntegratorMethod::Euler => {
             let steps_per_period = match (cfg.steps_per_period, &opts.integrator) {
