@@ -43,6 +43,13 @@ pub enum IntegrationFailure {
         /// The budget.
         max_events: usize,
     },
+    /// The closed-form propagator was asked to integrate a motion it cannot solve (not affine
+    /// in v, or not underdamped).
+    #[error("the closed-form propagator does not apply to this motion (it needs a law affine in v within each sliding mode and an underdamped oscillator)")]
+    ClosedFormUnavailable {
+        /// Start of the segment [s].
+        time: f64,
+    },
     /// The event function could not be evaluated while locating a turning point.
     #[error("the velocity could not be evaluated while locating a turning point")]
     EventNotLocated {
@@ -59,6 +66,7 @@ impl IntegrationFailure {
             | Self::StepSizeTooSmall { time, .. }
             | Self::NonFiniteState { time, .. }
             | Self::EventBudgetExceeded { time, .. }
+            | Self::ClosedFormUnavailable { time }
             | Self::EventNotLocated { time } => *time,
         }
     }

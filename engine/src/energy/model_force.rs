@@ -170,7 +170,7 @@ fn integrate_interval(
     along: &AlongMotion<'_>,
     z: &mut [f64],
 ) -> Result<(), IntegrationFailure> {
-    stepper.reset(along, along.t0, z, along.t0 + along.span);
+    stepper.reset(along, along.t0, z, along.t0 + along.span)?;
     while !stepper.reached_end() {
         if stepper.counts().attempts() >= MAX_SUBSTEPS {
             return Err(IntegrationFailure::StepBudgetExceeded {

@@ -98,7 +98,13 @@ impl BogackiShampine {
 }
 
 impl Stepper for BogackiShampine {
-    fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) {
+    fn reset<S: OdeSystem>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        t_end: f64,
+    ) -> Result<(), IntegrationFailure> {
         self.span = t_end - t;
         if self.h.is_nan() || self.h <= 0.0 || self.h > self.span {
             self.h = self.span;
@@ -112,6 +118,7 @@ impl Stepper for BogackiShampine {
         let [k1, .., k_prev] = &mut self.k;
         k_prev.copy_from_slice(k1);
         self.counts.rhs_evaluations += 1;
+        Ok(())
     }
 
     fn step<S: OdeSystem>(

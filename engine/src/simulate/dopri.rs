@@ -277,7 +277,13 @@ impl Dopri5 {
 }
 
 impl Stepper for Dopri5 {
-    fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) {
+    fn reset<S: OdeSystem>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        t_end: f64,
+    ) -> Result<(), IntegrationFailure> {
         self.t = t;
         self.t_prev = t;
         self.t_end = t_end;
@@ -289,6 +295,7 @@ impl Stepper for Dopri5 {
         // Leaves f(t, y) in k[0], ready for the first step.
         self.h = self.initial_step(system);
         self.counts.rhs_evaluations += 2;
+        Ok(())
     }
 
     fn step<S: OdeSystem>(

@@ -3,7 +3,7 @@
 //! output grid, budgets and statistics. Any [`Stepper`] plugs in.
 
 use super::root::illinois;
-use super::stepper::{OdeSystem, StepOutcome, Stepper};
+use super::stepper::{AffineMotion, OdeSystem, StepOutcome, Stepper};
 use super::{Dynamics, Event, EventKind, Law, Recorder, Rest, SimStats, Start};
 use crate::error::{EngineError, IntegrationFailure};
 
@@ -20,6 +20,10 @@ impl OdeSystem for Segment<'_> {
     #[inline]
     fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
         self.dynamics.rhs(y, dy, self.dir);
+    }
+
+    fn affine_motion(&self) -> Option<AffineMotion> {
+        self.dynamics.affine_motion(self.dir)
     }
 }
 
@@ -86,7 +90,7 @@ impl<R: Recorder> Driver<'_, R> {
                 dynamics: self.dynamics,
                 dir,
             };
-            stepper.reset(&segment, t, &y, t_end);
+            stepper.reset(&segment, t, &y, t_end)?;
             match self.advance(stepper, &segment, &mut y, t_end)? {
                 SegmentEnd::Finished => return Ok(()),
                 SegmentEnd::Turn(t_e) => {

@@ -40,7 +40,13 @@ impl Euler {
 }
 
 impl Stepper for Euler {
-    fn reset<S: OdeSystem>(&mut self, _system: &S, t: f64, y: &[f64], t_end: f64) {
+    fn reset<S: OdeSystem>(
+        &mut self,
+        _system: &S,
+        t: f64,
+        y: &[f64],
+        t_end: f64,
+    ) -> Result<(), IntegrationFailure> {
         self.t_seg = t;
         self.steps_in_segment = 0;
         self.t = t;
@@ -48,6 +54,7 @@ impl Stepper for Euler {
         self.t_end = t_end;
         self.y.copy_from_slice(y);
         self.y_prev.copy_from_slice(y);
+        Ok(())
     }
 
     fn step<S: OdeSystem>(

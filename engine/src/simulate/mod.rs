@@ -37,6 +37,7 @@
 //! method would remove that bound. There is no stiffness abort: such runs finish.
 
 mod bogacki;
+mod closed_form;
 mod dopri;
 mod driver;
 mod euler;
@@ -44,9 +45,10 @@ mod root;
 mod stepper;
 
 pub use bogacki::BogackiShampine;
+pub use closed_form::ClosedForm;
 pub use dopri::Dopri5;
 pub use euler::Euler;
-pub use stepper::{OdeSystem, StepCounts, StepOutcome, Stepper};
+pub use stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper};
 
 use driver::Driver;
 
@@ -67,7 +69,8 @@ const H_MAX_PERIODS: f64 = 1.0 / 8.0;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 #[serde(tag = "method", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Integrator {
-    /// Adaptive Dormand-Prince 5(4) with dense output and event location ([`Dopri5`]).
+    /// Adaptive Dormand-Prince 5(4) with dense output and event location ([`Dopri5`]), the
+    /// default.
     #[default]
     Dopri5,
     /// The paper's fixed-step explicit Euler with step T_n / `steps_per_period` (paper: 1e6).
@@ -75,6 +78,11 @@ pub enum Integrator {
         /// Steps per undamped natural period T_n.
         steps_per_period: f64,
     },
+    /// The exact propagator ([`ClosedForm`]) for laws affine in v within each sliding mode
+    /// (coulomb, viscous_coulomb, none) on an underdamped oscillator; an error otherwise.
+    Exact,
+    /// The exact propagator where it applies, Dopri5 otherwise.
+    Auto,
 }
 
 /// Options of [`simulate`].
@@ -96,7 +104,8 @@ pub struct SimOptions {
 impl Default for SimOptions {
     /// Dopri5 with rtol = 2e-9 and atol = 1e-11. On the paper's Coulomb cases this reproduces
     /// the exact solution to about 3e-10 m (rest position and 1 kHz samples), 4e-9 m/s and
-    /// 6e-11 s (rest time) with about 2000 RHS evaluations for 6 half-cycles. Up to 20 million
+    /// 6e-11 s (rest time) with about 2000 RHS evaluations for 6 half-cycles (`Exact` or
+    /// `Auto`: to 1e-12 m with no RHS evaluation). Up to 20 million
     /// steps (a fit exploring very stiff bristle models should lower this) and 100 000 events.
     fn default() -> Self {
         Self {
@@ -439,6 +448,28 @@ impl Dynamics<'_> {
         *dv = self.accel(*x, *v, f);
     }
 
+    /// The segment's linear equation when the law is affine in v in direction `dir`.
+    pub fn affine_motion(&self, dir: f64) -> Option<AffineMotion> {
+        if self.law == Law::Dynamic {
+            return None;
+        }
+        let (offset, slope) = self.model.affine_slip(dir, self.normal)?;
+        Some(AffineMotion {
+            mass: self.mass,
+            damping: self.damping + slope,
+            stiffness: self.stiffness,
+            offset,
+        })
+    }
+
+    /// Whether every sliding mode of this law is solved in closed form.
+    pub fn closed_form_applies(&self) -> bool {
+        [1.0, -1.0].into_iter().all(|dir| {
+            self.affine_motion(dir)
+                .is_some_and(|m| ClosedForm::supports(&m))
+        })
+    }
+
     /// The mode at the start of a segment from state (x, v, z).
     pub fn start(&self, x: f64, v: f64, z: &[f64]) -> Start {
         if v != 0.0 {
@@ -507,14 +538,15 @@ pub(crate) fn run<R: Recorder>(
         rest_swing: REST_SWING_ATOLS * opts.atol,
     };
     let period = osc.natural_period();
-    match opts.integrator {
-        Integrator::Dopri5 => {
-            let h_max = period * H_MAX_PERIODS;
-            let mut stepper = Dopri5::new(y0.len(), opts.rtol, opts.atol, h_max);
-            driver.run(&mut stepper, &y0, t_end)?;
-        }
+    match resolve_method(opts.integrator, &dynamics)? {
+        Integrator::Exact => driver.run(&mut ClosedForm::new(), &y0, t_end)?,
         Integrator::Euler { steps_per_period } => {
             let mut stepper = Euler::new(y0.len(), period / steps_per_period);
+            driver.run(&mut stepper, &y0, t_end)?;
+        }
+        Integrator::Dopri5 | Integrator::Auto => {
+            let h_max = period * H_MAX_PERIODS;
+            let mut stepper = Dopri5::new(y0.len(), opts.rtol, opts.atol, h_max);
             driver.run(&mut stepper, &y0, t_end)?;
         }
     }
@@ -523,6 +555,27 @@ pub(crate) fn run<R: Recorder>(
         rest: driver.rest,
         stats: driver.stats,
     })
+}
+
+/// The concrete method for `requested`: `Auto` picks the exact propagator where it applies,
+/// Dopri5 otherwise; `Exact` where it does not apply is an input error.
+fn resolve_method(
+    requested: Integrator,
+    dynamics: &Dynamics<'_>,
+) -> Result<Integrator, EngineError> {
+    match requested {
+        Integrator::Auto if dynamics.closed_form_applies() => Ok(Integrator::Exact),
+        Integrator::Auto => Ok(Integrator::Dopri5),
+        Integrator::Exact if !dynamics.closed_form_applies() => {
+            Err(EngineError::InvalidInput(format!(
+                "integrator `exact` needs a law affine in v within each sliding mode \
+                 (coulomb, viscous_coulomb, none) and an underdamped oscillator; model `{}` \
+                 does not qualify here",
+                dynamics.model.name()
+            )))
+        }
+        other => Ok(other),
+    }
 }
 
 /// How the engine treats `model`'s law: dynamic, switched (with its static limit) or smooth.

@@ -40,6 +40,9 @@ impl FrictionModel for Coulomb {
     fn slip_force(&self, _v: f64, direction: f64, normal: f64) -> f64 {
         self.mu * normal * direction
     }
+    fn affine_slip(&self, direction: f64, normal: f64) -> Option<(f64, f64)> {
+        Some((self.mu * normal * direction, 0.0))
+    }
     fn steady_state(&self, v: f64, normal: f64) -> f64 {
         self.force(v, &[], normal)
     }

@@ -24,6 +24,9 @@ impl FrictionModel for NoFriction {
     fn force(&self, _v: f64, _z: &[f64], _normal: f64) -> f64 {
         0.0
     }
+    fn affine_slip(&self, _direction: f64, _normal: f64) -> Option<(f64, f64)> {
+        Some((0.0, 0.0))
+    }
     fn steady_state(&self, _v: f64, _normal: f64) -> f64 {
         0.0
     }

@@ -43,6 +43,9 @@ impl FrictionModel for ViscousCoulomb {
     fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
         self.mu * normal * direction + self.viscous * v
     }
+    fn affine_slip(&self, direction: f64, normal: f64) -> Option<(f64, f64)> {
+        Some((self.mu * normal * direction, self.viscous))
+    }
     fn steady_state(&self, v: f64, normal: f64) -> f64 {
         self.force(v, &[], normal)
     }
