@@ -300,3 +300,40 @@ fn the_comparison_gives_akaike_weights_and_names_the_simplest_model() {
     assert_eq!(v.simplest, "coulomb", "{}", v.message);
     assert!(c.warnings.is_empty(), "{:?}", c.warnings);
 }
+
+/// x0 known to a few percent: records released from 1.03 x the stated x0. With `x0 = true`
+/// the fit recovers mu within 0.3 % and every record's true x0, inside its default bounds
+/// (the stated value +- 20 %).
+#[test]
+fn x0_as_a_nuisance_parameter_recovers_mu_when_x0_is_off() {
+    let osc = Oscillator::fmm();
+    let mut recs = records(&osc, &Coulomb { mu: 0.24 }, NOISE, 111);
+    let truth: Vec<f64> = recs.iter().map(|r| r.x0).collect();
+    for r in &mut recs {
+        r.x0 /= 1.03;
+    }
+    let opts = FitOptions {
+        x0: true,
+        ..FitOptions::default()
+    };
+    let r = fit(&osc, &Coulomb::default(), &recs, &opts).unwrap();
+    let mu = r.param("mu").unwrap();
+    assert!(rel(mu.value, 0.24) < 3e-3, "mu {}", mu.value);
+    let [lo, hi] = mu.ci95.unwrap();
+    assert!(lo < 0.24 && 0.24 < hi, "[{lo}, {hi}]");
+    for (rec, x0) in recs.iter().zip(&truth) {
+        let fitted = r.param(&format!("x0[{}]", rec.name)).unwrap();
+        assert!(rel(fitted.value, *x0) < 1e-3, "{} vs {x0}", fitted.value);
+        assert_eq!(fitted.unit, "m");
+    }
+    // Bounds are settable in metres, and a bound that excludes the truth is hit.
+    let mut tight = opts.clone();
+    tight.bounds.insert("x0".into(), (0.0, 0.0099));
+    let r = fit(&osc, &Coulomb::default(), &recs[..1], &tight).unwrap();
+    let name = format!("x0[{}]", recs[0].name);
+    assert!((r.value(&name).unwrap() - 0.0099).abs() < 1e-9);
+    assert!(r
+        .diagnostics
+        .iter()
+        .any(|f| f.check == frictionid_engine::identify::Check::ParameterAtBound));
+}

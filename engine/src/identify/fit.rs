@@ -8,7 +8,7 @@ use super::layout::{FreeParam, ParamKind};
 use super::options::{FitOptions, OscillatorParam};
 use super::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
 use super::problem::{FitProblem, ProblemParts, Realised};
-use super::residuals::{Residuals, VelocityResponse};
+use super::residuals::{NuisanceValues, Residuals, VelocityResponse};
 use super::setup::{build_layout, Layout};
 use super::starts::{fit_starting_points, run_starts, start_count, MultiStart, StartRun};
 use super::stats::{aic, bic, covariance, t_quantile_975, Covariance};
@@ -37,7 +37,7 @@ pub fn fit(
     records: &[Record],
     opts: &FitOptions,
 ) -> Result<FitResult, EngineError> {
-    let residuals = VelocityResponse::new(opts.velocity_offset, opts.time_shift);
+    let residuals = VelocityResponse::new(opts.velocity_offset, opts.time_shift, opts.x0);
     fit_with(Arc::new(residuals), osc, model, records, opts)
 }
 
@@ -368,8 +368,8 @@ fn record_fits<R: Residuals>(
             .sum();
         out.sum_sq += ss;
         out.n_total += measured.len();
-        let offset = world.nuisance[ri].offset;
-        let (energy_force, ebf, mf) = match energy_check(rec, offset, world, opts) {
+        let nuisance = &world.nuisance[ri];
+        let (energy_force, ebf, mf) = match energy_check(rec, nuisance, world, opts) {
             Ok((ef, ebf, mf)) => {
                 out.findings
                     .push(diagnostics::energy_balance(&rec.name, &ef));
@@ -386,7 +386,7 @@ fn record_fits<R: Residuals>(
         };
         out.records.push(RecordFit {
             file: rec.name.clone(),
-            x0: rec.x0,
+            x0: nuisance.x0_of(rec),
             samples: rec.len(),
             channel: problem.residuals.channel().to_string(),
             rms_residual: (ss / measured.len() as f64).sqrt(),
@@ -404,15 +404,17 @@ fn record_fits<R: Residuals>(
 /// The energy check of one record, its energy-based force and the model force along it.
 fn energy_check(
     rec: &Record,
-    offset: f64,
+    nuisance: &NuisanceValues,
     world: &Realised,
     opts: &FitOptions,
 ) -> Result<(EnergyForce, Vec<f64>, Vec<f64>), EngineError> {
-    // The energy analysis sees the measured velocity corrected by the fitted offset.
+    // The energy analysis sees the measured velocity corrected by the fitted offset, from the
+    // fitted release displacement.
     let mut corrected = rec.clone();
     for v in &mut corrected.velocity {
-        *v -= offset;
+        *v -= nuisance.offset;
     }
+    corrected.x0 = nuisance.x0_of(rec);
     let osc = &world.oscillator;
     let analysis = analyze_record(&corrected, osc, &opts.energy)?;
     let model_force = model_force_along(world.model.as_ref(), osc, &analysis.time, &analysis.v)?;
