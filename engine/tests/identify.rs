@@ -337,3 +337,50 @@ fn x0_as_a_nuisance_parameter_recovers_mu_when_x0_is_off() {
         .iter()
         .any(|f| f.check == frictionid_engine::identify::Check::ParameterAtBound));
 }
+
+/// Coloured (AR(1), phi = 0.9) noise: the classical standard error of mu would be about
+/// sqrt((1 + phi) / (1 - phi)) = 4.4 times too small. The widened one matches the spread of
+/// mu over independent realisations (within the sampling error of 30 of them), and the fit
+/// says it widened.
+#[test]
+fn standard_errors_are_widened_for_coloured_noise() {
+    use frictionid_engine::identify::Check;
+    use rand::rngs::StdRng;
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+    let osc = Oscillator::fmm();
+    let clean = records(&osc, &Coulomb { mu: 0.24 }, 0.0, 0);
+    let phi: f64 = 0.9;
+    let innovation = Normal::new(0.0, NOISE * (1.0 - phi * phi).sqrt()).unwrap();
+    let (mut estimates, mut errors) = (Vec::new(), Vec::new());
+    for seed in 0..30 {
+        let mut rng = StdRng::seed_from_u64(1000 + seed);
+        let mut recs = clean.clone();
+        for r in &mut recs {
+            let mut e = Normal::new(0.0, NOISE).unwrap().sample(&mut rng);
+            for v in &mut r.velocity {
+                *v += e;
+                e = phi * e + innovation.sample(&mut rng);
+            }
+        }
+        let r = fit(&osc, &Coulomb::default(), &recs, &FitOptions::default()).unwrap();
+        let widened = r
+            .diagnostics
+            .iter()
+            .find(|f| f.check == Check::NoiseCorrelation)
+            .and_then(|f| f.value)
+            .unwrap_or(1.0);
+        assert!(widened > 2.0, "seed {seed}: widened by {widened}");
+        estimates.push(r.value("mu").unwrap());
+        errors.push(r.param("mu").unwrap().std_error.unwrap());
+    }
+    let n = estimates.len() as f64;
+    let mean = estimates.iter().sum::<f64>() / n;
+    let spread = (estimates.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let reported = errors.iter().sum::<f64>() / n;
+    let ratio = reported / spread;
+    assert!(
+        (0.6..1.7).contains(&ratio),
+        "reported {reported} vs spread {spread}"
+    );
+}
