@@ -1,7 +1,7 @@
 //! Command-line arguments (clap derive).
 
 use clap::{Args, Parser, Subcommand};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Identify friction models from the measured free vibration of an oscillator.
 #[derive(Debug, Parser)]
@@ -20,15 +20,37 @@ pub struct Cli {
 /// Output options shared by the commands that write a report.
 #[derive(Debug, Clone, Args)]
 pub struct OutputArgs {
-    /// Output directory for report.json, report.md, plots and data files.
-    #[arg(long, value_name = "DIR", default_value = "frictionid-out")]
-    pub out: PathBuf,
+    /// Output directory for report.json, report.md, plots and data files
+    /// [default: frictionid-out/<config file stem>/<command>/].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
     /// Print nothing but errors and warnings.
     #[arg(long, short)]
     pub quiet: bool,
     /// Print report.json to standard output (instead of the summary table).
     #[arg(long)]
     pub json: bool,
+}
+
+/// The default parent of the output directories.
+pub const DEFAULT_OUT: &str = "frictionid-out";
+
+impl OutputArgs {
+    /// The output directory of `command` run on `config`: `--out` if given, else
+    /// `frictionid-out/<config file stem>/<command>/`, so that commands and configs never
+    /// mix their files.
+    pub fn dir_for(&self, config: &Path, command: &str) -> PathBuf {
+        match &self.out {
+            Some(dir) => dir.clone(),
+            None => {
+                let stem = config
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| "config".into());
+                Path::new(DEFAULT_OUT).join(stem).join(command)
+            }
+        }
+    }
 }
 
 /// The subcommands.
@@ -40,6 +62,9 @@ pub enum Command {
         /// Print the listing as JSON.
         #[arg(long)]
         json: bool,
+        /// Print nothing (accepted for symmetry with the other commands).
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Simulate a free vibration from the config's oscillator, model and simulation tables.
     #[command(
@@ -66,7 +91,8 @@ pub enum Command {
     Compare {
         /// The TOML configuration file.
         config: PathBuf,
-        /// Comma-separated model names (default: every registered model).
+        /// Comma-separated model names [default: the config's `[fit.options] models`, else
+        /// every registered model].
         #[arg(long, value_delimiter = ',', value_name = "A,B,...")]
         models: Option<Vec<String>>,
         #[command(flatten)]
@@ -80,4 +106,29 @@ pub enum Command {
         #[command(flatten)]
         output: OutputArgs,
     },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_output_directories_are_per_config_and_command() {
+        let args = OutputArgs {
+            out: None,
+            quiet: false,
+            json: false,
+        };
+        let cfg = Path::new("fixtures/fmm-fit.toml");
+        assert_eq!(
+            args.dir_for(cfg, "fit"),
+            Path::new("frictionid-out/fmm-fit/fit")
+        );
+        assert_ne!(args.dir_for(cfg, "fit"), args.dir_for(cfg, "energy"));
+        let explicit = OutputArgs {
+            out: Some("results".into()),
+            ..args
+        };
+        assert_eq!(explicit.dir_for(cfg, "fit"), Path::new("results"));
+    }
 }

@@ -25,20 +25,24 @@
 //! [energy]                      # optional options of the energy analysis
 //! method = "savitzky_golay"
 //!
+//! [record_defaults]             # optional: any [[records]] key, for every record
+//! velocity_scale = 1e-3         # (a record's own key wins)
+//!
 //! [[records]]                   # for fit, compare and energy
 //! file = "x14mm.csv"            # relative to this file
 //! x0 = 0.014                    # m
+//! release = "auto"              # optional: drop the pre-trigger rest (or a time in s)
 //! ```
 //!
 //! Unknown keys are errors that name the key, the line and the nearest valid name; TOML
 //! syntax errors name the line and column.
 
 use crate::error::CliError;
-use frictionid_engine::data::{read_record, DataFormat, ReadOptions, MAX_SAMPLES};
+use frictionid_engine::record::RecordSource;
+use frictionid_engine::spec::{EnergySpec, FitSpec, ModelSpec, SimulationSpec, Spec, SpecError};
 use frictionid_engine::{Oscillator, Record};
-use frictionid_models::{build_toml, FrictionModel};
+use frictionid_models::build_toml;
 use serde::Deserialize;
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Most `[[records]]` entries accepted in one configuration file.
@@ -47,204 +51,21 @@ pub const MAX_RECORDS: usize = 1000;
 /// Largest configuration file read \[bytes\] (1 MiB).
 pub const MAX_CONFIG_BYTES: u64 = 1024 * 1024;
 
-/// A loaded and checked configuration file.
+/// A loaded and checked configuration file: the engine's [`Spec`] and the records to read.
 #[derive(Debug, Clone)]
 pub struct Config {
     /// The configuration file.
     pub path: PathBuf,
     /// The directory that relative paths in the file are taken from.
     pub base_dir: PathBuf,
-    /// The oscillator (`[oscillator]`).
-    pub oscillator: Oscillator,
-    /// The friction model of `[model]`, if the file has one.
-    pub model: Option<ModelConfig>,
-    /// Fit options (`[fit]`; defaults when absent).
-    pub fit: FitConfig,
-    /// Simulation settings (`[simulation]`), if present.
-    pub simulation: Option<SimulationConfig>,
-    /// Energy-analysis options (`[energy]`; defaults when absent).
-    pub energy: EnergyConfig,
+    /// Oscillator, model, fit, simulation and energy settings.
+    pub spec: Spec,
     /// The measured records (`[[records]]`), not yet read.
     pub records: Vec<RecordConfig>,
 }
 
-/// The `[model]` table: the built model, its validation warnings and the table as written.
-#[derive(Debug, Clone)]
-pub struct ModelConfig {
-    /// The model with the given parameter values (defaults for the others).
-    pub model: Box<dyn FrictionModel>,
-    /// Admissible but unusual values (printed to stderr by the CLI).
-    pub warnings: Vec<String>,
-    /// The table as written (`type` and the parameters given explicitly).
-    pub table: toml::Table,
-}
-
-/// The `[fit]` table.
-#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct FitConfig {
-    /// Names of the parameters to fit; `None` means every parameter of the model that is not
-    /// fixed by default.
-    pub free: Option<Vec<String>>,
-    /// Search bounds [lower, upper] per parameter (default: the model's physical bounds).
-    pub bounds: BTreeMap<String, [f64; 2]>,
-    /// Largest number of solver iterations.
-    pub max_iterations: Option<u64>,
-    /// Convergence tolerance of the solver (relative change of the cost).
-    pub tolerance: Option<f64>,
-    /// Further identifier options, passed through as written (`[fit.options]`).
-    pub options: toml::Table,
-}
-
-impl FitConfig {
-    /// Checks that `free` and `bounds` name parameters of `model` and that each bound is an
-    /// ordered, finite-or-infinite pair. The error names the key and suggests the nearest name.
-    pub fn check_against(&self, model: &dyn FrictionModel) -> Result<(), CliError> {
-        let names: Vec<String> = model.param_info().into_iter().map(|p| p.name).collect();
-        let check = |key: &str, what: &str| -> Result<(), CliError> {
-            if names.iter().any(|n| n == key) {
-                return Ok(());
-            }
-            Err(CliError::Config(format!(
-                "[fit] {what}: model `{}` has no parameter `{key}`{}; its parameters: {}",
-                model.name(),
-                hint(key, names.iter().map(String::as_str)),
-                names.join(", ")
-            )))
-        };
-        for name in self.free.iter().flatten() {
-            check(name, "free")?;
-        }
-        for (name, [lo, hi]) in &self.bounds {
-            check(name, "bounds")?;
-            if lo.is_nan() || hi.is_nan() || lo >= hi {
-                return Err(CliError::Config(format!(
-                    "[fit] bounds: `{name}` = [{lo}, {hi}] is not an interval with lower < upper"
-                )));
-            }
-        }
-        Ok(())
-    }
-
-    /// The free parameter names for `model`: `free` as written, or else every parameter not
-    /// marked fixed by default (such as the Stribeck shape exponent).
-    pub fn free_names(&self, model: &dyn FrictionModel) -> Vec<String> {
-        match &self.free {
-            Some(list) => list.clone(),
-            None => model
-                .param_info()
-                .into_iter()
-                .filter(|p| !p.fixed_by_default)
-                .map(|p| p.name)
-                .collect(),
-        }
-    }
-}
-
-/// The ODE integrator chosen in `[simulation.integrator]`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum IntegratorMethod {
-    /// Adaptive Dormand-Prince 5(4) with dense output and event location.
-    #[default]
-    Dopri5,
-    /// Fixed-step explicit Euler (for comparison only).
-    Euler,
-}
-
-/// `[simulation.integrator]`: integrator choice and tolerances (engine defaults when absent).
-#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct IntegratorConfig {
-    /// The integration method.
-    pub method: IntegratorMethod,
-    /// Euler only: steps per natural period.
-    pub steps_per_period: Option<f64>,
-    /// Relative tolerance.
-    pub rtol: Option<f64>,
-    /// Absolute tolerance.
-    pub atol: Option<f64>,
-    /// Largest number of steps.
-    pub max_steps: Option<u64>,
-    /// Largest number of events (turning points, sticks).
-    pub max_events: Option<usize>,
-}
-
-/// `[simulation]`: the release state, the time grid and optional synthetic noise.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SimulationConfig {
-    /// Release displacement \[m\].
-    pub x0: f64,
-    /// Release velocity [m/s].
-    pub v0: f64,
-    /// Initial internal states of the model (default: the model's own).
-    pub z0: Option<Vec<f64>>,
-    /// Simulated time \[s\].
-    pub duration: f64,
-    /// Output sample rate \[Hz\].
-    pub sample_rate: f64,
-    /// Standard deviation of the Gaussian velocity noise of `record.csv` [m/s]; `None`: no record.
-    pub noise: Option<f64>,
-    /// Seed of the noise generator.
-    pub seed: u64,
-    /// Integrator options.
-    pub integrator: IntegratorConfig,
-}
-
-/// The differentiator of the energy analysis (`[energy] method`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum DifferentiatorMethod {
-    /// The paper's differentiation (central differences and a moving average).
-    Paper,
-    /// Savitzky-Golay smoothing differentiator.
-    SavitzkyGolay,
-}
-
-/// `[energy]`: energy-analysis options; `None` fields take the engine's defaults.
-#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct EnergyConfig {
-    /// Differentiator.
-    pub method: Option<DifferentiatorMethod>,
-    /// Savitzky-Golay window length (odd number of samples).
-    pub window: Option<usize>,
-    /// Savitzky-Golay polynomial order.
-    pub order: Option<usize>,
-    /// Speeds below this are masked in the friction-force estimate [m/s].
-    pub velocity_threshold: Option<f64>,
-    /// Reference friction force for the comparison \[N\] (default: from `[model]`).
-    pub reference_force: Option<f64>,
-}
-
-/// One `[[records]]` entry.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RecordConfig {
-    /// The file, resolved against the config file's directory.
-    pub file: PathBuf,
-    /// The file as written in the config (for messages and reports).
-    pub file_as_written: String,
-    /// Release displacement \[m\].
-    pub x0: f64,
-    /// Release velocity [m/s].
-    pub v0: f64,
-    /// Weight in a joint fit.
-    pub weight: f64,
-    /// How to read the file.
-    pub read: ReadOptions,
-}
-
-impl RecordConfig {
-    /// Reads the file into a record with this entry's x0, v0 and weight.
-    pub fn load(&self) -> Result<Record, CliError> {
-        let mut record = read_record(&self.file, &self.read)?;
-        record.name = self.file_as_written.clone();
-        record.x0 = self.x0;
-        record.v0 = self.v0;
-        record.weight = self.weight;
-        Ok(record)
-    }
-}
+/// One `[[records]]` entry, checked and resolved (the engine's shared record source).
+pub use frictionid_engine::record::source::ResolvedSource as RecordConfig;
 
 // ---------------------------------------------------------------------------------------------
 // Raw (as written) structures.
@@ -254,43 +75,12 @@ impl RecordConfig {
 struct RawConfig {
     oscillator: Option<Oscillator>,
     model: Option<toml::Table>,
-    fit: Option<FitConfig>,
-    simulation: Option<RawSimulation>,
-    energy: Option<EnergyConfig>,
+    fit: Option<FitSpec>,
+    simulation: Option<SimulationSpec>,
+    energy: Option<EnergySpec>,
+    record_defaults: Option<RecordSource>,
     #[serde(default)]
-    records: Vec<RawRecord>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawSimulation {
-    x0: Option<f64>,
-    #[serde(default)]
-    v0: f64,
-    z0: Option<Vec<f64>>,
-    duration: Option<f64>,
-    sample_rate: Option<f64>,
-    noise: Option<f64>,
-    #[serde(default)]
-    seed: u64,
-    #[serde(default)]
-    integrator: IntegratorConfig,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawRecord {
-    file: Option<String>,
-    x0: Option<f64>,
-    #[serde(default)]
-    v0: f64,
-    weight: Option<f64>,
-    format: Option<DataFormat>,
-    time_column: Option<String>,
-    velocity_column: Option<String>,
-    velocity_scale: Option<f64>,
-    min_samples: Option<usize>,
-    sampling_tolerance: Option<f64>,
+    records: Vec<RecordSource>,
 }
 
 use frictionid_models::suggest::did_you_mean as hint;
@@ -334,27 +124,51 @@ fn section_at(text: &str, pos: usize) -> Option<String> {
         .map(|l| l.split('#').next().unwrap_or(l).trim().to_string())
 }
 
+/// The names between backticks after "expected" in a serde message.
+fn expected_names(rest: &str) -> Vec<&str> {
+    rest.split("expected")
+        .nth(1)
+        .map(|s| s.split('`').skip(1).step_by(2).collect())
+        .unwrap_or_default()
+}
+
+/// "unknown key `k` in [section] (did you mean `x`?); valid keys: ..." for serde's
+/// "unknown field" message (`rest` follows its opening backtick).
+fn unknown_key_message(rest: &str, section: Option<String>) -> String {
+    let key = rest.split('`').next().unwrap_or_default();
+    let expected = expected_names(rest);
+    let section = section
+        .map(|s| format!(" in {s}"))
+        .unwrap_or_else(|| " at the top level".into());
+    format!(
+        "unknown key `{key}`{section}{}; valid keys: {}",
+        hint(key, expected.iter().copied()),
+        expected.join(", ")
+    )
+}
+
+/// "unknown value `v` (did you mean `x`?); valid values: ..." for serde's "unknown variant"
+/// message (`rest` follows its opening backtick).
+fn unknown_value_message(rest: &str, section: Option<String>) -> String {
+    let value = rest.split('`').next().unwrap_or_default();
+    let expected = expected_names(rest);
+    let section = section.map(|s| format!(" in {s}")).unwrap_or_default();
+    format!(
+        "unknown value `{value}`{section}{}; valid values: {}",
+        hint(value, expected.iter().copied()),
+        expected.join(", ")
+    )
+}
+
 /// Turns a TOML/serde error into one line: `file:line:col: message`, with unknown keys
 /// named and the nearest valid key suggested.
 fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> CliError {
     let raw = e.message().replace('\n', " ");
+    let section = || e.span().and_then(|s| section_at(text, s.start));
     let message = if let Some(rest) = raw.strip_prefix("unknown field `") {
-        let key = rest.split('`').next().unwrap_or_default();
-        let expected: Vec<&str> = rest
-            .split("expected")
-            .nth(1)
-            .map(|s| s.split('`').skip(1).step_by(2).collect())
-            .unwrap_or_default();
-        let section = e
-            .span()
-            .and_then(|s| section_at(text, s.start))
-            .map(|s| format!(" in {s}"))
-            .unwrap_or_else(|| " at the top level".into());
-        format!(
-            "unknown key `{key}`{section}{}; valid keys: {}",
-            hint(key, expected.iter().copied()),
-            expected.join(", ")
-        )
+        unknown_key_message(rest, section())
+    } else if let Some(rest) = raw.strip_prefix("unknown variant `") {
+        unknown_value_message(rest, section())
     } else if let Some(rest) = raw.strip_prefix("missing field `") {
         let key = rest.split('`').next().unwrap_or_default();
         format!("missing key `{key}`")
@@ -370,37 +184,52 @@ fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> CliError {
     }
 }
 
+/// Reads at most [`MAX_CONFIG_BYTES`] of UTF-8 text from `path` (also for pipes and devices,
+/// whose length is unknown).
+fn read_config_text(path: &Path) -> Result<String, CliError> {
+    use std::io::Read;
+    let io = |e: std::io::Error| {
+        CliError::Config(format!(
+            "{}: cannot read the config file: {}",
+            path.display(),
+            match e.kind() {
+                std::io::ErrorKind::NotFound => "no such file".to_string(),
+                std::io::ErrorKind::InvalidData => "it is not UTF-8 text".to_string(),
+                _ => e.to_string(),
+            }
+        ))
+    };
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .map_err(io)?
+        .take(MAX_CONFIG_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_CONFIG_BYTES {
+        return Err(CliError::Config(format!(
+            "{}: the config file is over {} KiB; is it the right file?",
+            path.display(),
+            MAX_CONFIG_BYTES / 1024
+        )));
+    }
+    String::from_utf8(bytes).map_err(|_| io(std::io::Error::from(std::io::ErrorKind::InvalidData)))
+}
+
+/// The `[model]` table built into a model spec.
+fn model_spec(table: toml::Table) -> Result<ModelSpec, String> {
+    let built =
+        build_toml(&toml::Value::Table(table.clone())).map_err(|e| format!("[model]: {e}"))?;
+    Ok(ModelSpec::new(
+        built.model,
+        built.warnings,
+        table.into_iter().map(|(k, _)| k),
+    ))
+}
+
 impl Config {
     /// Reads and checks the configuration file at `path`.
     pub fn load(path: &Path) -> Result<Self, CliError> {
-        use std::io::Read;
-        let io = |e: std::io::Error| {
-            CliError::Config(format!(
-                "{}: cannot read the config file: {}",
-                path.display(),
-                match e.kind() {
-                    std::io::ErrorKind::NotFound => "no such file".to_string(),
-                    std::io::ErrorKind::InvalidData => "it is not UTF-8 text".to_string(),
-                    _ => e.to_string(),
-                }
-            ))
-        };
-        // Never read past the limit (also for pipes and devices, whose length is unknown).
-        let mut bytes = Vec::new();
-        std::fs::File::open(path)
-            .map_err(io)?
-            .take(MAX_CONFIG_BYTES + 1)
-            .read_to_end(&mut bytes)
-            .map_err(io)?;
-        if bytes.len() as u64 > MAX_CONFIG_BYTES {
-            return Err(CliError::Config(format!(
-                "{}: the config file is over {} KiB; is it the right file?",
-                path.display(),
-                MAX_CONFIG_BYTES / 1024
-            )));
-        }
-        let text = String::from_utf8(bytes)
-            .map_err(|_| io(std::io::Error::from(std::io::ErrorKind::InvalidData)))?;
+        let text = read_config_text(path)?;
         Self::parse(path, &text)
     }
 
@@ -413,185 +242,78 @@ impl Config {
             .parent()
             .map(Path::to_path_buf)
             .unwrap_or_else(|| PathBuf::from("."));
-
         let oscillator = raw.oscillator.ok_or_else(|| {
             cfg_err("missing table [oscillator] (mass, damping, stiffness, normal_force)".into())
         })?;
         oscillator
             .validate()
             .map_err(|e| cfg_err(format!("[oscillator]: {e}")))?;
-
-        let model = match raw.model {
-            None => None,
-            Some(table) => {
-                let built = build_toml(&toml::Value::Table(table.clone()))
-                    .map_err(|e| cfg_err(format!("[model]: {e}")))?;
-                Some(ModelConfig {
-                    model: built.model,
-                    warnings: built.warnings,
-                    table,
-                })
-            }
-        };
-
-        let fit = raw.fit.unwrap_or_default();
-        if let Some(m) = &model {
-            fit.check_against(m.model.as_ref())
-                .map_err(|e| cfg_err(e.to_string()))?;
-        }
-
-        let simulation = raw
-            .simulation
-            .map(|s| simulation_config(s).map_err(cfg_err))
-            .transpose()?;
-
-        let energy = raw.energy.unwrap_or_default();
-
+        let model = raw.model.map(model_spec).transpose().map_err(cfg_err)?;
+        let spec = Spec::new(
+            oscillator,
+            model,
+            raw.fit.unwrap_or_default(),
+            raw.simulation,
+            raw.energy.unwrap_or_default(),
+        )
+        .map_err(|e| cfg_err(e.to_string()))?;
         if raw.records.len() > MAX_RECORDS {
             return Err(cfg_err(format!(
                 "{} [[records]] entries; at most {MAX_RECORDS} are accepted",
                 raw.records.len()
             )));
         }
+        let record_defaults = raw.record_defaults.unwrap_or_default();
         let records = raw
             .records
             .into_iter()
             .enumerate()
-            .map(|(i, r)| record_config(r, i + 1, &base_dir).map_err(cfg_err))
+            .map(|(i, r)| {
+                r.with_defaults(&record_defaults)
+                    .resolve(i + 1, &base_dir)
+                    .map_err(|e| cfg_err(e.to_string()))
+            })
             .collect::<Result<Vec<_>, _>>()?;
-
         Ok(Self {
             path: path.to_path_buf(),
             base_dir,
-            oscillator,
-            model,
-            fit,
-            simulation,
-            energy,
+            spec,
             records,
         })
     }
 
+    /// A spec error as a config error naming this file.
+    pub fn error(&self, e: impl std::fmt::Display) -> CliError {
+        CliError::Config(format!("{}: {e}", self.path.display()))
+    }
+
     /// The `[model]`, or an error naming what needs it.
-    pub fn require_model(&self, purpose: &str) -> Result<&ModelConfig, CliError> {
-        self.model.as_ref().ok_or_else(|| {
-            CliError::Config(format!(
-                "{}: {purpose} needs a [model] table (e.g. type = \"coulomb\")",
-                self.path.display()
-            ))
-        })
+    pub fn require_model(&self, purpose: &str) -> Result<&ModelSpec, CliError> {
+        self.spec.require_model(purpose).map_err(|e| self.error(e))
     }
 
     /// The `[simulation]`, or an error naming what needs it.
-    pub fn require_simulation(&self, purpose: &str) -> Result<&SimulationConfig, CliError> {
-        self.simulation.as_ref().ok_or_else(|| {
-            CliError::Config(format!(
-                "{}: {purpose} needs a [simulation] table (x0, duration, sample_rate)",
-                self.path.display()
-            ))
-        })
+    pub fn require_simulation(&self, purpose: &str) -> Result<&SimulationSpec, CliError> {
+        self.spec
+            .require_simulation(purpose)
+            .map_err(|e: SpecError| self.error(e))
     }
 
     /// Reads every `[[records]]` file; an error if there are none.
     pub fn load_records(&self, purpose: &str) -> Result<Vec<Record>, CliError> {
         if self.records.is_empty() {
-            return Err(CliError::Config(format!(
-                "{}: {purpose} needs at least one [[records]] entry (file, x0)",
-                self.path.display()
+            return Err(self.error(format!(
+                "{purpose} needs at least one [[records]] entry (file, x0)"
             )));
         }
-        self.records.iter().map(RecordConfig::load).collect()
+        self.records
+            .iter()
+            .map(|r| {
+                r.load_checked(&self.spec.oscillator)
+                    .map_err(CliError::from)
+            })
+            .collect()
     }
-}
-
-fn positive(what: &str, value: f64) -> Result<f64, String> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        Err(format!("{what} must be a positive number, got {value}"))
-    }
-}
-
-fn finite(what: &str, value: f64) -> Result<f64, String> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(format!("{what} must be finite, got {value}"))
-    }
-}
-
-fn simulation_config(s: RawSimulation) -> Result<SimulationConfig, String> {
-    let x0 =
-        s.x0.ok_or("[simulation]: missing `x0` (the release displacement, m)")?;
-    let duration = s
-        .duration
-        .ok_or("[simulation]: missing `duration` (the simulated time, s)")?;
-    let noise = match s.noise {
-        Some(n) if !(n.is_finite() && n >= 0.0) => {
-            return Err(format!("[simulation]: `noise` must be >= 0, got {n}"))
-        }
-        other => other,
-    };
-    let duration = positive("[simulation]: `duration`", duration)?;
-    let sample_rate = positive(
-        "[simulation]: `sample_rate`",
-        s.sample_rate.unwrap_or(1000.0),
-    )?;
-    // The output holds duration * sample_rate + 1 samples: bound it before allocating.
-    let samples = duration * sample_rate;
-    if samples >= MAX_SAMPLES as f64 {
-        return Err(format!(
-            "[simulation]: duration * sample_rate = {samples:e} samples; at most {MAX_SAMPLES} are written"
-        ));
-    }
-    Ok(SimulationConfig {
-        x0: finite("[simulation]: `x0`", x0)?,
-        v0: finite("[simulation]: `v0`", s.v0)?,
-        z0: s.z0,
-        duration,
-        sample_rate,
-        noise,
-        seed: s.seed,
-        integrator: s.integrator,
-    })
-}
-
-fn record_config(r: RawRecord, index: usize, base: &Path) -> Result<RecordConfig, String> {
-    let Some(file) = r.file else {
-        return Err(format!(
-            "[[records]] entry {index}: missing `file` (the record's data file)"
-        ));
-    };
-    let who = format!("[[records]] entry {index} (`{file}`)");
-    let x0 =
-        r.x0.ok_or_else(|| format!("{who}: missing `x0` (the release displacement, m)"))?;
-    let weight = r.weight.unwrap_or(1.0);
-    if !(weight.is_finite() && weight > 0.0) {
-        return Err(format!("{who}: `weight` must be > 0, got {weight}"));
-    }
-    let defaults = ReadOptions::default();
-    let read = ReadOptions {
-        format: r.format.unwrap_or(defaults.format),
-        time_column: r.time_column.unwrap_or(defaults.time_column),
-        velocity_column: r.velocity_column.unwrap_or(defaults.velocity_column),
-        velocity_scale: r.velocity_scale.unwrap_or(defaults.velocity_scale),
-        min_samples: r.min_samples.unwrap_or(defaults.min_samples),
-        sampling_tolerance: r.sampling_tolerance.unwrap_or(defaults.sampling_tolerance),
-    };
-    let path = Path::new(&file);
-    let resolved = if path.is_absolute() {
-        path.to_path_buf()
-    } else {
-        base.join(path)
-    };
-    Ok(RecordConfig {
-        file: resolved,
-        file_as_written: file.clone(),
-        x0: finite(&format!("{who}: `x0`"), x0)?,
-        v0: finite(&format!("{who}: `v0`"), r.v0)?,
-        weight,
-        read,
-    })
 }
 
 #[cfg(test)]
@@ -613,18 +335,26 @@ mod tests {
              [[records]]\nfile = \"a.csv\"\nx0 = 0.014\nvelocity_scale = 1e-3\n",
         )
         .unwrap();
-        assert_eq!(c.oscillator, Oscillator::fmm());
-        let m = c.model.unwrap();
+        assert_eq!(c.spec.oscillator, Oscillator::fmm());
+        let m = c.spec.model.unwrap();
         assert_eq!(m.model.params(), vec![0.3]);
-        assert_eq!(c.fit.free, Some(vec!["mu".to_string()]));
-        let s = c.simulation.unwrap();
+        assert_eq!(c.spec.fit.free, Some(vec!["mu".to_string()]));
+        let s = c.spec.simulation.unwrap();
         assert_eq!(
             (s.x0, s.sample_rate, s.noise, s.seed),
             (0.01, 1000.0, Some(2e-4), 3)
         );
-        assert_eq!(s.integrator.method, IntegratorMethod::Euler);
+        assert_eq!(
+            s.integrator.method,
+            frictionid_engine::spec::IntegratorMethod::Euler
+        );
         assert_eq!(c.records[0].file, Path::new("dir/a.csv"));
-        assert_eq!(c.records[0].read.velocity_scale, 1e-3);
+        assert_eq!(
+            c.records[0]
+                .read
+                .scale(frictionid_engine::record::Channel::Velocity),
+            1e-3
+        );
     }
 
     #[test]

@@ -4,9 +4,10 @@
 //! A crate that registers its own friction models (typetag) builds its own binary with the
 //! same line; its models then appear in `frictionid models` and can be named in configs.
 //!
-//! Modules: [`args`] (clap), [`config`] (TOML), [`commands`] (one per subcommand), [`report`]
-//! (atomic output files and tables), [`plots`] (SVG charts), [`progress`] (progress bars),
-//! [`error`] (typed errors).
+//! Modules: [`args`] (clap), [`config`] (TOML into the engine's `Spec`), [`commands`] (one per
+//! subcommand: load, run the engine's job, write), [`report`] (atomic output files and
+//! tables), [`terminal`] (the terminal writer of report values), [`plots`] (SVG charts),
+//! [`progress`] (progress bars), [`error`] (typed errors).
 //!
 //! Exit codes: 0 success, 1 error (one line on stderr), 2 a fit that did not converge (its
 //! report is written).
@@ -18,6 +19,7 @@ pub mod error;
 pub mod plots;
 pub mod progress;
 pub mod report;
+pub mod terminal;
 
 use args::{Cli, Command};
 use clap::Parser;
@@ -37,7 +39,9 @@ pub const EXIT_ERROR: u8 = 1;
 /// Runs parsed arguments.
 pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
-        Command::Models { json } => commands::models::run(json).map(|_| Outcome::Done),
+        Command::Models { json, quiet } => {
+            commands::models::run(json, quiet).map(|_| Outcome::Done)
+        }
         Command::Simulate { config, output } => commands::simulate::run(&config, &output),
         Command::Energy { config, output } => commands::energy::run(&config, &output),
         Command::Fit { config, output } => commands::fit::run(&config, &output),

@@ -1,10 +1,11 @@
-//! Output files: atomic writes into the output directory, Markdown and terminal tables.
+//! Output files: atomic writes into the output directory, terminal tables, CSV columns.
 //!
 //! Every file is written to a temporary name in its final directory and renamed into place,
 //! so a reader never sees a half-written `report.json`, and an error leaves no partial file.
 //! Commands write `report.json` last: its presence means the run completed.
 
 use crate::error::CliError;
+pub use frictionid_engine::report::fmt_num;
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -92,56 +93,6 @@ impl OutputDir {
     }
 }
 
-/// Formats a float compactly for tables: fixed for moderate magnitudes, exponent otherwise.
-pub fn fmt_num(x: f64) -> String {
-    if x == 0.0 {
-        return "0".into();
-    }
-    if !x.is_finite() {
-        return format!("{x}");
-    }
-    let a = x.abs();
-    if (1e-3..1e5).contains(&a) {
-        let s = format!("{x:.6}");
-        let s = s.trim_end_matches('0').trim_end_matches('.');
-        s.to_string()
-    } else {
-        let s = format!("{x:.4e}");
-        match s.split_once('e') {
-            Some((mant, exp)) => {
-                let mant = if mant.contains('.') {
-                    mant.trim_end_matches('0').trim_end_matches('.')
-                } else {
-                    mant
-                };
-                format!("{mant}e{exp}")
-            }
-            None => s,
-        }
-    }
-}
-
-/// A Markdown table.
-pub fn markdown_table(headers: &[&str], rows: &[Vec<String>]) -> String {
-    let esc = |s: &str| s.replace('|', "\\|");
-    let mut out = format!(
-        "| {} |\n|{}|\n",
-        headers
-            .iter()
-            .map(|h| esc(h))
-            .collect::<Vec<_>>()
-            .join(" | "),
-        headers.iter().map(|_| "---").collect::<Vec<_>>().join("|")
-    );
-    for r in rows {
-        out.push_str(&format!(
-            "| {} |\n",
-            r.iter().map(|c| esc(c)).collect::<Vec<_>>().join(" | ")
-        ));
-    }
-    out
-}
-
 /// A plain-text table with aligned columns, for the terminal.
 pub fn text_table(headers: &[&str], rows: &[Vec<String>]) -> String {
     let n = headers.len();
@@ -227,12 +178,8 @@ mod tests {
     }
 
     #[test]
-    fn tables_align_and_escape() {
+    fn tables_align() {
         let rows = vec![vec!["mu".to_string(), "0.2".to_string()]];
-        assert_eq!(
-            markdown_table(&["name", "a|b"], &rows),
-            "| name | a\\|b |\n|---|---|\n| mu | 0.2 |\n"
-        );
         assert_eq!(
             text_table(&["name", "value"], &rows),
             "name  value\n----  -----\nmu    0.2\n"
@@ -247,14 +194,5 @@ mod tests {
             csv_columns(&[("time", &t), ("velocity", &v)]),
             "time,velocity\n0,0.1\n0.001,-0.0000001\n"
         );
-    }
-
-    #[test]
-    fn numbers_are_compact() {
-        assert_eq!(fmt_num(0.24), "0.24");
-        assert_eq!(fmt_num(100000.0), "1e5");
-        assert_eq!(fmt_num(-1.25e-7), "-1.25e-7");
-        assert_eq!(fmt_num(-0.009297), "-0.009297");
-        assert_eq!(fmt_num(0.0), "0");
     }
 }

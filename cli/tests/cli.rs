@@ -304,7 +304,7 @@ fn fixture_configs_parse() {
         "fmm-energy.toml",
     ] {
         let c = frictionid_cli::Config::load(&fixtures().join(f)).unwrap();
-        assert!(c.oscillator.mass > 0.0, "{f}");
+        assert!(c.spec.oscillator.mass > 0.0, "{f}");
     }
 }
 

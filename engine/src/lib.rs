@@ -8,9 +8,12 @@ pub mod energy;
 pub mod error;
 pub mod exact;
 pub mod identify;
+pub mod jobs;
 pub mod oscillator;
 pub mod record;
+pub mod report;
 pub mod simulate;
+pub mod spec;
 pub mod synthetic;
 
 pub use energy::{
@@ -18,9 +21,12 @@ pub use energy::{
     Differentiator, EnergyAnalysis, EnergyOptions, ForceResiduals, HalfCycle,
 };
 pub use error::EngineError;
+pub use jobs::JobError;
 pub use oscillator::Oscillator;
 pub use record::Record;
+pub use report::{CompareReport, EnergyReport, FitReport, ModelsReport, SimulateReport};
 pub use simulate::{
     simulate, simulate_velocity, Event, EventKind, Initial, Integrator, Rest, SimOptions, SimStats,
     Trajectory,
 };
+pub use spec::{Hooks, Spec, SpecError};

@@ -158,7 +158,7 @@ fn nuisance_offset_and_release_shift_are_recovered() {
     let mut recs = records(&osc, &Coulomb { mu: 0.24 }, NOISE, 61);
     // A constant vibrometer offset of 3e-4 m/s on every record.
     for r in &mut recs {
-        for v in &mut r.velocity {
+        for v in r.velocity_mut() {
             *v += 3e-4;
         }
     }
@@ -193,7 +193,7 @@ fn bad_fit_requests_are_clear_errors() {
         .to_string();
     assert!(e.contains("at least one record"), "{e}");
     let mut bad = recs.clone();
-    bad[1].velocity[5] = f64::NAN;
+    bad[1].velocity_mut()[5] = f64::NAN;
     let e = fit(&osc, &Coulomb::default(), &bad, &FitOptions::default())
         .unwrap_err()
         .to_string();
@@ -232,7 +232,7 @@ fn an_unmodelled_offset_or_a_wrong_scale_fails_a_diagnostic() {
     let clean = records(&osc, &Coulomb { mu: 0.24 }, NOISE, 91);
     let mut offset = clean.clone();
     for r in &mut offset {
-        for v in &mut r.velocity {
+        for v in r.velocity_mut() {
             *v += 3e-3;
         }
     }
@@ -240,7 +240,7 @@ fn an_unmodelled_offset_or_a_wrong_scale_fails_a_diagnostic() {
     assert_eq!(r.verdict(), Verdict::DiagnosticFailed, "{:?}", r.warnings);
     let mut mm = clean;
     for r in &mut mm {
-        for v in &mut r.velocity {
+        for v in r.velocity_mut() {
             *v *= 1e3;
         }
     }
@@ -358,7 +358,7 @@ fn standard_errors_are_widened_for_coloured_noise() {
         let mut recs = clean.clone();
         for r in &mut recs {
             let mut e = Normal::new(0.0, NOISE).unwrap().sample(&mut rng);
-            for v in &mut r.velocity {
+            for v in r.velocity_mut() {
                 *v += e;
                 e = phi * e + innovation.sample(&mut rng);
             }

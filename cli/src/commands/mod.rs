@@ -1,4 +1,5 @@
-//! The subcommands. Each returns an [`Outcome`]; errors propagate as `anyhow` to the edge.
+//! The subcommands: each loads its inputs, runs the engine's job and writes the report.
+//! Errors propagate as `anyhow` to the edge ([`crate::main_with_args`] decides exit codes).
 
 pub mod compare;
 pub mod energy;
@@ -7,7 +8,17 @@ pub mod models;
 pub mod simulate;
 
 use crate::args::OutputArgs;
+use crate::error::CliError;
+use crate::progress::Progress;
+use crate::report::OutputDir;
+use crate::terminal::TerminalWriter;
+use frictionid_engine::report::json::to_json_text;
+use frictionid_engine::report::markdown::MarkdownWriter;
+use frictionid_engine::report::{Render, Verdict};
+use frictionid_engine::spec::Hooks;
+use serde::Serialize;
 use std::io::Write;
+use std::sync::Arc;
 
 /// How a command ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -16,6 +27,15 @@ pub enum Outcome {
     Done,
     /// A fit ran to its end without converging (its report is written): exit code 2.
     NotConverged,
+}
+
+impl From<Verdict> for Outcome {
+    fn from(v: Verdict) -> Self {
+        match v {
+            Verdict::Done => Self::Done,
+            Verdict::NotConverged => Self::NotConverged,
+        }
+    }
 }
 
 /// Prints `text` to stdout unless `--quiet`, ignoring a closed pipe.
@@ -30,15 +50,6 @@ pub fn warn(text: &str) {
     let _ = writeln!(std::io::stderr(), "warning: {text}");
 }
 
-/// With `--json`, prints the report to stdout.
-pub fn print_json(output: &OutputArgs, report: &serde_json::Value) -> anyhow::Result<()> {
-    if output.json {
-        let text = serde_json::to_string_pretty(report)?;
-        let _ = writeln!(std::io::stdout(), "{text}");
-    }
-    Ok(())
-}
-
 /// A checked configuration with its records read, for `fit`, `compare` and `energy`.
 #[derive(Debug, Clone)]
 pub struct Inputs {
@@ -48,18 +59,69 @@ pub struct Inputs {
     pub records: Vec<frictionid_engine::Record>,
 }
 
-/// Loads `config`, prints the model's warnings to stderr and reads every record; `purpose`
-/// (the command name) appears in the message when something it needs is missing.
-pub fn load_inputs(config: &std::path::Path, purpose: &str) -> anyhow::Result<Inputs> {
+/// Loads `config` and prints the model's warnings to stderr.
+pub fn load_config(config: &std::path::Path) -> anyhow::Result<crate::config::Config> {
     let cfg = crate::config::Config::load(config)?;
-    if let Some(m) = &cfg.model {
+    if let Some(m) = &cfg.spec.model {
         for w in &m.warnings {
             warn(&format!("{}: [model]: {w}", config.display()));
         }
     }
+    Ok(cfg)
+}
+
+/// Loads `config` and reads every record; `purpose` (the command name) appears in the
+/// message when something it needs is missing.
+pub fn load_inputs(config: &std::path::Path, purpose: &str) -> anyhow::Result<Inputs> {
+    let cfg = load_config(config)?;
     let records = cfg.load_records(purpose)?;
     Ok(Inputs {
         config: cfg,
         records,
     })
+}
+
+/// A progress bar over `total` units (hidden with `--quiet` or `--json`).
+pub fn progress_bar(output: &OutputArgs, total: u64, message: &str) -> Arc<Progress> {
+    Arc::new(Progress::new(total, message, !output.quiet && !output.json))
+}
+
+/// Hooks whose progress callback is `on_progress`.
+pub fn hooks(
+    on_progress: impl Fn(&frictionid_engine::identify::Progress) + Send + Sync + 'static,
+) -> Hooks {
+    Hooks {
+        progress: Some(Arc::new(on_progress)),
+        ..Hooks::default()
+    }
+}
+
+/// The names of the report files, listed last in a report's `files`.
+pub const REPORT_FILES: [&str; 2] = ["report.md", "report.json"];
+
+/// Writes report.md and then report.json (its presence means the run completed), prints the
+/// terminal summary (or, with `--json`, report.json) and the output directory.
+pub fn publish<R: Render + Serialize>(
+    out: &OutputDir,
+    report: &R,
+    output: &OutputArgs,
+) -> anyhow::Result<()> {
+    let json = to_json_text(report).map_err(|e| CliError::Write {
+        path: out.path("report.json"),
+        reason: e.to_string(),
+    })?;
+    out.write_text("report.md", &MarkdownWriter::render(report))?;
+    out.write_text("report.json", &json)?;
+    say(
+        output,
+        &format!(
+            "{}wrote {}\n",
+            TerminalWriter::render(report),
+            out.dir().display()
+        ),
+    );
+    if output.json {
+        let _ = std::io::stdout().write_all(json.as_bytes());
+    }
+    Ok(())
 }

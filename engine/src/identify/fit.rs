@@ -458,7 +458,7 @@ fn record_fits<R: Residuals>(
             channel: problem.residuals.channel().to_string(),
             rms_residual: (ss / measured.len() as f64).sqrt(),
             energy_force,
-            time: rec.time.clone(),
+            time: rec.time().to_vec(),
             measured: measured.to_vec(),
             fitted,
             energy_based_force: ebf,
@@ -478,7 +478,7 @@ fn energy_check(
     // The energy analysis sees the measured velocity corrected by the fitted offset, from the
     // fitted release displacement.
     let mut corrected = rec.clone();
-    for v in &mut corrected.velocity {
+    for v in corrected.velocity_mut() {
         *v -= nuisance.offset;
     }
     corrected.x0 = nuisance.x0_of(rec);

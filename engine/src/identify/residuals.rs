@@ -257,11 +257,14 @@ impl VelocityResponse {
         record: &Record,
         nuisance: &NuisanceValues,
     ) -> Result<Vec<f64>, EngineError> {
-        let t0 = record.time.first().copied().unwrap_or(0.0);
+        let t0 = record.time().first().copied().unwrap_or(0.0);
         let release = t0 + nuisance.shift;
         // Sample times on the simulation clock; samples before the release see the initial state.
-        let first = record.time.partition_point(|&t| t < release);
-        let times: Vec<f64> = record.time[first..].iter().map(|&t| t - release).collect();
+        let first = record.time().partition_point(|&t| t < release);
+        let times: Vec<f64> = record.time()[first..]
+            .iter()
+            .map(|&t| t - release)
+            .collect();
         let mut v = vec![record.v0; first];
         if let Some(&t_end) = times.last() {
             at.count_simulation();
@@ -304,7 +307,7 @@ impl Residuals for VelocityResponse {
     }
 
     fn measured<'a>(&'a self, _index: usize, record: &'a Record) -> &'a [f64] {
-        &record.velocity
+        record.velocity()
     }
 
     fn predict(

@@ -31,7 +31,7 @@ pub fn guess_hint(osc: &Oscillator, records: &[Record], opts: &FitOptions) -> Gu
                 levels.push(a.mean_abs_force);
             }
         }
-        let peak = rec.velocity.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let peak = rec.velocity().iter().fold(0.0f64, |m, v| m.max(v.abs()));
         if peak > 0.0 {
             speeds.push(peak / 2.0);
         }

@@ -1,0 +1,243 @@
+//! SVG plots (plotters): line charts of named series against time in one or more stacked
+//! panels, with axis labels and units, dashed reference lines, and the steady-state friction
+//! curves F_ss(v) of several models.
+//!
+//! Non-finite values (e.g. the masked samples of the energy-based friction force) break a line
+//! into segments instead of being drawn.
+
+mod charts;
+mod panel;
+pub mod sets;
+
+pub use charts::{
+    displacement_acceleration, displacement_velocity, energy_rate, friction_force,
+    steady_state_curves, velocity_fit,
+};
+
+use crate::error::CliError;
+use crate::report::write_atomic;
+use panel::{draw_panel, range};
+use plotters::prelude::*;
+use std::path::Path;
+
+/// Line colours (Tableau 10), cycled.
+pub(crate) const COLORS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+];
+
+/// One named line.
+#[derive(Debug, Clone)]
+pub struct Series<'a> {
+    /// Legend label.
+    pub label: String,
+    /// Abscissa values.
+    pub x: &'a [f64],
+    /// Ordinate values (same length as `x`; non-finite values leave gaps).
+    pub y: &'a [f64],
+    /// Draw dashed instead of solid.
+    pub dashed: bool,
+    /// Line width in pixels.
+    pub width: u32,
+}
+
+impl<'a> Series<'a> {
+    /// A solid line.
+    pub fn solid(label: impl Into<String>, x: &'a [f64], y: &'a [f64]) -> Self {
+        Self {
+            label: label.into(),
+            x,
+            y,
+            dashed: false,
+            width: 2,
+        }
+    }
+
+    /// The same line drawn `width` pixels wide.
+    pub fn width(self, width: u32) -> Self {
+        Self { width, ..self }
+    }
+
+    /// A dashed line.
+    pub fn dashed(label: impl Into<String>, x: &'a [f64], y: &'a [f64]) -> Self {
+        Self {
+            dashed: true,
+            ..Self::solid(label, x, y)
+        }
+    }
+}
+
+/// A horizontal dashed reference line (e.g. the Coulomb level mu N).
+#[derive(Debug, Clone)]
+pub struct RefLine {
+    /// Legend label.
+    pub label: String,
+    /// Level on the panel's y axis.
+    pub y: f64,
+}
+
+/// One chart panel: its y axis and its lines.
+#[derive(Debug, Clone)]
+pub struct Panel<'a> {
+    /// Quantity on the y axis, e.g. "velocity".
+    pub y_label: String,
+    /// Unit of the y axis, e.g. "m/s".
+    pub y_unit: String,
+    /// The lines.
+    pub series: Vec<Series<'a>>,
+    /// Dashed horizontal reference lines.
+    pub reference: Vec<RefLine>,
+}
+
+impl<'a> Panel<'a> {
+    /// A panel with a y label and unit and no lines yet.
+    pub fn new(y_label: impl Into<String>, y_unit: impl Into<String>) -> Self {
+        Self {
+            y_label: y_label.into(),
+            y_unit: y_unit.into(),
+            series: Vec::new(),
+            reference: Vec::new(),
+        }
+    }
+
+    /// Adds a line.
+    pub fn with(mut self, s: Series<'a>) -> Self {
+        self.series.push(s);
+        self
+    }
+
+    /// Adds a dashed reference level.
+    pub fn with_reference(mut self, label: impl Into<String>, y: f64) -> Self {
+        self.reference.push(RefLine {
+            label: label.into(),
+            y,
+        });
+        self
+    }
+}
+
+/// A figure: a title, a shared x axis and one or more panels stacked vertically.
+#[derive(Debug, Clone)]
+pub struct Figure<'a> {
+    /// Title above the panels.
+    pub title: String,
+    /// Quantity on the x axis.
+    pub x_label: String,
+    /// Unit of the x axis.
+    pub x_unit: String,
+    /// The panels, top to bottom.
+    pub panels: Vec<Panel<'a>>,
+}
+
+impl<'a> Figure<'a> {
+    /// A figure of `panels` against time in seconds.
+    pub fn over_time(title: impl Into<String>, panels: Vec<Panel<'a>>) -> Self {
+        Self {
+            title: title.into(),
+            x_label: "time".into(),
+            x_unit: "s".into(),
+            panels,
+        }
+    }
+}
+
+/// Renders `fig` as SVG text.
+pub fn render(fig: &Figure<'_>) -> Result<String, String> {
+    let n = fig.panels.len().max(1);
+    let size = (960u32, 70 + 330 * n as u32);
+    let mut buf = String::new();
+    {
+        let root = SVGBackend::with_string(&mut buf, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let root = root
+            .titled(&fig.title, ("sans-serif", 22))
+            .map_err(|e| e.to_string())?;
+        let x_range = range(
+            fig.panels
+                .iter()
+                .flat_map(|p| p.series.iter())
+                .flat_map(|s| s.x.iter().copied()),
+            false,
+        );
+        let areas = root.split_evenly((n, 1));
+        for (i, (area, panel)) in areas.iter().zip(&fig.panels).enumerate() {
+            draw_panel(area, fig, panel, x_range, i + 1 == fig.panels.len())?;
+        }
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(buf)
+}
+
+/// Renders `fig` and writes it atomically to `path`.
+pub fn draw(path: &Path, fig: &Figure<'_>) -> Result<(), CliError> {
+    let svg = render(fig).map_err(|reason| CliError::Plot {
+        path: path.to_path_buf(),
+        reason,
+    })?;
+    write_atomic(path, svg.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::panel::{segments, tick};
+    use super::*;
+
+    #[test]
+    fn segments_split_at_non_finite_values() {
+        let x = [0.0, 1.0, 2.0, 3.0, 4.0];
+        let y = [1.0, f64::NAN, 2.0, 3.0, f64::INFINITY];
+        assert_eq!(
+            segments(&x, &y),
+            vec![vec![(0.0, 1.0)], vec![(2.0, 2.0), (3.0, 3.0)]]
+        );
+    }
+
+    #[test]
+    fn ticks_hide_round_off_and_follow_the_span() {
+        assert_eq!(tick(-5.6e-17, 0.5), "0");
+        assert_eq!(tick(0.25, 0.5), "0.25");
+        assert_eq!(tick(1.5, 20.0), "1.5");
+        assert_eq!(tick(2e-5, 1e-4), "2e-5");
+    }
+
+    #[test]
+    fn ranges_are_padded_and_never_empty() {
+        assert_eq!(range([0.0, 10.0].into_iter(), true), (-0.5, 10.5));
+        assert_eq!(range([f64::NAN].into_iter(), true), (0.0, 1.0));
+        let (lo, hi) = range([2.0, 2.0].into_iter(), true);
+        assert!(lo < 2.0 && hi > 2.0);
+    }
+
+    #[test]
+    fn svg_has_title_labels_and_one_path_per_line() {
+        let t = [0.0, 0.5, 1.0];
+        let y1 = [0.0, 1.0, 0.0];
+        let y2 = [0.0, 0.5, f64::NAN];
+        let fig = Figure {
+            title: "T1".into(),
+            x_label: "time".into(),
+            x_unit: "s".into(),
+            panels: vec![Panel::new("velocity", "m/s")
+                .with(Series::solid("measured", &t, &y1))
+                .with(Series::dashed("fitted", &t, &y2))
+                .with_reference("mu N", 0.8)],
+        };
+        let svg = render(&fig).unwrap();
+        for text in [
+            "T1",
+            "time [s]",
+            "velocity [m/s]",
+            "measured",
+            "fitted",
+            "mu N",
+        ] {
+            assert!(svg.contains(text), "missing {text}");
+        }
+    }
+}

@@ -1,0 +1,225 @@
+//! Drawing one panel of a figure: axes, lines, reference levels and the legend.
+
+use super::{Figure, Panel, COLORS};
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+fn axis_text(label: &str, unit: &str) -> String {
+    if unit.is_empty() {
+        label.to_string()
+    } else {
+        format!("{label} [{unit}]")
+    }
+}
+
+/// Tick label for `v` on an axis spanning `span`: round-off next to zero shows as 0, and the
+/// number of decimals follows the span.
+pub(super) fn tick(v: f64, span: f64) -> String {
+    let span = if span.is_finite() && span > 0.0 {
+        span
+    } else {
+        1.0
+    };
+    if v.abs() < 1e-9 * span {
+        return "0".into();
+    }
+    if !(1e-3..1e5).contains(&span) {
+        let s = format!("{v:.2e}");
+        return match s.split_once('e') {
+            Some((m, e)) => format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.')),
+            None => s,
+        };
+    }
+    let decimals = (2.0 - (span / 10.0).log10().floor()).clamp(0.0, 8.0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// The finite range of `values`, padded by 5 %; [0, 1] if there is none.
+pub(super) fn range(values: impl Iterator<Item = f64>, pad: bool) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (0.0, 1.0);
+    }
+    if hi - lo <= f64::EPSILON * (lo.abs() + hi.abs()).max(1e-300) {
+        let d = if lo == 0.0 { 1.0 } else { lo.abs() * 0.1 };
+        return (lo - d, hi + d);
+    }
+    let p = if pad { 0.05 * (hi - lo) } else { 0.0 };
+    (lo - p, hi + p)
+}
+
+/// Runs of consecutive finite points.
+pub(super) fn segments(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
+    let mut out = Vec::new();
+    let mut cur = Vec::new();
+    for (&a, &b) in x.iter().zip(y) {
+        if a.is_finite() && b.is_finite() {
+            cur.push((a, b));
+        } else if !cur.is_empty() {
+            out.push(std::mem::take(&mut cur));
+        }
+    }
+    if !cur.is_empty() {
+        out.push(cur);
+    }
+    out
+}
+
+type PlotResult<T> = Result<T, String>;
+
+type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// Labelled entries of the panel's legend.
+fn legend_entries(panel: &Panel<'_>) -> usize {
+    panel.series.iter().filter(|s| !s.label.is_empty()).count()
+        + panel
+            .reference
+            .iter()
+            .filter(|r| !r.label.is_empty())
+            .count()
+}
+
+/// A legend is drawn for more than one line, or any reference line.
+fn shows_legend(panel: &Panel<'_>) -> bool {
+    legend_entries(panel) > 1 || !panel.reference.is_empty()
+}
+
+/// The y range of the panel's lines and levels, padded; with a legend, extended upwards so
+/// that the legend (upper right corner) covers no data.
+fn y_range(panel: &Panel<'_>) -> (f64, f64) {
+    let mut y_range = range(
+        panel
+            .series
+            .iter()
+            .flat_map(|s| s.y.iter().copied())
+            .chain(panel.reference.iter().map(|r| r.y)),
+        true,
+    );
+    if shows_legend(panel) {
+        let entries = legend_entries(panel) as f64;
+        y_range.1 += (0.04 + 0.075 * entries) * (y_range.1 - y_range.0);
+    }
+    y_range
+}
+
+/// Axes, grid, tick labels and axis descriptions (the x description on the last panel only).
+fn draw_mesh(
+    chart: &mut Chart<'_, '_>,
+    fig: &Figure<'_>,
+    panel: &Panel<'_>,
+    spans: (f64, f64),
+    is_last: bool,
+) -> PlotResult<()> {
+    let x_fmt = |v: &f64| tick(*v, spans.0);
+    let y_fmt = |v: &f64| tick(*v, spans.1);
+    let mut mesh = chart.configure_mesh();
+    mesh.y_desc(axis_text(&panel.y_label, &panel.y_unit))
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .light_line_style(RGBColor(235, 235, 235));
+    if is_last {
+        mesh.x_desc(axis_text(&fig.x_label, &fig.x_unit));
+    }
+    mesh.draw().map_err(|e| e.to_string())
+}
+
+/// The panel's lines, broken at non-finite values, each labelled once in the legend.
+fn draw_lines(chart: &mut Chart<'_, '_>, panel: &Panel<'_>) -> PlotResult<()> {
+    for (i, s) in panel.series.iter().enumerate() {
+        let color = COLORS[i % COLORS.len()];
+        let style = color.stroke_width(s.width);
+        let width = s.width;
+        for (k, seg) in segments(s.x, s.y).into_iter().enumerate() {
+            let anno = if s.dashed {
+                chart
+                    .draw_series(DashedLineSeries::new(seg, 8, 5, style))
+                    .map_err(|e| e.to_string())?
+            } else {
+                chart
+                    .draw_series(LineSeries::new(seg, style))
+                    .map_err(|e| e.to_string())?
+            };
+            if k == 0 && !s.label.is_empty() {
+                anno.label(s.label.clone()).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 22, y)], color.stroke_width(width))
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Dashed horizontal reference levels across the whole x range.
+fn draw_references(
+    chart: &mut Chart<'_, '_>,
+    panel: &Panel<'_>,
+    x_range: (f64, f64),
+) -> PlotResult<()> {
+    for (j, r) in panel.reference.iter().enumerate() {
+        let color = if j == 0 {
+            BLACK
+        } else {
+            RGBColor(110, 110, 110)
+        };
+        let style = color.stroke_width(1);
+        let line = vec![(x_range.0, r.y), (x_range.1, r.y)];
+        let anno = chart
+            .draw_series(DashedLineSeries::new(line, 6, 4, style))
+            .map_err(|e| e.to_string())?;
+        if !r.label.is_empty() {
+            anno.label(r.label.clone()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 8, y), (x + 14, y), (x + 22, y)], style)
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The legend box in the upper right corner.
+fn draw_legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>) -> PlotResult<()> {
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", 14))
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(160, 160, 160))
+        .draw()
+        .map_err(|e| e.to_string())
+}
+
+/// Draws one panel of `fig` into `area` over the shared `x_range`.
+pub(super) fn draw_panel(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    fig: &Figure<'_>,
+    panel: &Panel<'_>,
+    x_range: (f64, f64),
+    is_last: bool,
+) -> PlotResult<()> {
+    let y_range = y_range(panel);
+    let spans = (x_range.1 - x_range.0, y_range.1 - y_range.0);
+    let mut chart = ChartBuilder::on(area)
+        .margin(12)
+        .x_label_area_size(if is_last { 45 } else { 30 })
+        .y_label_area_size(80)
+        .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
+        .map_err(|e| e.to_string())?;
+    draw_mesh(&mut chart, fig, panel, spans, is_last)?;
+    draw_lines(&mut chart, panel)?;
+    draw_references(&mut chart, panel, x_range)?;
+    if shows_legend(panel) {
+        draw_legend(&mut chart)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,273 @@
+//! The plots of each report: which charts a command draws from its report value, and their
+//! file names in the output directory.
+
+use super::{draw, Figure, Panel, Series};
+use crate::error::CliError;
+use crate::report::{fmt_num, OutputDir};
+use frictionid_engine::identify::{FitResult, RecordFit};
+use frictionid_engine::report::{EnergyRecord, EnergyReport, SimulateReport};
+use frictionid_models::FrictionModel;
+use std::path::Path;
+
+/// A file-name stem for a record's plots: its file name without extension.
+pub fn plot_stem(record_name: &str) -> String {
+    Path::new(record_name)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "record".into())
+}
+
+/// Plot stems of the records `names`, one per record and all distinct: the file stem where it
+/// is unique; else the path as written with separators as `_` (`a/data.csv` -> `a_data`);
+/// else that with the record's position appended (`data_2`).
+pub fn unique_stems(names: &[&str]) -> Vec<String> {
+    let stems: Vec<String> = names.iter().map(|n| plot_stem(n)).collect();
+    let count = |list: &[String], s: &String| list.iter().filter(|t| *t == s).count();
+    let with_path: Vec<String> = names
+        .iter()
+        .zip(&stems)
+        .map(|(name, stem)| {
+            if count(&stems, stem) == 1 {
+                return stem.clone();
+            }
+            let parent = Path::new(name)
+                .parent()
+                .map(|p| p.to_string_lossy().into_owned());
+            match parent.filter(|p| !p.is_empty()) {
+                Some(p) => format!("{}_{stem}", p.replace(['/', '\\', ':', '.'], "_")),
+                None => stem.clone(),
+            }
+        })
+        .collect();
+    with_path
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            if count(&with_path, s) == 1 {
+                s.clone()
+            } else {
+                format!("{s}_{}", i + 1)
+            }
+        })
+        .collect()
+}
+
+/// The model force where the energy-based force is defined (not masked), NaN elsewhere.
+pub fn where_defined(model_force: &[f64], energy_force: &[f64]) -> Vec<f64> {
+    model_force
+        .iter()
+        .zip(energy_force)
+        .map(|(&m, e)| if e.is_finite() { m } else { f64::NAN })
+        .collect()
+}
+
+/// `simulate`: displacement and velocity; energies and the dissipation rate.
+pub fn simulate_plots(out: &OutputDir, report: &SimulateReport) -> Result<Vec<String>, CliError> {
+    let traj = &report.trajectory;
+    let title = format!("{} from x0 = {} m", report.model.name(), fmt_num(report.x0));
+    super::displacement_velocity(
+        &out.path("displacement_velocity.svg"),
+        &format!("Free vibration: {title}"),
+        &traj.time,
+        &traj.x,
+        &traj.v,
+    )?;
+    let t = &traj.time;
+    draw(
+        &out.path("energy.svg"),
+        &Figure::over_time(
+            format!("Energy: {title}"),
+            vec![
+                Panel::new("energy", "J")
+                    .with(Series::solid("kinetic", t, &traj.kinetic))
+                    .with(Series::solid("potential", t, &traj.potential))
+                    .with(Series::solid("E = KE + PE", t, &traj.energy)),
+                Panel::new("dE/dt", "W").with(Series::solid(
+                    "dE/dt = -(c v + F) v",
+                    t,
+                    &report.energy_rate,
+                )),
+            ],
+        ),
+    )?;
+    Ok(vec![
+        "displacement_velocity.svg".into(),
+        "energy.svg".into(),
+    ])
+}
+
+/// The energy-based against the fitted model's friction force of one fitted record.
+fn fit_force_plot(
+    out: &OutputDir,
+    name: &str,
+    fit: &FitResult,
+    r: &RecordFit,
+) -> Result<(), CliError> {
+    let shown = where_defined(&r.model_force, &r.energy_based_force);
+    let label = format!("model ({})", fit.model);
+    let reference = r.energy_force.as_ref().map(|e| e.reference);
+    let ref_label = reference
+        .map(|x| format!("model mean |F| ±{} N", fmt_num(x)))
+        .unwrap_or_default();
+    super::friction_force(
+        &out.path(name),
+        &format!("{}: energy-based and model friction force", r.file),
+        &r.time,
+        &r.energy_based_force,
+        Some((label.as_str(), shown.as_slice())),
+        reference
+            .filter(|x| x.is_finite())
+            .map(|x| (ref_label.as_str(), x)),
+    )
+}
+
+/// `fit` and `compare`: the velocity fit and the friction-force check of every record;
+/// `prefix` starts every file name.
+pub fn fit_record_plots(
+    out: &OutputDir,
+    fit: &FitResult,
+    prefix: &str,
+) -> Result<Vec<String>, CliError> {
+    let mut files = Vec::new();
+    let names: Vec<&str> = fit.records.iter().map(|r| r.file.as_str()).collect();
+    for (r, stem) in fit.records.iter().zip(unique_stems(&names)) {
+        let vf = format!("{prefix}{stem}_velocity_fit.svg");
+        super::velocity_fit(
+            &out.path(&vf),
+            &r.file,
+            &r.time,
+            &r.measured,
+            &r.fitted,
+            &fit.model,
+        )?;
+        files.push(vf);
+        if !r.energy_based_force.is_empty() {
+            let ff = format!("{prefix}{stem}_friction_force.svg");
+            fit_force_plot(out, &ff, fit, r)?;
+            files.push(ff);
+        }
+    }
+    Ok(files)
+}
+
+/// The largest measured speed of the records (for steady-state plots).
+pub fn peak_speed(fit: &FitResult) -> f64 {
+    fit.records
+        .iter()
+        .flat_map(|r| r.measured.iter())
+        .fold(0.0f64, |m, v| m.max(v.abs()))
+}
+
+/// The steady-state curves of `fits` (the first sets the normal force and the speed range)
+/// in file `name`.
+pub fn steady_state_plot(
+    out: &OutputDir,
+    name: &str,
+    fits: &[FitResult],
+) -> Result<Vec<String>, CliError> {
+    let Some(first) = fits.first() else {
+        return Ok(Vec::new());
+    };
+    let curves: Vec<(&str, &dyn FrictionModel)> = fits
+        .iter()
+        .map(|f| (f.model.as_str(), f.fitted_model.as_ref()))
+        .collect();
+    super::steady_state_curves(
+        &out.path(name),
+        &curves,
+        first.oscillator.normal_force,
+        peak_speed(first),
+    )?;
+    Ok(vec![name.to_string()])
+}
+
+/// `energy`: displacement and acceleration, energy and its rate, and the friction force
+/// against the reference of one record.
+fn energy_record_plots(
+    out: &OutputDir,
+    report: &EnergyReport,
+    r: &EnergyRecord,
+    stem: &str,
+) -> Result<Vec<String>, CliError> {
+    let a = &r.analysis;
+    let xa = format!("{stem}_displacement_acceleration.svg");
+    super::displacement_acceleration(
+        &out.path(&xa),
+        &format!("{}: displacement and acceleration", r.file),
+        &a.time,
+        &a.x,
+        &a.a,
+    )?;
+    let en = format!("{stem}_energy.svg");
+    super::energy_rate(
+        &out.path(&en),
+        &format!("{}: energy and dissipation rate", r.file),
+        &a.time,
+        &a.energy,
+        &a.de_dt,
+    )?;
+    let ff = format!("{stem}_friction_force.svg");
+    let model_label = report
+        .reference_model
+        .as_ref()
+        .map(|m| format!("model ({m})"));
+    let model_shown = r
+        .model_force
+        .as_ref()
+        .map(|f| where_defined(f, &a.friction));
+    let ref_label = format!("reference ±{} N", fmt_num(r.reference));
+    super::friction_force(
+        &out.path(&ff),
+        &format!("{}: friction force", r.file),
+        &a.time,
+        &a.friction,
+        model_label.as_deref().zip(model_shown.as_deref()),
+        Some((ref_label.as_str(), r.reference)).filter(|(_, v)| v.is_finite()),
+    )?;
+    Ok(vec![xa, en, ff])
+}
+
+/// `energy`: the plots of every record.
+pub fn energy_plots(out: &OutputDir, report: &EnergyReport) -> Result<Vec<String>, CliError> {
+    let mut files = Vec::new();
+    let names: Vec<&str> = report.records.iter().map(|r| r.file.as_str()).collect();
+    for (r, stem) in report.records.iter().zip(unique_stems(&names)) {
+        files.extend(energy_record_plots(out, report, r, &stem)?);
+    }
+    Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plot_stems_come_from_file_names() {
+        assert_eq!(plot_stem("data/x14mm.csv"), "x14mm");
+        assert_eq!(plot_stem("x14mm.uff"), "x14mm");
+    }
+
+    #[test]
+    fn record_stems_stay_distinct_when_file_names_collide() {
+        assert_eq!(
+            unique_stems(&["x10mm.csv", "x14mm.csv"]),
+            ["x10mm", "x14mm"]
+        );
+        assert_eq!(
+            unique_stems(&["a/data.csv", "b/data.csv", "c.csv"]),
+            ["a_data", "b_data", "c"]
+        );
+        assert_eq!(
+            unique_stems(&["data.csv", "data.csv"]),
+            ["data_1", "data_2"]
+        );
+    }
+
+    #[test]
+    fn model_force_is_hidden_where_the_energy_force_is_masked() {
+        let shown = where_defined(&[1.0, 2.0, 3.0], &[0.5, f64::NAN, -1.0]);
+        assert_eq!(shown[0], 1.0);
+        assert!(shown[1].is_nan());
+        assert_eq!(shown[2], 3.0);
+    }
+}

@@ -1,0 +1,120 @@
+//! Where the commands write: per config and command by default, `--out` when given, and
+//! distinct plot files when record file names collide.
+
+use assert_cmd::Command;
+use std::path::{Path, PathBuf};
+
+fn frictionid() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_frictionid"))
+}
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("frictionid-out-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+const OSC: &str =
+    "[oscillator]\nmass = 10.391\ndamping = 0.275\nstiffness = 1982.0\nnormal_force = 14.5\n";
+
+fn run_in(dir: &Path, args: &[&str]) {
+    let o = frictionid()
+        .current_dir(dir)
+        .args(args)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn default_output_directories_of_the_commands_are_disjoint() {
+    let dir = scratch("layout");
+    let cfg = format!(
+        "{OSC}[model]\ntype = \"coulomb\"\nmu = 0.2\n[simulation]\nx0 = 0.014\nduration = 1.0\n\
+         [[records]]\nfile = \"{}\"\nx0 = 0.014\n",
+        fixtures().join("x14mm.csv").display()
+    );
+    std::fs::write(dir.join("rig.toml"), cfg).unwrap();
+    for cmd in ["simulate", "fit", "energy"] {
+        run_in(&dir, &[cmd, "rig.toml"]);
+    }
+    let base = dir.join("frictionid-out").join("rig");
+    assert_eq!(files_in(&base), ["energy", "fit", "simulate"]);
+    let sim = files_in(&base.join("simulate"));
+    let fit = files_in(&base.join("fit"));
+    let energy = files_in(&base.join("energy"));
+    for (name, files) in [("simulate", &sim), ("fit", &fit), ("energy", &energy)] {
+        assert!(
+            files.contains(&"report.json".to_string()),
+            "{name}: {files:?}"
+        );
+    }
+    assert!(sim.contains(&"trajectory.csv".to_string()));
+    assert!(!fit.contains(&"trajectory.csv".to_string()), "{fit:?}");
+    assert!(
+        fit.contains(&"x14mm_friction_force.svg".to_string()),
+        "{fit:?}"
+    );
+    assert!(
+        energy.contains(&"x14mm_friction_force.svg".to_string()),
+        "{energy:?}"
+    );
+    // --out still wins.
+    run_in(&dir, &["energy", "rig.toml", "--out", "mine"]);
+    assert!(dir.join("mine").join("report.json").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn records_with_the_same_file_name_get_distinct_plots() {
+    let dir = scratch("same-name");
+    for sub in ["a", "b"] {
+        std::fs::create_dir_all(dir.join(sub)).unwrap();
+        std::fs::copy(fixtures().join("x14mm.csv"), dir.join(sub).join("data.csv")).unwrap();
+    }
+    let cfg = format!(
+        "{OSC}[[records]]\nfile = \"a/data.csv\"\nx0 = 0.014\n[[records]]\nfile = \"b/data.csv\"\nx0 = 0.014\n\
+         [energy]\nreference_force = 3.48\n"
+    );
+    std::fs::write(dir.join("two.toml"), cfg).unwrap();
+    run_in(&dir, &["energy", "two.toml", "--out", "out"]);
+    let out = dir.join("out");
+    for stem in ["a_data", "b_data"] {
+        assert!(
+            out.join(format!("{stem}_friction_force.svg")).is_file(),
+            "{stem}"
+        );
+    }
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let files: Vec<&str> = r["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    let mut unique = files.clone();
+    unique.sort();
+    unique.dedup();
+    assert_eq!(unique.len(), files.len(), "{files:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,297 @@
+//! The commands as library calls: a [`Spec`] and records in, a report value out.
+//!
+//! Each job is what a front end runs for one command (the CLI's `simulate`, `fit`, `compare`,
+//! `energy`); the front end then names the source (`config`), writes plots and files, lists
+//! them in the report's `files`, and hands the report to its writers.
+
+use crate::energy::{
+    analyze_record, mean_abs_where_defined, model_force_along, percent_difference, EnergyAnalysis,
+    EnergyOptions,
+};
+use crate::error::EngineError;
+use crate::identify::{compare, fit, FitOptions, FitResult};
+use crate::oscillator::Oscillator;
+use crate::record::Record;
+use crate::report::{CompareReport, EnergyRecord, EnergyReport, FitReport, SimulateReport};
+use crate::simulate::{simulate, Initial, Trajectory};
+use crate::spec::{Hooks, SimulationSpec, Spec, SpecError};
+use crate::synthetic::{add_gaussian_noise, uniform_times};
+use frictionid_models::{Coulomb, FrictionModel};
+use std::time::Instant;
+use thiserror::Error;
+
+/// Why a job could not produce its report.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum JobError {
+    /// The spec lacks something the job needs, or is inconsistent.
+    #[error(transparent)]
+    Spec(#[from] SpecError),
+    /// The simulation failed.
+    #[error("simulation failed: {0}")]
+    Simulation(EngineError),
+    /// A record cannot be analysed.
+    #[error("record `{record}`: {source}")]
+    Record {
+        /// The record's name.
+        record: String,
+        /// Why.
+        source: EngineError,
+    },
+    /// No reference was given and the Coulomb fit that would provide one failed.
+    #[error("no [model] or reference_force, and the Coulomb fit for a reference failed: {0}")]
+    ReferenceFit(EngineError),
+    /// The identifier could not run.
+    #[error(transparent)]
+    Fit(EngineError),
+    /// Every model of a comparison failed; the reasons, one per model.
+    #[error("no model could be fitted ({})", .0.join("; "))]
+    NothingFitted(Vec<String>),
+}
+
+/// Rate of change of the mechanical energy along exact states:
+/// dE/dt = v (m a + k x) = -(c v + F) v.
+pub fn energy_rate(mass: f64, stiffness: f64, x: &[f64], v: &[f64], a: &[f64]) -> Vec<f64> {
+    x.iter()
+        .zip(v)
+        .zip(a)
+        .map(|((&x, &v), &a)| v * (mass * a + stiffness * x))
+        .collect()
+}
+
+/// Final displacement and rest time: at rest if the mass stuck for good, else at the end.
+fn final_state(traj: &Trajectory) -> (f64, Option<f64>) {
+    match &traj.rest {
+        Some(r) => (r.displacement, Some(r.time)),
+        None => (traj.x.last().copied().unwrap_or(f64::NAN), None),
+    }
+}
+
+/// `simulate`: one free vibration of the spec's model from `[simulation]`, with a noisy
+/// velocity record when the spec asks for noise.
+pub fn simulate_job(spec: &Spec) -> Result<SimulateReport, JobError> {
+    let model = &spec.require_model("simulate")?.model;
+    let sim: &SimulationSpec = spec.require_simulation("simulate")?;
+    let times = uniform_times(sim.duration, sim.sample_rate);
+    let init = Initial {
+        x0: sim.x0,
+        v0: sim.v0,
+        z0: sim.z0.clone(),
+    };
+    let osc = &spec.oscillator;
+    let started = Instant::now();
+    let traj = simulate(
+        osc,
+        model.as_ref(),
+        &init,
+        sim.duration,
+        &times,
+        &sim.sim_options(),
+    )
+    .map_err(JobError::Simulation)?;
+    let wall_time_s = started.elapsed().as_secs_f64();
+    let (final_displacement, rest_time) = final_state(&traj);
+    let noisy_velocity = sim.noise.map(|sigma| {
+        let mut noisy = traj.v.clone();
+        add_gaussian_noise(&mut noisy, sigma, sim.seed);
+        noisy
+    });
+    Ok(SimulateReport {
+        command: "simulate".into(),
+        config: String::new(),
+        oscillator: *osc,
+        model: model.clone(),
+        x0: sim.x0,
+        v0: sim.v0,
+        duration: sim.duration,
+        sample_rate: sim.sample_rate,
+        samples: traj.time.len(),
+        final_displacement,
+        rest_time,
+        half_cycles: traj.half_cycles(),
+        events: traj.events.clone(),
+        stats: traj.stats,
+        wall_time_s,
+        noise: sim.noise,
+        seed: sim.noise.map(|_| sim.seed),
+        files: Vec::new(),
+        energy_rate: energy_rate(osc.mass, osc.stiffness, &traj.x, &traj.v, &traj.a),
+        trajectory: traj,
+        noisy_velocity,
+    })
+}
+
+/// `fit`: the spec's model fitted to `records`; parameters the model table gives start from
+/// their given values.
+pub fn fit_job(spec: &Spec, records: &[Record], hooks: &Hooks) -> Result<FitReport, JobError> {
+    let model = spec.require_model("fit")?;
+    let opts = spec.fit_options(&model.given, hooks);
+    let fit = fit(&spec.oscillator, model.model.as_ref(), records, &opts).map_err(JobError::Fit)?;
+    Ok(FitReport {
+        config: String::new(),
+        fit,
+        files: Vec::new(),
+    })
+}
+
+/// `compare`: every model of `models` (see [`Spec::models_to_compare`]) fitted to `records`
+/// and ranked by AIC; an error when none could be fitted.
+pub fn compare_job(
+    spec: &Spec,
+    models: &[Box<dyn FrictionModel>],
+    records: &[Record],
+    hooks: &Hooks,
+) -> Result<CompareReport, JobError> {
+    // Options common to every model; per-model free lists and bounds are filtered by the
+    // identifier to the parameters each model has.
+    let opts = spec.fit_options(&[], hooks);
+    let comparison = compare(&spec.oscillator, models, records, &opts).map_err(JobError::Fit)?;
+    if comparison.ranking.is_empty() {
+        let why = comparison
+            .failed
+            .iter()
+            .map(|f| format!("{}: {}", f.model, f.error))
+            .collect();
+        return Err(JobError::NothingFitted(why));
+    }
+    Ok(CompareReport {
+        config: String::new(),
+        comparison,
+        records: records.len(),
+        files: Vec::new(),
+    })
+}
+
+/// The model whose force is the energy analysis's reference: the spec's `[model]` as given;
+/// none when a `reference_force` is given instead; else Coulomb friction fitted to the same
+/// records (the paper's procedure: fit mu, then compare with mu N).
+pub fn reference_model(
+    spec: &Spec,
+    records: &[Record],
+    hooks: &Hooks,
+) -> Result<Option<Box<dyn FrictionModel>>, JobError> {
+    if let Some(m) = &spec.model {
+        return Ok(Some(m.model.clone()));
+    }
+    if spec.energy.reference_force.is_some() {
+        return Ok(None);
+    }
+    let coulomb = Coulomb::default();
+    let opts: FitOptions = spec.fit_options(&[], hooks);
+    let fitted: FitResult =
+        fit(&spec.oscillator, &coulomb, records, &opts).map_err(JobError::ReferenceFit)?;
+    Ok(Some(fitted.fitted_model))
+}
+
+/// The reference force of one record: `given`, else the model's mean |force| over the samples
+/// the energy estimate uses (mu N for Coulomb friction), else NaN.
+pub fn record_reference(given: Option<f64>, model_force: Option<&[f64]>, friction: &[f64]) -> f64 {
+    match (given, model_force) {
+        (Some(r), _) => r,
+        (None, Some(f)) => mean_abs_where_defined(f, friction),
+        (None, None) => f64::NAN,
+    }
+}
+
+/// The energy analysis of one record against its reference.
+fn energy_record(
+    record: &Record,
+    osc: &Oscillator,
+    opts: &EnergyOptions,
+    model: Option<&dyn FrictionModel>,
+    given: Option<f64>,
+) -> Result<EnergyRecord, JobError> {
+    let in_record = |source| JobError::Record {
+        record: record.name.clone(),
+        source,
+    };
+    let analysis: EnergyAnalysis = analyze_record(record, osc, opts).map_err(in_record)?;
+    let model_force = model
+        .map(|m| model_force_along(m, osc, &analysis.time, &analysis.v))
+        .transpose()
+        .map_err(in_record)?;
+    let reference = record_reference(given, model_force.as_deref(), &analysis.friction);
+    Ok(EnergyRecord {
+        file: record.name.clone(),
+        mean_abs_force: analysis.mean_abs_force,
+        reference,
+        percent_difference: percent_difference(analysis.mean_abs_force, reference),
+        half_cycle_forces: analysis.half_cycles.iter().map(|h| h.force).collect(),
+        half_cycle_mean: analysis.half_cycle_mean,
+        half_cycle_std: analysis.half_cycle_std,
+        half_cycles: analysis.half_cycles.clone(),
+        masked: analysis.masked,
+        samples: analysis.time.len(),
+        analysis,
+        model_force,
+    })
+}
+
+/// `energy`: the energy-based friction force of every record (the paper's Eq. 7) against the
+/// reference of [`reference_model`] / [`record_reference`].
+pub fn energy_job(
+    spec: &Spec,
+    records: &[Record],
+    hooks: &Hooks,
+) -> Result<EnergyReport, JobError> {
+    let opts = spec.energy.options();
+    let model = reference_model(spec, records, hooks)?;
+    let analysed = records
+        .iter()
+        .map(|r| {
+            energy_record(
+                r,
+                &spec.oscillator,
+                &opts,
+                model.as_deref(),
+                spec.energy.reference_force,
+            )
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(EnergyReport {
+        command: "energy".into(),
+        config: String::new(),
+        oscillator: spec.oscillator,
+        model: spec.model.as_ref().map(|m| m.model.clone()),
+        options: opts,
+        records: analysed,
+        files: Vec::new(),
+        reference_model: model.map(|m| m.name().to_string()),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exact::coulomb_free_vibration;
+
+    /// The energy rate from the states equals the power of the dissipative forces,
+    /// -(c v + mu N sgn v) v, on the exact Coulomb solution.
+    #[test]
+    fn energy_rate_is_the_dissipated_power() {
+        let osc = Oscillator::fmm();
+        let f = 0.24 * osc.normal_force;
+        let t: Vec<f64> = (0..500).map(|i| i as f64 * 1e-3 + 1e-4).collect();
+        let s = coulomb_free_vibration(&osc, f, 0.014, &t).unwrap();
+        let rate = energy_rate(osc.mass, osc.stiffness, &s.x, &s.v, &s.a);
+        for i in 0..t.len() {
+            let v = s.v[i];
+            let expect = -(osc.damping * v + f * v.signum()) * v;
+            let expect = if v == 0.0 { 0.0 } else { expect };
+            assert!(
+                (rate[i] - expect).abs() < 1e-9,
+                "t = {}: {} vs {expect}",
+                t[i],
+                rate[i]
+            );
+        }
+    }
+
+    #[test]
+    fn a_given_reference_wins_over_the_model_force() {
+        let friction = [f64::NAN, 1.0, -1.0];
+        let model = [9.0, 2.0, -4.0];
+        assert_eq!(record_reference(Some(5.0), Some(&model), &friction), 5.0);
+        assert_eq!(record_reference(None, Some(&model), &friction), 3.0);
+        assert!(record_reference(None, None, &friction).is_nan());
+    }
+}

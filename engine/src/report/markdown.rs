@@ -1,0 +1,113 @@
+//! The Markdown writer (report.md).
+
+use super::{Render, Role, Sink, Table};
+
+/// Collects a report as Markdown text.
+#[derive(Debug, Clone, Default)]
+pub struct MarkdownWriter {
+    out: String,
+}
+
+impl MarkdownWriter {
+    /// The Markdown of `report`.
+    pub fn render(report: &dyn Render) -> String {
+        let mut w = Self::default();
+        report.render(&mut w);
+        w.finish()
+    }
+
+    /// The text written so far, ending in exactly one newline.
+    pub fn finish(self) -> String {
+        let mut text = self.out.trim_end().to_string();
+        text.push('\n');
+        text
+    }
+}
+
+/// A Markdown table (cells with `|` escaped).
+pub fn markdown_table(table: &Table) -> String {
+    let esc = |s: &str| s.replace('|', "\\|");
+    let row = |cells: &[String]| {
+        let cells: Vec<String> = cells.iter().map(|c| esc(c)).collect();
+        format!("| {} |\n", cells.join(" | "))
+    };
+    let rule: Vec<&str> = table.headers.iter().map(|_| "---").collect();
+    let mut out = row(&table.headers);
+    out.push_str(&format!("|{}|\n", rule.join("|")));
+    for r in &table.rows {
+        out.push_str(&row(r));
+    }
+    out
+}
+
+impl Sink for MarkdownWriter {
+    fn title(&mut self, text: &str) {
+        self.out.push_str(&format!("# {text}\n\n"));
+    }
+
+    fn heading(&mut self, level: usize, text: &str, role: Role) {
+        if role == Role::Brief {
+            return;
+        }
+        self.out
+            .push_str(&format!("{} {text}\n\n", "#".repeat(level.clamp(1, 6))));
+    }
+
+    fn paragraph(&mut self, text: &str, role: Role) {
+        if role == Role::Brief {
+            return;
+        }
+        self.out.push_str(&format!("{text}\n\n"));
+    }
+
+    fn table(&mut self, table: &Table, role: Role) {
+        if role == Role::Brief {
+            return;
+        }
+        self.out.push_str(&markdown_table(table));
+        self.out.push('\n');
+    }
+
+    fn list(&mut self, items: &[String], role: Role) {
+        if role == Role::Brief {
+            return;
+        }
+        for item in items {
+            self.out.push_str(&format!("- {item}\n"));
+        }
+        self.out.push('\n');
+    }
+
+    fn files(&mut self, files: &[String]) {
+        self.heading(2, "Files", Role::Detail);
+        let items: Vec<String> = files.iter().map(|f| format!("`{f}`")).collect();
+        self.list(&items, Role::Detail);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Tiny;
+    impl Render for Tiny {
+        fn render(&self, sink: &mut dyn Sink) {
+            sink.title("frictionid tiny");
+            sink.paragraph("Config: `c.toml`.", Role::Summary);
+            sink.paragraph("terminal only", Role::Brief);
+            sink.table(
+                &Table::new(&["name", "a|b"], vec![vec!["mu".into(), "0.2".into()]]),
+                Role::Summary,
+            );
+            sink.files(&["report.json".into()]);
+        }
+    }
+
+    #[test]
+    fn markdown_has_title_tables_and_files() {
+        assert_eq!(
+            MarkdownWriter::render(&Tiny),
+            "# frictionid tiny\n\nConfig: `c.toml`.\n\n| name | a\\|b |\n|---|---|\n| mu | 0.2 |\n\n## Files\n\n- `report.json`\n"
+        );
+    }
+}

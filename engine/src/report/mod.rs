@@ -1,0 +1,98 @@
+//! One report value per command, and the writers that turn it into files or text.
+//!
+//! A command's job ([`crate::jobs`]) returns a report value ([`SimulateReport`],
+//! [`FitReport`], [`CompareReport`], [`EnergyReport`], [`ModelsReport`]). Each value is
+//! serializable (its JSON form is report.json, see [`json::to_json`]) and implements
+//! [`Render`]: it pushes its document, block by block, into a [`Sink`]. Every writer is a
+//! sink (the idea of ripgrep's `Sink` and printers): [`markdown::MarkdownWriter`] here, a
+//! terminal summary in the CLI, HTML next. A new writer implements [`Sink`] and needs no
+//! change to the reports.
+//!
+//! Inline code in text is written between backticks (`` `x14mm.csv` ``); writers render it
+//! in their own syntax.
+
+pub mod compare;
+pub mod energy;
+pub mod fit;
+pub mod format;
+pub mod json;
+pub mod markdown;
+pub mod models;
+pub mod simulate;
+
+pub use compare::CompareReport;
+pub use energy::{EnergyRecord, EnergyReport};
+pub use fit::FitReport;
+pub use format::fmt_num;
+pub use models::ModelsReport;
+pub use simulate::SimulateReport;
+
+/// Where a block belongs: in the short summary a terminal shows, or only in the full report.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    /// Shown everywhere, including the terminal summary.
+    Summary,
+    /// Shown in full reports (files) only.
+    Detail,
+    /// Shown in the terminal summary only (a one-line result that the full report states at
+    /// length elsewhere).
+    Brief,
+}
+
+/// A table of formatted cells.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Table {
+    /// Column headers.
+    pub headers: Vec<String>,
+    /// Rows of cells, as many as headers.
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    /// A table with `headers` and `rows`.
+    pub fn new(headers: &[&str], rows: Vec<Vec<String>>) -> Self {
+        Self {
+            headers: headers.iter().map(|h| h.to_string()).collect(),
+            rows,
+        }
+    }
+}
+
+/// A writer: receives a report's document block by block.
+pub trait Sink {
+    /// The document's title (once, first).
+    fn title(&mut self, text: &str);
+    /// A section heading; `level` 2 is a section, 3 a subsection.
+    fn heading(&mut self, level: usize, text: &str, role: Role);
+    /// A paragraph of text.
+    fn paragraph(&mut self, text: &str, role: Role);
+    /// A table.
+    fn table(&mut self, table: &Table, role: Role);
+    /// A bulleted list.
+    fn list(&mut self, items: &[String], role: Role);
+    /// The files written with the report (plots, data), by name in the output directory.
+    fn files(&mut self, files: &[String]);
+}
+
+/// A report that can write itself into any [`Sink`].
+pub trait Render {
+    /// Pushes the report's document into `sink`.
+    fn render(&self, sink: &mut dyn Sink);
+}
+
+/// Whether a command's result can be trusted as it stands; decides the exit code of a front
+/// end.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// The command ran and its result stands.
+    Done,
+    /// A fit ran to its end without converging (its report is complete).
+    NotConverged,
+}
+
+/// Renders a "## Files" section (shared by the report values).
+fn render_files(sink: &mut dyn Sink, files: &[String]) {
+    if !files.is_empty() {
+        sink.files(files);
+    }
+}

@@ -1,0 +1,735 @@
+//! The run specification: what a front end (the CLI's TOML config, a Python dict) asks the
+//! engine to do, as one serializable value, and every rule that turns it into engine options.
+//!
+//! A front end parses its own syntax into a [`Spec`] (serde does the work: unknown keys are
+//! errors, defaults are filled in here, values are checked by `try_from` conversions), then
+//! asks the spec for engine options ([`Spec::fit_options`], [`SimulationSpec::sim_options`],
+//! [`EnergySpec::options`]). Run-time hooks (progress, parallelism) are not part of the spec:
+//! they travel apart in [`Hooks`].
+//!
+//! The measured records are not part of this value yet: front ends read them and hand them
+//! to the jobs in [`crate::jobs`].
+
+use crate::data::MAX_SAMPLES;
+use crate::energy::{Differentiator, EnergyOptions};
+use crate::identify::{FitOptions, OscillatorParam, ProgressFn};
+use crate::oscillator::Oscillator;
+use crate::simulate::{Integrator, SimOptions};
+use frictionid_models::suggest::did_you_mean;
+use frictionid_models::{default_model, names, FrictionModel, ModelError};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use thiserror::Error;
+
+/// Why a spec cannot be built or used.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SpecError {
+    /// A command needs a `[model]` the spec does not have.
+    #[error("{purpose} needs a [model] table (e.g. type = \"coulomb\")")]
+    MissingModel {
+        /// The command.
+        purpose: String,
+    },
+    /// A command needs a `[simulation]` the spec does not have.
+    #[error("{purpose} needs a [simulation] table (x0, duration, sample_rate)")]
+    MissingSimulation {
+        /// The command.
+        purpose: String,
+    },
+    /// `[fit] free` or `bounds` names a parameter the model does not have.
+    #[error(
+        "[fit] {key}: model `{model}` has no parameter `{name}`{hint}; its parameters: {known}"
+    )]
+    UnknownParameter {
+        /// `free` or `bounds`.
+        key: String,
+        /// The model.
+        model: String,
+        /// The name as written.
+        name: String,
+        /// " (did you mean `x`?)" or empty.
+        hint: String,
+        /// The model's parameters, comma-separated.
+        known: String,
+    },
+    /// A bound that is not an ordered interval.
+    #[error("[fit] bounds: `{name}` = [{lower}, {upper}] is not an interval with lower < upper")]
+    BadBounds {
+        /// The parameter.
+        name: String,
+        /// Lower bound as written.
+        lower: f64,
+        /// Upper bound as written.
+        upper: f64,
+    },
+    /// A value out of range or a key missing in `[simulation]`.
+    #[error("[simulation]: {0}")]
+    Simulation(String),
+    /// An empty list of models to compare.
+    #[error("no models to compare")]
+    NoModels,
+    /// A model name that is not registered.
+    #[error("unknown model `{name}` in the models to compare{hint}; registered models: {known}")]
+    UnknownModel {
+        /// The name as written.
+        name: String,
+        /// " (did you mean `x`?)" or empty.
+        hint: String,
+        /// Every registered name, comma-separated.
+        known: String,
+    },
+    /// A model error.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+}
+
+/// Run-time hooks of a job, kept apart from the (serializable) [`Spec`].
+#[derive(Clone)]
+pub struct Hooks {
+    /// Called after every solver iteration (from worker threads).
+    pub progress: Option<ProgressFn>,
+    /// Use several cores (records, Jacobian columns, starts, models).
+    pub parallel: bool,
+}
+
+impl Default for Hooks {
+    fn default() -> Self {
+        Self {
+            progress: None,
+            parallel: true,
+        }
+    }
+}
+
+impl std::fmt::Debug for Hooks {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Hooks")
+            .field("progress", &self.progress.is_some())
+            .field("parallel", &self.parallel)
+            .finish()
+    }
+}
+
+/// Everything but the records: oscillator, model, fit, simulation and energy settings.
+#[derive(Debug, Clone, Serialize)]
+pub struct Spec {
+    /// The oscillator.
+    pub oscillator: Oscillator,
+    /// The friction model, if given.
+    pub model: Option<ModelSpec>,
+    /// Fit settings (defaults when absent).
+    pub fit: FitSpec,
+    /// Simulation settings, if given.
+    pub simulation: Option<SimulationSpec>,
+    /// Energy-analysis settings (defaults when absent).
+    pub energy: EnergySpec,
+}
+
+/// The friction model of a spec and which of its parameters were given explicitly.
+#[derive(Debug, Clone, Serialize)]
+pub struct ModelSpec {
+    /// The model with the given parameter values (defaults for the others).
+    pub model: Box<dyn FrictionModel>,
+    /// Parameters whose values were written out: a fit starts from these values instead of a
+    /// data-driven guess.
+    pub given: Vec<String>,
+    /// Admissible but unusual values (front ends show them as warnings).
+    #[serde(skip)]
+    pub warnings: Vec<String>,
+}
+
+impl ModelSpec {
+    /// A model spec; `written` are the keys of the table the model was built from (those that
+    /// name parameters become [`ModelSpec::given`]).
+    pub fn new(
+        model: Box<dyn FrictionModel>,
+        warnings: Vec<String>,
+        written: impl IntoIterator<Item = String>,
+    ) -> Self {
+        let names = parameter_names(model.as_ref());
+        let given = written.into_iter().filter(|k| names.contains(k)).collect();
+        Self {
+            model,
+            given,
+            warnings,
+        }
+    }
+
+    /// Builds the model from a JSON table (`{"type": "coulomb", "mu": 0.2}`).
+    pub fn from_json(table: &serde_json::Value) -> Result<Self, SpecError> {
+        let built = frictionid_models::build_json(table)?;
+        let written = table
+            .as_object()
+            .map(|o| o.keys().cloned().collect::<Vec<_>>())
+            .unwrap_or_default();
+        Ok(Self::new(built.model, built.warnings, written))
+    }
+}
+
+fn parameter_names(model: &dyn FrictionModel) -> Vec<String> {
+    model.param_info().into_iter().map(|p| p.name).collect()
+}
+
+impl Spec {
+    /// A spec with `oscillator`, `model` and the other settings, checked against each other.
+    pub fn new(
+        oscillator: Oscillator,
+        model: Option<ModelSpec>,
+        fit: FitSpec,
+        simulation: Option<SimulationSpec>,
+        energy: EnergySpec,
+    ) -> Result<Self, SpecError> {
+        if let Some(m) = &model {
+            fit.check_against(m.model.as_ref())?;
+        }
+        Ok(Self {
+            oscillator,
+            model,
+            fit,
+            simulation,
+            energy,
+        })
+    }
+
+    /// The model, or an error naming the command that needs it.
+    pub fn require_model(&self, purpose: &str) -> Result<&ModelSpec, SpecError> {
+        self.model.as_ref().ok_or_else(|| SpecError::MissingModel {
+            purpose: purpose.into(),
+        })
+    }
+
+    /// The simulation settings, or an error naming the command that needs them.
+    pub fn require_simulation(&self, purpose: &str) -> Result<&SimulationSpec, SpecError> {
+        self.simulation
+            .as_ref()
+            .ok_or_else(|| SpecError::MissingSimulation {
+                purpose: purpose.into(),
+            })
+    }
+
+    /// The identifier options: `[fit]`, `[fit.options]` and `[energy]`, with `hooks`.
+    /// `keep_initial` names parameters whose current values start the fit (see
+    /// [`ModelSpec::given`]).
+    pub fn fit_options(&self, keep_initial: &[String], hooks: &Hooks) -> FitOptions {
+        let extras = &self.fit.options;
+        let defaults = FitOptions::default();
+        FitOptions {
+            free: self.fit.free.clone(),
+            bounds: self
+                .fit
+                .bounds
+                .iter()
+                .map(|(k, [lo, hi])| (k.clone(), (*lo, *hi)))
+                .collect(),
+            guess: extras.guess.unwrap_or(true),
+            keep_initial: keep_initial.to_vec(),
+            oscillator: extras.oscillator.clone(),
+            velocity_offset: extras.velocity_offset,
+            time_shift: extras.time_shift,
+            multistart: extras.multistart,
+            max_iterations: self.fit.max_iterations.unwrap_or(defaults.max_iterations),
+            tolerance: self.fit.tolerance.or(defaults.tolerance),
+            energy: self.energy.options(),
+            parallel: hooks.parallel,
+            progress: hooks.progress.clone(),
+            ..defaults
+        }
+    }
+
+    /// The models to compare: `requested`, else `[fit.options] models`, else every registered
+    /// model. A model named in `[model]` starts from the values given there.
+    pub fn models_to_compare(
+        &self,
+        requested: Option<&[String]>,
+    ) -> Result<Vec<Box<dyn FrictionModel>>, SpecError> {
+        let registered = names();
+        let list: Vec<String> = match (requested, &self.fit.options.models) {
+            (Some(r), _) => r.to_vec(),
+            (None, Some(c)) => c.clone(),
+            (None, None) => registered.clone(),
+        };
+        if list.is_empty() {
+            return Err(SpecError::NoModels);
+        }
+        list.iter()
+            .map(|name| self.model_to_compare(name.trim(), &registered))
+            .collect()
+    }
+
+    fn model_to_compare(
+        &self,
+        name: &str,
+        registered: &[String],
+    ) -> Result<Box<dyn FrictionModel>, SpecError> {
+        if !registered.iter().any(|n| n == name) {
+            return Err(SpecError::UnknownModel {
+                name: name.into(),
+                hint: did_you_mean(name, registered.iter().map(String::as_str)),
+                known: registered.join(", "),
+            });
+        }
+        Ok(match &self.model {
+            Some(m) if m.model.name() == name => m.model.clone(),
+            _ => default_model(name)?,
+        })
+    }
+}
+
+/// `[fit]`: which parameters to fit, their bounds and the solver's limits.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FitSpec {
+    /// Names of the parameters to fit; `None` means every parameter of the model that is not
+    /// fixed by default.
+    pub free: Option<Vec<String>>,
+    /// Search bounds [lower, upper] per parameter (default: the model's physical bounds).
+    pub bounds: BTreeMap<String, [f64; 2]>,
+    /// Largest number of solver iterations.
+    pub max_iterations: Option<u64>,
+    /// Convergence tolerance of the solver (relative change of the cost).
+    pub tolerance: Option<f64>,
+    /// Further identifier options (`[fit.options]`).
+    pub options: FitExtras,
+}
+
+/// `[fit.options]`: identifier options beyond `free` and `bounds`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FitExtras {
+    /// Oscillator properties to fit with the model: any of "mass", "damping", "stiffness".
+    pub oscillator: Vec<OscillatorParam>,
+    /// Fit a velocity offset per record.
+    pub velocity_offset: bool,
+    /// Fit a release-time shift per record.
+    pub time_shift: bool,
+    /// Number of starts (default: 1, or 4 when more than two model parameters are free).
+    pub multistart: Option<usize>,
+    /// Data-driven initial values for parameters the model table does not give (default true).
+    pub guess: Option<bool>,
+    /// Models compared by `compare` when none are requested.
+    pub models: Option<Vec<String>>,
+}
+
+impl FitSpec {
+    /// Checks that `free` and `bounds` name parameters of `model` and that each bound is an
+    /// ordered pair. The error names the key and suggests the nearest name.
+    pub fn check_against(&self, model: &dyn FrictionModel) -> Result<(), SpecError> {
+        let known = parameter_names(model);
+        let check = |name: &str, key: &str| -> Result<(), SpecError> {
+            if known.iter().any(|n| n == name) {
+                return Ok(());
+            }
+            Err(SpecError::UnknownParameter {
+                key: key.into(),
+                model: model.name().into(),
+                name: name.into(),
+                hint: did_you_mean(name, known.iter().map(String::as_str)),
+                known: known.join(", "),
+            })
+        };
+        for name in self.free.iter().flatten() {
+            check(name, "free")?;
+        }
+        for (name, [lower, upper]) in &self.bounds {
+            check(name, "bounds")?;
+            if lower.is_nan() || upper.is_nan() || lower >= upper {
+                return Err(SpecError::BadBounds {
+                    name: name.clone(),
+                    lower: *lower,
+                    upper: *upper,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The free parameter names for `model`: `free` as written, or else every parameter not
+    /// marked fixed by default (such as the Stribeck shape exponent).
+    pub fn free_names(&self, model: &dyn FrictionModel) -> Vec<String> {
+        match &self.free {
+            Some(list) => list.clone(),
+            None => model
+                .param_info()
+                .into_iter()
+                .filter(|p| !p.fixed_by_default)
+                .map(|p| p.name)
+                .collect(),
+        }
+    }
+}
+
+/// The ODE integrator chosen in `[simulation.integrator]`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IntegratorMethod {
+    /// Adaptive Dormand-Prince 5(4) with dense output and event location.
+    #[default]
+    Dopri5,
+    /// Fixed-step explicit Euler (for comparison only).
+    Euler,
+}
+
+/// `[simulation.integrator]`: integrator choice and tolerances (engine defaults when absent).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IntegratorSpec {
+    /// The integration method.
+    pub method: IntegratorMethod,
+    /// Euler only: steps per natural period.
+    pub steps_per_period: Option<f64>,
+    /// Relative tolerance.
+    pub rtol: Option<f64>,
+    /// Absolute tolerance.
+    pub atol: Option<f64>,
+    /// Largest number of steps.
+    pub max_steps: Option<u64>,
+    /// Largest number of events (turning points, sticks).
+    pub max_events: Option<usize>,
+}
+
+/// Steps per natural period of the Euler integrator when neither the spec nor the engine's
+/// default options name a number.
+pub const EULER_STEPS_PER_PERIOD: f64 = 10_000.0;
+
+impl IntegratorSpec {
+    /// The engine's simulation options (engine defaults where not given).
+    pub fn sim_options(&self) -> SimOptions {
+        let defaults = SimOptions::default();
+        let integrator = match self.method {
+            IntegratorMethod::Dopri5 => Integrator::Dopri5,
+            IntegratorMethod::Euler => Integrator::Euler {
+                steps_per_period: match (self.steps_per_period, &defaults.integrator) {
+                    (Some(n), _) => n,
+                    (None, Integrator::Euler { steps_per_period }) => *steps_per_period,
+                    (None, _) => EULER_STEPS_PER_PERIOD,
+                },
+            },
+        };
+        SimOptions {
+            integrator,
+            rtol: self.rtol.unwrap_or(defaults.rtol),
+            atol: self.atol.unwrap_or(defaults.atol),
+            max_steps: self.max_steps.unwrap_or(defaults.max_steps),
+            max_events: self.max_events.unwrap_or(defaults.max_events),
+        }
+    }
+}
+
+/// Sample rate of a simulation that does not name one \[Hz\].
+pub const DEFAULT_SAMPLE_RATE: f64 = 1000.0;
+
+/// `[simulation]`: the release state, the time grid and optional synthetic noise. Deserialized
+/// through [`SimulationInput`], which fills the defaults and checks every value.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "SimulationInput")]
+pub struct SimulationSpec {
+    /// Release displacement \[m\].
+    pub x0: f64,
+    /// Release velocity \[m/s\].
+    pub v0: f64,
+    /// Initial internal states of the model (default: the model's own).
+    pub z0: Option<Vec<f64>>,
+    /// Simulated time \[s\].
+    pub duration: f64,
+    /// Output sample rate \[Hz\].
+    pub sample_rate: f64,
+    /// Standard deviation of the Gaussian velocity noise of a synthetic record \[m/s\];
+    /// `None`: no record.
+    pub noise: Option<f64>,
+    /// Seed of the noise generator.
+    pub seed: u64,
+    /// Integrator options.
+    pub integrator: IntegratorSpec,
+}
+
+/// `[simulation]` as written: every key optional; [`SimulationSpec`] is built from it.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationInput {
+    x0: Option<f64>,
+    #[serde(default)]
+    v0: f64,
+    z0: Option<Vec<f64>>,
+    duration: Option<f64>,
+    sample_rate: Option<f64>,
+    noise: Option<f64>,
+    #[serde(default)]
+    seed: u64,
+    #[serde(default)]
+    integrator: IntegratorSpec,
+}
+
+fn positive(what: &str, value: f64) -> Result<f64, SpecError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(SpecError::Simulation(format!(
+            "`{what}` must be a positive number, got {value}"
+        )))
+    }
+}
+
+fn finite(what: &str, value: f64) -> Result<f64, SpecError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(SpecError::Simulation(format!(
+            "`{what}` must be finite, got {value}"
+        )))
+    }
+}
+
+fn required(what: &str, meaning: &str, value: Option<f64>) -> Result<f64, SpecError> {
+    value.ok_or_else(|| SpecError::Simulation(format!("missing `{what}` ({meaning})")))
+}
+
+impl TryFrom<SimulationInput> for SimulationSpec {
+    type Error = SpecError;
+
+    fn try_from(s: SimulationInput) -> Result<Self, SpecError> {
+        let x0 = required("x0", "the release displacement, m", s.x0)?;
+        let duration = required("duration", "the simulated time, s", s.duration)?;
+        if let Some(n) = s.noise.filter(|n| !(n.is_finite() && *n >= 0.0)) {
+            return Err(SpecError::Simulation(format!(
+                "`noise` must be >= 0, got {n}"
+            )));
+        }
+        let duration = positive("duration", duration)?;
+        let sample_rate = positive("sample_rate", s.sample_rate.unwrap_or(DEFAULT_SAMPLE_RATE))?;
+        // The output holds duration * sample_rate + 1 samples: bound it before allocating.
+        let samples = duration * sample_rate;
+        if samples >= MAX_SAMPLES as f64 {
+            return Err(SpecError::Simulation(format!(
+                "duration * sample_rate = {samples:e} samples; at most {MAX_SAMPLES} are written"
+            )));
+        }
+        Ok(Self {
+            x0: finite("x0", x0)?,
+            v0: finite("v0", s.v0)?,
+            z0: s.z0,
+            duration,
+            sample_rate,
+            noise: s.noise,
+            seed: s.seed,
+            integrator: s.integrator,
+        })
+    }
+}
+
+impl SimulationSpec {
+    /// The engine's simulation options.
+    pub fn sim_options(&self) -> SimOptions {
+        self.integrator.sim_options()
+    }
+}
+
+/// The differentiator of the energy analysis (`[energy] method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DifferentiatorMethod {
+    /// The paper's differentiation (central differences and a moving average).
+    Paper,
+    /// Savitzky-Golay smoothing differentiator.
+    SavitzkyGolay,
+}
+
+/// `[energy]`: energy-analysis options; `None` fields take the engine's defaults.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct EnergySpec {
+    /// Differentiator.
+    pub method: Option<DifferentiatorMethod>,
+    /// Savitzky-Golay window length (odd number of samples).
+    pub window: Option<usize>,
+    /// Savitzky-Golay polynomial order.
+    pub order: Option<usize>,
+    /// Speeds below this are masked in the friction-force estimate \[m/s\].
+    pub velocity_threshold: Option<f64>,
+    /// Reference friction force for the comparison \[N\] (default: from the model).
+    pub reference_force: Option<f64>,
+}
+
+/// Savitzky-Golay window and order used when the engine's default differentiator is not a
+/// Savitzky-Golay one.
+const FALLBACK_SAVITZKY_GOLAY: (usize, usize) = (21, 3);
+
+impl EnergySpec {
+    /// The engine's energy-analysis options (engine defaults where not given).
+    pub fn options(&self) -> EnergyOptions {
+        let defaults = EnergyOptions::default();
+        EnergyOptions {
+            differentiator: self.differentiator(defaults.differentiator),
+            velocity_threshold: self
+                .velocity_threshold
+                .unwrap_or(defaults.velocity_threshold),
+        }
+    }
+
+    fn differentiator(&self, default: Differentiator) -> Differentiator {
+        if self.method == Some(DifferentiatorMethod::Paper) {
+            return Differentiator::Paper;
+        }
+        if self.method.is_none() && self.window.is_none() && self.order.is_none() {
+            return default;
+        }
+        let (window, order) = match default {
+            Differentiator::SavitzkyGolay { window, order } => (window, order),
+            Differentiator::Paper => FALLBACK_SAVITZKY_GOLAY,
+        };
+        Differentiator::SavitzkyGolay {
+            window: self.window.unwrap_or(window),
+            order: self.order.unwrap_or(order),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn energy_spec_maps_onto_engine_options() {
+        let d = EnergyOptions::default();
+        assert_eq!(EnergySpec::default().options(), d);
+        let o = EnergySpec {
+            method: Some(DifferentiatorMethod::Paper),
+            velocity_threshold: Some(2e-3),
+            ..EnergySpec::default()
+        }
+        .options();
+        assert_eq!(o.differentiator, Differentiator::Paper);
+        assert_eq!(o.velocity_threshold, 2e-3);
+        let o = EnergySpec {
+            window: Some(41),
+            ..EnergySpec::default()
+        }
+        .options();
+        match (o.differentiator, d.differentiator) {
+            (
+                Differentiator::SavitzkyGolay { window, order },
+                Differentiator::SavitzkyGolay { order: order0, .. },
+            ) => assert_eq!((window, order), (41, order0)),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn integrator_spec_maps_onto_engine_options() {
+        let d = SimOptions::default();
+        assert_eq!(IntegratorSpec::default().sim_options(), d);
+        let o = IntegratorSpec {
+            method: IntegratorMethod::Euler,
+            steps_per_period: Some(1e5),
+            rtol: Some(1e-6),
+            max_events: Some(7),
+            ..IntegratorSpec::default()
+        }
+        .sim_options();
+        assert_eq!(
+            o.integrator,
+            Integrator::Euler {
+                steps_per_period: 1e5
+            }
+        );
+        assert_eq!((o.rtol, o.atol, o.max_events), (1e-6, d.atol, 7));
+    }
+
+    /// A Python front end builds the same spec from JSON dicts: defaults filled, values checked.
+    #[test]
+    fn simulation_and_fit_specs_deserialize_from_json_with_defaults() {
+        let s: SimulationSpec =
+            serde_json::from_value(serde_json::json!({"x0": 0.01, "duration": 1.0})).unwrap();
+        assert_eq!(
+            (s.v0, s.sample_rate, s.noise, s.seed),
+            (0.0, DEFAULT_SAMPLE_RATE, None, 0)
+        );
+        let e = serde_json::from_value::<SimulationSpec>(serde_json::json!({"duration": 1.0}))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("[simulation]: missing `x0`"), "{e}");
+        let e = serde_json::from_value::<FitSpec>(
+            serde_json::json!({"options": {"velocity_ofset": true}}),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("unknown field `velocity_ofset`"), "{e}");
+        let f: FitSpec = serde_json::from_value(
+            serde_json::json!({"options": {"oscillator": ["mass"], "multistart": 3}}),
+        )
+        .unwrap();
+        assert_eq!(f.options.oscillator, vec![OscillatorParam::Mass]);
+    }
+
+    #[test]
+    fn fit_options_take_the_spec_and_keep_hooks_apart() {
+        let model =
+            ModelSpec::from_json(&serde_json::json!({"type": "coulomb", "mu": 0.3})).unwrap();
+        assert_eq!(model.given, vec!["mu".to_string()]);
+        let fit: FitSpec = serde_json::from_value(serde_json::json!({
+            "free": ["mu"], "bounds": {"mu": [0.0, 1.0]}, "max_iterations": 7,
+            "options": {"velocity_offset": true, "guess": false}
+        }))
+        .unwrap();
+        let spec = Spec::new(
+            Oscillator::fmm(),
+            Some(model),
+            fit,
+            None,
+            EnergySpec::default(),
+        )
+        .unwrap();
+        let hooks = Hooks {
+            parallel: false,
+            ..Hooks::default()
+        };
+        let o = spec.fit_options(&["mu".to_string()], &hooks);
+        assert_eq!(o.free, Some(vec!["mu".to_string()]));
+        assert_eq!(o.bounds.get("mu"), Some(&(0.0, 1.0)));
+        assert_eq!(o.max_iterations, 7);
+        assert!(o.velocity_offset && !o.guess && !o.parallel);
+        assert_eq!(o.keep_initial, vec!["mu".to_string()]);
+        assert_eq!(o.sim, FitOptions::default().sim);
+    }
+
+    #[test]
+    fn fit_spec_names_unknown_parameters_and_bad_bounds() {
+        let coulomb = frictionid_models::Coulomb::default();
+        let fit = FitSpec {
+            free: Some(vec!["mu_".into()]),
+            ..FitSpec::default()
+        };
+        let e = fit.check_against(&coulomb).unwrap_err().to_string();
+        assert!(e.contains("no parameter `mu_` (did you mean `mu`?)"), "{e}");
+        let fit = FitSpec {
+            bounds: [("mu".to_string(), [1.0, 0.5])].into(),
+            ..FitSpec::default()
+        };
+        let e = fit.check_against(&coulomb).unwrap_err().to_string();
+        assert!(e.contains("not an interval"), "{e}");
+    }
+
+    #[test]
+    fn models_to_compare_prefer_the_request_and_suggest_names() {
+        let spec = Spec::new(
+            Oscillator::fmm(),
+            None,
+            FitSpec::default(),
+            None,
+            EnergySpec::default(),
+        )
+        .unwrap();
+        let request = vec!["coulomb".to_string()];
+        let models = spec.models_to_compare(Some(&request)).unwrap();
+        assert_eq!(models[0].name(), "coulomb");
+        assert_eq!(
+            spec.models_to_compare(Some(&[])).unwrap_err(),
+            SpecError::NoModels
+        );
+        let e = spec
+            .models_to_compare(Some(&["colomb".to_string()]))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("(did you mean `coulomb`?)"), "{e}");
+        assert_eq!(spec.models_to_compare(None).unwrap().len(), names().len());
+    }
+}
