@@ -97,7 +97,7 @@ fn autocorrelation(segments: &[Vec<f64>], lag: usize) -> f64 {
 /// residuals' first differences (for AR(1), their lag-1 autocorrelation is -(1 - phi) / 2).
 /// Differencing removes the slow, motion-locked part, which would otherwise pass for
 /// strongly coloured noise and hide itself.
-fn noise_correlation(segments: &[Vec<f64>]) -> f64 {
+pub(crate) fn noise_correlation(segments: &[Vec<f64>]) -> f64 {
     let differences: Vec<Vec<f64>> = segments
         .iter()
         .map(|s| s.windows(2).map(|w| w[1] - w[0]).collect())

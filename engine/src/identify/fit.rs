@@ -8,10 +8,10 @@ use super::layout::{FreeParam, ParamKind};
 use super::options::{FitOptions, OscillatorParam};
 use super::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
 use super::problem::{FitProblem, ProblemParts, Realised};
-use super::residuals::{Residuals, VelocityResponse};
+use super::residuals::{NuisanceValues, Residuals, VelocityResponse};
 use super::setup::{build_layout, Layout};
 use super::starts::{fit_starting_points, run_starts, start_count, MultiStart, StartRun};
-use super::stats::{aic, bic, covariance, t_quantile_975, Covariance};
+use super::stats::{self, aic, bic, covariance, t_quantile_975, Covariance};
 use crate::energy::{analyze_record, model_force_along};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
@@ -37,7 +37,7 @@ pub fn fit(
     records: &[Record],
     opts: &FitOptions,
 ) -> Result<FitResult, EngineError> {
-    let residuals = VelocityResponse::new(opts.velocity_offset, opts.time_shift);
+    let residuals = VelocityResponse::new(opts.velocity_offset, opts.time_shift, opts.x0);
     fit_with(Arc::new(residuals), osc, model, records, opts)
 }
 
@@ -137,6 +137,8 @@ struct Statistics {
     cov: Covariance,
     ssr: f64,
     t_quantile: f64,
+    /// Says how the standard errors were widened for autocorrelated residuals.
+    widening: Option<Finding>,
 }
 
 fn statistics<R: Residuals>(
@@ -147,7 +149,14 @@ fn statistics<R: Residuals>(
     let p_best = reference.physical(&best.u);
     let (jac, r) = reference.jacobian_physical(&p_best)?;
     let ssr = r.norm_squared();
-    let cov = covariance(&jac, ssr);
+    let mut cov = covariance(&jac, ssr);
+    let segments: Vec<usize> = reference
+        .records
+        .iter()
+        .enumerate()
+        .map(|(i, rec)| reference.residuals.residual_count(i, rec))
+        .collect();
+    let widening = widen_for_autocorrelation(&mut cov, &jac, r.as_slice(), &segments);
     let t_quantile = t_quantile_975(cov.dof);
     let world = reference.realise(&p_best)?;
     Ok(Statistics {
@@ -156,7 +165,64 @@ fn statistics<R: Residuals>(
         cov,
         ssr,
         t_quantile,
+        widening,
     })
+}
+
+/// Noise lag-1 correlation above which standard errors are checked for widening (white
+/// noise gives about 1/sqrt(n), far below).
+pub const AUTOCORRELATION_THRESHOLD: f64 = 0.1;
+
+/// Widens the covariance when the residuals are autocorrelated: each standard error becomes
+/// the larger of the classical and the Newey-West one (Bartlett lags covering the noise's
+/// correlation time), keeping the correlations. Returns the finding that says so.
+fn widen_for_autocorrelation(
+    cov: &mut Covariance,
+    jac: &DMatrix<f64>,
+    r: &[f64],
+    segments: &[usize],
+) -> Option<Finding> {
+    let mut start = 0;
+    let parts: Vec<Vec<f64>> = segments
+        .iter()
+        .map(|&len| {
+            let part = r[start..(start + len).min(r.len())].to_vec();
+            start += len;
+            part
+        })
+        .collect();
+    let phi = diagnostics::noise_correlation(&parts);
+    if phi <= AUTOCORRELATION_THRESHOLD
+        || cov.singular
+        || cov.residual_variance.is_nan()
+        || cov.residual_variance <= 0.0
+    {
+        return None;
+    }
+    let shortest = segments.iter().copied().min().unwrap_or(0);
+    let lags = ((5.0 * (1.0 + phi) / (1.0 - phi)).ceil() as usize).clamp(1, shortest / 4 + 1);
+    let bread = &cov.matrix / cov.residual_variance;
+    let hac = stats::newey_west(jac, r, segments, lags, &bread);
+    let p = cov.std_errors.len();
+    let factors: Vec<f64> = (0..p)
+        .map(|i| (hac[(i, i)] / cov.matrix[(i, i)]).sqrt())
+        .map(|f| if f.is_finite() { f.max(1.0) } else { 1.0 })
+        .collect();
+    for a in 0..p {
+        for b in 0..p {
+            cov.matrix[(a, b)] *= factors[a] * factors[b];
+        }
+        cov.std_errors[a] *= factors[a];
+    }
+    let widest = factors.iter().copied().fold(1.0, f64::max);
+    Some(Finding::new(
+        Check::NoiseCorrelation,
+        Status::Pass,
+        Some(widest),
+        format!(
+            "residuals are autocorrelated (noise lag-1 correlation {phi:.2}): standard errors widened by up to {widest:.2}x (Newey-West, {lags} lags)"
+        ),
+    ))
 }
 
 /// Statistics, per-record fits, the energy check and the findings at the best start.
@@ -229,6 +295,7 @@ fn diagnose<R: Residuals>(
     ));
     findings.extend(correlation_findings(params, &stats.cov));
     findings.push(diagnostics::standard_errors(parameters, stats.cov.singular));
+    findings.extend(stats.widening.clone());
     findings.extend(identifiability_findings(
         ctx.opts,
         ctx.layout.n_model_free(),
@@ -368,8 +435,8 @@ fn record_fits<R: Residuals>(
             .sum();
         out.sum_sq += ss;
         out.n_total += measured.len();
-        let offset = world.nuisance[ri].offset;
-        let (energy_force, ebf, mf) = match energy_check(rec, offset, world, opts) {
+        let nuisance = &world.nuisance[ri];
+        let (energy_force, ebf, mf) = match energy_check(rec, nuisance, world, opts) {
             Ok((ef, ebf, mf)) => {
                 out.findings
                     .push(diagnostics::energy_balance(&rec.name, &ef));
@@ -386,7 +453,7 @@ fn record_fits<R: Residuals>(
         };
         out.records.push(RecordFit {
             file: rec.name.clone(),
-            x0: rec.x0,
+            x0: nuisance.x0_of(rec),
             release_time: rec.release_time,
             samples: rec.len(),
             channel: problem.residuals.channel().to_string(),
@@ -405,15 +472,17 @@ fn record_fits<R: Residuals>(
 /// The energy check of one record, its energy-based force and the model force along it.
 fn energy_check(
     rec: &Record,
-    offset: f64,
+    nuisance: &NuisanceValues,
     world: &Realised,
     opts: &FitOptions,
 ) -> Result<(EnergyForce, Vec<f64>, Vec<f64>), EngineError> {
-    // The energy analysis sees the measured velocity corrected by the fitted offset.
+    // The energy analysis sees the measured velocity corrected by the fitted offset, from the
+    // fitted release displacement.
     let mut corrected = rec.clone();
     for v in corrected.velocity_mut() {
-        *v -= offset;
+        *v -= nuisance.offset;
     }
+    corrected.x0 = nuisance.x0_of(rec);
     let osc = &world.oscillator;
     let analysis = analyze_record(&corrected, osc, &opts.energy)?;
     let model_force = model_force_along(world.model.as_ref(), osc, &analysis.time, &analysis.v)?;
