@@ -67,7 +67,7 @@ fn uff58_regressions() {
         let text = String::from_utf8_lossy(&data);
         match read_uff58(Path::new("fuzz.uff"), &text, &opts()) {
             Ok(r) => assert!(
-                r.time.iter().chain(&r.velocity).all(|v| v.is_finite()),
+                r.time().iter().chain(r.velocity()).all(|v| v.is_finite()),
                 "{}: non-finite samples accepted",
                 path.display()
             ),

@@ -75,8 +75,8 @@ fn a_million_line_record_is_read() {
     std::fs::write(&path, csv(&time, &velocity)).expect("write");
     let r = read_record(&path, &ReadOptions::default()).expect("a million lines are read");
     assert_eq!(r.len(), n);
-    assert_eq!(r.time[n - 1], time[n - 1]);
-    assert_eq!(r.velocity[12345], velocity[12345]);
+    assert_eq!(r.time()[n - 1], time[n - 1]);
+    assert_eq!(r.velocity()[12345], velocity[12345]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -210,12 +210,12 @@ fn a_record_of_zeros_is_read_and_analysed_without_panic() {
 #[test]
 fn a_spike_of_1e30_is_read_and_the_fit_does_not_panic() {
     let mut rec = fmm_record(&Coulomb { mu: 0.2 }, 0.014);
-    rec.velocity[100] = 1e30;
+    rec.velocity_mut()[100] = 1e30;
     let dir = scratch("spike");
     let path = dir.join("spike.csv");
-    std::fs::write(&path, csv(&rec.time, &rec.velocity)).expect("write");
+    std::fs::write(&path, csv(rec.time(), rec.velocity())).expect("write");
     let mut read = read_record(&path, &ReadOptions::default()).expect("1e30 is finite");
-    assert_eq!(read.velocity[100], 1e30);
+    assert_eq!(read.velocity()[100], 1e30);
     read.x0 = 0.014;
     let osc = Oscillator::fmm();
     if let Ok(a) = analyze_record(&read, &osc, &EnergyOptions::default()) {

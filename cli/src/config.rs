@@ -34,7 +34,7 @@
 //! syntax errors name the line and column.
 
 use crate::error::CliError;
-use frictionid_engine::data::{read_record, DataFormat, ReadOptions};
+use frictionid_engine::record::RecordSource;
 use frictionid_engine::spec::{EnergySpec, FitSpec, ModelSpec, SimulationSpec, Spec, SpecError};
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::build_toml;
@@ -60,34 +60,8 @@ pub struct Config {
     pub records: Vec<RecordConfig>,
 }
 
-/// One `[[records]]` entry.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RecordConfig {
-    /// The file, resolved against the config file's directory.
-    pub file: PathBuf,
-    /// The file as written in the config (for messages and reports).
-    pub file_as_written: String,
-    /// Release displacement \[m\].
-    pub x0: f64,
-    /// Release velocity [m/s].
-    pub v0: f64,
-    /// Weight in a joint fit.
-    pub weight: f64,
-    /// How to read the file.
-    pub read: ReadOptions,
-}
-
-impl RecordConfig {
-    /// Reads the file into a record with this entry's x0, v0 and weight.
-    pub fn load(&self) -> Result<Record, CliError> {
-        let mut record = read_record(&self.file, &self.read)?;
-        record.name = self.file_as_written.clone();
-        record.x0 = self.x0;
-        record.v0 = self.v0;
-        record.weight = self.weight;
-        Ok(record)
-    }
-}
+/// One `[[records]]` entry, checked and resolved (the engine's shared record source).
+pub use frictionid_engine::record::source::ResolvedSource as RecordConfig;
 
 // ---------------------------------------------------------------------------------------------
 // Raw (as written) structures.
@@ -101,23 +75,7 @@ struct RawConfig {
     simulation: Option<SimulationSpec>,
     energy: Option<EnergySpec>,
     #[serde(default)]
-    records: Vec<RawRecord>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawRecord {
-    file: Option<String>,
-    x0: Option<f64>,
-    #[serde(default)]
-    v0: f64,
-    weight: Option<f64>,
-    format: Option<DataFormat>,
-    time_column: Option<String>,
-    velocity_column: Option<String>,
-    velocity_scale: Option<f64>,
-    min_samples: Option<usize>,
-    sampling_tolerance: Option<f64>,
+    records: Vec<RecordSource>,
 }
 
 use frictionid_models::suggest::did_you_mean as hint;
@@ -304,7 +262,10 @@ impl Config {
             .records
             .into_iter()
             .enumerate()
-            .map(|(i, r)| record_config(r, i + 1, &base_dir).map_err(&cfg_err))
+            .map(|(i, r)| {
+                r.resolve(i + 1, &base_dir)
+                    .map_err(|e| cfg_err(e.to_string()))
+            })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             path: path.to_path_buf(),
@@ -338,54 +299,11 @@ impl Config {
                 "{purpose} needs at least one [[records]] entry (file, x0)"
             )));
         }
-        self.records.iter().map(RecordConfig::load).collect()
+        self.records
+            .iter()
+            .map(|r| r.load().map_err(CliError::from))
+            .collect()
     }
-}
-
-fn finite(what: &str, value: f64) -> Result<f64, String> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(format!("{what} must be finite, got {value}"))
-    }
-}
-
-fn record_config(r: RawRecord, index: usize, base: &Path) -> Result<RecordConfig, String> {
-    let Some(file) = r.file else {
-        return Err(format!(
-            "[[records]] entry {index}: missing `file` (the record's data file)"
-        ));
-    };
-    let who = format!("[[records]] entry {index} (`{file}`)");
-    let x0 =
-        r.x0.ok_or_else(|| format!("{who}: missing `x0` (the release displacement, m)"))?;
-    let weight = r.weight.unwrap_or(1.0);
-    if !(weight.is_finite() && weight > 0.0) {
-        return Err(format!("{who}: `weight` must be > 0, got {weight}"));
-    }
-    let defaults = ReadOptions::default();
-    let read = ReadOptions {
-        format: r.format.unwrap_or(defaults.format),
-        time_column: r.time_column.unwrap_or(defaults.time_column),
-        velocity_column: r.velocity_column.unwrap_or(defaults.velocity_column),
-        velocity_scale: r.velocity_scale.unwrap_or(defaults.velocity_scale),
-        min_samples: r.min_samples.unwrap_or(defaults.min_samples),
-        sampling_tolerance: r.sampling_tolerance.unwrap_or(defaults.sampling_tolerance),
-    };
-    let path = Path::new(&file);
-    let resolved = if path.is_absolute() {
-        path.to_path_buf()
-    } else {
-        base.join(path)
-    };
-    Ok(RecordConfig {
-        file: resolved,
-        file_as_written: file.clone(),
-        x0: finite(&format!("{who}: `x0`"), x0)?,
-        v0: finite(&format!("{who}: `v0`"), r.v0)?,
-        weight,
-        read,
-    })
 }
 
 #[cfg(test)]
@@ -421,7 +339,12 @@ mod tests {
             frictionid_engine::spec::IntegratorMethod::Euler
         );
         assert_eq!(c.records[0].file, Path::new("dir/a.csv"));
-        assert_eq!(c.records[0].read.velocity_scale, 1e-3);
+        assert_eq!(
+            c.records[0]
+                .read
+                .scale(frictionid_engine::record::Channel::Velocity),
+            1e-3
+        );
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! dataset 58 twins (written by pyuff) against their CSV record.
 
 use assert_cmd::Command;
-use frictionid_engine::data::{read_record, ReadOptions};
+use frictionid_engine::data::{read_record, Channel, ReadOptions};
 use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::Oscillator;
 use std::path::{Path, PathBuf};
@@ -79,15 +79,12 @@ fn simulate_paper_140mm_stops_where_the_exact_solution_does() {
     // The trajectory file holds the exact solution at its sample times.
     let traj = read_record(
         &out.join("trajectory.csv"),
-        &ReadOptions {
-            velocity_column: "x".into(),
-            ..ReadOptions::default()
-        },
+        &ReadOptions::default().with_column(Channel::Velocity, "x"),
     )
     .unwrap();
-    let ex = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.140, &traj.time).unwrap();
+    let ex = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.140, traj.time()).unwrap();
     let err = traj
-        .velocity
+        .velocity()
         .iter()
         .zip(&ex.x)
         .map(|(a, b)| (a - b).abs())
@@ -124,11 +121,11 @@ fn fmm_records_match_their_documented_truth() {
     ] {
         let r = read_record(&fixtures().join(file), &ReadOptions::default()).unwrap();
         assert_eq!(r.len(), 2001, "{file}");
-        assert!((r.time[2000] - 2.0).abs() < 1e-12);
-        let exact = coulomb_free_vibration(&osc, 0.24 * 14.5, x0, &r.time).unwrap();
+        assert!((r.time()[2000] - 2.0).abs() < 1e-12);
+        let exact = coulomb_free_vibration(&osc, 0.24 * 14.5, x0, r.time()).unwrap();
         let n = r.len() as f64;
         let resid: Vec<f64> = r
-            .velocity
+            .velocity()
             .iter()
             .zip(&exact.v)
             .map(|(a, b)| a - b)
@@ -147,11 +144,11 @@ fn simulate_with_noise_writes_a_record_usable_in_records() {
     let rec = read_record(&out.join("record.csv"), &ReadOptions::default()).unwrap();
     let committed = read_record(&fixtures().join("x14mm.csv"), &ReadOptions::default()).unwrap();
     // Same config and seed: the committed fixture is reproduced.
-    assert_eq!(rec.time, committed.time);
+    assert_eq!(rec.time(), committed.time());
     let worst = rec
-        .velocity
+        .velocity()
         .iter()
-        .zip(&committed.velocity)
+        .zip(committed.velocity())
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
     assert!(worst < 1e-9, "{worst}");
@@ -164,11 +161,11 @@ fn uff_twins_read_to_the_csv_record() {
     for (file, rel) in [("x14mm.uff", 1e-11), ("x14mm-single.uff", 1e-5)] {
         let uff = read_record(&fixtures().join(file), &ReadOptions::default()).unwrap();
         assert_eq!(uff.len(), csv.len(), "{file}");
-        for (a, b) in uff.time.iter().zip(&csv.time) {
+        for (a, b) in uff.time().iter().zip(csv.time()) {
             assert!((a - b).abs() < 1e-12, "{file}: t {a} vs {b}");
         }
-        let scale = csv.velocity.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for (a, b) in uff.velocity.iter().zip(&csv.velocity) {
+        let scale = csv.velocity().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (a, b) in uff.velocity().iter().zip(csv.velocity()) {
             assert!(
                 (a - b).abs() <= rel * b.abs() + 1e-15 * scale,
                 "{file}: v {a} vs {b}"

@@ -39,7 +39,7 @@ fn bench(c: &mut Criterion) {
     });
     let lugre = LuGre::default();
     c.bench_function("model_force_along_2000_lugre", |b| {
-        b.iter(|| model_force_along(&lugre, &osc, black_box(&record.time), &record.velocity))
+        b.iter(|| model_force_along(&lugre, &osc, black_box(record.time()), record.velocity()))
     });
 }
 

@@ -487,26 +487,28 @@ fn bad_records_are_clear_errors() {
     let t = uniform_times(1.0, 1000.0);
     let good = record(0.014, 0.0, 0);
     let base = |v: Vec<f64>| Record::new("bad", t.clone(), v, 0.014);
+    let with_time = |time: Vec<f64>, v: Vec<f64>| Record::new("bad", time, v, 0.014);
 
     expect_record_error(
         analyze_record(&base(vec![0.0; t.len()]), &osc, &opts),
         "zeros",
     );
-    let mut short = base(good.velocity[..20].to_vec());
-    short.time.truncate(20);
+    let short = with_time(t[..20].to_vec(), good.velocity()[..20].to_vec());
     expect_record_error(analyze_record(&short, &osc, &opts), "short");
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-        let mut v = good.velocity[..t.len()].to_vec();
+        let mut v = good.velocity()[..t.len()].to_vec();
         v[300] = bad;
         expect_record_error(analyze_record(&base(v), &osc, &opts), "non-finite v");
     }
-    let mut r = base(good.velocity[..t.len()].to_vec());
-    r.time[500] = r.time[499];
+    let mut time = t.clone();
+    time[500] = time[499];
+    let r = with_time(time, good.velocity()[..t.len()].to_vec());
     expect_record_error(analyze_record(&r, &osc, &opts), "repeated time");
-    let mut r = base(good.velocity[..t.len()].to_vec());
-    r.time[10] = f64::NAN;
+    let mut time = t.clone();
+    time[10] = f64::NAN;
+    let r = with_time(time, good.velocity()[..t.len()].to_vec());
     expect_record_error(analyze_record(&r, &osc, &opts), "NaN time");
-    let mut r = base(good.velocity[..t.len()].to_vec());
+    let mut r = base(good.velocity()[..t.len()].to_vec());
     r.x0 = f64::INFINITY;
     expect_record_error(analyze_record(&r, &osc, &opts), "infinite x0");
     expect_record_error(
@@ -515,8 +517,7 @@ fn bad_records_are_clear_errors() {
     );
     expect_record_error(analyze_record(&base(Vec::new()), &osc, &opts), "empty");
     // The paper's recipe needs its 10-sample span.
-    let mut tiny = base(good.velocity[..8].to_vec());
-    tiny.time.truncate(8);
+    let tiny = with_time(t[..8].to_vec(), good.velocity()[..8].to_vec());
     let paper = EnergyOptions {
         differentiator: Differentiator::Paper,
         ..opts

@@ -158,7 +158,7 @@ fn nuisance_offset_and_release_shift_are_recovered() {
     let mut recs = records(&osc, &Coulomb { mu: 0.24 }, NOISE, 61);
     // A constant vibrometer offset of 3e-4 m/s on every record.
     for r in &mut recs {
-        for v in &mut r.velocity {
+        for v in r.velocity_mut() {
             *v += 3e-4;
         }
     }
@@ -193,7 +193,7 @@ fn bad_fit_requests_are_clear_errors() {
         .to_string();
     assert!(e.contains("at least one record"), "{e}");
     let mut bad = recs.clone();
-    bad[1].velocity[5] = f64::NAN;
+    bad[1].velocity_mut()[5] = f64::NAN;
     let e = fit(&osc, &Coulomb::default(), &bad, &FitOptions::default())
         .unwrap_err()
         .to_string();

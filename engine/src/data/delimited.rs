@@ -1,7 +1,10 @@
 //! Delimited text records: CSV (comma, semicolon or tab) or whitespace-separated columns with a
 //! header row. Blank lines and lines starting with `#` are skipped anywhere in the file.
 
-use super::{finish, quoted, too_many_samples, DataError, DataFormat, ReadOptions, MAX_SAMPLES};
+use super::{
+    finish, quoted, too_many_samples, Channel, DataError, DataFormat, RawSamples, ReadOptions,
+    MAX_SAMPLES,
+};
 use crate::record::Record;
 use std::path::Path;
 
@@ -53,6 +56,19 @@ fn find_column(header: &[&str], name: &str) -> Option<usize> {
         .or_else(|| header.iter().position(|h| h.eq_ignore_ascii_case(name)))
 }
 
+/// The header row: its line, the separator it implies and its column names.
+struct Header<'a> {
+    line: usize,
+    sep: Separator,
+    names: Vec<&'a str>,
+}
+
+/// Where the time and each channel found are in a line's fields.
+struct Columns {
+    time: usize,
+    channels: Vec<(Channel, usize, f64)>,
+}
+
 /// Parses delimited text (already read from `path`) into a record.
 pub fn read_delimited(
     path: &Path,
@@ -60,7 +76,6 @@ pub fn read_delimited(
     format: DataFormat,
     opts: &ReadOptions,
 ) -> Result<Record, DataError> {
-    let file = || path.to_path_buf();
     let mut lines = text
         .lines()
         .enumerate()
@@ -69,84 +84,139 @@ pub fn read_delimited(
             let t = l.trim_start();
             !t.is_empty() && !t.starts_with('#')
         });
-    let Some((header_line, header_text)) = lines.next() else {
+    let header = read_header(path, lines.next(), format, opts)?;
+    let columns = locate_columns(path, &header, opts)?;
+    let raw = read_rows(path, &header, &columns, lines)?;
+    finish(path, raw, opts)
+}
+
+/// The header row (the first line that is not blank or a comment).
+fn read_header<'a>(
+    path: &Path,
+    first: Option<(usize, &'a str)>,
+    format: DataFormat,
+    opts: &ReadOptions,
+) -> Result<Header<'a>, DataError> {
+    let Some((line, text)) = first else {
         return Err(DataError::Empty {
-            file: file(),
+            file: path.to_path_buf(),
             reason: "the file has no header row and no data".into(),
         });
     };
-    let sep = Separator::detect(header_text, format);
-    let header = sep.split(header_text);
-    if header.iter().all(|h| h.parse::<f64>().is_ok()) {
+    let sep = Separator::detect(text, format);
+    let names = sep.split(text);
+    if names.iter().all(|h| h.parse::<f64>().is_ok()) {
+        let first_channel = opts
+            .channels
+            .values()
+            .next()
+            .map_or("velocity", |c| &c.column);
         return Err(DataError::Empty {
-            file: file(),
+            file: path.to_path_buf(),
             reason: format!(
-                "line {header_line}: expected a header row with column names (`{}`, `{}`), found numbers",
-                opts.time_column, opts.velocity_column
+                "line {line}: expected a header row with column names (`{}`, `{first_channel}`), found numbers",
+                opts.time.column
             ),
         });
     }
+    Ok(Header { line, sep, names })
+}
+
+/// The positions of the time column and of every configured channel.
+fn locate_columns(path: &Path, header: &Header, opts: &ReadOptions) -> Result<Columns, DataError> {
     let column = |name: &str| {
-        find_column(&header, name).ok_or_else(|| DataError::MissingColumn {
-            file: file(),
-            line: header_line,
+        find_column(&header.names, name).ok_or_else(|| DataError::MissingColumn {
+            file: path.to_path_buf(),
+            line: header.line,
             column: quoted(name),
             // Only short names are compared (the edit distance costs the product of lengths).
             hint: frictionid_models::suggest::did_you_mean(
                 name,
-                header.iter().copied().filter(|h| h.len() <= 64),
+                header.names.iter().copied().filter(|h| h.len() <= 64),
             ),
-            available: quoted(&header.join(", ")),
+            available: quoted(&header.names.join(", ")),
         })
     };
-    let ti = column(&opts.time_column)?;
-    let vi = column(&opts.velocity_column)?;
+    let time = column(&opts.time.column)?;
+    let channels = opts
+        .channels
+        .iter()
+        .map(|(&channel, spec)| Ok((channel, column(&spec.column)?, spec.scale)))
+        .collect::<Result<Vec<_>, DataError>>()?;
+    Ok(Columns { time, channels })
+}
 
-    let (mut time, mut velocity, mut line_numbers) = (Vec::new(), Vec::new(), Vec::new());
+/// Parses the data rows: time and each channel's column, scaled.
+fn read_rows<'a>(
+    path: &Path,
+    header: &Header,
+    columns: &Columns,
+    lines: impl Iterator<Item = (usize, &'a str)>,
+) -> Result<RawSamples, DataError> {
+    let mut raw = RawSamples {
+        time: Vec::new(),
+        channels: columns
+            .channels
+            .iter()
+            .map(|&(c, _, _)| (c, Vec::new()))
+            .collect(),
+        lines: Vec::new(),
+    };
     for (line, text) in lines {
-        if time.len() >= MAX_SAMPLES {
+        if raw.time.len() >= MAX_SAMPLES {
             return Err(too_many_samples(path, line));
         }
-        let fields = sep.split(text);
-        if fields.len() != header.len() {
+        let fields = header.sep.split(text);
+        if fields.len() != header.names.len() {
             return Err(DataError::ColumnCount {
-                file: file(),
+                file: path.to_path_buf(),
                 line,
                 found: fields.len(),
-                expected: header.len(),
+                expected: header.names.len(),
             });
         }
-        let number = |idx: usize| -> Result<f64, DataError> {
-            let name = header.get(idx).copied().unwrap_or_default();
-            let raw = fields.get(idx).copied().unwrap_or_default();
-            let value = raw.parse::<f64>().map_err(|_| DataError::BadNumber {
-                file: file(),
-                line,
-                column: quoted(name),
-                text: quoted(raw),
-            })?;
-            if value.is_finite() {
-                Ok(value)
-            } else {
-                Err(DataError::NonFinite {
-                    file: file(),
-                    line,
-                    column: quoted(name),
-                    value,
-                })
-            }
-        };
-        time.push(number(ti)?);
-        velocity.push(number(vi)? * opts.velocity_scale);
-        line_numbers.push(line);
+        let number = |idx: usize| field_number(path, line, header, &fields, idx);
+        raw.time.push(number(columns.time)?);
+        for ((_, idx, scale), (_, values)) in columns.channels.iter().zip(&mut raw.channels) {
+            values.push(number(*idx)? * scale);
+        }
+        raw.lines.push(line);
     }
-    if time.is_empty() {
+    if raw.time.is_empty() {
         return Err(DataError::Empty {
-            file: file(),
-            reason: format!("no data rows after the header on line {header_line}"),
+            file: path.to_path_buf(),
+            reason: format!("no data rows after the header on line {}", header.line),
         });
     }
-    finish(path, time, velocity, &line_numbers, opts)
+    Ok(raw)
+}
+
+/// The finite number in field `idx` of a data line.
+fn field_number(
+    path: &Path,
+    line: usize,
+    header: &Header,
+    fields: &[&str],
+    idx: usize,
+) -> Result<f64, DataError> {
+    let name = header.names.get(idx).copied().unwrap_or_default();
+    let raw = fields.get(idx).copied().unwrap_or_default();
+    let value = raw.parse::<f64>().map_err(|_| DataError::BadNumber {
+        file: path.to_path_buf(),
+        line,
+        column: quoted(name),
+        text: quoted(raw),
+    })?;
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(DataError::NonFinite {
+            file: path.to_path_buf(),
+            line,
+            column: quoted(name),
+            value,
+        })
+    }
 }
 
 #[cfg(test)]
@@ -175,8 +245,8 @@ mod tests {
     fn reads_csv_with_comments_and_blank_lines() {
         let text = format!("# exported by a test\n\ntime,velocity\n{}# end\n", rows(5));
         let r = read(&text).unwrap();
-        assert_eq!(r.time, vec![0.0, 0.001, 0.002, 0.003, 0.004]);
-        assert_eq!(r.velocity, vec![0.0, 0.5, 1.0, 1.5, 2.0]);
+        assert_eq!(r.time(), vec![0.0, 0.001, 0.002, 0.003, 0.004]);
+        assert_eq!(r.velocity(), vec![0.0, 0.5, 1.0, 1.5, 2.0]);
         assert_eq!(r.name, "r.csv");
     }
 
@@ -184,26 +254,26 @@ mod tests {
     fn reads_whitespace_columns_in_any_order_with_scale() {
         let text = "velocity   extra time\n 1.0 a 0.0\n2.0 b 0.1\n\t3.0 c 0.2\n";
         let opts = ReadOptions {
-            velocity_scale: 1e-3,
             min_samples: 3,
             ..ReadOptions::default()
-        };
+        }
+        .with_scale(Channel::Velocity, 1e-3);
         let r = read_delimited(Path::new("w.txt"), text, DataFormat::Whitespace, &opts).unwrap();
-        assert_eq!(r.time, vec![0.0, 0.1, 0.2]);
-        assert_eq!(r.velocity, vec![1e-3, 2e-3, 3e-3]);
+        assert_eq!(r.time(), vec![0.0, 0.1, 0.2]);
+        assert_eq!(r.velocity(), vec![1e-3, 2e-3, 3e-3]);
     }
 
     #[test]
     fn semicolon_and_quoted_headers_with_custom_columns() {
         let text = "\"t [s]\";\"v [mm/s]\"\n0;1\n1;2\n2;3\n";
         let opts = ReadOptions {
-            time_column: "t [s]".into(),
-            velocity_column: "v [mm/s]".into(),
+            time: crate::data::ColumnSpec::named("t [s]"),
             min_samples: 3,
             ..ReadOptions::default()
-        };
+        }
+        .with_column(Channel::Velocity, "v [mm/s]");
         let r = read_delimited(Path::new("s.csv"), text, DataFormat::Csv, &opts).unwrap();
-        assert_eq!(r.velocity, vec![1.0, 2.0, 3.0]);
+        assert_eq!(r.velocity(), vec![1.0, 2.0, 3.0]);
     }
 
     #[test]

@@ -12,8 +12,10 @@ mod uff58;
 pub use delimited::read_delimited;
 pub use uff58::read_uff58;
 
-use crate::record::Record;
+pub use crate::record::Channel;
+use crate::record::{Record, RecordSourceError, TimeBase, TimeError};
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -55,18 +57,36 @@ pub enum DataFormat {
     Uff58,
 }
 
-/// How to read a record file.
+/// Where one quantity is in a file and the factor that turns the file's unit into SI.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColumnSpec {
+    /// Header name of the column (delimited text only).
+    pub column: String,
+    /// Factor from the file's unit to SI (1e-3 for mm/s; negative to flip a sign convention).
+    pub scale: f64,
+}
+
+impl ColumnSpec {
+    /// The column `column` with unit scale.
+    pub fn named(column: impl Into<String>) -> Self {
+        Self {
+            column: column.into(),
+            scale: 1.0,
+        }
+    }
+}
+
+/// How to read a record file: the time column and, keyed by [`Channel`], the channels to read.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ReadOptions {
     /// File format.
     pub format: DataFormat,
-    /// Header name of the time column \[s\] (delimited text only).
-    pub time_column: String,
-    /// Header name of the velocity column (delimited text only).
-    pub velocity_column: String,
-    /// Factor that turns the file's velocity unit into m/s (1e-3 for mm/s, 1e-6 for um/s).
-    pub velocity_scale: f64,
+    /// The time column \[s after scaling\].
+    pub time: ColumnSpec,
+    /// The channels read, each from its column (every one must be present).
+    pub channels: BTreeMap<Channel, ColumnSpec>,
     /// Fewest samples accepted.
     pub min_samples: usize,
     /// Largest accepted deviation of one time step from the median step, relative to the
@@ -75,15 +95,74 @@ pub struct ReadOptions {
 }
 
 impl Default for ReadOptions {
+    /// Time from column `time`, velocity from column `velocity`, both unscaled.
     fn default() -> Self {
         Self {
             format: DataFormat::Auto,
-            time_column: "time".into(),
-            velocity_column: "velocity".into(),
-            velocity_scale: 1.0,
+            time: ColumnSpec::named("time"),
+            channels: BTreeMap::from([(Channel::Velocity, ColumnSpec::named("velocity"))]),
             min_samples: 10,
             sampling_tolerance: 0.01,
         }
+    }
+}
+
+impl ReadOptions {
+    /// The column spec of `channel`, added with the channel's own name as column and unit
+    /// scale if it is not read yet.
+    pub fn channel_mut(&mut self, channel: Channel) -> &mut ColumnSpec {
+        self.channels
+            .entry(channel)
+            .or_insert_with(|| ColumnSpec::named(channel.name()))
+    }
+
+    /// These options with `channel` read from `column`.
+    pub fn with_column(mut self, channel: Channel, column: impl Into<String>) -> Self {
+        self.channel_mut(channel).column = column.into();
+        self
+    }
+
+    /// These options with `channel` scaled by `scale`.
+    pub fn with_scale(mut self, channel: Channel, scale: f64) -> Self {
+        self.channel_mut(channel).scale = scale;
+        self
+    }
+
+    /// The column `channel` is read from (its own name when it is not configured).
+    pub fn column(&self, channel: Channel) -> &str {
+        self.channels
+            .get(&channel)
+            .map_or(channel.name(), |c| c.column.as_str())
+    }
+
+    /// The scale of `channel` (1 when it is not configured).
+    pub fn scale(&self, channel: Channel) -> f64 {
+        self.channels.get(&channel).map_or(1.0, |c| c.scale)
+    }
+
+    /// Checks scales and the sampling tolerance; the message is the reason.
+    fn check(&self) -> Result<(), String> {
+        if !(self.time.scale.is_finite() && self.time.scale > 0.0) {
+            return Err(format!(
+                "time_scale must be finite and > 0, got {}",
+                self.time.scale
+            ));
+        }
+        for (channel, spec) in &self.channels {
+            if !(spec.scale.is_finite() && spec.scale != 0.0) {
+                return Err(format!(
+                    "{channel}_scale must be finite and non-zero, got {}",
+                    spec.scale
+                ));
+            }
+        }
+        if !(self.sampling_tolerance.is_finite() && self.sampling_tolerance > 0.0) {
+            return Err(format!(
+                "sampling_tolerance must be > 0, got {}",
+                self.sampling_tolerance
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -168,28 +247,17 @@ pub enum DataError {
     /// Invalid read options.
     #[error("{file}: {reason}")]
     Options { file: PathBuf, reason: String },
+    /// A `[[records]]` entry that cannot be used.
+    #[error(transparent)]
+    Source(#[from] RecordSourceError),
 }
 
 /// Reads a record file in the format given by `opts.format` (see [`DataFormat::Auto`]).
 pub fn read_record(path: &Path, opts: &ReadOptions) -> Result<Record, DataError> {
-    if !(opts.velocity_scale.is_finite() && opts.velocity_scale != 0.0) {
-        return Err(DataError::Options {
-            file: path.to_path_buf(),
-            reason: format!(
-                "velocity_scale must be finite and non-zero, got {}",
-                opts.velocity_scale
-            ),
-        });
-    }
-    if !(opts.sampling_tolerance.is_finite() && opts.sampling_tolerance > 0.0) {
-        return Err(DataError::Options {
-            file: path.to_path_buf(),
-            reason: format!(
-                "sampling_tolerance must be > 0, got {}",
-                opts.sampling_tolerance
-            ),
-        });
-    }
+    opts.check().map_err(|reason| DataError::Options {
+        file: path.to_path_buf(),
+        reason,
+    })?;
     let text = read_text(path)?;
     match resolve_format(path, opts.format) {
         DataFormat::Uff58 => read_uff58(path, &text, opts),
@@ -267,26 +335,33 @@ fn record_name(path: &Path) -> String {
     path.display().to_string()
 }
 
-/// Checks time and velocity samples (with the file line of each sample) and builds the record.
-fn finish(
-    path: &Path,
-    time: Vec<f64>,
-    velocity: Vec<f64>,
-    lines: &[usize],
-    opts: &ReadOptions,
-) -> Result<Record, DataError> {
+/// Samples read from a file, before the checks: time, the channels found and the file line of
+/// each sample.
+pub(crate) struct RawSamples {
+    pub time: Vec<f64>,
+    pub channels: Vec<(Channel, Vec<f64>)>,
+    pub lines: Vec<usize>,
+}
+
+/// Checks the samples (count, finite values, increasing time, even sampling) and builds the
+/// record.
+fn finish(path: &Path, raw: RawSamples, opts: &ReadOptions) -> Result<Record, DataError> {
     let file = || path.to_path_buf();
-    let line_of = |i: usize| lines.get(i).copied().unwrap_or(0);
-    if time.len() < opts.min_samples.max(2) {
+    let line_of = |i: usize| raw.lines.get(i).copied().unwrap_or(0);
+    let needed = opts.min_samples.max(2);
+    if raw.time.len() < needed {
         return Err(DataError::TooFewSamples {
             file: file(),
-            found: time.len(),
-            needed: opts.min_samples.max(2),
+            found: raw.time.len(),
+            needed,
         });
     }
     // Values parse as finite, but scaling or an evenly spaced UFF abscissa can overflow.
-    for (i, (&t, &v)) in time.iter().zip(&velocity).enumerate() {
-        for (column, value) in [("time", t), ("velocity", v)] {
+    for i in 0..raw.time.len() {
+        let columns = std::iter::once(("time", &raw.time))
+            .chain(raw.channels.iter().map(|(c, v)| (c.name(), v)));
+        for (column, values) in columns {
+            let value = values.get(i).copied().unwrap_or(f64::NAN);
             if !value.is_finite() {
                 return Err(DataError::NonFinite {
                     file: file(),
@@ -297,32 +372,62 @@ fn finish(
             }
         }
     }
-    for (i, w) in time.windows(2).enumerate() {
-        if w[1] <= w[0] {
-            return Err(DataError::NotIncreasing {
-                file: file(),
-                line: line_of(i + 1),
-                time: w[1],
-                previous: w[0],
-            });
-        }
-    }
+    let time = TimeBase::new(raw.time).map_err(|e| match e {
+        TimeError::TooFew { found, needed } => DataError::TooFewSamples {
+            file: file(),
+            found,
+            needed,
+        },
+        TimeError::NonFinite { index, value } => DataError::NonFinite {
+            file: file(),
+            line: line_of(index),
+            column: "time".into(),
+            value,
+        },
+        TimeError::NotIncreasing {
+            index,
+            time,
+            previous,
+        } => DataError::NotIncreasing {
+            file: file(),
+            line: line_of(index),
+            time,
+            previous,
+        },
+    })?;
+    check_even_sampling(path, time.as_slice(), &raw.lines, opts.sampling_tolerance)?;
+    let record = Record::from_time_base(record_name(path), time);
+    Ok(raw
+        .channels
+        .into_iter()
+        .fold(record, |r, (channel, values)| {
+            r.with_channel(channel, values)
+        }))
+}
+
+/// Checks that no time step deviates from the median step by more than `tolerance` of it.
+fn check_even_sampling(
+    path: &Path,
+    time: &[f64],
+    lines: &[usize],
+    tolerance: f64,
+) -> Result<(), DataError> {
     let mut steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
     steps.sort_by(f64::total_cmp);
     let median = steps.get(steps.len() / 2).copied().unwrap_or(0.0);
     for (i, w) in time.windows(2).enumerate() {
         let step = w[1] - w[0];
-        if (step - median).abs() > opts.sampling_tolerance * median {
+        if (step - median).abs() > tolerance * median {
             return Err(DataError::UnevenSampling {
-                file: file(),
-                line: line_of(i + 1),
+                file: path.to_path_buf(),
+                line: lines.get(i + 1).copied().unwrap_or(0),
                 step,
                 median,
-                tolerance_percent: opts.sampling_tolerance * 100.0,
+                tolerance_percent: tolerance * 100.0,
             });
         }
     }
-    Ok(Record::new(record_name(path), time, velocity, 0.0))
+    Ok(())
 }
 
 #[cfg(test)]
@@ -356,10 +461,7 @@ mod tests {
 
     #[test]
     fn bad_scale_is_rejected() {
-        let opts = ReadOptions {
-            velocity_scale: 0.0,
-            ..ReadOptions::default()
-        };
+        let opts = ReadOptions::default().with_scale(Channel::Velocity, 0.0);
         let e = read_record(Path::new("x.csv"), &opts).unwrap_err();
         assert!(matches!(e, DataError::Options { .. }), "{e}");
     }

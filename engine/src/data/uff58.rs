@@ -17,7 +17,7 @@
 //! skipped. Values are read as whitespace-separated numbers, or by their fixed field widths
 //! when adjacent numbers touch. Binary files (`58b`) are rejected with a message.
 
-use super::{finish, quoted, DataError, ReadOptions, MAX_SAMPLES};
+use super::{finish, quoted, Channel, DataError, RawSamples, ReadOptions, MAX_SAMPLES};
 use crate::record::Record;
 use std::path::Path;
 
@@ -140,6 +140,76 @@ pub fn read_uff58(path: &Path, text: &str, opts: &ReadOptions) -> Result<Record,
     })
 }
 
+/// What records 6-11 of a dataset 58 declare about its data.
+struct DatasetHeader {
+    /// Number of points.
+    n: usize,
+    /// Ordinates in double precision.
+    double: bool,
+    /// An evenly spaced abscissa (`x_min + i dx`), else (x, y) pairs.
+    even: bool,
+    x_min: f64,
+    dx: f64,
+    /// The channel the ordinate holds.
+    channel: Channel,
+}
+
+impl DatasetHeader {
+    /// Number of values in the data record.
+    fn values(&self) -> usize {
+        if self.even {
+            self.n
+        } else {
+            2 * self.n
+        }
+    }
+
+    /// The fixed field widths of a data line.
+    fn widths(&self) -> &'static [usize] {
+        match (self.double, self.even) {
+            (false, _) => &[13; 6],
+            (true, true) => &[20; 4],
+            (true, false) => &[13, 20, 13, 20],
+        }
+    }
+}
+
+/// The lines of one dataset and how to report its errors.
+struct Dataset<'a, 'l> {
+    path: &'a Path,
+    lines: &'a [(usize, &'l str)],
+    /// Index in `lines` of header record 1.
+    start: usize,
+}
+
+impl<'l> Dataset<'_, 'l> {
+    fn err(&self, line: usize, reason: String) -> DataError {
+        DataError::Uff {
+            file: self.path.to_path_buf(),
+            line,
+            reason,
+        }
+    }
+
+    fn last_line(&self) -> usize {
+        self.lines.last().map(|l| l.0).unwrap_or(0)
+    }
+
+    /// Header record `k` (1-based) and its line number.
+    fn record(&self, k: usize) -> Result<(usize, &'l str), DataError> {
+        self.lines
+            .get(self.start + k - 1)
+            .copied()
+            .filter(|(_, l)| !is_delimiter(l))
+            .ok_or_else(|| {
+                self.err(
+                    self.last_line(),
+                    format!("dataset 58 ends before its header record {k}"),
+                )
+            })
+    }
+}
+
 /// Parses the dataset 58 whose first header record (ID line 1) is `lines[start]`.
 fn parse_dataset(
     path: &Path,
@@ -147,39 +217,37 @@ fn parse_dataset(
     start: usize,
     opts: &ReadOptions,
 ) -> Result<Record, DataError> {
-    let err = |line: usize, reason: String| DataError::Uff {
-        file: path.to_path_buf(),
-        line,
-        reason,
-    };
-    let last_line = lines.last().map(|l| l.0).unwrap_or(0);
-    let record = |k: usize| -> Result<(usize, &str), DataError> {
-        lines
-            .get(start + k - 1)
-            .copied()
-            .filter(|(_, l)| !is_delimiter(l))
-            .ok_or_else(|| {
-                err(
-                    last_line,
-                    format!("dataset 58 ends before its header record {k}"),
-                )
-            })
-    };
+    let ds = Dataset { path, lines, start };
+    check_function_type(&ds)?;
+    let mut header = parse_layout(&ds)?;
+    check_abscissa(&ds)?;
+    header.channel = ordinate_channel(&ds)?;
+    ds.record(10)?;
+    ds.record(11)?;
+    let (values, value_lines) = read_values(&ds, &header)?;
+    finish(path, samples(&header, values, value_lines, opts), opts)
+}
 
-    let (l6, r6) = record(6)?;
+/// Record 6: the function type must be a time response (1) or general (0).
+fn check_function_type(ds: &Dataset) -> Result<(), DataError> {
+    let (l6, r6) = ds.record(6)?;
     let func_type = leading_int(r6, 5)
-        .ok_or_else(|| err(l6, "record 6: the function type is not an integer".into()))?;
+        .ok_or_else(|| ds.err(l6, "record 6: the function type is not an integer".into()))?;
     if !(func_type == 0 || func_type == 1) {
-        return Err(err(
+        return Err(ds.err(
             l6,
             format!("function type {func_type} is not a time response (1)"),
         ));
     }
+    Ok(())
+}
 
-    let (l7, r7) = record(7)?;
+/// Record 7: data type, number of points and abscissa spacing.
+fn parse_layout(ds: &Dataset) -> Result<DatasetHeader, DataError> {
+    let (l7, r7) = ds.record(7)?;
     let r7v = header_numbers(r7, &[10, 10, 10, 13, 13, 13]).unwrap_or_default();
     let [data_type, n_points, even, x_min, dx, ..] = r7v[..] else {
-        return Err(err(
+        return Err(ds.err(
             l7,
             "record 7: expected 3 integers and 3 reals (data type, points, spacing, start, increment, z)".into(),
         ));
@@ -188,47 +256,57 @@ fn parse_dataset(
         2 => false,
         4 => true,
         5 | 6 => {
-            return Err(err(
+            return Err(ds.err(
                 l7,
                 "complex ordinate data is not a velocity time history".into(),
             ))
         }
-        other => return Err(err(l7, format!("unknown ordinate data type {other}"))),
+        other => return Err(ds.err(l7, format!("unknown ordinate data type {other}"))),
     };
     if !(n_points >= 0.0 && n_points.fract() == 0.0) {
-        return Err(err(l7, format!("bad number of points {n_points}")));
+        return Err(ds.err(l7, format!("bad number of points {n_points}")));
     }
     if n_points > MAX_SAMPLES as f64 {
         return Err(DataError::TooLarge {
-            file: path.to_path_buf(),
+            file: ds.path.to_path_buf(),
             reason: format!(
                 "line {l7}: record 7 declares {n_points} points; more than {MAX_SAMPLES} samples are refused"
             ),
         });
     }
-    // In range: a non-negative integer of at most MAX_SAMPLES.
-    let n = n_points as usize;
     let even = match even as i64 {
         1 => true,
         0 => false,
-        other => return Err(err(l7, format!("bad abscissa spacing flag {other}"))),
+        other => return Err(ds.err(l7, format!("bad abscissa spacing flag {other}"))),
     };
     if even && !(dx.is_finite() && dx > 0.0 && x_min.is_finite()) {
-        return Err(err(
+        return Err(ds.err(
             l7,
             format!("even abscissa needs a positive increment, got start {x_min}, increment {dx}"),
         ));
     }
+    Ok(DatasetHeader {
+        // In range: a non-negative integer of at most MAX_SAMPLES.
+        n: n_points as usize,
+        double,
+        even,
+        x_min,
+        dx,
+        channel: Channel::Velocity,
+    })
+}
 
-    let (l8, r8) = record(8)?;
+/// Record 8: the abscissa must be time (17) or unknown (0).
+fn check_abscissa(ds: &Dataset) -> Result<(), DataError> {
+    let (l8, r8) = ds.record(8)?;
     let abscissa = leading_int(r8, 10).ok_or_else(|| {
-        err(
+        ds.err(
             l8,
             "record 8: the abscissa data type is not an integer".into(),
         )
     })?;
     if !(abscissa == 0 || abscissa == 17) {
-        return Err(err(
+        return Err(ds.err(
             l8,
             format!(
                 "the abscissa is {} (specific data type {abscissa}), not time (17)",
@@ -236,15 +314,20 @@ fn parse_dataset(
             ),
         ));
     }
-    let (l9, r9) = record(9)?;
+    Ok(())
+}
+
+/// Record 9: the channel of the ordinate; velocity (11) or unknown (0, read as velocity).
+fn ordinate_channel(ds: &Dataset) -> Result<Channel, DataError> {
+    let (l9, r9) = ds.record(9)?;
     let ordinate = leading_int(r9, 10).ok_or_else(|| {
-        err(
+        ds.err(
             l9,
             "record 9: the ordinate data type is not an integer".into(),
         )
     })?;
     if !(ordinate == 0 || ordinate == 11) {
-        return Err(err(
+        return Err(ds.err(
             l9,
             format!(
                 "the ordinate is {} (specific data type {ordinate}), not velocity (11)",
@@ -252,79 +335,105 @@ fn parse_dataset(
             ),
         ));
     }
-    record(10)?;
-    record(11)?;
+    Ok(Channel::Velocity)
+}
 
-    // Data values, to the closing delimiter.
-    let widths: &[usize] = match (double, even) {
-        (false, _) => &[13; 6],
-        (true, true) => &[20; 4],
-        (true, false) => &[13, 20, 13, 20],
-    };
-    let expected = if even { n } else { 2 * n };
+/// Record 12: every value to the closing delimiter, with its line; checks the declared count.
+fn read_values(ds: &Dataset, header: &DatasetHeader) -> Result<(Vec<f64>, Vec<usize>), DataError> {
+    let expected = header.values();
+    let first = ds.start + 11;
     // The declared count is not trusted for the allocation: at most six values fit a line.
-    let room = expected.min(6 * lines.len().saturating_sub(start + 11));
+    let room = expected.min(6 * ds.lines.len().saturating_sub(first));
     let mut values = Vec::with_capacity(room);
     let mut value_lines = Vec::with_capacity(room);
     let mut end_line = None;
-    for &(ln, text) in lines.iter().skip(start + 11) {
+    for &(ln, text) in ds.lines.iter().skip(first) {
         if is_delimiter(text) {
             end_line = Some(ln);
             break;
         }
-        let tokens: Option<Vec<f64>> = text.split_whitespace().map(parse_fortran).collect();
-        let parsed = tokens.or_else(|| {
-            fixed_fields(text, widths)?
-                .into_iter()
-                .filter(|f| !f.is_empty())
-                .map(parse_fortran)
-                .collect()
-        });
-        let Some(parsed) = parsed else {
-            return Err(err(
-                ln,
-                format!("`{}` is not a list of numbers", quoted(text.trim())),
-            ));
-        };
-        for v in parsed {
-            if !v.is_finite() {
-                return Err(err(ln, format!("value {v} is not finite")));
-            }
+        for v in parse_data_line(ds, ln, text, header.widths())? {
             values.push(v);
             value_lines.push(ln);
         }
     }
     let Some(end_line) = end_line else {
-        return Err(err(last_line, "dataset 58 has no closing `-1` line".into()));
+        return Err(ds.err(ds.last_line(), "dataset 58 has no closing `-1` line".into()));
     };
     if values.len() != expected {
-        return Err(err(
+        return Err(ds.err(
             end_line,
             format!(
-                "record 7 declares {n} points ({expected} values) but the dataset holds {}",
+                "record 7 declares {} points ({expected} values) but the dataset holds {}",
+                header.n,
                 values.len()
             ),
         ));
     }
-    let (time, velocity, sample_lines): (Vec<f64>, Vec<f64>, Vec<usize>) = if even {
+    Ok((values, value_lines))
+}
+
+/// The finite numbers of one data line: whitespace tokens, or fixed-width fields when
+/// adjacent numbers touch.
+fn parse_data_line(
+    ds: &Dataset,
+    line: usize,
+    text: &str,
+    widths: &[usize],
+) -> Result<Vec<f64>, DataError> {
+    let tokens: Option<Vec<f64>> = text.split_whitespace().map(parse_fortran).collect();
+    let parsed = tokens.or_else(|| {
+        fixed_fields(text, widths)?
+            .into_iter()
+            .filter(|f| !f.is_empty())
+            .map(parse_fortran)
+            .collect()
+    });
+    let Some(parsed) = parsed else {
+        return Err(ds.err(
+            line,
+            format!("`{}` is not a list of numbers", quoted(text.trim())),
+        ));
+    };
+    if let Some(v) = parsed.iter().find(|v| !v.is_finite()) {
+        return Err(ds.err(line, format!("value {v} is not finite")));
+    }
+    Ok(parsed)
+}
+
+/// Time, the ordinate's channel and the line of each sample, scaled.
+fn samples(
+    header: &DatasetHeader,
+    values: Vec<f64>,
+    value_lines: Vec<usize>,
+    opts: &ReadOptions,
+) -> RawSamples {
+    let (time_scale, scale) = (opts.time.scale, opts.scale(header.channel));
+    let (time, ordinate, lines): (Vec<f64>, Vec<f64>, Vec<usize>) = if header.even {
         (
-            (0..n).map(|i| x_min + i as f64 * dx).collect(),
-            values.iter().map(|v| v * opts.velocity_scale).collect(),
+            (0..header.n)
+                .map(|i| (header.x_min + i as f64 * header.dx) * time_scale)
+                .collect(),
+            values.iter().map(|v| v * scale).collect(),
             value_lines,
         )
     } else {
         (
-            values.iter().step_by(2).copied().collect(),
+            values.iter().step_by(2).map(|t| t * time_scale).collect(),
             values
                 .iter()
                 .skip(1)
                 .step_by(2)
-                .map(|v| v * opts.velocity_scale)
+                .map(|v| v * scale)
                 .collect(),
             value_lines.iter().step_by(2).copied().collect(),
         )
     };
-    finish(path, time, velocity, &sample_lines, opts)
+    RawSamples {
+        time,
+        channels: vec![(header.channel, ordinate)],
+        lines,
+    }
 }
 
 #[cfg(test)]
@@ -380,7 +489,7 @@ mod tests {
         s.push_str(" 0.700000D-02\n    -1\n");
         let r = read_uff58(Path::new("a.uff"), &s, &opts()).unwrap();
         assert_eq!(r.len(), 7);
-        for (i, (&t, &v)) in r.time.iter().zip(&r.velocity).enumerate() {
+        for (i, (&t, &v)) in r.time().iter().zip(r.velocity()).enumerate() {
             assert!((t - (0.5 + 0.01 * i as f64)).abs() < 1e-12);
             let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
             assert!((v - sign * 1e-3 * (i + 1) as f64).abs() < 1e-15);
@@ -396,8 +505,8 @@ mod tests {
         ));
         s.push_str(&format!("{:13.5e}{:20.11e}\n    -1\n", 0.2, 3.5));
         let r = read_uff58(Path::new("b.uff"), &s, &opts()).unwrap();
-        assert_eq!(r.time, vec![0.0, 0.1, 0.2]);
-        assert_eq!(r.velocity, vec![1.5, -2.5, 3.5]);
+        assert_eq!(r.time(), vec![0.0, 0.1, 0.2]);
+        assert_eq!(r.velocity(), vec![1.5, -2.5, 3.5]);
     }
 
     #[test]

@@ -201,8 +201,8 @@ pub fn analyze_record(
     opts.validate()?;
     osc.validate()?;
     record.validate(opts.differentiator.min_samples().max(MIN_RUN + 1))?;
-    let time = &record.time;
-    let v = &record.velocity;
+    let time = record.time();
+    let v = record.velocity();
     let x = cumulative_trapezoid(time, v, record.x0);
     let samples = Samples {
         time,
@@ -263,14 +263,7 @@ pub fn analyze_states(
             time[i], x[i], v[i], a[i]
         )));
     }
-    if let Some(i) = time.windows(2).position(|w| w[1] <= w[0]) {
-        return Err(err(format!(
-            "time is not strictly increasing at sample {} (t = {} then {})",
-            i + 1,
-            time[i],
-            time[i + 1]
-        )));
-    }
+    crate::record::check_time(time).map_err(|e| err(e.to_string()))?;
     let samples = Samples {
         time,
         x,

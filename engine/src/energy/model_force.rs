@@ -62,10 +62,11 @@ pub fn model_force_along(
             time[i], v[i]
         )));
     }
-    if let Some(i) = time.windows(2).position(|w| w[1] <= w[0]) {
+    if let Err(crate::record::TimeError::NotIncreasing { index, .. }) =
+        crate::record::check_time(time)
+    {
         return Err(EngineError::InvalidInput(format!(
-            "time is not strictly increasing at sample {}",
-            i + 1
+            "time is not strictly increasing at sample {index}"
         )));
     }
     let normal = osc.normal_force;

@@ -202,7 +202,7 @@ pub fn guess_hint(osc: &Oscillator, records: &[Record], opts: &FitOptions) -> Gu
                 levels.push(a.mean_abs_force);
             }
         }
-        let peak = rec.velocity.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let peak = rec.velocity().iter().fold(0.0f64, |m, v| m.max(v.abs()));
         if peak > 0.0 {
             speeds.push(peak / 2.0);
         }
@@ -807,7 +807,7 @@ fn finish(input: FinishInput<'_>, clock: Instant) -> Result<FitResult, EngineErr
         let fitted: Vec<f64> = sim.iter().map(|v| v + world.offsets[ri]).collect();
         let ss: f64 = fitted
             .iter()
-            .zip(&rec.velocity)
+            .zip(rec.velocity())
             .map(|(f, m)| (f - m).powi(2))
             .sum();
         sum_sq += ss;
@@ -828,8 +828,8 @@ fn finish(input: FinishInput<'_>, clock: Instant) -> Result<FitResult, EngineErr
             samples: rec.len(),
             rms_residual: (ss / rec.len() as f64).sqrt(),
             energy_force,
-            time: rec.time.clone(),
-            measured: rec.velocity.clone(),
+            time: rec.time().to_vec(),
+            measured: rec.velocity().to_vec(),
             fitted,
             energy_based_force: ebf,
             model_force: mf,
@@ -895,7 +895,7 @@ fn energy_check(
 ) -> Result<EnergyCheck, EngineError> {
     // The energy analysis sees the measured velocity corrected by the fitted offset.
     let mut corrected = rec.clone();
-    for v in &mut corrected.velocity {
+    for v in corrected.velocity_mut() {
         *v -= world.offsets[ri];
     }
     let analysis = analyze_record(&corrected, &world.oscillator, &opts.energy)?;

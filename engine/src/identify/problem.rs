@@ -159,11 +159,11 @@ impl FitProblem {
             .records
             .get(r)
             .ok_or_else(|| EngineError::InvalidInput(format!("no record {r}")))?;
-        let t0 = rec.time.first().copied().unwrap_or(0.0);
+        let t0 = rec.time().first().copied().unwrap_or(0.0);
         let release = t0 + world.shifts[r];
         // Sample times on the simulation clock; samples before the release see the initial state.
-        let first = rec.time.partition_point(|&t| t < release);
-        let times: Vec<f64> = rec.time[first..].iter().map(|&t| t - release).collect();
+        let first = rec.time().partition_point(|&t| t < release);
+        let times: Vec<f64> = rec.time()[first..].iter().map(|&t| t - release).collect();
         let mut v = vec![rec.v0; first];
         if let Some(&t_end) = times.last() {
             self.simulations.fetch_add(1, Ordering::Relaxed);
@@ -200,7 +200,7 @@ impl FitProblem {
             let w = rec.weight.sqrt();
             Ok(sim
                 .iter()
-                .zip(&rec.velocity)
+                .zip(rec.velocity())
                 .map(|(s, m)| w * (s + world.offsets[r] - m))
                 .collect())
         };

@@ -679,12 +679,14 @@ fn check_times(t_end: f64, times: &[f64]) -> Result<(), EngineError> {
             )));
         }
     }
-    if let Some(i) = times.windows(2).position(|w| w[1] < w[0]) {
+    if let Err(crate::record::TimeError::NotIncreasing {
+        index,
+        time,
+        previous,
+    }) = crate::record::check_sorted(times)
+    {
         return Err(EngineError::InvalidInput(format!(
-            "sample times are not sorted at index {} ({} s after {} s)",
-            i + 1,
-            times.get(i + 1).copied().unwrap_or(f64::NAN),
-            times.get(i).copied().unwrap_or(f64::NAN)
+            "sample times are not sorted at index {index} ({time} s after {previous} s)"
         )));
     }
     Ok(())

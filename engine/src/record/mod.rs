@@ -1,0 +1,311 @@
+//! Measured records: a time base and named channels ([`Channel`]) sampled on it, the release
+//! state, and the normal force of the contact (constant or sampled).
+//!
+//! - [`time`]: the [`TimeBase`] and the one check of time stamps used everywhere.
+//! - [`channel`]: the [`Channel`] names and the [`NormalForce`].
+//! - [`source`]: one `[[records]]` entry of a configuration ([`RecordSource`]) and its loading.
+
+pub mod channel;
+pub mod source;
+pub mod time;
+
+pub use channel::{Channel, NormalForce};
+pub use source::{RecordSource, RecordSourceError};
+pub use time::{check_sorted, check_time, TimeBase, TimeError};
+
+use crate::error::EngineError;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// One measured record: time stamps, the channels sampled on them and the known release state.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Record {
+    /// A name for messages and reports (usually the file name).
+    pub name: String,
+    /// Time stamps [s], strictly increasing.
+    time: TimeBase,
+    /// Sampled channels other than the normal force, each as long as the time base.
+    channels: BTreeMap<Channel, Vec<f64>>,
+    /// The contact's normal force; `None`: the oscillator's.
+    normal_force: Option<NormalForce>,
+    /// Displacement at the first time stamp (release) [m].
+    pub x0: f64,
+    /// Velocity at release [m/s] (0 for a release from rest).
+    pub v0: f64,
+    /// Weight of this record in a joint fit.
+    pub weight: f64,
+}
+
+impl Record {
+    /// A velocity record released from rest with unit weight. The samples are checked by
+    /// [`Record::validate`] (which every analysis calls), not here.
+    pub fn new(name: impl Into<String>, time: Vec<f64>, velocity: Vec<f64>, x0: f64) -> Self {
+        Self::from_time_base(name, TimeBase::unchecked(time))
+            .with_channel(Channel::Velocity, velocity)
+            .with_x0(x0)
+    }
+
+    /// A record with no channels yet on a time base, released from rest at x0 = 0 with unit
+    /// weight; add channels with [`Record::with_channel`].
+    pub fn from_time_base(name: impl Into<String>, time: TimeBase) -> Self {
+        Self {
+            name: name.into(),
+            time,
+            channels: BTreeMap::new(),
+            normal_force: None,
+            x0: 0.0,
+            v0: 0.0,
+            weight: 1.0,
+        }
+    }
+
+    /// The record with `values` as its `channel` (replacing one already there). A
+    /// [`Channel::NormalForce`] becomes the sampled [`NormalForce`].
+    pub fn with_channel(mut self, channel: Channel, values: Vec<f64>) -> Self {
+        match channel {
+            Channel::NormalForce => self.normal_force = Some(NormalForce::Sampled(values)),
+            other => {
+                self.channels.insert(other, values);
+            }
+        }
+        self
+    }
+
+    fn with_x0(mut self, x0: f64) -> Self {
+        self.x0 = x0;
+        self
+    }
+
+    /// The time stamps \[s\].
+    pub fn time(&self) -> &[f64] {
+        self.time.as_slice()
+    }
+
+    /// The time base.
+    pub fn time_base(&self) -> &TimeBase {
+        &self.time
+    }
+
+    /// The velocity samples [m/s]; empty when the record has no velocity channel
+    /// ([`Record::validate`] rejects such a record).
+    pub fn velocity(&self) -> &[f64] {
+        self.channel(Channel::Velocity).unwrap_or_default()
+    }
+
+    /// The velocity samples, mutable (empty when there is no velocity channel).
+    pub fn velocity_mut(&mut self) -> &mut [f64] {
+        self.channel_mut(Channel::Velocity).unwrap_or_default()
+    }
+
+    /// The samples of `channel`, if the record has it.
+    pub fn channel(&self, channel: Channel) -> Option<&[f64]> {
+        match channel {
+            Channel::NormalForce => match &self.normal_force {
+                Some(NormalForce::Sampled(values)) => Some(values),
+                _ => None,
+            },
+            other => self.channels.get(&other).map(Vec::as_slice),
+        }
+    }
+
+    /// The samples of `channel`, mutable, if the record has it.
+    pub fn channel_mut(&mut self, channel: Channel) -> Option<&mut [f64]> {
+        match channel {
+            Channel::NormalForce => match &mut self.normal_force {
+                Some(NormalForce::Sampled(values)) => Some(values),
+                _ => None,
+            },
+            other => self.channels.get_mut(&other).map(Vec::as_mut_slice),
+        }
+    }
+
+    /// The channels the record holds, in [`Channel::ALL`] order.
+    pub fn channels(&self) -> Vec<Channel> {
+        Channel::ALL
+            .into_iter()
+            .filter(|&c| self.channel(c).is_some())
+            .collect()
+    }
+
+    /// The record's own normal force, constant or sampled; `None`: the oscillator's applies.
+    pub fn normal_force(&self) -> Option<&NormalForce> {
+        self.normal_force.as_ref()
+    }
+
+    /// Sets (or with `None` removes) the record's own normal force.
+    pub fn set_normal_force(&mut self, normal_force: Option<NormalForce>) {
+        self.normal_force = normal_force;
+    }
+
+    /// The record from sample `first` on: the same channels, release state and weight.
+    pub fn starting_at(&self, first: usize) -> Self {
+        let tail = |v: &Vec<f64>| v.get(first..).unwrap_or_default().to_vec();
+        Self {
+            name: self.name.clone(),
+            time: self.time.tail(first),
+            channels: self.channels.iter().map(|(&c, v)| (c, tail(v))).collect(),
+            normal_force: self.normal_force.as_ref().map(|n| match n {
+                NormalForce::Sampled(v) => NormalForce::Sampled(tail(v)),
+                constant => constant.clone(),
+            }),
+            x0: self.x0,
+            v0: self.v0,
+            weight: self.weight,
+        }
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.time.len()
+    }
+
+    /// Whether the record has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.time.is_empty()
+    }
+
+    /// Checks that the record has velocity, every channel as long as the time, finite values,
+    /// strictly increasing time, at least `min_samples` samples and a valid release state.
+    pub fn validate(&self, min_samples: usize) -> Result<(), EngineError> {
+        let err = |reason: String| EngineError::Record {
+            record: self.name.clone(),
+            reason,
+        };
+        if !self.channels.contains_key(&Channel::Velocity) {
+            return Err(err(format!(
+                "no velocity channel (the record has: {})",
+                channel_list(&self.channels())
+            )));
+        }
+        self.check_lengths().map_err(err)?;
+        self.check_finite().map_err(err)?;
+        self.time
+            .check(min_samples)
+            .map_err(|e| err(e.to_string()))?;
+        if !self.x0.is_finite() || !self.v0.is_finite() {
+            return Err(err("x0 and v0 must be finite".into()));
+        }
+        if !(self.weight.is_finite() && self.weight > 0.0) {
+            return Err(err(format!("weight must be > 0, got {}", self.weight)));
+        }
+        Ok(())
+    }
+
+    fn check_lengths(&self) -> Result<(), String> {
+        let n = self.time.len();
+        for channel in self.channels() {
+            let len = self.channel(channel).map_or(0, <[f64]>::len);
+            if len != n {
+                let what = match channel {
+                    Channel::Velocity => "velocities".to_string(),
+                    other => format!("{other} samples"),
+                };
+                return Err(format!("{n} time stamps but {len} {what}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Time and velocity are checked together (the message shows both), then the others.
+    fn check_finite(&self) -> Result<(), String> {
+        let time = self.time();
+        let v = self.velocity();
+        if let Some(i) = (0..time.len()).find(|&i| !(time[i].is_finite() && v[i].is_finite())) {
+            return Err(format!(
+                "sample {i} is not finite (t = {}, v = {})",
+                time[i], v[i]
+            ));
+        }
+        for channel in self.channels() {
+            let values = self.channel(channel).unwrap_or_default();
+            if let Some(i) = values.iter().position(|x| !x.is_finite()) {
+                return Err(format!(
+                    "{channel} sample {i} is {} (values must be finite)",
+                    values[i]
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `a, b, c`, or `none`.
+pub(crate) fn channel_list(channels: &[Channel]) -> String {
+    if channels.is_empty() {
+        return "none".into();
+    }
+    channels
+        .iter()
+        .map(|c| c.name())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record() -> Record {
+        Record::new(
+            "r",
+            vec![0.0, 0.1, 0.2, 0.3],
+            vec![0.0, 1.0, 0.5, -0.2],
+            0.01,
+        )
+    }
+
+    #[test]
+    fn new_keeps_the_velocity_record_of_old() {
+        let r = record();
+        assert_eq!(r.time(), &[0.0, 0.1, 0.2, 0.3]);
+        assert_eq!(r.velocity(), &[0.0, 1.0, 0.5, -0.2]);
+        assert_eq!((r.x0, r.v0, r.weight), (0.01, 0.0, 1.0));
+        assert_eq!(r.channels(), vec![Channel::Velocity]);
+        assert!(r.normal_force().is_none());
+        r.validate(4).unwrap();
+    }
+
+    #[test]
+    fn channels_and_sampled_normal_force() {
+        let r = record()
+            .with_channel(Channel::Force, vec![1.0; 4])
+            .with_channel(Channel::NormalForce, vec![5.0, 5.0, 6.0, 6.0]);
+        assert_eq!(
+            r.channels(),
+            vec![Channel::Velocity, Channel::Force, Channel::NormalForce]
+        );
+        assert_eq!(r.normal_force().map(|n| n.mean()), Some(5.5));
+        let tail = r.starting_at(2);
+        assert_eq!(tail.time(), &[0.2, 0.3]);
+        assert_eq!(tail.channel(Channel::NormalForce), Some(&[6.0, 6.0][..]));
+        assert_eq!(tail.velocity(), &[0.5, -0.2]);
+    }
+
+    #[test]
+    fn validate_names_what_is_wrong() {
+        let msg = |r: &Record| r.validate(3).unwrap_err().to_string();
+        let short = Record::new("r", vec![0.0, 0.1, 0.2], vec![0.0; 2], 0.0);
+        assert_eq!(msg(&short), "record `r`: 3 time stamps but 2 velocities");
+        let repeated = Record::new("r", vec![0.0, 0.1, 0.1], vec![0.0; 3], 0.0);
+        assert_eq!(
+            msg(&repeated),
+            "record `r`: time is not strictly increasing at sample 2 (t = 0.1 then 0.1)"
+        );
+        let nan = Record::new("r", vec![0.0, 0.1, 0.2], vec![0.0, f64::NAN, 0.0], 0.0);
+        assert_eq!(
+            msg(&nan),
+            "record `r`: sample 1 is not finite (t = 0.1, v = NaN)"
+        );
+        let force_only = Record::from_time_base("r", TimeBase::new(vec![0.0, 1.0]).unwrap())
+            .with_channel(Channel::Force, vec![0.0, 1.0]);
+        assert_eq!(
+            msg(&force_only),
+            "record `r`: no velocity channel (the record has: force)"
+        );
+        let few = record();
+        assert_eq!(
+            few.validate(5).unwrap_err().to_string(),
+            "record `r`: 4 samples, at least 5 needed"
+        );
+    }
+}

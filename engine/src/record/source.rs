@@ -1,0 +1,287 @@
+//! One `[[records]]` entry of a configuration: where a record's file is, how to read it, and
+//! the record's release state. Shared by every front end (CLI, Python).
+//!
+//! ```toml
+//! [[records]]
+//! file = "x14mm.csv"          # relative to the configuration file
+//! x0 = 0.014                  # m, the release displacement
+//! v0 = 0.0                    # m/s, optional
+//! weight = 1.0                # optional, in a joint fit
+//! format = "auto"             # auto | csv | whitespace | uff58
+//! time_column = "time"
+//! velocity_column = "velocity"
+//! velocity_scale = 1e-3       # the file's velocity unit in m/s (here mm/s)
+//! min_samples = 10
+//! sampling_tolerance = 0.01
+//! ```
+
+use super::{Channel, Record};
+use crate::data::{read_record, DataError, ReadOptions};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// A `[[records]]` entry as written: every key optional, unknown keys rejected.
+///
+/// [`RecordSource::check`] gives the errors a configuration reports on loading;
+/// [`RecordSource::load`] reads the file.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RecordSource {
+    /// The data file, relative to the base directory (the configuration file's) or absolute.
+    pub file: Option<String>,
+    /// Release displacement \[m\] (required).
+    pub x0: Option<f64>,
+    /// Release velocity [m/s] (default 0).
+    pub v0: Option<f64>,
+    /// Weight in a joint fit (default 1).
+    pub weight: Option<f64>,
+    /// File format (default: from the extension).
+    pub format: Option<crate::data::DataFormat>,
+    /// Header name of the time column (default `time`).
+    pub time_column: Option<String>,
+    /// Header name of the velocity column (default `velocity`).
+    pub velocity_column: Option<String>,
+    /// Factor from the file's velocity unit to m/s (default 1).
+    pub velocity_scale: Option<f64>,
+    /// Fewest samples accepted (default 10).
+    pub min_samples: Option<usize>,
+    /// Largest relative deviation of a time step from the median step (default 0.01).
+    pub sampling_tolerance: Option<f64>,
+}
+
+/// Why a `[[records]]` entry cannot be used. `index` is the entry's 1-based position.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum RecordSourceError {
+    /// No `file` key.
+    #[error("[[records]] entry {index}: missing `file` (the record's data file)")]
+    MissingFile { index: usize },
+    /// No `x0` key.
+    #[error("[[records]] entry {index} (`{file}`): missing `x0` (the release displacement, m)")]
+    MissingX0 { index: usize, file: String },
+    /// A value that must be finite is not.
+    #[error("[[records]] entry {index} (`{file}`): `{key}` must be finite, got {value}")]
+    NotFinite {
+        index: usize,
+        file: String,
+        key: &'static str,
+        value: f64,
+    },
+    /// A weight that is not a positive number.
+    #[error("[[records]] entry {index} (`{file}`): `weight` must be > 0, got {value}")]
+    BadWeight {
+        index: usize,
+        file: String,
+        value: f64,
+    },
+}
+
+/// A checked entry: the resolved file, the release state and how to read the file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResolvedSource {
+    /// The file, resolved against the base directory.
+    pub file: PathBuf,
+    /// The file as written (the record's name in messages and reports).
+    pub file_as_written: String,
+    /// Release displacement \[m\].
+    pub x0: f64,
+    /// Release velocity [m/s].
+    pub v0: f64,
+    /// Weight in a joint fit.
+    pub weight: f64,
+    /// How to read the file.
+    pub read: ReadOptions,
+}
+
+impl ResolvedSource {
+    /// Reads the file into a record named after the file as written, with this entry's x0, v0
+    /// and weight.
+    pub fn load(&self) -> Result<Record, DataError> {
+        let mut record = read_record(&self.file, &self.read)?;
+        record.name = self.file_as_written.clone();
+        record.x0 = self.x0;
+        record.v0 = self.v0;
+        record.weight = self.weight;
+        Ok(record)
+    }
+}
+
+impl RecordSource {
+    /// Checks the entry (the `index`-th, 1-based, for messages) and resolves its file against
+    /// `base_dir`.
+    pub fn resolve(
+        &self,
+        index: usize,
+        base_dir: &Path,
+    ) -> Result<ResolvedSource, RecordSourceError> {
+        let Some(file) = self.file.clone() else {
+            return Err(RecordSourceError::MissingFile { index });
+        };
+        let x0 = self.x0.ok_or_else(|| RecordSourceError::MissingX0 {
+            index,
+            file: file.clone(),
+        })?;
+        let finite = |key: &'static str, value: f64| {
+            if value.is_finite() {
+                Ok(value)
+            } else {
+                Err(RecordSourceError::NotFinite {
+                    index,
+                    file: file.clone(),
+                    key,
+                    value,
+                })
+            }
+        };
+        let weight = self.weight.unwrap_or(1.0);
+        if !(weight.is_finite() && weight > 0.0) {
+            return Err(RecordSourceError::BadWeight {
+                index,
+                file,
+                value: weight,
+            });
+        }
+        let path = Path::new(&file);
+        Ok(ResolvedSource {
+            file: if path.is_absolute() {
+                path.to_path_buf()
+            } else {
+                base_dir.join(path)
+            },
+            x0: finite("x0", x0)?,
+            v0: finite("v0", self.v0.unwrap_or(0.0))?,
+            weight,
+            read: self.read_options(),
+            file_as_written: file,
+        })
+    }
+
+    /// How to read the file: the entry's keys over [`ReadOptions::default`].
+    pub fn read_options(&self) -> ReadOptions {
+        let mut read = ReadOptions::default();
+        if let Some(format) = self.format {
+            read.format = format;
+        }
+        if let Some(column) = &self.time_column {
+            read.time.column = column.clone();
+        }
+        let velocity = read.channel_mut(Channel::Velocity);
+        if let Some(column) = &self.velocity_column {
+            velocity.column = column.clone();
+        }
+        if let Some(scale) = self.velocity_scale {
+            velocity.scale = scale;
+        }
+        if let Some(n) = self.min_samples {
+            read.min_samples = n;
+        }
+        if let Some(tolerance) = self.sampling_tolerance {
+            read.sampling_tolerance = tolerance;
+        }
+        read
+    }
+
+    /// Checks the entry and reads its file (relative paths against `base_dir`). An entry
+    /// error is a [`DataError::Source`].
+    pub fn load(&self, base_dir: &Path) -> Result<Record, DataError> {
+        self.resolve(1, base_dir)?.load()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The entry from TOML-like `key = value` lines (parsed as JSON: the engine has no TOML).
+    fn source(text: &str) -> Result<RecordSource, serde_json::Error> {
+        let fields: Vec<String> = text
+            .lines()
+            .filter_map(|l| l.split_once(" = "))
+            .map(|(k, v)| format!("\"{k}\": {v}"))
+            .collect();
+        serde_json::from_str(&format!("{{{}}}", fields.join(",")))
+    }
+
+    #[test]
+    fn defaults_and_keys() {
+        let s = source("file = \"a.csv\"\nx0 = 0.014\nvelocity_scale = 1e-3\n").unwrap();
+        let r = s.resolve(1, Path::new("dir")).unwrap();
+        assert_eq!(r.file, Path::new("dir/a.csv"));
+        assert_eq!(r.file_as_written, "a.csv");
+        assert_eq!((r.x0, r.v0, r.weight), (0.014, 0.0, 1.0));
+        assert_eq!(r.read.scale(Channel::Velocity), 1e-3);
+        assert_eq!(r.read.time.column, "time");
+        assert_eq!(r.read.column(Channel::Velocity), "velocity");
+        let abs = source("file = \"/data/a.csv\"\nx0 = 0.0\n").unwrap();
+        assert_eq!(
+            abs.resolve(1, Path::new("dir")).unwrap().file,
+            Path::new("/data/a.csv")
+        );
+    }
+
+    #[test]
+    fn errors_name_the_entry_and_key() {
+        let e = source("x0 = 1.0")
+            .unwrap()
+            .resolve(2, Path::new("."))
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "[[records]] entry 2: missing `file` (the record's data file)"
+        );
+        let e = source("file = \"a.csv\"")
+            .unwrap()
+            .resolve(1, Path::new("."))
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "[[records]] entry 1 (`a.csv`): missing `x0` (the release displacement, m)"
+        );
+        let e = source("file = \"a.csv\"\nx0 = 0.01\nweight = 0.0")
+            .unwrap()
+            .resolve(1, Path::new("."))
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "[[records]] entry 1 (`a.csv`): `weight` must be > 0, got 0"
+        );
+        let nan = RecordSource {
+            x0: Some(f64::NAN),
+            ..source("file = \"a.csv\"").unwrap()
+        };
+        let e = nan.resolve(1, Path::new(".")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "[[records]] entry 1 (`a.csv`): `x0` must be finite, got NaN"
+        );
+        let e = source("file = \"a.csv\"\nx0 = 0.01\nvelocity_colum = \"v\"").unwrap_err();
+        assert!(
+            e.to_string().starts_with("unknown field `velocity_colum`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn load_reads_the_file_and_sets_the_release_state() {
+        let dir = std::env::temp_dir().join(format!("frictionid-source-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let rows: String = (0..12)
+            .map(|i| format!("{},{}\n", i as f64 * 1e-3, i))
+            .collect();
+        std::fs::write(dir.join("r.csv"), format!("time,v\n{rows}")).unwrap();
+        let s = source(
+            "file = \"r.csv\"\nx0 = 0.02\nv0 = 0.1\nvelocity_column = \"v\"\nvelocity_scale = 1e-3",
+        )
+        .unwrap();
+        let r = s.load(&dir).unwrap();
+        assert_eq!(r.name, "r.csv");
+        assert_eq!((r.x0, r.v0, r.len()), (0.02, 0.1, 12));
+        assert_eq!(r.velocity()[11], 11e-3);
+        let e = source("file = \"r.csv\"").unwrap().load(&dir).unwrap_err();
+        assert!(
+            matches!(e, DataError::Source(RecordSourceError::MissingX0 { .. })),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
