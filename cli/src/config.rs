@@ -25,9 +25,13 @@
 //! [energy]                      # optional options of the energy analysis
 //! method = "savitzky_golay"
 //!
+//! [record_defaults]             # optional: any [[records]] key, for every record
+//! velocity_scale = 1e-3         # (a record's own key wins)
+//!
 //! [[records]]                   # for fit, compare and energy
 //! file = "x14mm.csv"            # relative to this file
 //! x0 = 0.014                    # m
+//! release = "auto"              # optional: drop the pre-trigger rest (or a time in s)
 //! ```
 //!
 //! Unknown keys are errors that name the key, the line and the nearest valid name; TOML
@@ -74,6 +78,7 @@ struct RawConfig {
     fit: Option<FitSpec>,
     simulation: Option<SimulationSpec>,
     energy: Option<EnergySpec>,
+    record_defaults: Option<RecordSource>,
     #[serde(default)]
     records: Vec<RecordSource>,
 }
@@ -258,12 +263,14 @@ impl Config {
                 raw.records.len()
             )));
         }
+        let record_defaults = raw.record_defaults.unwrap_or_default();
         let records = raw
             .records
             .into_iter()
             .enumerate()
             .map(|(i, r)| {
-                r.resolve(i + 1, &base_dir)
+                r.with_defaults(&record_defaults)
+                    .resolve(i + 1, &base_dir)
                     .map_err(|e| cfg_err(e.to_string()))
             })
             .collect::<Result<Vec<_>, _>>()?;
@@ -301,7 +308,10 @@ impl Config {
         }
         self.records
             .iter()
-            .map(|r| r.load().map_err(CliError::from))
+            .map(|r| {
+                r.load_checked(&self.spec.oscillator)
+                    .map_err(CliError::from)
+            })
             .collect()
     }
 }

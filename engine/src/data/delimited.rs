@@ -26,6 +26,10 @@ impl Separator {
             DataFormat::Whitespace => Separator::Whitespace,
             DataFormat::Csv => by_char.unwrap_or(Separator::Char(',')),
             _ => match by_char {
+                // Tabs separate names that hold spaces (`Time [s]`); otherwise any whitespace.
+                Some(Separator::Char('\t')) if tab_fields_hold_spaces(header) => {
+                    Separator::Char('\t')
+                }
                 Some(Separator::Char('\t')) | None => Separator::Whitespace,
                 Some(sep) => sep,
             },
@@ -38,6 +42,13 @@ impl Separator {
             Separator::Whitespace => line.split_whitespace().map(clean_field).collect(),
         }
     }
+}
+
+/// Whether a tab-separated header has a column name with a space inside.
+fn tab_fields_hold_spaces(header: &str) -> bool {
+    header
+        .split('\t')
+        .any(|f| f.trim().contains(char::is_whitespace))
 }
 
 fn clean_field(field: &str) -> &str {
@@ -66,6 +77,7 @@ struct Header<'a> {
 /// Where the time and each channel found are in a line's fields.
 struct Columns {
     time: usize,
+    time_scale: f64,
     channels: Vec<(Channel, usize, f64)>,
 }
 
@@ -122,28 +134,64 @@ fn read_header<'a>(
     Ok(Header { line, sep, names })
 }
 
-/// The positions of the time column and of every configured channel.
+/// The positions of the time column and of every channel found: a required column that is
+/// missing is an error, and so is a header without any channel column.
 fn locate_columns(path: &Path, header: &Header, opts: &ReadOptions) -> Result<Columns, DataError> {
-    let column = |name: &str| {
-        find_column(&header.names, name).ok_or_else(|| DataError::MissingColumn {
-            file: path.to_path_buf(),
-            line: header.line,
-            column: quoted(name),
-            // Only short names are compared (the edit distance costs the product of lengths).
-            hint: frictionid_models::suggest::did_you_mean(
-                name,
-                header.names.iter().copied().filter(|h| h.len() <= 64),
-            ),
-            available: quoted(&header.names.join(", ")),
-        })
+    let missing = |name: &str| DataError::MissingColumn {
+        file: path.to_path_buf(),
+        line: header.line,
+        column: quoted(name),
+        hint: suggestion(header, name),
+        available: quoted(&header.names.join(", ")),
     };
-    let time = column(&opts.time.column)?;
-    let channels = opts
-        .channels
-        .iter()
-        .map(|(&channel, spec)| Ok((channel, column(&spec.column)?, spec.scale)))
-        .collect::<Result<Vec<_>, DataError>>()?;
-    Ok(Columns { time, channels })
+    let time =
+        find_column(&header.names, &opts.time.column).ok_or_else(|| missing(&opts.time.column))?;
+    let mut channels = Vec::new();
+    for (&channel, spec) in &opts.channels {
+        match find_column(&header.names, &spec.column) {
+            Some(idx) => channels.push((channel, idx, spec.scale)),
+            None if spec.required => return Err(missing(&spec.column)),
+            None => {}
+        }
+    }
+    if channels.is_empty() {
+        return Err(no_channel(path, header, opts, missing));
+    }
+    Ok(Columns {
+        time,
+        time_scale: opts.time.scale,
+        channels,
+    })
+}
+
+/// The error for a header without any channel column: a near miss of one column name is
+/// named as missing (with its suggestion), otherwise every column looked for is listed.
+fn no_channel(
+    path: &Path,
+    header: &Header,
+    opts: &ReadOptions,
+    missing: impl Fn(&str) -> DataError,
+) -> DataError {
+    let columns: Vec<&str> = opts.channels.values().map(|s| s.column.as_str()).collect();
+    if let Some(near) = columns.iter().find(|c| !suggestion(header, c).is_empty()) {
+        return missing(near);
+    }
+    let looked_for: Vec<String> = columns.iter().map(|c| format!("`{}`", quoted(c))).collect();
+    DataError::NoChannel {
+        file: path.to_path_buf(),
+        line: header.line,
+        looked_for: looked_for.join(", "),
+        available: quoted(&header.names.join(", ")),
+    }
+}
+
+/// ` (did you mean `...`?)` for a near header name, or empty.
+fn suggestion(header: &Header, name: &str) -> String {
+    // Only short names are compared (the edit distance costs the product of lengths).
+    frictionid_models::suggest::did_you_mean(
+        name,
+        header.names.iter().copied().filter(|h| h.len() <= 64),
+    )
 }
 
 /// Parses the data rows: time and each channel's column, scaled.
@@ -176,7 +224,7 @@ fn read_rows<'a>(
             });
         }
         let number = |idx: usize| field_number(path, line, header, &fields, idx);
-        raw.time.push(number(columns.time)?);
+        raw.time.push(number(columns.time)? * columns.time_scale);
         for ((_, idx, scale), (_, values)) in columns.channels.iter().zip(&mut raw.channels) {
             values.push(number(*idx)? * scale);
         }
@@ -348,5 +396,63 @@ mod tests {
         assert!(matches!(e, DataError::Empty { .. }), "{e}");
         let e = read("time,velocity\n").unwrap_err();
         assert!(e.to_string().contains("no data rows"), "{e}");
+    }
+
+    #[test]
+    fn every_channel_found_is_read_with_its_scale() {
+        let text = "time_ms;displacement;force;velocity;normal_force;other\n\
+                    0;1;-2;3;4;x\n1;2;-4;6;8;y\n2;3;-6;9;12;z\n";
+        let opts = ReadOptions {
+            time: crate::data::ColumnSpec::named("time_ms"),
+            min_samples: 3,
+            ..ReadOptions::default()
+        }
+        .with_time_scale(1e-3)
+        .with_column(Channel::Displacement, "DISPLACEMENT")
+        .with_scale(Channel::Displacement, 1e-3)
+        .with_scale(Channel::Force, -1.0);
+        let r = read_delimited(Path::new("c.csv"), text, DataFormat::Auto, &opts).unwrap();
+        assert_eq!(r.time(), vec![0.0, 1e-3, 2e-3]);
+        assert_eq!(
+            r.channel(Channel::Displacement),
+            Some(&[1e-3, 2e-3, 3e-3][..])
+        );
+        assert_eq!(r.channel(Channel::Force), Some(&[2.0, 4.0, 6.0][..]));
+        assert_eq!(r.velocity(), vec![3.0, 6.0, 9.0]);
+        assert_eq!(r.channel(Channel::NormalForce), Some(&[4.0, 8.0, 12.0][..]));
+        assert_eq!(r.channel(Channel::Acceleration), None);
+    }
+
+    #[test]
+    fn a_displacement_only_file_is_a_record_without_velocity() {
+        let r = read("time,displacement\n0,1\n1,2\n2,3\n").unwrap();
+        assert_eq!(r.channels(), vec![Channel::Displacement]);
+        assert!(r.velocity().is_empty());
+    }
+
+    #[test]
+    fn a_named_column_must_exist_and_some_channel_must_be_found() {
+        let opts = ReadOptions {
+            min_samples: 3,
+            ..ReadOptions::default()
+        }
+        .with_column(Channel::Force, "F [N]");
+        let e = read_delimited(
+            Path::new("r.csv"),
+            "time,velocity\n0,1\n",
+            DataFormat::Auto,
+            &opts,
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "r.csv: line 1: no column `F [N]`; the header has: time, velocity"
+        );
+        let e = read("time,pressure\n0,1\n1,2\n2,3\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "r.csv: line 1: no channel column found (looked for `velocity`, `displacement`, \
+             `acceleration`, `force`, `normal_force`); the header has: time, pressure"
+        );
     }
 }

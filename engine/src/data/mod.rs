@@ -13,7 +13,7 @@ pub use delimited::read_delimited;
 pub use uff58::read_uff58;
 
 pub use crate::record::Channel;
-use crate::record::{Record, RecordSourceError, TimeBase, TimeError};
+use crate::record::{Record, RecordSourceError, ScaleError, TimeBase, TimeError};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -65,14 +65,27 @@ pub struct ColumnSpec {
     pub column: String,
     /// Factor from the file's unit to SI (1e-3 for mm/s; negative to flip a sign convention).
     pub scale: f64,
+    /// Whether a file without the column is an error (a column named in the configuration);
+    /// otherwise the channel is read when its column is found.
+    #[serde(default)]
+    pub required: bool,
 }
 
 impl ColumnSpec {
-    /// The column `column` with unit scale.
+    /// The required column `column` with unit scale.
     pub fn named(column: impl Into<String>) -> Self {
         Self {
             column: column.into(),
             scale: 1.0,
+            required: true,
+        }
+    }
+
+    /// The channel's own name as an optional column, with unit scale.
+    pub fn default_for(channel: Channel) -> Self {
+        Self {
+            required: false,
+            ..Self::named(channel.name())
         }
     }
 }
@@ -85,7 +98,8 @@ pub struct ReadOptions {
     pub format: DataFormat,
     /// The time column \[s after scaling\].
     pub time: ColumnSpec,
-    /// The channels read, each from its column (every one must be present).
+    /// The channels looked for, each in its column: a required column must be present, an
+    /// optional one is read when present; at least one channel must be found.
     pub channels: BTreeMap<Channel, ColumnSpec>,
     /// Fewest samples accepted.
     pub min_samples: usize,
@@ -95,12 +109,16 @@ pub struct ReadOptions {
 }
 
 impl Default for ReadOptions {
-    /// Time from column `time`, velocity from column `velocity`, both unscaled.
+    /// Time from column `time`, and every channel whose own name is a column (`velocity`,
+    /// `displacement`, `acceleration`, `force`, `normal_force`), all unscaled.
     fn default() -> Self {
         Self {
             format: DataFormat::Auto,
             time: ColumnSpec::named("time"),
-            channels: BTreeMap::from([(Channel::Velocity, ColumnSpec::named("velocity"))]),
+            channels: Channel::ALL
+                .into_iter()
+                .map(|c| (c, ColumnSpec::default_for(c)))
+                .collect(),
             min_samples: 10,
             sampling_tolerance: 0.01,
         }
@@ -108,17 +126,25 @@ impl Default for ReadOptions {
 }
 
 impl ReadOptions {
-    /// The column spec of `channel`, added with the channel's own name as column and unit
-    /// scale if it is not read yet.
+    /// The column spec of `channel`, added as [`ColumnSpec::default_for`] if it is not looked
+    /// for yet.
     pub fn channel_mut(&mut self, channel: Channel) -> &mut ColumnSpec {
         self.channels
             .entry(channel)
-            .or_insert_with(|| ColumnSpec::named(channel.name()))
+            .or_insert_with(|| ColumnSpec::default_for(channel))
     }
 
-    /// These options with `channel` read from `column`.
+    /// These options with `channel` read from `column`, which must be present.
     pub fn with_column(mut self, channel: Channel, column: impl Into<String>) -> Self {
-        self.channel_mut(channel).column = column.into();
+        let spec = self.channel_mut(channel);
+        spec.column = column.into();
+        spec.required = true;
+        self
+    }
+
+    /// These options with the time stamps multiplied by `scale` (1e-3 for milliseconds).
+    pub fn with_time_scale(mut self, scale: f64) -> Self {
+        self.time.scale = scale;
         self
     }
 
@@ -182,6 +208,14 @@ pub enum DataError {
         line: usize,
         column: String,
         hint: String,
+        available: String,
+    },
+    /// None of the channel columns looked for is in the header row.
+    #[error("{file}: line {line}: no channel column found (looked for {looked_for}); the header has: {available}")]
+    NoChannel {
+        file: PathBuf,
+        line: usize,
+        looked_for: String,
         available: String,
     },
     /// A line does not have as many fields as the header.
@@ -250,6 +284,9 @@ pub enum DataError {
     /// A `[[records]]` entry that cannot be used.
     #[error(transparent)]
     Source(#[from] RecordSourceError),
+    /// The record's units disagree with its oscillator.
+    #[error(transparent)]
+    Scale(#[from] ScaleError),
 }
 
 /// Reads a record file in the format given by `opts.format` (see [`DataFormat::Auto`]).

@@ -5,6 +5,7 @@
 //! coefficient near 1; all others are divided by a scale (their starting magnitude). Bounds
 //! map to bounds of the internal coordinates, which the projected Levenberg-Marquardt keeps.
 
+use super::residuals::NuisanceKind;
 use serde::Serialize;
 
 /// What a free parameter is.
@@ -19,10 +20,13 @@ pub enum ParamKind {
     Damping,
     /// The oscillator stiffness.
     Stiffness,
-    /// The velocity offset of record i.
-    Offset(usize),
-    /// The release-time shift of record i.
-    Shift(usize),
+    /// A nuisance parameter of one record.
+    Nuisance {
+        /// What it is.
+        kind: NuisanceKind,
+        /// The record's index.
+        record: usize,
+    },
 }
 
 /// One free parameter of a fit.

@@ -12,9 +12,10 @@
 //! through [`Jacobian`]. A residual vector with a non-finite entry (e.g. a simulation that
 //! failed for the trial parameters) is treated as an infinitely bad trial and rejected.
 
+use super::outcome::TerminationReason;
 use argmin::core::{
-    Error, IterState, Jacobian, Operator, Problem, Solver, State, TerminationReason,
-    TerminationStatus, KV,
+    Error, IterState, Jacobian, Operator, Problem, Solver, State,
+    TerminationReason as ArgminReason, TerminationStatus, KV,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -50,7 +51,7 @@ pub struct LevenbergMarquardt {
     residuals: DVector<f64>,
     jacobian: DMatrix<f64>,
     cost: f64,
-    converged: Option<String>,
+    converged: Option<TerminationReason>,
 }
 
 impl LevenbergMarquardt {
@@ -159,31 +160,105 @@ where
         let p = state
             .take_param()
             .ok_or_else(|| Error::msg("Levenberg-Marquardt lost its parameter vector"))?;
-        if self.history.len() > self.stall_window {
-            let then = self.history[self.history.len() - 1 - self.stall_window];
-            if then - self.cost <= self.stall_tol * self.cost {
-                self.converged = Some(format!(
-                    "cost changed by less than {:e} relative over {} steps",
-                    self.stall_tol, self.stall_window
-                ));
-                return Ok((state.param(p).cost(self.cost), None));
-            }
-        }
-        let j = &self.jacobian;
-        let a = j.transpose() * j;
-        let g = j.transpose() * &self.residuals;
-        let n = p.len();
-        let diag: Vec<f64> = (0..n)
-            .map(|i| a[(i, i)].max(1e-12 * (1.0 + a[(i, i)])))
-            .collect();
-
-        if self.scaled_gradient_norm(&p, &g, &diag) < self.gtol {
-            self.converged = Some("gradient below tolerance".into());
+        if self.stagnated() {
+            self.converged = Some(TerminationReason::Stagnation {
+                tolerance: self.stall_tol,
+                window: self.stall_window,
+            });
             return Ok((state.param(p).cost(self.cost), None));
         }
+        let normal = NormalEquations::new(&self.jacobian, &self.residuals);
+        if self.scaled_gradient_norm(&p, &normal.g, &normal.diag) < self.gtol {
+            self.converged = Some(TerminationReason::GradientBelowTolerance);
+            return Ok((state.param(p).cost(self.cost), None));
+        }
+        let Some(delta) = self.damped_step(&p, &normal) else {
+            self.raise_damping();
+            return Ok((state.param(p).cost(self.cost), None));
+        };
+        let trial = self.project(&(&p + &delta));
+        let step = &trial - &p;
+        let small_step = step
+            .iter()
+            .zip(p.iter())
+            .all(|(s, x)| s.abs() <= self.xtol * (x.abs() + self.xtol));
+        if small_step {
+            self.converged = Some(TerminationReason::StepBelowTolerance);
+            return Ok((state.param(p).cost(self.cost), None));
+        }
+        let r_new = problem.apply(&trial)?;
+        let cost_new = half_sq(&r_new);
+        // Predicted reduction of the linear model for the projected step.
+        let predicted = -(step.dot(&normal.g)) - 0.5 * step.dot(&(&normal.a * &step));
+        let actual = self.cost - cost_new;
+        let rho = if predicted > 0.0 {
+            actual / predicted
+        } else {
+            -1.0
+        };
+        if cost_new.is_finite() && rho > 0.0 {
+            self.accept(r_new, cost_new, actual, rho);
+            self.jacobian = problem.jacobian(&trial)?;
+            Ok((state.param(trial).cost(cost_new), None))
+        } else {
+            self.raise_damping();
+            if self.mu > 1e20 {
+                self.converged = Some(TerminationReason::DampingLimit);
+            }
+            Ok((state.param(p).cost(self.cost), None))
+        }
+    }
 
-        // Parameters held at a bound by a gradient pointing outwards stay put; the damped
-        // normal equations are solved for the others only.
+    fn terminate(&mut self, _state: &LmState) -> TerminationStatus {
+        match &self.converged {
+            Some(why) => TerminationStatus::Terminated(ArgminReason::SolverExit(why.to_string())),
+            None => TerminationStatus::NotTerminated,
+        }
+    }
+}
+
+/// The Gauss-Newton quantities at the current point: JᵀJ, the gradient Jᵀr and Marquardt's
+/// scaling diagonal.
+struct NormalEquations {
+    a: DMatrix<f64>,
+    g: DVector<f64>,
+    diag: Vec<f64>,
+}
+
+impl NormalEquations {
+    fn new(j: &DMatrix<f64>, r: &DVector<f64>) -> Self {
+        let a = j.transpose() * j;
+        let g = j.transpose() * r;
+        let diag: Vec<f64> = (0..a.nrows())
+            .map(|i| a[(i, i)].max(1e-12 * (1.0 + a[(i, i)])))
+            .collect();
+        Self { a, g, diag }
+    }
+}
+
+impl LevenbergMarquardt {
+    /// The typed reason of the last run's convergence (`None` while running, or when it was
+    /// stopped from outside, e.g. by the iteration limit).
+    pub fn termination(&self) -> Option<&TerminationReason> {
+        self.converged.as_ref()
+    }
+
+    /// Whether the cost fell by less than `stall_tol` relative over the last `stall_window`
+    /// accepted steps.
+    fn stagnated(&self) -> bool {
+        if self.history.len() <= self.stall_window {
+            return false;
+        }
+        let then = self.history[self.history.len() - 1 - self.stall_window];
+        then - self.cost <= self.stall_tol * self.cost
+    }
+
+    /// The damped, length-capped step; `None` when the damped system is not positive definite.
+    /// Parameters held at a bound by a gradient pointing outwards stay put; the damped normal
+    /// equations are solved for the others only.
+    fn damped_step(&self, p: &DVector<f64>, normal: &NormalEquations) -> Option<DVector<f64>> {
+        let (a, g, diag) = (&normal.a, &normal.g, &normal.diag);
+        let n = p.len();
         let free: Vec<usize> = (0..n)
             .filter(|&i| {
                 !((p[i] <= self.lower[i] && g[i] > 0.0) || (p[i] >= self.upper[i] && g[i] < 0.0))
@@ -199,14 +274,7 @@ where
             }
             lhs[(r, r)] += self.mu * diag[i];
         }
-        let reduced = match lhs.cholesky() {
-            Some(ch) => ch.solve(&rhs),
-            None => {
-                self.mu *= self.nu;
-                self.nu *= 2.0;
-                return Ok((state.param(p).cost(self.cost), None));
-            }
-        };
+        let reduced = lhs.cholesky()?.solve(&rhs);
         let mut delta = DVector::zeros(n);
         for (r, &i) in free.iter().enumerate() {
             delta[i] = reduced[r];
@@ -215,67 +283,48 @@ where
         if longest > self.max_step {
             delta *= self.max_step / longest;
         }
-        let trial = self.project(&(&p + &delta));
-        let step = &trial - &p;
-        let small_step = step
-            .iter()
-            .zip(p.iter())
-            .all(|(s, x)| s.abs() <= self.xtol * (x.abs() + self.xtol));
-        if small_step {
-            self.converged = Some("step below tolerance".into());
-            return Ok((state.param(p).cost(self.cost), None));
-        }
-        let r_new = problem.apply(&trial)?;
-        let cost_new = half_sq(&r_new);
-        // Predicted reduction of the linear model for the projected step.
-        let predicted = -(step.dot(&g)) - 0.5 * step.dot(&(&a * &step));
-        let actual = self.cost - cost_new;
-        let rho = if predicted > 0.0 {
-            actual / predicted
-        } else {
-            -1.0
-        };
-        if cost_new.is_finite() && rho > 0.0 {
-            let old = self.cost;
-            self.history.push(old);
-            self.residuals = r_new;
-            self.cost = cost_new;
-            self.jacobian = problem.jacobian(&trial)?;
-            self.mu *= (1.0_f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
-            self.nu = 2.0;
-            if actual <= self.ftol * old {
-                self.converged = Some("relative cost reduction below tolerance".into());
-            }
-            Ok((state.param(trial).cost(cost_new), None))
-        } else {
-            self.mu *= self.nu;
-            self.nu *= 2.0;
-            if self.mu > 1e20 {
-                self.converged = Some("no further decrease possible (damping limit)".into());
-            }
-            Ok((state.param(p).cost(self.cost), None))
+        Some(delta)
+    }
+
+    /// Takes an accepted step: new residuals and cost, Nielsen's damping decrease.
+    fn accept(&mut self, r_new: DVector<f64>, cost_new: f64, actual: f64, rho: f64) {
+        let old = self.cost;
+        self.history.push(old);
+        self.residuals = r_new;
+        self.cost = cost_new;
+        self.mu *= (1.0_f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
+        self.nu = 2.0;
+        if actual <= self.ftol * old {
+            self.converged = Some(TerminationReason::CostReductionBelowTolerance);
         }
     }
 
-    fn terminate(&mut self, _state: &LmState) -> TerminationStatus {
-        match &self.converged {
-            Some(why) => TerminationStatus::Terminated(TerminationReason::SolverExit(format!(
-                "converged: {why}"
-            ))),
-            None => TerminationStatus::NotTerminated,
-        }
+    /// Rejects a step: more damping.
+    fn raise_damping(&mut self) {
+        self.mu *= self.nu;
+        self.nu *= 2.0;
     }
 }
 
-/// Whether an argmin termination status means the solver converged.
-pub fn is_converged(status: &TerminationStatus) -> bool {
-    match status {
-        TerminationStatus::Terminated(TerminationReason::SolverExit(s)) => {
-            s.starts_with("converged")
+/// The typed reason a run of `solver` stopped with argmin status `status`, given the run's
+/// iteration limit.
+pub fn termination_reason(
+    solver: &LevenbergMarquardt,
+    status: &TerminationStatus,
+    max_iterations: u64,
+) -> TerminationReason {
+    match (status, solver.termination()) {
+        (TerminationStatus::Terminated(ArgminReason::MaxItersReached), _) => {
+            TerminationReason::IterationLimit {
+                limit: max_iterations,
+            }
         }
-        TerminationStatus::Terminated(TerminationReason::SolverConverged)
-        | TerminationStatus::Terminated(TerminationReason::TargetCostReached) => true,
-        _ => false,
+        (TerminationStatus::Terminated(ArgminReason::SolverExit(_)), Some(reason)) => {
+            reason.clone()
+        }
+        (other, _) => TerminationReason::Other {
+            text: other.to_string(),
+        },
     }
 }
 
@@ -315,7 +364,7 @@ mod tests {
         }
     }
 
-    fn run<O>(problem: O, p0: Vec<f64>, lo: Vec<f64>, hi: Vec<f64>) -> LmState
+    fn run<O>(problem: O, p0: Vec<f64>, lo: Vec<f64>, hi: Vec<f64>) -> (LmState, TerminationReason)
     where
         O: Operator<Param = DVector<f64>, Output = DVector<f64>>
             + Jacobian<Param = DVector<f64>, Jacobian = DMatrix<f64>>,
@@ -324,29 +373,25 @@ mod tests {
         // Exact (zero-residual) problems: tolerances far below the defaults for noisy data.
         solver.xtol = 1e-13;
         solver.ftol = 1e-15;
-        Executor::new(problem, solver)
+        let res = Executor::new(problem, solver)
             .configure(|s| s.param(DVector::from_vec(p0)).max_iters(500))
             .run()
-            .unwrap()
-            .state()
-            .clone()
+            .unwrap();
+        let reason = termination_reason(&res.solver, &res.state().termination_status, 500);
+        (res.state().clone(), reason)
     }
 
     #[test]
     fn finds_the_rosenbrock_minimum() {
         let inf = f64::INFINITY;
-        let s = run(Rosenbrock, vec![-1.2, 1.0], vec![-inf; 2], vec![inf; 2]);
+        let (s, reason) = run(Rosenbrock, vec![-1.2, 1.0], vec![-inf; 2], vec![inf; 2]);
         let (p, cost) = best(&s).unwrap();
         assert!(
             (p[0] - 1.0).abs() < 1e-8 && (p[1] - 1.0).abs() < 1e-8,
             "{p}"
         );
         assert!(cost < 1e-20);
-        assert!(
-            is_converged(&s.termination_status),
-            "{:?}",
-            s.termination_status
-        );
+        assert!(reason.is_converged(), "{reason:?}");
     }
 
     #[test]
@@ -354,15 +399,11 @@ mod tests {
         // The unconstrained minimum (1, 1) is outside x <= 0.5: the bounded minimum of
         // 100 (y - x^2)^2 + (1 - x)^2 on x <= 0.5 is at x = 0.5, y = 0.25.
         let inf = f64::INFINITY;
-        let s = run(Rosenbrock, vec![-1.2, 1.0], vec![-inf; 2], vec![0.5, inf]);
+        let (s, reason) = run(Rosenbrock, vec![-1.2, 1.0], vec![-inf; 2], vec![0.5, inf]);
         let (p, _) = best(&s).unwrap();
         assert!((p[0] - 0.5).abs() < 1e-12, "{p}");
         assert!((p[1] - 0.25).abs() < 1e-8, "{p}");
-        assert!(
-            is_converged(&s.termination_status),
-            "{:?}",
-            s.termination_status
-        );
+        assert!(reason.is_converged(), "{reason:?}");
     }
 
     /// Exponential decay y = a exp(-b t) from exact data: recovers a and b exactly.
@@ -402,7 +443,7 @@ mod tests {
         let t: Vec<f64> = (0..50).map(|i| i as f64 * 0.1).collect();
         let y = t.iter().map(|t| 3.0 * (-0.7 * t).exp()).collect();
         let inf = f64::INFINITY;
-        let s = run(Decay { t, y }, vec![1.0, 3.0], vec![0.0; 2], vec![inf; 2]);
+        let (s, _) = run(Decay { t, y }, vec![1.0, 3.0], vec![0.0; 2], vec![inf; 2]);
         let (p, _) = best(&s).unwrap();
         assert!(
             (p[0] - 3.0).abs() < 1e-9 && (p[1] - 0.7).abs() < 1e-9,

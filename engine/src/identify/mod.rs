@@ -1,20 +1,40 @@
 //! The least-squares identifier: fits any registered friction model (any subset of its
 //! parameters, optionally the oscillator and per-record nuisance parameters) to one or more
-//! measured velocity records, and compares models on the same records.
+//! measured records, and compares models on the same records.
 //!
-//! The problem (`problem::FitProblem`) implements argmin's `Operator` and `Jacobian`; the
-//! solver is our bounded Levenberg-Marquardt (`lm::LevenbergMarquardt`), an argmin `Solver`,
-//! run by argmin's `Executor` with an observer for progress.
+//! The seams:
+//! - [`residuals::Residuals`]: what a fit compares. [`residuals::VelocityResponse`] simulates
+//!   the free vibration and compares the velocity; each producer declares the per-record
+//!   nuisance parameters ([`residuals::NuisanceKind`]) it adds.
+//! - [`problem::FitProblem`]: generic over the producer; implements argmin's `Operator` and
+//!   `Jacobian`, so the solver, our bounded Levenberg-Marquardt ([`lm::LevenbergMarquardt`],
+//!   an argmin `Solver`), knows nothing of friction.
+//! - [`starts`]: the multi-start strategy; [`setup`]: options to free parameters.
+//! - [`outcome`]: typed outcomes ([`outcome::TerminationReason`], [`outcome::StartOutcome`])
+//!   and the findings ([`outcome::Finding`]) every [`FitResult`] carries.
+//! - [`energy_check::energy_force_check`]: the energy-balance check, shared with the
+//!   `energy` command.
 
 pub mod compare;
+pub mod diagnostics;
+pub mod energy_check;
 pub mod fit;
 pub mod layout;
 pub mod lm;
 pub mod options;
+pub mod outcome;
 pub mod problem;
+pub mod residuals;
+pub mod result;
+pub mod setup;
+pub mod starts;
 pub mod stats;
 
-pub use compare::{compare, Comparison, FailedFit};
-pub use fit::{fit, guess_hint, Derived, EnergyForce, FitResult, FittedParam, RecordFit};
+pub use compare::{compare, Comparison, ComparisonVerdict, FailedFit};
+pub use energy_check::{energy_force_check, EnergyForce, ForceReference};
+pub use fit::{fit, fit_with, guess_hint, Derived, FitResult, FittedParam, RecordFit};
 pub use lm::LevenbergMarquardt;
 pub use options::{FitOptions, OscillatorParam, Progress, ProgressFn};
+pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
+pub use residuals::{Evaluation, NuisanceKind, NuisanceValues, Residuals, VelocityResponse};
+pub use result::{Rank, Verdict};

@@ -91,7 +91,7 @@ pub struct FitOptions {
     /// Fit a release-time shift per record.
     pub time_shift: bool,
     /// Number of starts; `None`: 1 when at most two model parameters are free, else
-    /// [`super::fit::DEFAULT_STARTS`].
+    /// [`super::starts::DEFAULT_STARTS`].
     pub multistart: Option<usize>,
     /// Iteration limit of each start.
     pub max_iterations: u64,

@@ -1,42 +1,43 @@
-//! The fitting problem: parameters in, weighted velocity residuals of every record out.
+//! The fitting problem: parameters in, the weighted residuals of every record out.
 //!
-//! Implements argmin's [`Operator`] (residuals) and [`Jacobian`] (forward differences), so
+//! What the residuals are comes from a [`Residuals`] producer (the velocity response by
+//! default); the problem maps the solver's coordinates to a model, an oscillator and the
+//! per-record nuisance values, and concatenates the producer's residuals over the records.
+//! It implements argmin's [`Operator`] (residuals) and [`Jacobian`] (forward differences), so
 //! any argmin least-squares solver can drive it; ours is [`super::lm::LevenbergMarquardt`].
 
 use super::layout::{FreeParam, ParamKind};
+use super::residuals::{Evaluation, NuisanceValues, Residuals, VelocityResponse};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
-use crate::simulate::{simulate_velocity, Initial, SimOptions};
+use crate::simulate::SimOptions;
 use argmin::core::{Error, Jacobian, Operator};
 use frictionid_models::FrictionModel;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
+
+pub use super::residuals::STEPS_PER_SAMPLE;
 
 /// Relative forward-difference step in internal coordinates. The ODE engine's default
 /// tolerances (rtol 1e-10) leave ~1e-10 relative noise in the residuals, so a step of 1e-6
 /// balances truncation against that noise (error ~ 1e-4 of the derivative).
 pub const FD_STEP: f64 = 1e-6;
 
-/// Step budget of a simulation per sample of its record. Friction dynamics so fast that the
-/// integrator needs more than this many steps per sample interval are far beyond what the
-/// record resolves (a bristle that relaxes within a twentieth of a sample looks rigid), so
-/// trial parameters that demand it are rejected as infeasible instead of integrated for
-/// seconds: this keeps the cost of a fit bounded when a bristle stiffness runs away.
-pub const STEPS_PER_SAMPLE: u64 = 20;
-
-/// The residual function of a fit.
-pub struct FitProblem {
+/// The residual function of a fit, generic over what produces the residuals.
+pub struct FitProblem<R: Residuals = VelocityResponse> {
     /// The oscillator with its fixed values.
     pub oscillator: Oscillator,
     /// The model with its fixed values.
     pub model: Box<dyn FrictionModel>,
-    /// The records.
-    pub records: Vec<Record>,
+    /// The records (shared by the problems of a multi-start fit).
+    pub records: Arc<[Record]>,
     /// The free parameters.
     pub layout: Vec<FreeParam>,
+    /// What produces the residuals.
+    pub residuals: Arc<R>,
     /// Simulation options.
     pub sim: SimOptions,
     /// Simulate records (and Jacobian columns) in parallel.
@@ -53,38 +54,51 @@ pub struct Realised {
     pub oscillator: Oscillator,
     /// The model.
     pub model: Box<dyn FrictionModel>,
-    /// Velocity offset per record.
-    pub offsets: Vec<f64>,
-    /// Release-time shift per record.
-    pub shifts: Vec<f64>,
+    /// Nuisance values per record.
+    pub nuisance: Vec<NuisanceValues>,
 }
 
-impl FitProblem {
-    /// A problem over `layout`; the model and oscillator carry the fixed values.
-    pub fn new(
-        oscillator: Oscillator,
-        model: Box<dyn FrictionModel>,
-        records: Vec<Record>,
-        layout: Vec<FreeParam>,
-        sim: SimOptions,
-        parallel: bool,
-    ) -> Self {
+/// What a fit problem is built from, apart from its residual producer.
+pub struct ProblemParts {
+    /// The oscillator with its fixed values.
+    pub oscillator: Oscillator,
+    /// The model with its fixed values.
+    pub model: Box<dyn FrictionModel>,
+    /// The records.
+    pub records: Arc<[Record]>,
+    /// The free parameters.
+    pub layout: Vec<FreeParam>,
+    /// Simulation options.
+    pub sim: SimOptions,
+    /// Evaluate records and Jacobian columns in parallel.
+    pub parallel: bool,
+}
+
+impl<R: Residuals> FitProblem<R> {
+    /// A problem over `parts.layout` with residuals from `residuals`; the model and
+    /// oscillator carry the fixed values.
+    pub fn new(residuals: Arc<R>, parts: ProblemParts) -> Self {
         Self {
-            oscillator,
-            model,
-            records,
-            layout,
-            sim,
-            parallel,
+            oscillator: parts.oscillator,
+            model: parts.model,
+            records: parts.records,
+            layout: parts.layout,
+            residuals,
+            sim: parts.sim,
+            parallel: parts.parallel,
             simulations: AtomicU64::new(0),
             last_error: Mutex::new(None),
             cache: Mutex::new(None),
         }
     }
 
-    /// Number of residuals (samples over all records).
+    /// Number of residuals (over all records).
     pub fn n_residuals(&self) -> usize {
-        self.records.iter().map(Record::len).sum()
+        self.records
+            .iter()
+            .enumerate()
+            .map(|(i, r)| self.residuals.residual_count(i, r))
+            .sum()
     }
 
     /// Simulations run so far.
@@ -119,8 +133,7 @@ impl FitProblem {
         let mut osc = self.oscillator;
         let mut model = self.model.clone();
         let mut values = model.params();
-        let mut offsets = vec![0.0; self.records.len()];
-        let mut shifts = vec![0.0; self.records.len()];
+        let mut nuisance = vec![NuisanceValues::default(); self.records.len()];
         for (f, &x) in self.layout.iter().zip(p) {
             match f.kind {
                 ParamKind::Model(i) => {
@@ -131,14 +144,9 @@ impl FitProblem {
                 ParamKind::Mass => osc.mass = x,
                 ParamKind::Damping => osc.damping = x,
                 ParamKind::Stiffness => osc.stiffness = x,
-                ParamKind::Offset(r) => {
-                    if let Some(o) = offsets.get_mut(r) {
-                        *o = x;
-                    }
-                }
-                ParamKind::Shift(r) => {
-                    if let Some(s) = shifts.get_mut(r) {
-                        *s = x;
+                ParamKind::Nuisance { kind, record } => {
+                    if let Some(n) = nuisance.get_mut(record) {
+                        n.set(kind, x);
                     }
                 }
             }
@@ -148,61 +156,37 @@ impl FitProblem {
         Ok(Realised {
             oscillator: osc,
             model,
-            offsets,
-            shifts,
+            nuisance,
         })
     }
 
-    /// The simulated velocity of record `r` at its time stamps (without offset).
-    pub fn simulate_record(&self, world: &Realised, r: usize) -> Result<Vec<f64>, EngineError> {
+    /// The values a producer evaluates at for the realised `world`.
+    pub fn evaluation<'a>(&'a self, world: &'a Realised) -> Evaluation<'a> {
+        Evaluation::new(
+            &world.oscillator,
+            world.model.as_ref(),
+            &self.sim,
+            &self.simulations,
+        )
+    }
+
+    /// The prediction of record `r`'s measured series at `world`.
+    pub fn predict_record(&self, world: &Realised, r: usize) -> Result<Vec<f64>, EngineError> {
         let rec = self
             .records
             .get(r)
             .ok_or_else(|| EngineError::InvalidInput(format!("no record {r}")))?;
-        let t0 = rec.time().first().copied().unwrap_or(0.0);
-        let release = t0 + world.shifts[r];
-        // Sample times on the simulation clock; samples before the release see the initial state.
-        let first = rec.time().partition_point(|&t| t < release);
-        let times: Vec<f64> = rec.time()[first..].iter().map(|&t| t - release).collect();
-        let mut v = vec![rec.v0; first];
-        if let Some(&t_end) = times.last() {
-            self.simulations.fetch_add(1, Ordering::Relaxed);
-            let init = Initial {
-                x0: rec.x0,
-                v0: rec.v0,
-                z0: None,
-            };
-            let mut sim = Vec::with_capacity(times.len());
-            let mut opts = self.sim;
-            opts.max_steps = opts
-                .max_steps
-                .min(STEPS_PER_SAMPLE * (rec.len() as u64).max(100));
-            simulate_velocity(
-                &world.oscillator,
-                world.model.as_ref(),
-                &init,
-                t_end,
-                &times,
-                &opts,
-                &mut sim,
-            )?;
-            v.extend_from_slice(&sim);
-        }
-        Ok(v)
+        self.residuals
+            .predict(&self.evaluation(world), r, rec, &world.nuisance[r])
     }
 
-    /// Weighted residuals sqrt(w) (v_sim + offset - v_measured) of every record, concatenated.
+    /// Weighted residuals of every record at physical parameters `p`, concatenated.
     pub fn residuals_at(&self, p: &[f64]) -> Result<DVector<f64>, EngineError> {
         let world = self.realise(p)?;
+        let at = self.evaluation(&world);
         let run = |r: usize| -> Result<Vec<f64>, EngineError> {
-            let rec = &self.records[r];
-            let sim = self.simulate_record(&world, r)?;
-            let w = rec.weight.sqrt();
-            Ok(sim
-                .iter()
-                .zip(rec.velocity())
-                .map(|(s, m)| w * (s + world.offsets[r] - m))
-                .collect())
+            self.residuals
+                .residuals(&at, r, &self.records[r], &world.nuisance[r])
         };
         let parts: Vec<Result<Vec<f64>, EngineError>> = if self.parallel && self.records.len() > 1 {
             (0..self.records.len()).into_par_iter().map(run).collect()
@@ -269,7 +253,7 @@ impl FitProblem {
     }
 }
 
-impl Operator for FitProblem {
+impl<R: Residuals> Operator for FitProblem<R> {
     type Param = DVector<f64>;
     type Output = DVector<f64>;
     fn apply(&self, u: &DVector<f64>) -> Result<DVector<f64>, Error> {
@@ -281,7 +265,7 @@ impl Operator for FitProblem {
     }
 }
 
-impl Jacobian for FitProblem {
+impl<R: Residuals> Jacobian for FitProblem<R> {
     type Param = DVector<f64>;
     type Jacobian = DMatrix<f64>;
     fn jacobian(&self, u: &DVector<f64>) -> Result<DMatrix<f64>, Error> {

@@ -4,13 +4,19 @@
 //! - [`time`]: the [`TimeBase`] and the one check of time stamps used everywhere.
 //! - [`channel`]: the [`Channel`] names and the [`NormalForce`].
 //! - [`source`]: one `[[records]]` entry of a configuration ([`RecordSource`]) and its loading.
+//! - [`release`]: the release instant, given or found in the pre-trigger rest.
+//! - [`sanity`]: units checked against the oscillator (mm/s, milliseconds, x0 in mm).
 
 pub mod channel;
+pub mod release;
+pub mod sanity;
 pub mod source;
 pub mod time;
 
 pub use channel::{Channel, NormalForce};
-pub use source::{RecordSource, RecordSourceError};
+pub use release::{detect_release, Release};
+pub use sanity::{check_scales, ScaleError};
+pub use source::{RecordSource, RecordSourceError, ResolvedSource};
 pub use time::{check_sorted, check_time, TimeBase, TimeError};
 
 use crate::error::EngineError;
@@ -34,6 +40,11 @@ pub struct Record {
     pub v0: f64,
     /// Weight of this record in a joint fit.
     pub weight: f64,
+    /// The release instant \[s\] when the record was cut at its release (`release = "auto"`
+    /// found it, or `release = <s>` gave it); the record then starts at the last sample at or
+    /// before it. `None`: the record starts at release.
+    #[serde(default)]
+    pub release_time: Option<f64>,
 }
 
 impl Record {
@@ -56,6 +67,7 @@ impl Record {
             x0: 0.0,
             v0: 0.0,
             weight: 1.0,
+            release_time: None,
         }
     }
 
@@ -151,6 +163,7 @@ impl Record {
             x0: self.x0,
             v0: self.v0,
             weight: self.weight,
+            release_time: self.release_time,
         }
     }
 

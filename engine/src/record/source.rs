@@ -2,28 +2,41 @@
 //! the record's release state. Shared by every front end (CLI, Python).
 //!
 //! ```toml
+//! [record_defaults]           # optional: any key below, for every record (a record's own wins)
+//! velocity_scale = 1e-3
+//!
 //! [[records]]
 //! file = "x14mm.csv"          # relative to the configuration file
 //! x0 = 0.014                  # m, the release displacement
 //! v0 = 0.0                    # m/s, optional
 //! weight = 1.0                # optional, in a joint fit
 //! format = "auto"             # auto | csv | whitespace | uff58
-//! time_column = "time"
+//! time_column = "time"        # and time_scale (1e-3 for milliseconds)
 //! velocity_column = "velocity"
 //! velocity_scale = 1e-3       # the file's velocity unit in m/s (here mm/s)
+//! # displacement_, acceleration_, force_ and normal_force_ column and scale alike: a channel
+//! # is read when its column is found (default: the channel's own name); a negative scale
+//! # flips a sign convention
+//! normal_force = 14.5         # N, this record's constant normal force (else the oscillator's)
+//! release = "auto"            # or a time in s: drop the pre-trigger rest (default: none)
 //! min_samples = 10
 //! sampling_tolerance = 0.01
 //! ```
 
-use super::{Channel, Record};
-use crate::data::{read_record, DataError, ReadOptions};
+use super::release::{detect_release, Release};
+use super::sanity::check_scales;
+use super::{Channel, NormalForce, Record};
+use crate::data::{read_record, DataError, DataFormat, ReadOptions};
+use crate::Oscillator;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
-/// A `[[records]]` entry as written: every key optional, unknown keys rejected.
+/// A `[[records]]` (or `[record_defaults]`) entry as written: every key optional, unknown keys
+/// rejected.
 ///
-/// [`RecordSource::check`] gives the errors a configuration reports on loading;
+/// [`RecordSource::with_defaults`] fills keys from `[record_defaults]`;
+/// [`RecordSource::resolve`] gives the errors a configuration reports on loading;
 /// [`RecordSource::load`] reads the file.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -37,13 +50,36 @@ pub struct RecordSource {
     /// Weight in a joint fit (default 1).
     pub weight: Option<f64>,
     /// File format (default: from the extension).
-    pub format: Option<crate::data::DataFormat>,
+    pub format: Option<DataFormat>,
     /// Header name of the time column (default `time`).
     pub time_column: Option<String>,
+    /// Factor from the file's time unit to s (default 1; 1e-3 for milliseconds).
+    pub time_scale: Option<f64>,
     /// Header name of the velocity column (default `velocity`).
     pub velocity_column: Option<String>,
     /// Factor from the file's velocity unit to m/s (default 1).
     pub velocity_scale: Option<f64>,
+    /// Header name of the displacement column (default `displacement`).
+    pub displacement_column: Option<String>,
+    /// Factor from the file's displacement unit to m (default 1).
+    pub displacement_scale: Option<f64>,
+    /// Header name of the acceleration column (default `acceleration`).
+    pub acceleration_column: Option<String>,
+    /// Factor from the file's acceleration unit to m/s^2 (default 1).
+    pub acceleration_scale: Option<f64>,
+    /// Header name of the friction-force column (default `force`).
+    pub force_column: Option<String>,
+    /// Factor from the file's force unit to N (default 1; negative for the opposite sign
+    /// convention).
+    pub force_scale: Option<f64>,
+    /// Header name of the normal-force column (default `normal_force`).
+    pub normal_force_column: Option<String>,
+    /// Factor from the file's normal-force unit to N (default 1).
+    pub normal_force_scale: Option<f64>,
+    /// This record's constant normal force \[N\] (default: the oscillator's, or the channel).
+    pub normal_force: Option<f64>,
+    /// Where the free vibration starts (default: at the first sample).
+    pub release: Option<Release>,
     /// Fewest samples accepted (default 10).
     pub min_samples: Option<usize>,
     /// Largest relative deviation of a time step from the median step (default 0.01).
@@ -74,6 +110,45 @@ pub enum RecordSourceError {
         file: String,
         value: f64,
     },
+    /// A negative constant normal force.
+    #[error("[[records]] entry {index} (`{file}`): `normal_force` must be >= 0, got {value}")]
+    BadNormalForce {
+        index: usize,
+        file: String,
+        value: f64,
+    },
+    /// Both a constant normal force and a normal-force column.
+    #[error("[[records]] entry {index} (`{file}`): give either `normal_force` (a constant) or `normal_force_column`, not both")]
+    NormalForceTwice { index: usize, file: String },
+}
+
+/// Every key of [`RecordSource`], for the merge with `[record_defaults]`.
+macro_rules! record_keys {
+    ($m:ident) => {
+        $m!(
+            file,
+            x0,
+            v0,
+            weight,
+            format,
+            time_column,
+            time_scale,
+            velocity_column,
+            velocity_scale,
+            displacement_column,
+            displacement_scale,
+            acceleration_column,
+            acceleration_scale,
+            force_column,
+            force_scale,
+            normal_force_column,
+            normal_force_scale,
+            normal_force,
+            release,
+            min_samples,
+            sampling_tolerance
+        )
+    };
 }
 
 /// A checked entry: the resolved file, the release state and how to read the file.
@@ -89,24 +164,93 @@ pub struct ResolvedSource {
     pub v0: f64,
     /// Weight in a joint fit.
     pub weight: f64,
+    /// This record's constant normal force \[N\], if given.
+    pub normal_force: Option<f64>,
+    /// Where the free vibration starts (`None`: at the first sample).
+    pub release: Option<Release>,
     /// How to read the file.
     pub read: ReadOptions,
 }
 
 impl ResolvedSource {
-    /// Reads the file into a record named after the file as written, with this entry's x0, v0
-    /// and weight.
+    /// Reads the file into a record named after the file as written, with this entry's x0,
+    /// v0, weight and normal force, starting at its release.
     pub fn load(&self) -> Result<Record, DataError> {
         let mut record = read_record(&self.file, &self.read)?;
         record.name = self.file_as_written.clone();
         record.x0 = self.x0;
         record.v0 = self.v0;
         record.weight = self.weight;
+        if let Some(n) = self.normal_force {
+            record.set_normal_force(Some(NormalForce::Constant(n)));
+        }
+        self.start_at_release(record)
+    }
+
+    /// [`ResolvedSource::load`], then the units checked against `osc`
+    /// ([`super::sanity::check_scales`]).
+    pub fn load_checked(&self, osc: &Oscillator) -> Result<Record, DataError> {
+        let record = self.load()?;
+        check_scales(&record, osc)?;
         Ok(record)
+    }
+
+    /// The record from its release on (the last sample at or before the release instant).
+    fn start_at_release(&self, record: Record) -> Result<Record, DataError> {
+        let options = |reason: String| DataError::Options {
+            file: self.file.clone(),
+            reason,
+        };
+        let release = match self.release {
+            None => return Ok(record),
+            Some(Release::At(t)) => t,
+            Some(Release::Auto) => {
+                if record.channel(Channel::Velocity).is_none() {
+                    return Err(options(
+                        "release = \"auto\" needs a velocity channel".into(),
+                    ));
+                }
+                detect_release(record.time(), record.velocity())
+                    .unwrap_or_else(|| record.time().first().copied().unwrap_or(0.0))
+            }
+        };
+        let last = record.time().last().copied().unwrap_or(f64::NAN);
+        if release.is_nan() || release > last || last.is_nan() {
+            return Err(options(format!(
+                "release = {release} s is not before the last sample ({last} s)"
+            )));
+        }
+        let first = record
+            .time()
+            .partition_point(|&t| t <= release)
+            .saturating_sub(1);
+        let mut started = record.starting_at(first);
+        started.release_time = Some(release);
+        let needed = self.read.min_samples.max(2);
+        if started.len() < needed {
+            return Err(DataError::TooFewSamples {
+                file: self.file.clone(),
+                found: started.len(),
+                needed,
+            });
+        }
+        Ok(started)
     }
 }
 
 impl RecordSource {
+    /// This entry with every key it does not give taken from `defaults`.
+    pub fn with_defaults(&self, defaults: &RecordSource) -> RecordSource {
+        macro_rules! merge {
+            ($($key:ident),*) => {
+                RecordSource {
+                    $($key: self.$key.clone().or_else(|| defaults.$key.clone()),)*
+                }
+            };
+        }
+        record_keys!(merge)
+    }
+
     /// Checks the entry (the `index`-th, 1-based, for messages) and resolves its file against
     /// `base_dir`.
     pub fn resolve(
@@ -141,6 +285,12 @@ impl RecordSource {
                 value: weight,
             });
         }
+        let x0 = finite("x0", x0)?;
+        let v0 = finite("v0", self.v0.unwrap_or(0.0))?;
+        if let Some(Release::At(t)) = self.release {
+            finite("release", t)?;
+        }
+        let normal_force = self.normal_force(index, &file)?;
         let path = Path::new(&file);
         Ok(ResolvedSource {
             file: if path.is_absolute() {
@@ -148,15 +298,75 @@ impl RecordSource {
             } else {
                 base_dir.join(path)
             },
-            x0: finite("x0", x0)?,
-            v0: finite("v0", self.v0.unwrap_or(0.0))?,
+            x0,
+            v0,
             weight,
+            normal_force,
+            release: self.release,
             read: self.read_options(),
             file_as_written: file,
         })
     }
 
-    /// How to read the file: the entry's keys over [`ReadOptions::default`].
+    /// The checked constant normal force, if given.
+    fn normal_force(&self, index: usize, file: &str) -> Result<Option<f64>, RecordSourceError> {
+        let Some(n) = self.normal_force else {
+            return Ok(None);
+        };
+        if self.normal_force_column.is_some() {
+            return Err(RecordSourceError::NormalForceTwice {
+                index,
+                file: file.into(),
+            });
+        }
+        if !n.is_finite() {
+            return Err(RecordSourceError::NotFinite {
+                index,
+                file: file.into(),
+                key: "normal_force",
+                value: n,
+            });
+        }
+        if n < 0.0 {
+            return Err(RecordSourceError::BadNormalForce {
+                index,
+                file: file.into(),
+                value: n,
+            });
+        }
+        Ok(Some(n))
+    }
+
+    /// The column and scale keys of each channel.
+    fn channel_keys(&self) -> [(Channel, Option<&String>, Option<f64>); 5] {
+        [
+            (
+                Channel::Velocity,
+                self.velocity_column.as_ref(),
+                self.velocity_scale,
+            ),
+            (
+                Channel::Displacement,
+                self.displacement_column.as_ref(),
+                self.displacement_scale,
+            ),
+            (
+                Channel::Acceleration,
+                self.acceleration_column.as_ref(),
+                self.acceleration_scale,
+            ),
+            (Channel::Force, self.force_column.as_ref(), self.force_scale),
+            (
+                Channel::NormalForce,
+                self.normal_force_column.as_ref(),
+                self.normal_force_scale,
+            ),
+        ]
+    }
+
+    /// How to read the file: the entry's keys over [`ReadOptions::default`]. A channel whose
+    /// column is named must be in the file; a record with a constant `normal_force` does not
+    /// look for a normal-force column.
     pub fn read_options(&self) -> ReadOptions {
         let mut read = ReadOptions::default();
         if let Some(format) = self.format {
@@ -165,12 +375,19 @@ impl RecordSource {
         if let Some(column) = &self.time_column {
             read.time.column = column.clone();
         }
-        let velocity = read.channel_mut(Channel::Velocity);
-        if let Some(column) = &self.velocity_column {
-            velocity.column = column.clone();
+        if let Some(scale) = self.time_scale {
+            read.time.scale = scale;
         }
-        if let Some(scale) = self.velocity_scale {
-            velocity.scale = scale;
+        for (channel, column, scale) in self.channel_keys() {
+            if let Some(column) = column {
+                read = read.with_column(channel, column.clone());
+            }
+            if let Some(scale) = scale {
+                read = read.with_scale(channel, scale);
+            }
+        }
+        if self.normal_force.is_some() {
+            read.channels.remove(&Channel::NormalForce);
         }
         if let Some(n) = self.min_samples {
             read.min_samples = n;
@@ -185,6 +402,11 @@ impl RecordSource {
     /// error is a [`DataError::Source`].
     pub fn load(&self, base_dir: &Path) -> Result<Record, DataError> {
         self.resolve(1, base_dir)?.load()
+    }
+
+    /// [`RecordSource::load`], then the units checked against `osc`.
+    pub fn load_checked(&self, base_dir: &Path, osc: &Oscillator) -> Result<Record, DataError> {
+        self.resolve(1, base_dir)?.load_checked(osc)
     }
 }
 

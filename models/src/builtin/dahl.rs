@@ -3,11 +3,13 @@
 //! dF/dt = sigma0 v |1 - F sgn(v) / (mu_c N)|^alpha sgn(1 - F sgn(v) / (mu_c N)); the friction
 //! force is the internal state F.
 //!
-//! | parameter | unit | default | bounds | meaning |
-//! |---|---|---|---|---|
-//! | `sigma0` | N/m | 1e5 | (0, 1e12] | rest stiffness (slope of F against displacement at F = 0) |
-//! | `mu_c` | 1 | 0.2 | (0, 10] | Coulomb friction coefficient (the force saturates at mu_c N) |
-//! | `alpha` | 1 | 1 | (0, 10] | shape exponent of the hysteresis loop |
+//! | parameter | unit | default | bounds | fit | meaning |
+//! |---|---|---|---|---|---|
+//! | `sigma0` | N/m | 1e5 | (0, 1e12] | free | rest stiffness of the contact |
+//! | `mu_c` | 1 | 0.2 | (0, 10] | free | Coulomb friction coefficient |
+//! | `alpha` | 1 | 1 | (0, 10] | free | shape exponent of the hysteresis |
+//!
+//! The rest stiffness sigma0 is the slope of F against the displacement at F = 0.
 //!
 //! Stored energy: F^2 / (2 sigma0) (exact for alpha = 1: the model then dissipates
 //! F^2 |v| / (mu_c N) >= 0).
@@ -15,58 +17,30 @@
 //! Reference: P. R. Dahl, "A solid friction model", Technical Report TOR-0158(3107-18)-1,
 //! The Aerospace Corporation, 1968.
 
-use crate::error::ModelError;
-use crate::model::{check_len, sgn, FrictionModel, GuessHint, ParamInfo};
+use crate::model::{sgn, FrictionModel, GuessHint};
 use serde::{Deserialize, Serialize};
 
-/// Dahl's dynamic friction model with the friction force as internal state.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct Dahl {
-    /// Rest stiffness [N/m].
-    pub sigma0: f64,
-    /// Coulomb coefficient.
-    pub mu_c: f64,
-    /// Shape exponent.
-    pub alpha: f64,
-}
-
-impl Default for Dahl {
-    fn default() -> Self {
-        Self {
-            sigma0: 1e5,
-            mu_c: 0.2,
-            alpha: 1.0,
-        }
+crate::declare_params! {
+    /// Dahl's dynamic friction model with the friction force as internal state.
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    #[serde(default, deny_unknown_fields)]
+    pub struct Dahl {
+        sigma0: positive("N/m", 1e5, 1e12, "rest stiffness of the contact"),
+        mu_c: positive("1", 0.2, 10.0, "Coulomb friction coefficient"),
+        alpha: positive("1", 1.0, 10.0, "shape exponent of the hysteresis"),
     }
 }
 
 #[typetag::serde(name = "dahl")]
 impl FrictionModel for Dahl {
+    crate::declared_param_methods!();
+
     fn name(&self) -> &'static str {
         "dahl"
     }
     fn equation(&self) -> String {
         "dF/dt = sigma0 v |1 - F sgn(v)/(mu_c N)|^alpha sgn(1 - F sgn(v)/(mu_c N)), friction = F"
             .into()
-    }
-    fn param_info(&self) -> Vec<ParamInfo> {
-        vec![
-            ParamInfo::positive("sigma0", "N/m", 1e5, 1e12, "rest stiffness of the contact"),
-            ParamInfo::positive("mu_c", "1", 0.2, 10.0, "Coulomb friction coefficient"),
-            ParamInfo::positive("alpha", "1", 1.0, 10.0, "shape exponent of the hysteresis"),
-        ]
-    }
-    fn params(&self) -> Vec<f64> {
-        vec![self.sigma0, self.mu_c, self.alpha]
-    }
-    fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
-        check_len(self.name(), 3, values.len())?;
-        // Indexing below is in range: check_len has just verified the length.
-        self.sigma0 = values[0];
-        self.mu_c = values[1];
-        self.alpha = values[2];
-        Ok(())
     }
     fn n_states(&self) -> usize {
         1

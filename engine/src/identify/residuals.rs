@@ -1,0 +1,347 @@
+//! What a fit compares: the [`Residuals`] trait and its implementation for the velocity
+//! response ([`VelocityResponse`]: simulate the free vibration, compare the velocity).
+//!
+//! A residual producer says which nuisance parameters it adds to every record (a velocity
+//! offset, a release-time shift, ...), what it measures and what the model predicts for it
+//! at given model, oscillator and nuisance values. The fit problem
+//! ([`super::problem::FitProblem`]) weighs and concatenates the residuals of all records and
+//! knows nothing else of them, so a producer in the force domain (replay the measured motion,
+//! compare a force) plugs in beside this one.
+
+use crate::error::EngineError;
+use crate::oscillator::Oscillator;
+use crate::record::Record;
+use crate::simulate::{simulate_velocity, Initial, SimOptions};
+use frictionid_models::FrictionModel;
+use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Step budget of a simulation per sample of its record. Friction dynamics so fast that the
+/// integrator needs more than this many steps per sample interval are far beyond what the
+/// record resolves (a bristle that relaxes within a twentieth of a sample looks rigid), so
+/// trial parameters that demand it are rejected as infeasible instead of integrated for
+/// seconds: this keeps the cost of a fit bounded when a bristle stiffness runs away.
+pub const STEPS_PER_SAMPLE: u64 = 20;
+
+/// A per-record parameter that is not part of the friction law or the oscillator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NuisanceKind {
+    /// A constant added to the predicted velocity (an instrument's DC offset) [m/s].
+    VelocityOffset,
+    /// The release instant relative to the record's first time stamp [s].
+    ReleaseShift,
+}
+
+impl NuisanceKind {
+    /// The key of its bounds in `FitOptions::bounds` and the prefix of its reported name
+    /// (`offset[x14mm.csv]`).
+    pub fn key(self) -> &'static str {
+        match self {
+            Self::VelocityOffset => "offset",
+            Self::ReleaseShift => "shift",
+        }
+    }
+
+    /// SI unit.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Self::VelocityOffset => "m/s",
+            Self::ReleaseShift => "s",
+        }
+    }
+
+    /// The scale of its internal coordinate (it starts at 0, which gives none).
+    pub fn typical(self) -> f64 {
+        match self {
+            Self::VelocityOffset => 1e-4,
+            Self::ReleaseShift => 1e-3,
+        }
+    }
+
+    /// Bounds when the options give none.
+    pub fn default_bounds(self) -> (f64, f64) {
+        match self {
+            Self::VelocityOffset => (f64::NEG_INFINITY, f64::INFINITY),
+            Self::ReleaseShift => (-0.1, 0.1),
+        }
+    }
+
+    /// The value a fit starts from (before clipping to the bounds).
+    pub fn start(self) -> f64 {
+        0.0
+    }
+
+    /// Every kind, in the order a record's nuisance parameters are laid out.
+    pub const ALL: [NuisanceKind; 2] = [Self::VelocityOffset, Self::ReleaseShift];
+}
+
+/// The nuisance values of one record (0 for those not fitted).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct NuisanceValues {
+    /// Velocity offset [m/s].
+    pub offset: f64,
+    /// Release-time shift [s].
+    pub shift: f64,
+}
+
+impl NuisanceValues {
+    /// The value of `kind`.
+    pub fn get(&self, kind: NuisanceKind) -> f64 {
+        match kind {
+            NuisanceKind::VelocityOffset => self.offset,
+            NuisanceKind::ReleaseShift => self.shift,
+        }
+    }
+
+    /// Sets the value of `kind`.
+    pub fn set(&mut self, kind: NuisanceKind, value: f64) {
+        match kind {
+            NuisanceKind::VelocityOffset => self.offset = value,
+            NuisanceKind::ReleaseShift => self.shift = value,
+        }
+    }
+}
+
+/// The values a producer evaluates at: the oscillator and model of one parameter vector, the
+/// simulation options, and a counter of the simulations run.
+pub struct Evaluation<'a> {
+    /// The oscillator.
+    pub oscillator: &'a Oscillator,
+    /// The friction model.
+    pub model: &'a dyn FrictionModel,
+    /// Simulation options.
+    pub sim: &'a SimOptions,
+    simulations: &'a AtomicU64,
+}
+
+impl<'a> Evaluation<'a> {
+    /// Values to evaluate at; `simulations` counts the simulations producers run.
+    pub fn new(
+        oscillator: &'a Oscillator,
+        model: &'a dyn FrictionModel,
+        sim: &'a SimOptions,
+        simulations: &'a AtomicU64,
+    ) -> Self {
+        Self {
+            oscillator,
+            model,
+            sim,
+            simulations,
+        }
+    }
+
+    /// Records that one simulation was run.
+    pub fn count_simulation(&self) {
+        self.simulations.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+/// What produces a fit's residuals: a measured series per record and the model's prediction
+/// of it. Residuals are `sqrt(weight) (predicted - measured)`, sample by sample.
+pub trait Residuals: Send + Sync {
+    /// The quantity compared, for reports (`velocity`, `force`).
+    fn channel(&self) -> &'static str;
+
+    /// Its SI unit.
+    fn unit(&self) -> &'static str;
+
+    /// The nuisance parameters this producer adds to every record, in layout order.
+    fn nuisance(&self) -> &[NuisanceKind];
+
+    /// The measured series of record `index` that the prediction is compared with.
+    fn measured<'a>(&'a self, index: usize, record: &'a Record) -> &'a [f64];
+
+    /// The model's prediction of the measured series of record `index` (nuisance applied),
+    /// one value per measured sample.
+    fn predict(
+        &self,
+        at: &Evaluation<'_>,
+        index: usize,
+        record: &Record,
+        nuisance: &NuisanceValues,
+    ) -> Result<Vec<f64>, EngineError>;
+
+    /// Number of residuals record `index` contributes.
+    fn residual_count(&self, index: usize, record: &Record) -> usize {
+        self.measured(index, record).len()
+    }
+
+    /// Weighted residuals `sqrt(weight) (predicted - measured)` of record `index`.
+    fn residuals(
+        &self,
+        at: &Evaluation<'_>,
+        index: usize,
+        record: &Record,
+        nuisance: &NuisanceValues,
+    ) -> Result<Vec<f64>, EngineError> {
+        let mut out = self.predict(at, index, record, nuisance)?;
+        let measured = self.measured(index, record);
+        if out.len() != measured.len() {
+            return Err(EngineError::InvalidInput(format!(
+                "record `{}`: {} predicted values for {} measured",
+                record.name,
+                out.len(),
+                measured.len()
+            )));
+        }
+        let w = record.weight.sqrt();
+        for (p, m) in out.iter_mut().zip(measured) {
+            *p = w * (*p - m);
+        }
+        Ok(out)
+    }
+}
+
+/// The velocity response: simulate the free vibration from the record's release state and
+/// compare the simulated velocity (plus the record's offset) with the measured one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VelocityResponse {
+    nuisance: Vec<NuisanceKind>,
+}
+
+impl VelocityResponse {
+    /// A velocity response with a per-record velocity offset and/or release shift.
+    pub fn new(velocity_offset: bool, time_shift: bool) -> Self {
+        let nuisance = NuisanceKind::ALL
+            .into_iter()
+            .filter(|k| match k {
+                NuisanceKind::VelocityOffset => velocity_offset,
+                NuisanceKind::ReleaseShift => time_shift,
+            })
+            .collect();
+        Self { nuisance }
+    }
+
+    /// The simulated velocity of `record` at its time stamps, released `shift` seconds after
+    /// its first time stamp (samples before the release see the release velocity); no offset.
+    pub fn simulate(
+        &self,
+        at: &Evaluation<'_>,
+        record: &Record,
+        shift: f64,
+    ) -> Result<Vec<f64>, EngineError> {
+        let t0 = record.time().first().copied().unwrap_or(0.0);
+        let release = t0 + shift;
+        // Sample times on the simulation clock; samples before the release see the initial state.
+        let first = record.time().partition_point(|&t| t < release);
+        let times: Vec<f64> = record.time()[first..]
+            .iter()
+            .map(|&t| t - release)
+            .collect();
+        let mut v = vec![record.v0; first];
+        if let Some(&t_end) = times.last() {
+            at.count_simulation();
+            let init = Initial {
+                x0: record.x0,
+                v0: record.v0,
+                z0: None,
+            };
+            let mut sim = Vec::with_capacity(times.len());
+            let mut opts = *at.sim;
+            opts.max_steps = opts
+                .max_steps
+                .min(STEPS_PER_SAMPLE * (record.len() as u64).max(100));
+            simulate_velocity(
+                at.oscillator,
+                at.model,
+                &init,
+                t_end,
+                &times,
+                &opts,
+                &mut sim,
+            )?;
+            v.extend_from_slice(&sim);
+        }
+        Ok(v)
+    }
+}
+
+impl Residuals for VelocityResponse {
+    fn channel(&self) -> &'static str {
+        "velocity"
+    }
+
+    fn unit(&self) -> &'static str {
+        "m/s"
+    }
+
+    fn nuisance(&self) -> &[NuisanceKind] {
+        &self.nuisance
+    }
+
+    fn measured<'a>(&'a self, _index: usize, record: &'a Record) -> &'a [f64] {
+        record.velocity()
+    }
+
+    fn predict(
+        &self,
+        at: &Evaluation<'_>,
+        _index: usize,
+        record: &Record,
+        nuisance: &NuisanceValues,
+    ) -> Result<Vec<f64>, EngineError> {
+        let mut v = self.simulate(at, record, nuisance.shift)?;
+        for x in &mut v {
+            *x += nuisance.offset;
+        }
+        Ok(v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exact::coulomb_free_vibration;
+    use frictionid_models::Coulomb;
+
+    /// The velocity response of a Coulomb oscillator against the exact piecewise solution:
+    /// residuals are sqrt(w) (exact + offset - measured).
+    #[test]
+    fn velocity_residuals_match_the_exact_coulomb_solution() {
+        let osc = Oscillator::fmm();
+        let model = Coulomb { mu: 0.24 };
+        let time: Vec<f64> = (0..400).map(|i| i as f64 * 2e-3).collect();
+        let exact = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.014, &time)
+            .unwrap()
+            .v;
+        let mut record = Record::new("r", time, vec![0.0; 400], 0.014);
+        record.weight = 4.0;
+        let producer = VelocityResponse::new(true, false);
+        assert_eq!(producer.nuisance(), &[NuisanceKind::VelocityOffset]);
+        let counter = AtomicU64::new(0);
+        let sim = SimOptions::default();
+        let at = Evaluation::new(&osc, &model, &sim, &counter);
+        let nuisance = NuisanceValues {
+            offset: 1e-3,
+            shift: 0.0,
+        };
+        let r = producer.residuals(&at, 0, &record, &nuisance).unwrap();
+        assert_eq!(counter.load(Ordering::Relaxed), 1);
+        for (ri, e) in r.iter().zip(&exact) {
+            assert!((ri - 2.0 * (e + 1e-3)).abs() < 1e-7, "{ri} vs {e}");
+        }
+    }
+
+    #[test]
+    fn samples_before_a_shifted_release_see_the_release_velocity() {
+        let osc = Oscillator::fmm();
+        let model = Coulomb { mu: 0.24 };
+        let time: Vec<f64> = (0..100).map(|i| i as f64 * 1e-3).collect();
+        let record = Record::new("r", time.clone(), vec![0.0; 100], 0.01);
+        let counter = AtomicU64::new(0);
+        let sim = SimOptions::default();
+        let at = Evaluation::new(&osc, &model, &sim, &counter);
+        let v = VelocityResponse::new(false, true)
+            .simulate(&at, &record, 0.0305)
+            .unwrap();
+        assert!(v[..31].iter().all(|&x| x == 0.0));
+        let shifted: Vec<f64> = time[31..].iter().map(|t| t - 0.0305).collect();
+        let exact = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.01, &shifted)
+            .unwrap()
+            .v;
+        for (got, e) in v[31..].iter().zip(&exact) {
+            assert!((got - e).abs() < 1e-8, "{got} vs {e}");
+        }
+    }
+}

@@ -1,0 +1,192 @@
+//! The values a fit returns.
+
+use super::energy_check::EnergyForce;
+use super::outcome::{as_display, worst_status, Finding, StartOutcome, Status, TerminationReason};
+use crate::oscillator::Oscillator;
+use frictionid_models::FrictionModel;
+use serde::Serialize;
+
+/// One parameter of a fit result.
+#[derive(Debug, Clone, Serialize)]
+pub struct FittedParam {
+    /// Name.
+    pub name: String,
+    /// Value (fitted, or fixed).
+    pub value: f64,
+    /// Standard error (`None` for fixed or unidentifiable parameters).
+    pub std_error: Option<f64>,
+    /// 95 % confidence interval.
+    pub ci95: Option<[f64; 2]>,
+    /// Unit.
+    pub unit: String,
+    /// Whether it was fitted.
+    pub free: bool,
+}
+
+/// The fit of one record.
+#[derive(Debug, Clone, Serialize)]
+pub struct RecordFit {
+    /// Record name (file).
+    pub file: String,
+    /// Release displacement [m].
+    pub x0: f64,
+    /// Samples.
+    pub samples: usize,
+    /// The quantity compared (`velocity`).
+    pub channel: String,
+    /// RMS of fitted - measured, in the unit of the compared quantity (m/s for velocity).
+    pub rms_residual: f64,
+    /// Energy-based force check (absent when the record cannot be analysed).
+    pub energy_force: Option<EnergyForce>,
+    /// Time stamps (for plots).
+    #[serde(skip)]
+    pub time: Vec<f64>,
+    /// The measured series compared.
+    #[serde(skip)]
+    pub measured: Vec<f64>,
+    /// The fitted series (the model's prediction, nuisance applied).
+    #[serde(skip)]
+    pub fitted: Vec<f64>,
+    /// Energy-based friction force (NaN where masked).
+    #[serde(skip)]
+    pub energy_based_force: Vec<f64>,
+    /// The model's force along the measured motion.
+    #[serde(skip)]
+    pub model_force: Vec<f64>,
+}
+
+/// A ratio the data fix even when its parts are not separately identifiable.
+#[derive(Debug, Clone, Serialize)]
+pub struct Derived {
+    /// Name (e.g. `k/m`).
+    pub name: String,
+    /// Value.
+    pub value: f64,
+    /// Standard error by the delta method (when the covariance exists).
+    pub std_error: Option<f64>,
+    /// Unit.
+    pub unit: String,
+}
+
+/// The result of a fit.
+#[derive(Debug, Clone, Serialize)]
+pub struct FitResult {
+    /// Registry name of the model.
+    pub model: String,
+    /// The fitted model (all parameters).
+    pub fitted_model: Box<dyn FrictionModel>,
+    /// The oscillator (fitted where requested).
+    pub oscillator: Oscillator,
+    /// Every model parameter, then fitted oscillator and nuisance parameters.
+    pub parameters: Vec<FittedParam>,
+    /// Names of the free parameters, in the order of `correlation`.
+    pub correlation_names: Vec<String>,
+    /// Correlation matrix of the free parameters (rows).
+    pub correlation: Vec<Vec<f64>>,
+    /// Ratios the data fix (k/m, c/m) when the oscillator is fitted.
+    pub derived: Vec<Derived>,
+    /// Per record.
+    pub records: Vec<RecordFit>,
+    /// RMS residual over all records [m/s].
+    pub rms_residual: f64,
+    /// Half the weighted sum of squared residuals.
+    pub cost: f64,
+    /// Akaike information criterion.
+    pub aic: f64,
+    /// Bayesian information criterion.
+    pub bic: f64,
+    /// Samples over all records.
+    pub samples: usize,
+    /// Free parameters (including nuisance parameters).
+    pub free_parameters: usize,
+    /// Whether the best start converged.
+    pub converged: bool,
+    /// Why the solver stopped (a sentence in JSON).
+    #[serde(serialize_with = "as_display")]
+    pub termination: TerminationReason,
+    /// Solver iterations over all starts.
+    pub iterations: u64,
+    /// Simulations over all starts and the statistics.
+    pub simulations: u64,
+    /// Number of starts.
+    pub starts: usize,
+    /// Starts that reached the best cost (within 1e-6 relative).
+    pub starts_at_best: usize,
+    /// What became of each start, in start order.
+    pub start_outcomes: Vec<StartOutcome>,
+    /// The checks of this fit, each pass, warn or fail.
+    pub diagnostics: Vec<Finding>,
+    /// The messages of the diagnostics that warn or fail, in order.
+    pub warnings: Vec<String>,
+    /// Wall time of the fit [s].
+    pub wall_time_s: f64,
+    /// Its place in a model comparison (set by [`super::compare::compare`]; its keys join the
+    /// fit's in JSON).
+    #[serde(flatten)]
+    pub rank: Option<Rank>,
+}
+
+/// A fit's standing in a model comparison.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Rank {
+    /// AIC minus the best AIC (0 for the best).
+    pub delta_aic: f64,
+    /// exp(-delta_aic / 2), normalised over the ranking: the weight of evidence for this
+    /// model among those compared.
+    pub akaike_weight: f64,
+    /// Within [`super::compare::INDISTINGUISHABLE_DELTA_AIC`] of the best: the data do not
+    /// tell it from the best.
+    pub indistinguishable: bool,
+}
+
+/// What a fit's outcome means for whoever decides an exit status: the CLI maps `Ok` to 0,
+/// `NotConverged` to 2 and `DiagnosticFailed` to 3 (1 is an error, no result at all).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// Converged, and no diagnostic failed (warnings allowed).
+    Ok,
+    /// The solver did not converge.
+    NotConverged,
+    /// Converged, but at least one diagnostic failed.
+    DiagnosticFailed,
+}
+
+impl Verdict {
+    /// The verdict of a fit that `converged` with `findings`.
+    pub fn of(converged: bool, findings: &[Finding]) -> Self {
+        if !converged {
+            Self::NotConverged
+        } else if worst_status(findings) == Status::Fail {
+            Self::DiagnosticFailed
+        } else {
+            Self::Ok
+        }
+    }
+}
+
+/// A fit's parameter value by name (model or oscillator), for callers and tests.
+impl FitResult {
+    /// The value of the parameter `name`.
+    pub fn value(&self, name: &str) -> Option<f64> {
+        self.parameters
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.value)
+    }
+
+    /// The parameter entry `name`.
+    pub fn param(&self, name: &str) -> Option<&FittedParam> {
+        self.parameters.iter().find(|p| p.name == name)
+    }
+
+    /// Converged and clean, not converged, or a diagnostic failed.
+    pub fn verdict(&self) -> Verdict {
+        Verdict::of(self.converged, &self.diagnostics)
+    }
+
+    /// The diagnostics that warn or fail.
+    pub fn problems(&self) -> impl Iterator<Item = &Finding> {
+        self.diagnostics.iter().filter(|f| f.status != Status::Pass)
+    }
+}

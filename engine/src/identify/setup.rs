@@ -1,0 +1,272 @@
+//! From options to a fit's free parameters: checks the names and bounds the options give,
+//! picks the starting model (data-driven guess or as given) and lays out the free model,
+//! oscillator and nuisance parameters with their bounds and starting values.
+
+use super::layout::{FreeParam, ParamKind};
+use super::options::{FitOptions, OscillatorParam};
+use super::residuals::{NuisanceKind, Residuals};
+use crate::energy::analyze_record;
+use crate::error::EngineError;
+use crate::oscillator::Oscillator;
+use crate::record::Record;
+use frictionid_models::{FrictionModel, GuessHint, ParamInfo};
+
+/// Bound keys that are not model parameters: the oscillator properties, then every nuisance
+/// parameter's key.
+pub fn non_model_bound_keys() -> Vec<&'static str> {
+    let mut keys = vec!["mass", "damping", "stiffness"];
+    keys.extend(NuisanceKind::ALL.map(NuisanceKind::key));
+    keys
+}
+
+/// Data-driven hints: the friction level from the half-cycle energy estimate, a typical speed.
+pub fn guess_hint(osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
+    let mut levels = Vec::new();
+    let mut speeds = Vec::new();
+    for rec in records {
+        if let Ok(a) = analyze_record(rec, osc, &opts.energy) {
+            if a.half_cycle_mean.is_finite() && a.half_cycle_mean > 0.0 {
+                levels.push(a.half_cycle_mean);
+            } else if a.mean_abs_force.is_finite() && a.mean_abs_force > 0.0 {
+                levels.push(a.mean_abs_force);
+            }
+        }
+        let peak = rec.velocity().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if peak > 0.0 {
+            speeds.push(peak / 2.0);
+        }
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let n = osc.normal_force;
+    let mu = if levels.is_empty() || n <= 0.0 {
+        0.2
+    } else {
+        (mean(&levels) / n).clamp(1e-4, 5.0)
+    };
+    GuessHint {
+        mu,
+        typical_velocity: if speeds.is_empty() {
+            0.05
+        } else {
+            mean(&speeds)
+        },
+        normal_force: n,
+        stiffness: osc.stiffness,
+        mass: osc.mass,
+    }
+}
+
+fn unknown_name(kind: &str, name: &str, valid: &[String]) -> EngineError {
+    let hint = frictionid_models::suggest::did_you_mean(name, valid.iter().map(String::as_str));
+    EngineError::InvalidInput(format!(
+        "{kind} `{name}` is not a parameter{hint}; valid: {}",
+        valid.join(", ")
+    ))
+}
+
+/// The free parameters of a fit, the model carrying the fixed values and where to start.
+pub struct Layout {
+    /// The model at its starting values (fixed parameters as given).
+    pub start_model: Box<dyn FrictionModel>,
+    /// The free parameters, in solver order.
+    pub params: Vec<FreeParam>,
+    /// Their starting physical values.
+    pub start: Vec<f64>,
+}
+
+impl Layout {
+    /// Number of free model parameters (not oscillator or nuisance).
+    pub fn n_model_free(&self) -> usize {
+        self.params
+            .iter()
+            .filter(|f| matches!(f.kind, ParamKind::Model(_)))
+            .count()
+    }
+
+    fn push(&mut self, param: FreeParam, start: f64) {
+        self.params.push(param);
+        self.start.push(start);
+    }
+}
+
+/// Builds the starting model and the free-parameter layout from the options, with the
+/// nuisance parameters `residuals` adds to every record.
+pub fn build_layout<R: Residuals + ?Sized>(
+    osc: &Oscillator,
+    model: &(dyn FrictionModel + 'static),
+    records: &[Record],
+    residuals: &R,
+    opts: &FitOptions,
+) -> Result<Layout, EngineError> {
+    let info = model.param_info();
+    let names: Vec<String> = info.iter().map(|p| p.name.clone()).collect();
+    check_bounds(opts, &names)?;
+    let free = free_model_indices(&info, &names, opts)?;
+    if let Some(k) = opts.keep_initial.iter().find(|k| !names.contains(k)) {
+        return Err(unknown_name("initial value", k, &names));
+    }
+    let mut layout = Layout {
+        start_model: starting_model(osc, model, records, opts, &free)?,
+        params: Vec::new(),
+        start: Vec::new(),
+    };
+    let values = layout.start_model.params();
+    for &i in &free {
+        let (param, x) = model_param(&info[i], i, values[i], opts);
+        layout.push(param, x);
+    }
+    for &q in &opts.oscillator {
+        let (param, x) = oscillator_param(osc, q, opts);
+        layout.push(param, x);
+    }
+    for (r, rec) in records.iter().enumerate() {
+        for &kind in residuals.nuisance() {
+            let (param, x) = nuisance_param(kind, r, rec, opts);
+            layout.push(param, x);
+        }
+    }
+    Ok(layout)
+}
+
+/// Every bound names a parameter (model, oscillator or nuisance) and has lower < upper.
+fn check_bounds(opts: &FitOptions, model_names: &[String]) -> Result<(), EngineError> {
+    let mut valid = model_names.to_vec();
+    valid.extend(non_model_bound_keys().into_iter().map(String::from));
+    if let Some(b) = opts.bounds.keys().find(|b| !valid.contains(b)) {
+        return Err(unknown_name("bound", b, &valid));
+    }
+    for (k, &(lo, hi)) in &opts.bounds {
+        if lo.is_nan() || hi.is_nan() || lo >= hi {
+            return Err(EngineError::InvalidInput(format!(
+                "bounds of `{k}` must satisfy lower < upper, got [{lo}, {hi}]"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Indices of the free model parameters, sorted: the options' list (oscillator names are
+/// allowed and skipped) or every parameter not fixed by default.
+fn free_model_indices(
+    info: &[ParamInfo],
+    names: &[String],
+    opts: &FitOptions,
+) -> Result<Vec<usize>, EngineError> {
+    let Some(list) = &opts.free else {
+        return Ok((0..info.len())
+            .filter(|&i| !info[i].fixed_by_default)
+            .collect());
+    };
+    let mut idx = Vec::new();
+    for name in list {
+        match names.iter().position(|n| n == name) {
+            Some(i) if !idx.contains(&i) => idx.push(i),
+            Some(_) => {}
+            None if OscillatorParam::parse(name).is_some() => {}
+            None => return Err(unknown_name("free parameter", name, names)),
+        }
+    }
+    idx.sort_unstable();
+    Ok(idx)
+}
+
+/// The model at its starting values: the data-driven guess for the free parameters (unless
+/// kept), the given values for the others.
+fn starting_model(
+    osc: &Oscillator,
+    model: &(dyn FrictionModel + 'static),
+    records: &[Record],
+    opts: &FitOptions,
+    free: &[usize],
+) -> Result<Box<dyn FrictionModel>, EngineError> {
+    let mut start_model = frictionid_models::clone_model(model);
+    if opts.guess && !free.is_empty() {
+        let given = model.params();
+        start_model.apply_guess(&guess_hint(osc, records, opts));
+        let mut values = start_model.params();
+        for (i, p) in model.param_info().iter().enumerate() {
+            if !free.contains(&i) || opts.keep_initial.contains(&p.name) {
+                values[i] = given[i];
+            }
+        }
+        start_model.set_params(&values)?;
+    }
+    Ok(start_model)
+}
+
+/// A free model parameter: log coordinates for a strictly positive one, its bounds from the
+/// options or the model; the start clipped into them.
+fn model_param(p: &ParamInfo, index: usize, value: f64, opts: &FitOptions) -> (FreeParam, f64) {
+    let (lo, hi) = opts
+        .bounds
+        .get(&p.name)
+        .copied()
+        .unwrap_or((p.lower, p.upper));
+    let log = p.lower_exclusive && p.lower == 0.0 && lo >= 0.0;
+    let (lo_eff, hi_eff) = if log { (lo.max(0.0), hi) } else { (lo, hi) };
+    let mut x = value;
+    if log {
+        x = x.max(lo_eff).max(f64::MIN_POSITIVE);
+    }
+    x = x.clamp(lo_eff, hi_eff);
+    let mut f = FreeParam::linear(
+        p.name.clone(),
+        &p.unit,
+        ParamKind::Model(index),
+        (lo_eff, hi_eff),
+        x,
+        1.0,
+    );
+    f.log = log;
+    (f, x)
+}
+
+/// A free oscillator property: mass and stiffness in log coordinates, damping linear.
+fn oscillator_param(osc: &Oscillator, q: OscillatorParam, opts: &FitOptions) -> (FreeParam, f64) {
+    let (current, kind) = match q {
+        OscillatorParam::Mass => (osc.mass, ParamKind::Mass),
+        OscillatorParam::Damping => (osc.damping, ParamKind::Damping),
+        OscillatorParam::Stiffness => (osc.stiffness, ParamKind::Stiffness),
+    };
+    let log = !matches!(q, OscillatorParam::Damping);
+    let (lo, hi) = opts
+        .bounds
+        .get(q.name())
+        .copied()
+        .unwrap_or((0.0, f64::INFINITY));
+    let typical = 2e-3 * (osc.mass * osc.stiffness).sqrt();
+    let mut f = FreeParam::linear(
+        q.name().to_string(),
+        q.unit(),
+        kind,
+        (lo, hi),
+        current,
+        typical,
+    );
+    f.log = log;
+    let floor = if log { f64::MIN_POSITIVE } else { lo };
+    (f, current.clamp(lo.max(floor), hi))
+}
+
+/// A nuisance parameter of record `r`, named `<key>[<record>]`.
+fn nuisance_param(
+    kind: NuisanceKind,
+    r: usize,
+    rec: &Record,
+    opts: &FitOptions,
+) -> (FreeParam, f64) {
+    let b = opts
+        .bounds
+        .get(kind.key())
+        .copied()
+        .unwrap_or_else(|| kind.default_bounds());
+    let param = FreeParam::linear(
+        format!("{}[{}]", kind.key(), rec.name),
+        kind.unit(),
+        ParamKind::Nuisance { kind, record: r },
+        b,
+        kind.start(),
+        kind.typical(),
+    );
+    (param, kind.start().clamp(b.0, b.1))
+}

@@ -1,0 +1,446 @@
+//! Multi-start strategy: where the starts begin, one Levenberg-Marquardt run per start, a short
+//! screening of every start and the continuation of the most promising one.
+
+use super::layout::{FreeParam, ParamKind};
+use super::lm::{termination_reason, LevenbergMarquardt, LmState};
+use super::options::{FitOptions, Progress, ProgressFn};
+use super::outcome::{StartOutcome, TerminationReason};
+use super::problem::FitProblem;
+use super::residuals::Residuals;
+use crate::error::EngineError;
+use argmin::core::observers::{Observe, ObserverMode};
+use argmin::core::{Executor, State, KV};
+use frictionid_models::FrictionModel;
+use nalgebra::DVector;
+use rayon::prelude::*;
+
+/// Starts of a multi-start fit when more than two model parameters are free.
+pub const DEFAULT_STARTS: usize = 4;
+
+/// Most starts of a multi-start fit (each is a full Levenberg-Marquardt run).
+pub const MAX_STARTS: usize = 1000;
+
+/// Iterations every start of a multi-start fit runs before the most promising is continued.
+pub const SCREEN_ITERATIONS: u64 = 15;
+
+/// Starts continued to convergence after the screening phase (the best one).
+pub const PROMOTED_STARTS: usize = 1;
+
+/// One start's run: where it ended and how.
+pub struct StartRun {
+    /// Internal coordinates of its best point.
+    pub u: DVector<f64>,
+    /// Its best cost.
+    pub cost: f64,
+    /// Solver iterations.
+    pub iterations: u64,
+    /// Simulations run.
+    pub simulations: u64,
+    /// Why it stopped.
+    pub termination: TerminationReason,
+}
+
+impl StartRun {
+    /// Whether it converged.
+    pub fn converged(&self) -> bool {
+        self.termination.is_converged()
+    }
+}
+
+/// The number of starts: as asked, else one when at most two model parameters are free.
+pub fn start_count(opts: &FitOptions, n_model_free: usize) -> Result<usize, EngineError> {
+    let n = opts
+        .multistart
+        .unwrap_or(if n_model_free > 2 { DEFAULT_STARTS } else { 1 })
+        .max(1);
+    if n > MAX_STARTS {
+        return Err(EngineError::InvalidInput(format!(
+            "multistart = {n}: at most {MAX_STARTS} starts"
+        )));
+    }
+    Ok(n)
+}
+
+/// Radical inverse in base `b` (the Halton sequence), in [0, 1).
+fn halton(mut i: usize, b: usize) -> f64 {
+    let (mut f, mut r) = (1.0, 0.0);
+    while i > 0 {
+        f /= b as f64;
+        r += f * (i % b) as f64;
+        i /= b;
+    }
+    r
+}
+
+const PRIMES: [usize; 12] = [2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37];
+
+/// Starting points: the initial values, then points spread by factors 3^(±1) around them
+/// along a Halton sequence (clipped to the bounds); nuisance parameters start at 0.
+pub fn starting_points(layout: &[FreeParam], start: &[f64], n: usize) -> Vec<Vec<f64>> {
+    let mut out = vec![start.to_vec()];
+    for s in 1..n {
+        let p = layout
+            .iter()
+            .zip(start)
+            .enumerate()
+            .map(|(j, (f, &x0))| {
+                if !matches!(f.kind, ParamKind::Model(_)) {
+                    return x0;
+                }
+                let q = 2.0 * halton(s, PRIMES[j % PRIMES.len()]) - 1.0;
+                let x = if x0 != 0.0 {
+                    x0 * 3f64.powf(q)
+                } else {
+                    f.scale * (q + 1.0)
+                };
+                let lo = if f.log {
+                    f.lower.max(f64::MIN_POSITIVE)
+                } else {
+                    f.lower
+                };
+                x.clamp(lo, f.upper)
+            })
+            .collect();
+        out.push(p);
+    }
+    out
+}
+
+/// The starting points of a fit: [`starting_points`], with the configured model values as a
+/// start of their own (second) when they differ from the data-driven guess (for the built-in
+/// models they are typical literature values).
+pub fn fit_starting_points(
+    layout: &[FreeParam],
+    start: &[f64],
+    configured_model: &dyn FrictionModel,
+    opts: &FitOptions,
+    n_starts: usize,
+) -> Vec<Vec<f64>> {
+    let mut points = starting_points(layout, start, n_starts);
+    if n_starts > 1 && opts.guess {
+        let given = configured_model.params();
+        let configured: Vec<f64> = layout
+            .iter()
+            .zip(start)
+            .map(|(f, &x)| match f.kind {
+                ParamKind::Model(i) => given[i].clamp(f.lower, f.upper),
+                _ => x,
+            })
+            .collect();
+        if configured != start {
+            points.insert(1, configured);
+            points.truncate(n_starts);
+        }
+    }
+    points
+}
+
+struct ProgressObserver {
+    model: String,
+    start: usize,
+    starts: usize,
+    max_iterations: u64,
+    callback: ProgressFn,
+}
+
+impl Observe<LmState> for ProgressObserver {
+    fn observe_iter(&mut self, state: &LmState, _kv: &KV) -> Result<(), argmin::core::Error> {
+        (self.callback)(&Progress {
+            model: self.model.clone(),
+            start: self.start,
+            starts: self.starts,
+            iteration: state.get_iter(),
+            max_iterations: self.max_iterations,
+            cost: state.get_best_cost(),
+        });
+        Ok(())
+    }
+}
+
+/// The solver for `problem`'s bounds with the fit's step cap and tolerance.
+fn solver_for<R: Residuals>(problem: &FitProblem<R>, opts: &FitOptions) -> LevenbergMarquardt {
+    let bounds: Vec<(f64, f64)> = problem
+        .layout
+        .iter()
+        .map(FreeParam::internal_bounds)
+        .collect();
+    let lower = DVector::from_iterator(bounds.len(), bounds.iter().map(|b| b.0));
+    let upper = DVector::from_iterator(bounds.len(), bounds.iter().map(|b| b.1));
+    let mut solver = LevenbergMarquardt::new(lower, upper);
+    // One step changes a log-scaled parameter by at most a factor e^2 and a linear one by at
+    // most twice its scale, so a poor linearisation cannot throw a trial point into a region
+    // where the simulation is stiff or degenerate.
+    solver.max_step = 2.0;
+    if let Some(t) = opts.tolerance {
+        solver.ftol = t;
+    }
+    solver
+}
+
+/// Which start of how many a run is, and its iteration budget.
+#[derive(Debug, Clone, Copy)]
+pub struct RunSlot {
+    /// Index of the start.
+    pub start: usize,
+    /// Number of starts.
+    pub starts: usize,
+    /// Iteration limit of this run.
+    pub max_iterations: u64,
+}
+
+/// Runs the solver on `problem` from `u0`.
+pub fn run_start<R: Residuals + 'static>(
+    problem: FitProblem<R>,
+    u0: DVector<f64>,
+    opts: &FitOptions,
+    slot: RunSlot,
+) -> Result<StartRun, EngineError> {
+    let solver = solver_for(&problem, opts);
+    let model_name = problem.model.name().to_string();
+    let mut exec = Executor::new(problem, solver)
+        .configure(|s| s.param(u0).max_iters(slot.max_iterations))
+        .ctrlc(false)
+        .timer(false);
+    if let Some(cb) = &opts.progress {
+        exec = exec.add_observer(
+            ProgressObserver {
+                model: model_name,
+                start: slot.start,
+                starts: slot.starts,
+                max_iterations: slot.max_iterations,
+                callback: cb.clone(),
+            },
+            ObserverMode::Always,
+        );
+    }
+    let res = exec.run().map_err(|e| EngineError::Fit(e.to_string()))?;
+    let state = res.state();
+    let simulations = res
+        .problem()
+        .problem
+        .as_ref()
+        .map(FitProblem::simulations)
+        .unwrap_or(0);
+    let u = state
+        .get_best_param()
+        .cloned()
+        .ok_or_else(|| EngineError::Fit("the solver returned no parameters".into()))?;
+    Ok(StartRun {
+        u,
+        cost: state.get_best_cost(),
+        iterations: state.get_iter(),
+        simulations,
+        termination: termination_reason(
+            &res.solver,
+            &state.termination_status,
+            slot.max_iterations,
+        ),
+    })
+}
+
+/// The result of every start: the best run and what became of each start.
+pub struct MultiStart {
+    /// The run with the lowest cost.
+    pub best: StartRun,
+    /// Solver iterations over all starts.
+    pub iterations: u64,
+    /// Simulations over all starts.
+    pub simulations: u64,
+    /// Starts that reached the best cost (within 1e-6 relative).
+    pub starts_at_best: usize,
+    /// One outcome per start, in start order.
+    pub outcomes: Vec<StartOutcome>,
+}
+
+/// Screened runs that produced a finite cost, by start index, and the outcomes of the others.
+struct Screened {
+    ok: Vec<(usize, StartRun)>,
+    outcomes: Vec<(usize, StartOutcome)>,
+    first_error: Option<EngineError>,
+}
+
+fn classify(runs: Vec<Result<StartRun, EngineError>>) -> Screened {
+    let mut screened = Screened {
+        ok: Vec::new(),
+        outcomes: Vec::new(),
+        first_error: None,
+    };
+    for (start, run) in runs.into_iter().enumerate() {
+        match run {
+            Ok(o) if o.cost.is_finite() => screened.ok.push((start, o)),
+            Ok(_) => screened
+                .outcomes
+                .push((start, StartOutcome::NonFiniteCost { start })),
+            Err(error) => {
+                screened.first_error.get_or_insert(error.clone());
+                screened
+                    .outcomes
+                    .push((start, StartOutcome::Failed { start, error }));
+            }
+        }
+    }
+    screened
+}
+
+/// Runs every start from `points` (phase 1: each for a few iterations when there are several;
+/// phase 2: the most promising to the iteration limit) and picks the best.
+/// `make_problem` builds a fresh problem per run; `reference` explains a total failure.
+pub fn run_starts<R, F>(
+    make_problem: F,
+    reference: &FitProblem<R>,
+    points: &[Vec<f64>],
+    opts: &FitOptions,
+) -> Result<MultiStart, EngineError>
+where
+    R: Residuals + 'static,
+    F: Fn() -> FitProblem<R> + Sync,
+{
+    let n_starts = points.len();
+    let screen = if n_starts > 1 {
+        SCREEN_ITERATIONS.min(opts.max_iterations)
+    } else {
+        opts.max_iterations
+    };
+    let run = |(s, p): (usize, &Vec<f64>)| {
+        let problem = make_problem();
+        let u0 = problem.internal(p);
+        let slot = RunSlot {
+            start: s,
+            starts: n_starts,
+            max_iterations: screen,
+        };
+        run_start(problem, u0, opts, slot)
+    };
+    let runs: Vec<Result<StartRun, EngineError>> = if opts.parallel && n_starts > 1 {
+        points.par_iter().enumerate().map(run).collect()
+    } else {
+        points.iter().enumerate().map(run).collect()
+    };
+    let mut screened = classify(runs);
+    if n_starts > 1 && screen < opts.max_iterations {
+        continue_best(&make_problem, &mut screened, opts, screen, n_starts);
+    }
+    let first_error = screened.first_error.take();
+    pick_best(screened).ok_or_else(|| total_failure(first_error, reference, points))
+}
+
+/// Phase 2: continues the best screened start (unless it converged) to the iteration limit.
+fn continue_best<R, F>(
+    make_problem: &F,
+    screened: &mut Screened,
+    opts: &FitOptions,
+    screen: u64,
+    n_starts: usize,
+) where
+    R: Residuals + 'static,
+    F: Fn() -> FitProblem<R> + Sync,
+{
+    screened.ok.sort_by(|a, b| a.1.cost.total_cmp(&b.1.cost));
+    let keep = PROMOTED_STARTS.min(screened.ok.len());
+    let promoted: Vec<(usize, DVector<f64>)> = screened.ok[..keep]
+        .iter()
+        .filter(|(_, o)| !o.converged())
+        .map(|(s, o)| (*s, o.u.clone()))
+        .collect();
+    let slot = |start| RunSlot {
+        start,
+        starts: n_starts,
+        max_iterations: opts.max_iterations - screen,
+    };
+    let finish =
+        |(s, u): &(usize, DVector<f64>)| (*s, run_start(make_problem(), u.clone(), opts, slot(*s)));
+    let finished: Vec<(usize, Result<StartRun, EngineError>)> = if opts.parallel {
+        promoted.par_iter().map(finish).collect()
+    } else {
+        promoted.iter().map(finish).collect()
+    };
+    for (start, run) in finished {
+        match run {
+            Ok(o) if o.cost.is_finite() => {
+                if let Some(slot) = screened.ok.iter_mut().find(|(t, _)| *t == start) {
+                    merge_continuation(&mut slot.1, o, opts.max_iterations);
+                }
+            }
+            Ok(_) => {}
+            Err(error) => screened
+                .outcomes
+                .push((start, StartOutcome::ContinuationFailed { start, error })),
+        }
+    }
+}
+
+/// Replaces a screened run by its continuation, adding up the work of both; an iteration
+/// limit is reported as the fit's limit.
+fn merge_continuation(screened: &mut StartRun, continued: StartRun, max_iterations: u64) {
+    let before = std::mem::replace(screened, continued);
+    screened.iterations += before.iterations;
+    screened.simulations += before.simulations;
+    if let TerminationReason::IterationLimit { limit } = &mut screened.termination {
+        *limit = max_iterations;
+    }
+}
+
+/// The error when no start produced a finite cost: the first start's error, with what the
+/// residuals at the first starting point say.
+fn total_failure<R: Residuals>(
+    first_error: Option<EngineError>,
+    reference: &FitProblem<R>,
+    points: &[Vec<f64>],
+) -> EngineError {
+    let why = first_error
+        .map(|e| e.to_string())
+        .unwrap_or_else(|| "no start produced a finite cost".into());
+    let detail = points
+        .first()
+        .and_then(|p| reference.residuals_at(p).err())
+        .map(|d| format!(" ({d})"))
+        .unwrap_or_default();
+    EngineError::Fit(format!("{why}{detail}"))
+}
+
+/// The best run, the totals and one outcome per start (a start whose continuation failed
+/// keeps its screened run among the candidates); `None` when no start has a finite cost.
+fn pick_best(screened: Screened) -> Option<MultiStart> {
+    let Screened {
+        ok, mut outcomes, ..
+    } = screened;
+    let iterations: u64 = ok.iter().map(|(_, o)| o.iterations).sum();
+    let simulations: u64 = ok.iter().map(|(_, o)| o.simulations).sum();
+    let best_cost = ok
+        .iter()
+        .map(|(_, o)| o.cost)
+        .min_by(f64::total_cmp)
+        .unwrap_or(f64::INFINITY);
+    let starts_at_best = ok
+        .iter()
+        .filter(|(_, o)| o.cost <= best_cost * (1.0 + 1e-6) + 1e-300)
+        .count();
+    let mut best = None;
+    for (start, run) in ok {
+        if !outcomes.iter().any(|(s, _)| *s == start) {
+            outcomes.push((
+                start,
+                StartOutcome::Finished {
+                    start,
+                    cost: run.cost,
+                    iterations: run.iterations,
+                    termination: run.termination.clone(),
+                },
+            ));
+        }
+        let better = best
+            .as_ref()
+            .is_none_or(|b: &StartRun| run.cost.total_cmp(&b.cost).is_lt());
+        if better {
+            best = Some(run);
+        }
+    }
+    outcomes.sort_by_key(|(s, _)| *s);
+    Some(MultiStart {
+        best: best?,
+        iterations,
+        simulations,
+        starts_at_best,
+        outcomes: outcomes.into_iter().map(|(_, o)| o).collect(),
+    })
+}
