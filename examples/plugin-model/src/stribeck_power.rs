@@ -34,15 +34,12 @@
 //! with supplemental fluid dampers", The Structural Design of Tall Buildings 2(2), 93-132, 1993.
 
 use frictionid_models::{check_bounds, mu_s_warning, sgn, FrictionModel, GuessHint, ModelError};
-use serde::{Deserialize, Serialize};
 
 /// The registry name of the model.
 pub const NAME: &str = "stribeck_power";
 
 frictionid_models::declare_params! {
     /// Gaussian Stribeck friction plus a power-law viscous force.
-    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-    #[serde(default, deny_unknown_fields)]
     pub struct StribeckPower {
         mu_c: new("1", 0.2, (0.0, 10.0), "Coulomb (kinetic) friction coefficient"),
         mu_s: new("1", 0.3, (0.0, 10.0), "static (breakaway) friction coefficient"),
@@ -86,16 +83,10 @@ impl StribeckPower {
 
 #[typetag::serde(name = "stribeck_power")]
 impl FrictionModel for StribeckPower {
-    frictionid_models::declared_param_methods!();
-
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn equation(&self) -> String {
-        "F = sgn(v) (N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)) + viscous v_ref |v/v_ref|^alpha)"
-            .into()
-    }
+    frictionid_models::declared_param_methods!(
+        name: NAME,
+        equation: "F = sgn(v) (N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)) + viscous v_ref |v/v_ref|^alpha)",
+    );
 
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         sgn(v) * (normal * self.coefficient(v) + self.viscous_force(v))

@@ -18,12 +18,9 @@
 //! The Aerospace Corporation, 1968.
 
 use crate::model::{sgn, FrictionModel, GuessHint};
-use serde::{Deserialize, Serialize};
 
 crate::declare_params! {
     /// Dahl's dynamic friction model with the friction force as internal state.
-    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-    #[serde(default, deny_unknown_fields)]
     pub struct Dahl {
         sigma0: positive("N/m", 1e5, 1e12, "rest stiffness of the contact"),
         mu_c: positive("1", 0.2, 10.0, "Coulomb friction coefficient"),
@@ -33,15 +30,11 @@ crate::declare_params! {
 
 #[typetag::serde(name = "dahl")]
 impl FrictionModel for Dahl {
-    crate::declared_param_methods!();
+    crate::declared_param_methods!(
+        name: "dahl",
+        equation: "dF/dt = sigma0 v |1 - F sgn(v)/(mu_c N)|^alpha sgn(1 - F sgn(v)/(mu_c N)), friction = F",
+    );
 
-    fn name(&self) -> &'static str {
-        "dahl"
-    }
-    fn equation(&self) -> String {
-        "dF/dt = sigma0 v |1 - F sgn(v)/(mu_c N)|^alpha sgn(1 - F sgn(v)/(mu_c N)), friction = F"
-            .into()
-    }
     fn n_states(&self) -> usize {
         1
     }

@@ -20,12 +20,9 @@
 use crate::builtin::stribeck::mu_s_warning;
 use crate::error::ModelError;
 use crate::model::{check_bounds, sgn, FrictionModel, GuessHint};
-use serde::{Deserialize, Serialize};
 
 crate::declare_params! {
     /// The LuGre bristle model with the Stribeck curve of Canudas de Wit et al. (1995).
-    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-    #[serde(default, deny_unknown_fields)]
     pub struct LuGre {
         sigma0: positive("N/m", 1e5, 1e12, "bristle stiffness"),
         sigma1: non_negative("N s/m", 300.0, "bristle damping"),
@@ -56,14 +53,11 @@ impl LuGre {
 
 #[typetag::serde(name = "lugre")]
 impl FrictionModel for LuGre {
-    crate::declared_param_methods!();
+    crate::declared_param_methods!(
+        name: "lugre",
+        equation: "dz/dt = v - sigma0 |v| z / g(v), g(v) = N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)), F = sigma0 z + sigma1 dz/dt + sigma2 v",
+    );
 
-    fn name(&self) -> &'static str {
-        "lugre"
-    }
-    fn equation(&self) -> String {
-        "dz/dt = v - sigma0 |v| z / g(v), g(v) = N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)), F = sigma0 z + sigma1 dz/dt + sigma2 v".into()
-    }
     fn n_states(&self) -> usize {
         1
     }

@@ -18,12 +18,9 @@
 
 use crate::error::ModelError;
 use crate::model::{check_bounds, sgn, FrictionModel, GuessHint};
-use serde::{Deserialize, Serialize};
 
 crate::declare_params! {
     /// Static friction law with a Stribeck dip between static and Coulomb levels.
-    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-    #[serde(default, deny_unknown_fields)]
     pub struct Stribeck {
         mu_c: new("1", 0.2, (0.0, 10.0), "Coulomb (kinetic) friction coefficient"),
         mu_s: new("1", 0.3, (0.0, 10.0), "static (breakaway) friction coefficient"),
@@ -42,14 +39,11 @@ impl Stribeck {
 
 #[typetag::serde(name = "stribeck")]
 impl FrictionModel for Stribeck {
-    crate::declared_param_methods!();
+    crate::declared_param_methods!(
+        name: "stribeck",
+        equation: "F = N (mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta)) sgn(v) + viscous v",
+    );
 
-    fn name(&self) -> &'static str {
-        "stribeck"
-    }
-    fn equation(&self) -> String {
-        "F = N (mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta)) sgn(v) + viscous v".into()
-    }
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         normal * self.coefficient(v) * sgn(v) + self.viscous * v
     }
