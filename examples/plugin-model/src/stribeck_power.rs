@@ -33,7 +33,9 @@
 //! e.g. M. C. Constantinou, M. D. Symans, "Experimental study of seismic response of buildings
 //! with supplemental fluid dampers", The Structural Design of Tall Buildings 2(2), 93-132, 1993.
 
-use frictionid_models::{check_bounds, mu_s_warning, sgn, FrictionModel, GuessHint, ModelError};
+use frictionid_models::{
+    check_bounds, mu_s_warning, sgn, FrictionModel, GuessHint, ModelError, StribeckLevels,
+};
 
 /// The registry name of the model.
 pub const NAME: &str = "stribeck_power";
@@ -107,13 +109,12 @@ impl FrictionModel for StribeckPower {
     }
 
     fn apply_guess(&mut self, hint: &GuessHint) {
-        let v = hint.typical_velocity.max(1e-6);
-        self.mu_c = 0.9 * hint.mu;
-        self.mu_s = 1.2 * hint.mu;
-        self.v_s = 0.2 * v;
-        self.viscous = 0.05 * hint.mu * hint.normal_force / v;
+        let levels = StribeckLevels::guess(hint);
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.viscous = levels.viscous;
     }
-
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(NAME, &self.param_info(), &self.params())?;
         Ok(mu_s_warning(NAME, self.mu_s, self.mu_c))

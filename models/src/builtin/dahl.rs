@@ -18,6 +18,7 @@
 //! The Aerospace Corporation, 1968.
 
 use crate::model::{sgn, FrictionModel, GuessHint};
+use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
 crate::declare_params! {
     /// Dahl's dynamic friction model with the friction force as internal state.
@@ -64,6 +65,16 @@ impl FrictionModel for Dahl {
     fn apply_guess(&mut self, hint: &GuessHint) {
         self.mu_c = hint.mu;
         // Presliding displacements of dry contacts are typically a few tens of micrometres.
-        self.sigma0 = (hint.mu * hint.normal_force / 2e-5).max(1.0);
+        self.sigma0 = (hint.mu * hint.normal_force / TYPICAL_PRESLIDING_DISPLACEMENT).max(1.0);
+    }
+    /// The Coulomb level of the fitted model and the rest stiffness that reaches it at the
+    /// presliding displacement.
+    fn start_from(&mut self, fitted: &dyn FrictionModel, ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.mu_c = levels.mu_c;
+        self.sigma0 = ctx.stiffness_for(levels.mu_c * ctx.normal_force);
+        true
     }
 }

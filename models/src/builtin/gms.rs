@@ -89,6 +89,7 @@ use crate::builtin::stribeck::mu_s_warning;
 use crate::error::ModelError;
 use crate::model::{check_bounds, check_len, sgn, FrictionModel, GuessHint, ParamInfo};
 use crate::params::ParamSpec;
+use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 use serde::de::{self, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -207,6 +208,24 @@ impl Gms {
     /// The metadata of the six shared parameters (the last six of `param_info`).
     pub fn shared_param_info() -> Vec<ParamInfo> {
         crate::params::infos(&SHARED_PARAMS)
+    }
+
+    /// Takes the levels mu_c, mu_s, v_s (when given) and viscous.
+    fn set_levels(&mut self, levels: &StribeckLevels) {
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.viscous = levels.viscous;
+    }
+
+    /// Scales the element stiffnesses, keeping their ratios, to the total `target` [N/m].
+    fn scale_stiffness(&mut self, target: f64) {
+        let total: f64 = self.elements.iter().map(|e| e.stiffness).sum();
+        if total > 0.0 && total.is_finite() {
+            for e in &mut self.elements {
+                e.stiffness *= target / total;
+            }
+        }
     }
 
     /// The Stribeck curve s(v) \[N\] (the total sliding force for weights summing to 1).
@@ -570,20 +589,36 @@ impl FrictionModel for Gms {
             .sum()
     }
     fn apply_guess(&mut self, hint: &GuessHint) {
-        let v = hint.typical_velocity.max(1e-6);
-        self.mu_c = 0.9 * hint.mu;
-        self.mu_s = 1.2 * hint.mu;
-        self.v_s = 0.2 * v;
-        self.viscous = 0.05 * hint.mu * hint.normal_force / v;
+        let levels = StribeckLevels::guess(hint);
+        self.set_levels(&levels);
         // Keep the ratios of the stiffnesses; scale the total presliding stiffness to a
         // breakaway displacement of about 20 micrometres (as the LuGre guess).
-        let total: f64 = self.elements.iter().map(|e| e.stiffness).sum();
-        let target = (hint.mu * hint.normal_force / 2e-5).max(1.0);
-        if total > 0.0 && total.is_finite() {
-            for e in &mut self.elements {
-                e.stiffness *= target / total;
-            }
+        self.scale_stiffness(
+            (hint.mu * hint.normal_force / TYPICAL_PRESLIDING_DISPLACEMENT).max(1.0),
+        );
+    }
+    /// The fitted Stribeck curve shared by the elements (weights rescaled to sum to 1, so
+    /// that the model slides at exactly that curve), the total stiffness from the presliding
+    /// displacement at the Coulomb level, the stiffness ratios kept.
+    fn start_from(&mut self, fitted: &dyn FrictionModel, ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.set_levels(&levels);
+        if let Some(delta) = levels.delta {
+            self.delta = delta;
         }
+        let total_weight: f64 = self.elements.iter().map(|e| e.weight).sum();
+        let equal = 1.0 / self.elements.len().max(1) as f64;
+        for e in &mut self.elements {
+            e.weight = if total_weight > 0.0 {
+                e.weight / total_weight
+            } else {
+                equal
+            };
+        }
+        self.scale_stiffness(ctx.stiffness_for(levels.mu_c * ctx.normal_force));
+        true
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         if self.elements.is_empty() {

@@ -20,6 +20,7 @@
 use crate::builtin::stribeck::mu_s_warning;
 use crate::error::ModelError;
 use crate::model::{check_bounds, sgn, FrictionModel, GuessHint};
+use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
 crate::declare_params! {
     /// The LuGre bristle model with the Stribeck curve of Canudas de Wit et al. (1995).
@@ -78,15 +79,30 @@ impl FrictionModel for LuGre {
         0.5 * self.sigma0 * z0 * z0
     }
     fn apply_guess(&mut self, hint: &GuessHint) {
-        let v = hint.typical_velocity.max(1e-6);
-        self.mu_c = 0.9 * hint.mu;
-        self.mu_s = 1.2 * hint.mu;
+        let levels = StribeckLevels::guess(hint);
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.sigma2 = levels.viscous;
         // Stribeck velocities are typically a few percent of the sliding speeds of a free
         // vibration; bristle damping a fraction of the critical damping of the bristle mode.
-        self.v_s = 0.05 * v;
-        self.sigma0 = (hint.mu * hint.normal_force / 2e-5).max(1.0);
+        self.v_s = 0.05 * hint.typical_velocity.max(1e-6);
+        self.sigma0 = (hint.mu * hint.normal_force / TYPICAL_PRESLIDING_DISPLACEMENT).max(1.0);
         self.sigma1 = 0.25 * (self.sigma0 * hint.mass).sqrt();
-        self.sigma2 = 0.05 * hint.mu * hint.normal_force / v;
+    }
+    /// The Stribeck levels (sliding at the fitted curve, which LuGre's Gaussian dip
+    /// reproduces exactly for delta = 2), the bristle stiffness from the presliding
+    /// displacement at the Coulomb level, the bristle damping at its critical value.
+    fn start_from(&mut self, fitted: &dyn FrictionModel, ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.sigma2 = levels.viscous;
+        self.sigma0 = ctx.stiffness_for(levels.mu_c * ctx.normal_force);
+        self.sigma1 = ctx.critical_damping(self.sigma0);
+        true
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(self.name(), &self.param_info(), &self.params())?;

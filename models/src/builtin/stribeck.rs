@@ -18,6 +18,7 @@
 
 use crate::error::ModelError;
 use crate::model::{check_bounds, sgn, FrictionModel, GuessHint};
+use crate::start::{StartContext, StribeckLevels};
 
 crate::declare_params! {
     /// Static friction law with a Stribeck dip between static and Coulomb levels.
@@ -31,6 +32,14 @@ crate::declare_params! {
 }
 
 impl Stribeck {
+    /// Takes the levels mu_c, mu_s, v_s (when given) and viscous.
+    fn set_levels(&mut self, levels: &StribeckLevels) {
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.viscous = levels.viscous;
+    }
+
     /// The velocity-dependent coefficient mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta).
     pub fn coefficient(&self, v: f64) -> f64 {
         self.mu_c + (self.mu_s - self.mu_c) * (-(v / self.v_s).abs().powf(self.delta)).exp()
@@ -57,11 +66,17 @@ impl FrictionModel for Stribeck {
         self.force(v, &[], normal)
     }
     fn apply_guess(&mut self, hint: &GuessHint) {
-        let v = hint.typical_velocity.max(1e-6);
-        self.mu_c = 0.9 * hint.mu;
-        self.mu_s = 1.2 * hint.mu;
-        self.v_s = 0.2 * v;
-        self.viscous = 0.05 * hint.mu * hint.normal_force / v;
+        self.set_levels(&StribeckLevels::guess(hint));
+    }
+    fn start_from(&mut self, fitted: &dyn FrictionModel, _ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.set_levels(&levels);
+        if let Some(delta) = levels.delta {
+            self.delta = delta;
+        }
+        true
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(self.name(), &self.param_info(), &self.params())?;
