@@ -354,7 +354,7 @@ fn velocity_only_variant_matches_the_full_trajectory() {
 
 fn integration_time(e: EngineError) -> f64 {
     match e {
-        EngineError::Integration { time, .. } => time,
+        EngineError::Integration(failure) => failure.time(),
         other => panic!("expected an integration error, got {other}"),
     }
 }

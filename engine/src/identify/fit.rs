@@ -2,6 +2,7 @@
 //! lays out the free parameters, runs the starts and turns the best one into a [`FitResult`]
 //! (statistics, per-record fits, the energy-balance check and the findings).
 
+use super::diagnostics;
 use super::energy_check::{energy_force_check, EnergyForce, ForceReference};
 use super::layout::{FreeParam, ParamKind};
 use super::options::{FitOptions, OscillatorParam};
@@ -20,7 +21,7 @@ use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use super::result::{Derived, FitResult, FittedParam, RecordFit};
+pub use super::result::{Derived, FitResult, FittedParam, Rank, RecordFit};
 pub use super::setup::guess_hint;
 pub use super::starts::{DEFAULT_STARTS, MAX_STARTS, PROMOTED_STARTS, SCREEN_ITERATIONS};
 
@@ -167,16 +168,10 @@ fn finish<R: Residuals>(
     let params = &ctx.layout.params;
     let stats = statistics(ctx.reference, &runs.best)?;
     let mut simulations = runs.simulations + ctx.reference.simulations();
-    let mut findings = start_findings(&runs.outcomes);
-    findings.extend(correlation_findings(params, &stats.cov));
-    findings.extend(identifiability_findings(
-        &stats.cov,
-        ctx.opts,
-        ctx.layout.n_model_free(),
-    ));
     let fits = record_fits(ctx.reference, &stats.world, ctx.opts)?;
     simulations += ctx.reference.records.len() as u64;
-    findings.extend(fits.findings);
+    let parameters = parameter_entries(&stats, params);
+    let findings = diagnose(ctx, &runs, &stats, &parameters, &fits);
     let n_free = params.len();
     let samples = ctx.reference.n_residuals();
     let k = params.len();
@@ -187,7 +182,7 @@ fn finish<R: Residuals>(
         .collect();
     Ok(FitResult {
         model: stats.world.model.name().to_string(),
-        parameters: parameter_entries(&stats, params),
+        parameters,
         correlation_names: params.iter().map(|f| f.name.clone()).collect(),
         correlation: (0..k)
             .map(|a| (0..k).map(|b| stats.cov.correlation[(a, b)]).collect())
@@ -210,9 +205,42 @@ fn finish<R: Residuals>(
         diagnostics: findings,
         warnings,
         wall_time_s: clock.elapsed().as_secs_f64(),
+        rank: None,
         fitted_model: stats.world.model,
         oscillator: stats.world.oscillator,
     })
+}
+
+/// Every check of the fit, in report order.
+fn diagnose<R: Residuals>(
+    ctx: &FinishContext<'_, R>,
+    runs: &MultiStart,
+    stats: &Statistics,
+    parameters: &[FittedParam],
+    fits: &RecordFits,
+) -> Vec<Finding> {
+    let params = &ctx.layout.params;
+    let mut findings = vec![diagnostics::convergence(&runs.best.termination)];
+    findings.extend(start_findings(&runs.outcomes));
+    findings.extend(diagnostics::start_agreement(
+        &runs.outcomes,
+        runs.best.cost,
+        stats.cov.residual_variance,
+    ));
+    findings.extend(correlation_findings(params, &stats.cov));
+    findings.push(diagnostics::standard_errors(parameters, stats.cov.singular));
+    findings.extend(identifiability_findings(
+        ctx.opts,
+        ctx.layout.n_model_free(),
+    ));
+    findings.extend(diagnostics::parameters_at_bounds(params, &stats.p_best));
+    findings.extend(fits.findings.iter().cloned());
+    findings.push(diagnostics::residual_structure(
+        &fits.records,
+        &stats.world.oscillator,
+        ctx.opts.energy.velocity_threshold,
+    ));
+    findings
 }
 
 /// A warning per failed start: screening failures first, then failed continuations.
@@ -260,7 +288,7 @@ fn param_entry(
 ) -> FittedParam {
     let std_error = slot
         .and_then(|s| se.get(s).copied())
-        .filter(|s| s.is_finite());
+        .filter(|s| s.is_finite() && *s > 0.0);
     FittedParam {
         name: name.to_string(),
         value,
@@ -292,21 +320,9 @@ fn correlation_findings(params: &[FreeParam], cov: &Covariance) -> Vec<Finding> 
     out
 }
 
-/// Warnings for a rank-deficient Jacobian and for a free mass with anything that scales
-/// with it.
-fn identifiability_findings(
-    cov: &Covariance,
-    opts: &FitOptions,
-    n_model_free: usize,
-) -> Vec<Finding> {
+/// A warning for a free mass with anything that scales with it.
+fn identifiability_findings(opts: &FitOptions, n_model_free: usize) -> Vec<Finding> {
     let mut out = Vec::new();
-    if cov.singular {
-        out.push(Finding::warn(
-            Check::StandardErrors,
-            None,
-            "the Jacobian is rank-deficient: some free parameters are not separately identifiable from these records (no standard errors)".into(),
-        ));
-    }
     let osc_free = |q: OscillatorParam| opts.oscillator.contains(&q);
     if osc_free(OscillatorParam::Mass)
         && (osc_free(OscillatorParam::Stiffness)
@@ -354,7 +370,11 @@ fn record_fits<R: Residuals>(
         out.n_total += measured.len();
         let offset = world.nuisance[ri].offset;
         let (energy_force, ebf, mf) = match energy_check(rec, offset, world, opts) {
-            Ok((ef, ebf, mf)) => (Some(ef), ebf, mf),
+            Ok((ef, ebf, mf)) => {
+                out.findings
+                    .push(diagnostics::energy_balance(&rec.name, &ef));
+                (Some(ef), ebf, mf)
+            }
             Err(e) => {
                 out.findings.push(Finding::warn(
                     Check::EnergyBalance,

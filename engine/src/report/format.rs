@@ -146,7 +146,7 @@ pub fn fmt_to_error(x: f64, se: Option<f64>) -> String {
         Some(s) if x.is_finite() => {
             let last = last_digit(s);
             let e = if x == 0.0 { last } else { exponent(x.abs()) };
-            if fixed_range(e) && last <= 0 && last >= -12 {
+            if fixed_range(e) && (-12..=0).contains(&last) {
                 format!("{x:.prec$}", prec = (-last) as usize)
             } else {
                 scientific_exact(x, (e - last).max(0) as usize)
