@@ -52,6 +52,30 @@ impl FrictionModel for Dahl {
             0.0
         };
     }
+    /// d(dF/dt)/dF = -sigma0 |v| alpha |r|^(alpha - 1) / (mu_c N), r = 1 - F sgn(v) / (mu_c N);
+    /// 0 without normal load. At r = 0 with alpha < 1 the derivative is unbounded: there
+    /// the finite-difference default gives a finite slope instead.
+    fn state_jacobian(&self, v: f64, z: &[f64], normal: f64, jac: &mut [f64]) {
+        let (Some(&f), Some(j)) = (z.first(), jac.first_mut()) else {
+            return;
+        };
+        let fc = self.mu_c * normal;
+        if fc <= 0.0 || v == 0.0 {
+            *j = 0.0;
+            return;
+        }
+        let r = 1.0 - f * sgn(v) / fc;
+        if r == 0.0 && self.alpha < 1.0 {
+            crate::model::finite_difference_jacobian(self, v, z, normal, jac);
+            return;
+        }
+        let slope = if self.alpha == 1.0 {
+            1.0
+        } else {
+            self.alpha * r.abs().powf(self.alpha - 1.0)
+        };
+        *j = -self.sigma0 * v.abs() * slope / fc;
+    }
     fn force(&self, _v: f64, z: &[f64], _normal: f64) -> f64 {
         z.first().copied().unwrap_or(0.0)
     }

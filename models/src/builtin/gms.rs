@@ -258,6 +258,28 @@ impl Gms {
     }
 }
 
+impl Gms {
+    /// d(dz/dt)/dz of the element law: -|v| m load^(m-1) k / (w s) while loading
+    /// (load = sgn(v) k z / (w s) > 0), 0 while unloading and for a frozen element.
+    fn z_dot_slope(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
+        let limit = e.weight * s;
+        if limit <= 0.0 {
+            return 0.0;
+        }
+        let rho = e.stiffness * z / limit;
+        let load = if v >= 0.0 { rho } else { -rho };
+        if load <= 0.0 {
+            return 0.0;
+        }
+        let power = if self.sharpness == 1.0 {
+            1.0
+        } else {
+            self.sharpness * load.powf(self.sharpness - 1.0)
+        };
+        -v.abs() * power * e.stiffness / limit
+    }
+}
+
 impl Default for Gms {
     fn default() -> Self {
         Self::with_elements(DEFAULT_ELEMENTS)
@@ -557,6 +579,18 @@ impl FrictionModel for Gms {
         let s = self.s(v, normal);
         for ((e, &zi), d) in self.elements.iter().zip(z).zip(dz.iter_mut()) {
             *d = self.z_dot(e, v, zi, s);
+        }
+    }
+    /// Diagonal: each element's rate depends on its own deflection only (see
+    /// `Gms::z_dot_slope`).
+    fn state_jacobian(&self, v: f64, z: &[f64], normal: f64, jac: &mut [f64]) {
+        let n = self.elements.len();
+        jac.iter_mut().for_each(|j| *j = 0.0);
+        let s = self.s(v, normal);
+        for (i, (e, &zi)) in self.elements.iter().zip(z).enumerate() {
+            if let Some(j) = jac.get_mut(i * n + i) {
+                *j = self.z_dot_slope(e, v, zi, s);
+            }
         }
     }
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {

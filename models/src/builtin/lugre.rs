@@ -67,6 +67,17 @@ impl FrictionModel for LuGre {
             *d = self.z_dot(v, z0, normal);
         }
     }
+    /// d(dz/dt)/dz = -sigma0 |v| / g(v) (0 without normal load).
+    fn state_jacobian(&self, v: f64, _z: &[f64], normal: f64, jac: &mut [f64]) {
+        if let Some(j) = jac.first_mut() {
+            let g = self.g(v, normal);
+            *j = if g > 0.0 {
+                -self.sigma0 * v.abs() / g
+            } else {
+                0.0
+            };
+        }
+    }
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
         let z0 = z.first().copied().unwrap_or(0.0);
         self.sigma0 * z0 + self.sigma1 * self.z_dot(v, z0, normal) + self.sigma2 * v
