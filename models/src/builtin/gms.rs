@@ -210,11 +210,12 @@ impl Gms {
         crate::params::infos(&SHARED_PARAMS)
     }
 
-    /// Takes the levels mu_c, mu_s, v_s (when given) and viscous.
+    /// Takes the levels mu_c, mu_s, v_s and delta (when given) and viscous.
     fn set_levels(&mut self, levels: &StribeckLevels) {
         self.mu_c = levels.mu_c;
         self.mu_s = levels.mu_s;
         self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.delta = levels.delta.unwrap_or(self.delta);
         self.viscous = levels.viscous;
     }
 
@@ -234,49 +235,49 @@ impl Gms {
             * (self.mu_c + (self.mu_s - self.mu_c) * (-(v / self.v_s).abs().powf(self.delta)).exp())
     }
 
+    /// The element's sliding force w s and its load sgn(v) k z / (w s): how far the motion
+    /// loads the element towards its sliding force in the direction of motion (unloading, v
+    /// against the deflection, is purely elastic). `None` for a frozen element (no sliding
+    /// force).
+    fn element_load(e: &GmsElement, v: f64, z: f64, s: f64) -> Option<(f64, f64)> {
+        let limit = e.weight * s;
+        if limit <= 0.0 {
+            return None;
+        }
+        let rho = e.stiffness * z / limit;
+        Some((limit, if v >= 0.0 { rho } else { -rho }))
+    }
+
     /// The element law dz/dt = v (1 - max(0, sgn(v) rho)^m).
     fn z_dot(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
-        let limit = e.weight * s;
-        if limit <= 0.0 {
-            // No sliding force: the element is frozen.
-            return 0.0;
-        }
-        let rho = e.stiffness * z / limit;
-        // How far the motion loads the element towards its sliding force in the direction of
-        // motion; unloading (v against the deflection) is purely elastic.
-        let load = if v >= 0.0 { rho } else { -rho };
-        if load > 0.0 {
-            let p = if self.sharpness == 1.0 {
-                load
-            } else {
-                load.powf(self.sharpness)
-            };
-            v * (1.0 - p)
-        } else {
-            v
+        match Self::element_load(e, v, z, s) {
+            None => 0.0,
+            Some((_, load)) if load > 0.0 => {
+                let p = if self.sharpness == 1.0 {
+                    load
+                } else {
+                    load.powf(self.sharpness)
+                };
+                v * (1.0 - p)
+            }
+            Some(_) => v,
         }
     }
-}
 
-impl Gms {
     /// d(dz/dt)/dz of the element law: -|v| m load^(m-1) k / (w s) while loading
-    /// (load = sgn(v) k z / (w s) > 0), 0 while unloading and for a frozen element.
+    /// (load > 0), 0 while unloading and for a frozen element.
     fn z_dot_slope(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
-        let limit = e.weight * s;
-        if limit <= 0.0 {
-            return 0.0;
+        match Self::element_load(e, v, z, s) {
+            Some((limit, load)) if load > 0.0 => {
+                let power = if self.sharpness == 1.0 {
+                    1.0
+                } else {
+                    self.sharpness * load.powf(self.sharpness - 1.0)
+                };
+                -v.abs() * power * e.stiffness / limit
+            }
+            _ => 0.0,
         }
-        let rho = e.stiffness * z / limit;
-        let load = if v >= 0.0 { rho } else { -rho };
-        if load <= 0.0 {
-            return 0.0;
-        }
-        let power = if self.sharpness == 1.0 {
-            1.0
-        } else {
-            self.sharpness * load.powf(self.sharpness - 1.0)
-        };
-        -v.abs() * power * e.stiffness / limit
     }
 }
 
@@ -639,9 +640,6 @@ impl FrictionModel for Gms {
             return false;
         };
         self.set_levels(&levels);
-        if let Some(delta) = levels.delta {
-            self.delta = delta;
-        }
         let total_weight: f64 = self.elements.iter().map(|e| e.weight).sum();
         let equal = 1.0 / self.elements.len().max(1) as f64;
         for e in &mut self.elements {

@@ -32,11 +32,12 @@ crate::declare_params! {
 }
 
 impl Stribeck {
-    /// Takes the levels mu_c, mu_s, v_s (when given) and viscous.
+    /// Takes the levels mu_c, mu_s, v_s and delta (when given) and viscous.
     fn set_levels(&mut self, levels: &StribeckLevels) {
         self.mu_c = levels.mu_c;
         self.mu_s = levels.mu_s;
         self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.delta = levels.delta.unwrap_or(self.delta);
         self.viscous = levels.viscous;
     }
 
@@ -73,9 +74,6 @@ impl FrictionModel for Stribeck {
             return false;
         };
         self.set_levels(&levels);
-        if let Some(delta) = levels.delta {
-            self.delta = delta;
-        }
         true
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
