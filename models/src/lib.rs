@@ -11,6 +11,7 @@ pub mod formula;
 pub mod model;
 pub mod params;
 pub mod registry;
+pub mod start;
 pub mod suggest;
 pub mod testing;
 
@@ -19,3 +20,4 @@ pub use error::ModelError;
 pub use model::{check_bounds, check_len, clone_model, sgn, FrictionModel, GuessHint, ParamInfo};
 pub use params::{DeclaredParams, ParamSpec};
 pub use registry::{build_json, build_toml, default_model, listings, names, Built, ModelListing};
+pub use start::{StartContext, StribeckLevels};

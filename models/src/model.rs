@@ -189,6 +189,16 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
     /// Sets data-driven initial values (levels from the energy estimate). Default: keep.
     fn apply_guess(&mut self, _hint: &GuessHint) {}
 
+    /// Takes the start of a staged fit from a fitted simpler model (see [`crate::start`]);
+    /// returns whether it did. Default: `false` (keep the values).
+    fn start_from(
+        &mut self,
+        _fitted: &dyn FrictionModel,
+        _ctx: &crate::start::StartContext,
+    ) -> bool {
+        false
+    }
+
     /// Checks every parameter against its physical bounds; returns warnings for values that
     /// are admissible but unusual (e.g. mu_s < mu_c).
     fn validate(&self) -> Result<Vec<String>, ModelError> {

@@ -165,12 +165,9 @@ pub fn fmt_value(x: f64) -> String {
 ///
 /// ```
 /// use frictionid_models::declare_params;
-/// use serde::{Deserialize, Serialize};
 ///
 /// declare_params! {
 ///     /// Coulomb friction with a viscous term.
-///     #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-///     #[serde(default, deny_unknown_fields)]
 ///     pub struct MyLaw {
 ///         mu: new("1", 0.2, (0.0, 10.0), "Coulomb friction coefficient"),
 ///         viscous: non_negative("N s/m", 0.5, "viscous friction coefficient"),
@@ -185,7 +182,9 @@ pub fn fmt_value(x: f64) -> String {
 /// name is the field's): `new(unit, default, (lower, upper), meaning)`,
 /// `positive(unit, default, upper, meaning)`, `non_negative(unit, default, meaning)`, then
 /// optionally `.fixed()`. The macro writes the struct with one `pub f64` field per line
-/// (the attributes above the struct are kept), `Default` from the
+/// (the attributes above the struct are kept; it derives `Debug`, `Clone`, `PartialEq` and
+/// serde's `Serialize` and `Deserialize` with `#[serde(default, deny_unknown_fields)]`, so
+/// the crate needs `serde` as a dependency), `Default` from the
 /// defaults, the table `PARAMS` and the [`DeclaredParams`] impl. Inside the model's
 /// `impl FrictionModel` block, [`declared_param_methods!`](crate::declared_param_methods)
 /// writes `param_info`, `params` and `set_params` from it.
@@ -198,6 +197,8 @@ macro_rules! declare_params {
         }
     ) => {
         $(#[$meta])*
+        #[derive(Debug, Clone, PartialEq, ::serde::Serialize, ::serde::Deserialize)]
+        #[serde(default, deny_unknown_fields)]
         $vis struct $model {
             $(
                 #[doc = concat!("Parameter `", stringify!($field), "`: see its declaration in `PARAMS`.")]
@@ -251,9 +252,19 @@ pub trait DeclaredParams {
 }
 
 /// Writes `param_info`, `params` and `set_params` of a [`DeclaredParams`] model inside its
-/// `impl FrictionModel` block.
+/// `impl FrictionModel` block; with `name: "..."` and `equation: "..."` also `name` (which
+/// must equal the typetag name) and `equation`.
 #[macro_export]
 macro_rules! declared_param_methods {
+    (name: $name:expr, equation: $equation:expr $(,)?) => {
+        fn name(&self) -> &'static str {
+            $name
+        }
+        fn equation(&self) -> ::std::string::String {
+            ::std::string::String::from($equation)
+        }
+        $crate::declared_param_methods!();
+    };
     () => {
         fn param_info(&self) -> ::std::vec::Vec<$crate::ParamInfo> {
             $crate::params::infos($crate::DeclaredParams::specs(self))

@@ -33,16 +33,15 @@
 //! e.g. M. C. Constantinou, M. D. Symans, "Experimental study of seismic response of buildings
 //! with supplemental fluid dampers", The Structural Design of Tall Buildings 2(2), 93-132, 1993.
 
-use frictionid_models::{check_bounds, mu_s_warning, sgn, FrictionModel, GuessHint, ModelError};
-use serde::{Deserialize, Serialize};
+use frictionid_models::{
+    check_bounds, mu_s_warning, sgn, FrictionModel, GuessHint, ModelError, StribeckLevels,
+};
 
 /// The registry name of the model.
 pub const NAME: &str = "stribeck_power";
 
 frictionid_models::declare_params! {
     /// Gaussian Stribeck friction plus a power-law viscous force.
-    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-    #[serde(default, deny_unknown_fields)]
     pub struct StribeckPower {
         mu_c: new("1", 0.2, (0.0, 10.0), "Coulomb (kinetic) friction coefficient"),
         mu_s: new("1", 0.3, (0.0, 10.0), "static (breakaway) friction coefficient"),
@@ -86,16 +85,10 @@ impl StribeckPower {
 
 #[typetag::serde(name = "stribeck_power")]
 impl FrictionModel for StribeckPower {
-    frictionid_models::declared_param_methods!();
-
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn equation(&self) -> String {
-        "F = sgn(v) (N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)) + viscous v_ref |v/v_ref|^alpha)"
-            .into()
-    }
+    frictionid_models::declared_param_methods!(
+        name: NAME,
+        equation: "F = sgn(v) (N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)) + viscous v_ref |v/v_ref|^alpha)",
+    );
 
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         sgn(v) * (normal * self.coefficient(v) + self.viscous_force(v))
@@ -116,13 +109,12 @@ impl FrictionModel for StribeckPower {
     }
 
     fn apply_guess(&mut self, hint: &GuessHint) {
-        let v = hint.typical_velocity.max(1e-6);
-        self.mu_c = 0.9 * hint.mu;
-        self.mu_s = 1.2 * hint.mu;
-        self.v_s = 0.2 * v;
-        self.viscous = 0.05 * hint.mu * hint.normal_force / v;
+        let levels = StribeckLevels::guess(hint);
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.viscous = levels.viscous;
     }
-
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(NAME, &self.param_info(), &self.params())?;
         Ok(mu_s_warning(NAME, self.mu_s, self.mu_c))

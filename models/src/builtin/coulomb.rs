@@ -10,12 +10,9 @@
 //! Coulomb friction is the paper's Eq. (1).
 
 use crate::model::{sgn, FrictionModel, GuessHint};
-use serde::{Deserialize, Serialize};
 
 crate::declare_params! {
     /// Coulomb friction: a constant force mu N opposing the sliding direction.
-    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-    #[serde(default, deny_unknown_fields)]
     pub struct Coulomb {
         mu: new("1", 0.2, (0.0, 10.0), "Coulomb friction coefficient"),
     }
@@ -23,14 +20,11 @@ crate::declare_params! {
 
 #[typetag::serde(name = "coulomb")]
 impl FrictionModel for Coulomb {
-    crate::declared_param_methods!();
+    crate::declared_param_methods!(
+        name: "coulomb",
+        equation: "F = mu N sgn(v)",
+    );
 
-    fn name(&self) -> &'static str {
-        "coulomb"
-    }
-    fn equation(&self) -> String {
-        "F = mu N sgn(v)".into()
-    }
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         self.mu * normal * sgn(v)
     }

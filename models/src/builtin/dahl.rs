@@ -18,12 +18,10 @@
 //! The Aerospace Corporation, 1968.
 
 use crate::model::{sgn, FrictionModel, GuessHint};
-use serde::{Deserialize, Serialize};
+use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
 crate::declare_params! {
     /// Dahl's dynamic friction model with the friction force as internal state.
-    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-    #[serde(default, deny_unknown_fields)]
     pub struct Dahl {
         sigma0: positive("N/m", 1e5, 1e12, "rest stiffness of the contact"),
         mu_c: positive("1", 0.2, 10.0, "Coulomb friction coefficient"),
@@ -33,15 +31,11 @@ crate::declare_params! {
 
 #[typetag::serde(name = "dahl")]
 impl FrictionModel for Dahl {
-    crate::declared_param_methods!();
+    crate::declared_param_methods!(
+        name: "dahl",
+        equation: "dF/dt = sigma0 v |1 - F sgn(v)/(mu_c N)|^alpha sgn(1 - F sgn(v)/(mu_c N)), friction = F",
+    );
 
-    fn name(&self) -> &'static str {
-        "dahl"
-    }
-    fn equation(&self) -> String {
-        "dF/dt = sigma0 v |1 - F sgn(v)/(mu_c N)|^alpha sgn(1 - F sgn(v)/(mu_c N)), friction = F"
-            .into()
-    }
     fn n_states(&self) -> usize {
         1
     }
@@ -58,6 +52,30 @@ impl FrictionModel for Dahl {
             0.0
         };
     }
+    /// d(dF/dt)/dF = -sigma0 |v| alpha |r|^(alpha - 1) / (mu_c N), r = 1 - F sgn(v) / (mu_c N);
+    /// 0 without normal load. At r = 0 with alpha < 1 the derivative is unbounded: there
+    /// the finite-difference default gives a finite slope instead.
+    fn state_jacobian(&self, v: f64, z: &[f64], normal: f64, jac: &mut [f64]) {
+        let (Some(&f), Some(j)) = (z.first(), jac.first_mut()) else {
+            return;
+        };
+        let fc = self.mu_c * normal;
+        if fc <= 0.0 || v == 0.0 {
+            *j = 0.0;
+            return;
+        }
+        let r = 1.0 - f * sgn(v) / fc;
+        if r == 0.0 && self.alpha < 1.0 {
+            crate::model::finite_difference_jacobian(self, v, z, normal, jac);
+            return;
+        }
+        let slope = if self.alpha == 1.0 {
+            1.0
+        } else {
+            self.alpha * r.abs().powf(self.alpha - 1.0)
+        };
+        *j = -self.sigma0 * v.abs() * slope / fc;
+    }
     fn force(&self, _v: f64, z: &[f64], _normal: f64) -> f64 {
         z.first().copied().unwrap_or(0.0)
     }
@@ -71,6 +89,16 @@ impl FrictionModel for Dahl {
     fn apply_guess(&mut self, hint: &GuessHint) {
         self.mu_c = hint.mu;
         // Presliding displacements of dry contacts are typically a few tens of micrometres.
-        self.sigma0 = (hint.mu * hint.normal_force / 2e-5).max(1.0);
+        self.sigma0 = (hint.mu * hint.normal_force / TYPICAL_PRESLIDING_DISPLACEMENT).max(1.0);
+    }
+    /// The Coulomb level of the fitted model and the rest stiffness that reaches it at the
+    /// presliding displacement.
+    fn start_from(&mut self, fitted: &dyn FrictionModel, ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.mu_c = levels.mu_c;
+        self.sigma0 = ctx.stiffness_for(levels.mu_c * ctx.normal_force);
+        true
     }
 }

@@ -89,6 +89,7 @@ use crate::builtin::stribeck::mu_s_warning;
 use crate::error::ModelError;
 use crate::model::{check_bounds, check_len, sgn, FrictionModel, GuessHint, ParamInfo};
 use crate::params::ParamSpec;
+use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 use serde::de::{self, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -209,32 +210,73 @@ impl Gms {
         crate::params::infos(&SHARED_PARAMS)
     }
 
+    /// Takes the levels mu_c, mu_s, v_s and delta (when given) and viscous.
+    fn set_levels(&mut self, levels: &StribeckLevels) {
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.delta = levels.delta.unwrap_or(self.delta);
+        self.viscous = levels.viscous;
+    }
+
+    /// Scales the element stiffnesses, keeping their ratios, to the total `target` [N/m].
+    fn scale_stiffness(&mut self, target: f64) {
+        let total: f64 = self.elements.iter().map(|e| e.stiffness).sum();
+        if total > 0.0 && total.is_finite() {
+            for e in &mut self.elements {
+                e.stiffness *= target / total;
+            }
+        }
+    }
+
     /// The Stribeck curve s(v) \[N\] (the total sliding force for weights summing to 1).
     pub fn s(&self, v: f64, normal: f64) -> f64 {
         normal
             * (self.mu_c + (self.mu_s - self.mu_c) * (-(v / self.v_s).abs().powf(self.delta)).exp())
     }
 
-    /// The element law dz/dt = v (1 - max(0, sgn(v) rho)^m).
-    fn z_dot(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
+    /// The element's sliding force w s and its load sgn(v) k z / (w s): how far the motion
+    /// loads the element towards its sliding force in the direction of motion (unloading, v
+    /// against the deflection, is purely elastic). `None` for a frozen element (no sliding
+    /// force).
+    fn element_load(e: &GmsElement, v: f64, z: f64, s: f64) -> Option<(f64, f64)> {
         let limit = e.weight * s;
         if limit <= 0.0 {
-            // No sliding force: the element is frozen.
-            return 0.0;
+            return None;
         }
         let rho = e.stiffness * z / limit;
-        // How far the motion loads the element towards its sliding force in the direction of
-        // motion; unloading (v against the deflection) is purely elastic.
-        let load = if v >= 0.0 { rho } else { -rho };
-        if load > 0.0 {
-            let p = if self.sharpness == 1.0 {
-                load
-            } else {
-                load.powf(self.sharpness)
-            };
-            v * (1.0 - p)
-        } else {
-            v
+        Some((limit, if v >= 0.0 { rho } else { -rho }))
+    }
+
+    /// The element law dz/dt = v (1 - max(0, sgn(v) rho)^m).
+    fn z_dot(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
+        match Self::element_load(e, v, z, s) {
+            None => 0.0,
+            Some((_, load)) if load > 0.0 => {
+                let p = if self.sharpness == 1.0 {
+                    load
+                } else {
+                    load.powf(self.sharpness)
+                };
+                v * (1.0 - p)
+            }
+            Some(_) => v,
+        }
+    }
+
+    /// d(dz/dt)/dz of the element law: -|v| m load^(m-1) k / (w s) while loading
+    /// (load > 0), 0 while unloading and for a frozen element.
+    fn z_dot_slope(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
+        match Self::element_load(e, v, z, s) {
+            Some((limit, load)) if load > 0.0 => {
+                let power = if self.sharpness == 1.0 {
+                    1.0
+                } else {
+                    self.sharpness * load.powf(self.sharpness - 1.0)
+                };
+                -v.abs() * power * e.stiffness / limit
+            }
+            _ => 0.0,
         }
     }
 }
@@ -540,6 +582,18 @@ impl FrictionModel for Gms {
             *d = self.z_dot(e, v, zi, s);
         }
     }
+    /// Diagonal: each element's rate depends on its own deflection only (see
+    /// `Gms::z_dot_slope`).
+    fn state_jacobian(&self, v: f64, z: &[f64], normal: f64, jac: &mut [f64]) {
+        let n = self.elements.len();
+        jac.iter_mut().for_each(|j| *j = 0.0);
+        let s = self.s(v, normal);
+        for (i, (e, &zi)) in self.elements.iter().zip(z).enumerate() {
+            if let Some(j) = jac.get_mut(i * n + i) {
+                *j = self.z_dot_slope(e, v, zi, s);
+            }
+        }
+    }
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
         let s = self.s(v, normal);
         let elements: f64 = self
@@ -570,20 +624,33 @@ impl FrictionModel for Gms {
             .sum()
     }
     fn apply_guess(&mut self, hint: &GuessHint) {
-        let v = hint.typical_velocity.max(1e-6);
-        self.mu_c = 0.9 * hint.mu;
-        self.mu_s = 1.2 * hint.mu;
-        self.v_s = 0.2 * v;
-        self.viscous = 0.05 * hint.mu * hint.normal_force / v;
+        let levels = StribeckLevels::guess(hint);
+        self.set_levels(&levels);
         // Keep the ratios of the stiffnesses; scale the total presliding stiffness to a
         // breakaway displacement of about 20 micrometres (as the LuGre guess).
-        let total: f64 = self.elements.iter().map(|e| e.stiffness).sum();
-        let target = (hint.mu * hint.normal_force / 2e-5).max(1.0);
-        if total > 0.0 && total.is_finite() {
-            for e in &mut self.elements {
-                e.stiffness *= target / total;
-            }
+        self.scale_stiffness(
+            (hint.mu * hint.normal_force / TYPICAL_PRESLIDING_DISPLACEMENT).max(1.0),
+        );
+    }
+    /// The fitted Stribeck curve shared by the elements (weights rescaled to sum to 1, so
+    /// that the model slides at exactly that curve), the total stiffness from the presliding
+    /// displacement at the Coulomb level, the stiffness ratios kept.
+    fn start_from(&mut self, fitted: &dyn FrictionModel, ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.set_levels(&levels);
+        let total_weight: f64 = self.elements.iter().map(|e| e.weight).sum();
+        let equal = 1.0 / self.elements.len().max(1) as f64;
+        for e in &mut self.elements {
+            e.weight = if total_weight > 0.0 {
+                e.weight / total_weight
+            } else {
+                equal
+            };
         }
+        self.scale_stiffness(ctx.stiffness_for(levels.mu_c * ctx.normal_force));
+        true
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         if self.elements.is_empty() {

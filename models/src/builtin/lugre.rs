@@ -20,12 +20,10 @@
 use crate::builtin::stribeck::mu_s_warning;
 use crate::error::ModelError;
 use crate::model::{check_bounds, sgn, FrictionModel, GuessHint};
-use serde::{Deserialize, Serialize};
+use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
 crate::declare_params! {
     /// The LuGre bristle model with the Stribeck curve of Canudas de Wit et al. (1995).
-    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-    #[serde(default, deny_unknown_fields)]
     pub struct LuGre {
         sigma0: positive("N/m", 1e5, 1e12, "bristle stiffness"),
         sigma1: non_negative("N s/m", 300.0, "bristle damping"),
@@ -56,20 +54,28 @@ impl LuGre {
 
 #[typetag::serde(name = "lugre")]
 impl FrictionModel for LuGre {
-    crate::declared_param_methods!();
+    crate::declared_param_methods!(
+        name: "lugre",
+        equation: "dz/dt = v - sigma0 |v| z / g(v), g(v) = N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)), F = sigma0 z + sigma1 dz/dt + sigma2 v",
+    );
 
-    fn name(&self) -> &'static str {
-        "lugre"
-    }
-    fn equation(&self) -> String {
-        "dz/dt = v - sigma0 |v| z / g(v), g(v) = N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)), F = sigma0 z + sigma1 dz/dt + sigma2 v".into()
-    }
     fn n_states(&self) -> usize {
         1
     }
     fn state_derivative(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) {
         if let (Some(&z0), Some(d)) = (z.first(), dz.first_mut()) {
             *d = self.z_dot(v, z0, normal);
+        }
+    }
+    /// d(dz/dt)/dz = -sigma0 |v| / g(v) (0 without normal load).
+    fn state_jacobian(&self, v: f64, _z: &[f64], normal: f64, jac: &mut [f64]) {
+        if let Some(j) = jac.first_mut() {
+            let g = self.g(v, normal);
+            *j = if g > 0.0 {
+                -self.sigma0 * v.abs() / g
+            } else {
+                0.0
+            };
         }
     }
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
@@ -84,15 +90,30 @@ impl FrictionModel for LuGre {
         0.5 * self.sigma0 * z0 * z0
     }
     fn apply_guess(&mut self, hint: &GuessHint) {
-        let v = hint.typical_velocity.max(1e-6);
-        self.mu_c = 0.9 * hint.mu;
-        self.mu_s = 1.2 * hint.mu;
+        let levels = StribeckLevels::guess(hint);
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.sigma2 = levels.viscous;
         // Stribeck velocities are typically a few percent of the sliding speeds of a free
         // vibration; bristle damping a fraction of the critical damping of the bristle mode.
-        self.v_s = 0.05 * v;
-        self.sigma0 = (hint.mu * hint.normal_force / 2e-5).max(1.0);
+        self.v_s = 0.05 * hint.typical_velocity.max(1e-6);
+        self.sigma0 = (hint.mu * hint.normal_force / TYPICAL_PRESLIDING_DISPLACEMENT).max(1.0);
         self.sigma1 = 0.25 * (self.sigma0 * hint.mass).sqrt();
-        self.sigma2 = 0.05 * hint.mu * hint.normal_force / v;
+    }
+    /// The Stribeck levels (sliding at the fitted curve, which LuGre's Gaussian dip
+    /// reproduces exactly for delta = 2), the bristle stiffness from the presliding
+    /// displacement at the Coulomb level, the bristle damping at its critical value.
+    fn start_from(&mut self, fitted: &dyn FrictionModel, ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.sigma2 = levels.viscous;
+        self.sigma0 = ctx.stiffness_for(levels.mu_c * ctx.normal_force);
+        self.sigma1 = ctx.critical_damping(self.sigma0);
+        true
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(self.name(), &self.param_info(), &self.params())?;

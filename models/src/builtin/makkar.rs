@@ -27,12 +27,9 @@
 
 use crate::error::ModelError;
 use crate::model::{check_bounds, FrictionModel, GuessHint};
-use serde::{Deserialize, Serialize};
 
 crate::declare_params! {
     /// Makkar et al.'s smooth friction law with Stribeck, Coulomb and viscous terms.
-    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-    #[serde(default, deny_unknown_fields)]
     pub struct Makkar {
         g1: non_negative("N", 1.9, "amplitude of the Stribeck term"),
         g2: non_negative("s/m", 200.0, "rise rate of the Stribeck term"),
@@ -45,14 +42,11 @@ crate::declare_params! {
 
 #[typetag::serde(name = "makkar")]
 impl FrictionModel for Makkar {
-    crate::declared_param_methods!();
+    crate::declared_param_methods!(
+        name: "makkar",
+        equation: "F = g1 (tanh(g2 v) - tanh(g3 v)) + g4 tanh(g5 v) + g6 v",
+    );
 
-    fn name(&self) -> &'static str {
-        "makkar"
-    }
-    fn equation(&self) -> String {
-        "F = g1 (tanh(g2 v) - tanh(g3 v)) + g4 tanh(g5 v) + g6 v".into()
-    }
     fn force(&self, v: f64, _z: &[f64], _normal: f64) -> f64 {
         self.g1 * ((self.g2 * v).tanh() - (self.g3 * v).tanh())
             + self.g4 * (self.g5 * v).tanh()

@@ -18,12 +18,10 @@
 
 use crate::error::ModelError;
 use crate::model::{check_bounds, sgn, FrictionModel, GuessHint};
-use serde::{Deserialize, Serialize};
+use crate::start::{StartContext, StribeckLevels};
 
 crate::declare_params! {
     /// Static friction law with a Stribeck dip between static and Coulomb levels.
-    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-    #[serde(default, deny_unknown_fields)]
     pub struct Stribeck {
         mu_c: new("1", 0.2, (0.0, 10.0), "Coulomb (kinetic) friction coefficient"),
         mu_s: new("1", 0.3, (0.0, 10.0), "static (breakaway) friction coefficient"),
@@ -34,6 +32,15 @@ crate::declare_params! {
 }
 
 impl Stribeck {
+    /// Takes the levels mu_c, mu_s, v_s and delta (when given) and viscous.
+    fn set_levels(&mut self, levels: &StribeckLevels) {
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.delta = levels.delta.unwrap_or(self.delta);
+        self.viscous = levels.viscous;
+    }
+
     /// The velocity-dependent coefficient mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta).
     pub fn coefficient(&self, v: f64) -> f64 {
         self.mu_c + (self.mu_s - self.mu_c) * (-(v / self.v_s).abs().powf(self.delta)).exp()
@@ -42,14 +49,11 @@ impl Stribeck {
 
 #[typetag::serde(name = "stribeck")]
 impl FrictionModel for Stribeck {
-    crate::declared_param_methods!();
+    crate::declared_param_methods!(
+        name: "stribeck",
+        equation: "F = N (mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta)) sgn(v) + viscous v",
+    );
 
-    fn name(&self) -> &'static str {
-        "stribeck"
-    }
-    fn equation(&self) -> String {
-        "F = N (mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta)) sgn(v) + viscous v".into()
-    }
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         normal * self.coefficient(v) * sgn(v) + self.viscous * v
     }
@@ -63,11 +67,14 @@ impl FrictionModel for Stribeck {
         self.force(v, &[], normal)
     }
     fn apply_guess(&mut self, hint: &GuessHint) {
-        let v = hint.typical_velocity.max(1e-6);
-        self.mu_c = 0.9 * hint.mu;
-        self.mu_s = 1.2 * hint.mu;
-        self.v_s = 0.2 * v;
-        self.viscous = 0.05 * hint.mu * hint.normal_force / v;
+        self.set_levels(&StribeckLevels::guess(hint));
+    }
+    fn start_from(&mut self, fitted: &dyn FrictionModel, _ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.set_levels(&levels);
+        true
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(self.name(), &self.param_info(), &self.params())?;

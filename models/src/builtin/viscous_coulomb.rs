@@ -12,12 +12,9 @@
 //! for the control of machines with friction", Automatica 30(7), 1994.
 
 use crate::model::{sgn, FrictionModel, GuessHint};
-use serde::{Deserialize, Serialize};
 
 crate::declare_params! {
     /// Coulomb friction with a viscous term proportional to the sliding velocity.
-    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-    #[serde(default, deny_unknown_fields)]
     pub struct ViscousCoulomb {
         mu: new("1", 0.2, (0.0, 10.0), "Coulomb friction coefficient"),
         viscous: non_negative("N s/m", 0.5, "viscous friction coefficient"),
@@ -26,14 +23,11 @@ crate::declare_params! {
 
 #[typetag::serde(name = "viscous_coulomb")]
 impl FrictionModel for ViscousCoulomb {
-    crate::declared_param_methods!();
+    crate::declared_param_methods!(
+        name: "viscous_coulomb",
+        equation: "F = mu N sgn(v) + viscous v",
+    );
 
-    fn name(&self) -> &'static str {
-        "viscous_coulomb"
-    }
-    fn equation(&self) -> String {
-        "F = mu N sgn(v) + viscous v".into()
-    }
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         self.mu * normal * sgn(v) + self.viscous * v
     }
