@@ -1,0 +1,338 @@
+//! The module's functions: dicts in, the engine's job, a dict out.
+//!
+//! Simulations and fits run with the GIL released, on a worker thread, while the calling
+//! thread watches for signals; Ctrl-C stops the fit at its next solver iteration (see
+//! [`run_job`]) and raises `KeyboardInterrupt`.
+
+use crate::convert::{serialized, to_f64_vec, to_json};
+use crate::errors::{engine_error, job_error, value_error};
+use crate::inputs;
+use crate::outputs::{compare_dict, energy_dict, fit_dict, simulate_dict};
+use frictionid_engine::jobs::{compare_job, energy_job, energy_rate, fit_job};
+use frictionid_engine::record::TimeBase;
+use frictionid_engine::report::{ModelsReport, SimulateReport};
+use frictionid_engine::simulate::{simulate as simulate_trajectory, Initial};
+use frictionid_engine::spec::{Hooks, IntegratorSpec, ModelSpec};
+use frictionid_engine::{Oscillator, Spec, Trajectory};
+use frictionid_models::FrictionModel;
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use std::any::Any;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// How often the calling thread looks for Ctrl-C while a job runs.
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+
+/// The unwinding payload that stops a cancelled fit (never a crash: caught in [`run_job`]).
+struct Cancelled;
+
+/// Hooks whose progress callback stops the fit once `cancel` is set. The engine's progress
+/// hook cannot return an error, so the callback unwinds with [`Cancelled`] through
+/// `resume_unwind` (which prints nothing); the worker thread catches it.
+fn cancellable_hooks(cancel: Arc<AtomicBool>) -> Hooks {
+    Hooks {
+        progress: Some(Arc::new(move |_| {
+            if cancel.load(Ordering::Relaxed) {
+                std::panic::resume_unwind(Box::new(Cancelled));
+            }
+        })),
+        ..Hooks::default()
+    }
+}
+
+/// Why a worker thread ended without a result.
+fn lost_worker(payload: Box<dyn Any + Send>) -> PyErr {
+    let msg = payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_default();
+    PyRuntimeError::new_err(format!("internal error: {msg} (please report this)"))
+}
+
+/// Runs `job` on a worker thread with the GIL released; the calling thread checks for
+/// signals every [`SIGNAL_POLL`]. On Ctrl-C the job is cancelled, joined, and the signal's
+/// exception (`KeyboardInterrupt`) raised.
+fn run_job<T: Send + 'static>(
+    py: Python<'_>,
+    job: impl FnOnce(Hooks) -> PyResult<T> + Send + 'static,
+) -> PyResult<T> {
+    let cancel = Arc::new(AtomicBool::new(false));
+    let hooks = cancellable_hooks(cancel.clone());
+    let (tx, rx) = mpsc::channel();
+    let worker = std::thread::spawn(move || {
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| job(hooks)));
+        let _ = tx.send(outcome);
+    });
+    // A Mutex makes the receiver shareable with the GIL-free closure (it is never contended).
+    let rx = std::sync::Mutex::new(rx);
+    let wait = || match rx.lock() {
+        Ok(r) => r.recv_timeout(SIGNAL_POLL),
+        Err(_) => Err(RecvTimeoutError::Disconnected),
+    };
+    loop {
+        match py.detach(wait) {
+            Ok(Ok(result)) => return result,
+            Ok(Err(payload)) => return Err(lost_worker(payload)),
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(PyRuntimeError::new_err(
+                    "internal error: the worker thread ended",
+                ))
+            }
+            Err(RecvTimeoutError::Timeout) => {
+                if let Err(signal) = py.check_signals() {
+                    cancel.store(true, Ordering::Relaxed);
+                    let _ = py.detach(|| worker.join());
+                    return Err(signal);
+                }
+            }
+        }
+    }
+}
+
+/// Every registered friction model: what `frictionid models --json` prints.
+#[pyfunction]
+pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    serialized(py, &ModelsReport::registered())
+}
+
+/// Integrator options and initial internal states from `simulate`'s `options` dict.
+fn simulate_options(
+    options: Option<&Bound<'_, PyAny>>,
+) -> PyResult<(IntegratorSpec, Option<Vec<f64>>)> {
+    let mut json = match options {
+        Some(o) if !o.is_none() => to_json(o, "options")?,
+        _ => serde_json::json!({}),
+    };
+    let z0 = json
+        .as_object_mut()
+        .and_then(|o| o.remove("z0"))
+        .map(serde_json::from_value::<Vec<f64>>)
+        .transpose()
+        .map_err(|e| value_error(format!("options: z0: {e}")))?;
+    let integrator =
+        serde_json::from_value(json).map_err(|e| value_error(format!("options: {e}")))?;
+    Ok((integrator, z0))
+}
+
+/// The simulate report of a trajectory sampled at arbitrary times (the same value the
+/// `simulate` job returns for a uniform grid).
+fn simulate_report(
+    osc: Oscillator,
+    model: Box<dyn FrictionModel>,
+    init: &Initial,
+    traj: Trajectory,
+    wall_time_s: f64,
+) -> SimulateReport {
+    let (final_displacement, rest_time) = match &traj.rest {
+        Some(r) => (r.displacement, Some(r.time)),
+        None => (traj.x.last().copied().unwrap_or(f64::NAN), None),
+    };
+    let duration = traj.time.last().copied().unwrap_or(0.0);
+    let samples = traj.time.len();
+    SimulateReport {
+        command: "simulate".into(),
+        config: String::new(),
+        oscillator: osc,
+        model,
+        x0: init.x0,
+        v0: init.v0,
+        duration,
+        sample_rate: samples.saturating_sub(1) as f64 / duration,
+        samples,
+        final_displacement,
+        rest_time,
+        half_cycles: traj.half_cycles(),
+        events: traj.events.clone(),
+        stats: traj.stats,
+        wall_time_s,
+        noise: None,
+        seed: None,
+        files: Vec::new(),
+        energy_rate: energy_rate(osc.mass, osc.stiffness, &traj.x, &traj.v, &traj.a),
+        trajectory: traj,
+        noisy_velocity: None,
+    }
+}
+
+/// One free vibration released at `x0` (and `v0`), sampled at the times `t`.
+#[pyfunction]
+#[pyo3(signature = (oscillator, model, x0, t, v0 = 0.0, options = None))]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    oscillator: &Bound<'py, PyAny>,
+    model: &Bound<'py, PyAny>,
+    x0: f64,
+    t: &Bound<'py, PyAny>,
+    v0: f64,
+    options: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let osc = inputs::oscillator(oscillator)?;
+    let model = inputs::model(model)?.model;
+    let times = TimeBase::new(to_f64_vec(t, "t")?).map_err(|e| value_error(format!("t: {e}")))?;
+    let (integrator, z0) = simulate_options(options)?;
+    let init = Initial { x0, v0, z0 };
+    let t_end = times.as_slice().last().copied().unwrap_or(0.0);
+    let report = py.detach(|| {
+        let started = Instant::now();
+        let sim = integrator.sim_options();
+        simulate_trajectory(&osc, model.as_ref(), &init, t_end, times.as_slice(), &sim).map(
+            |traj| {
+                simulate_report(
+                    osc,
+                    model.clone(),
+                    &init,
+                    traj,
+                    started.elapsed().as_secs_f64(),
+                )
+            },
+        )
+    });
+    simulate_dict(py, &report.map_err(engine_error)?)
+}
+
+/// The spec of `fit`, `compare` and `energy` from their dicts.
+fn spec_from(
+    oscillator: &Bound<'_, PyAny>,
+    model: Option<ModelSpec>,
+    fit: Option<&Bound<'_, PyAny>>,
+    energy: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Spec> {
+    inputs::spec(
+        inputs::oscillator(oscillator)?,
+        model,
+        inputs::fit_spec(fit)?,
+        inputs::energy_spec(energy)?,
+    )
+}
+
+/// The model fitted to `records`: report.json's structure plus the fitted series.
+#[pyfunction]
+#[pyo3(signature = (oscillator, model, records, fit = None))]
+pub fn fit<'py>(
+    py: Python<'py>,
+    oscillator: &Bound<'py, PyAny>,
+    model: &Bound<'py, PyAny>,
+    records: &Bound<'py, PyAny>,
+    fit: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let spec = spec_from(oscillator, Some(inputs::model(model)?), fit, None)?;
+    let records = inputs::records(records)?;
+    let report = run_job(py, move |hooks| {
+        fit_job(&spec, &records, &hooks).map_err(job_error)
+    })?;
+    fit_dict(py, &report)
+}
+
+/// The models to compare: names (registered models with their defaults) or model dicts.
+fn models_to_compare(
+    spec: &Spec,
+    models: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Vec<Box<dyn FrictionModel>>> {
+    let Some(list) = models.filter(|m| !m.is_none()) else {
+        return spec.models_to_compare(None).map_err(value_error);
+    };
+    let items: Vec<Bound<'_, PyAny>> = list
+        .try_iter()
+        .map_err(|_| value_error("models: expected a list of names or model dicts"))?
+        .collect::<PyResult<_>>()?;
+    if items.is_empty() {
+        return Err(value_error("no models to compare"));
+    }
+    items
+        .iter()
+        .map(|item| match item.cast::<PyString>() {
+            Ok(name) => {
+                let request = [name.extract::<String>()?];
+                let mut found = spec
+                    .models_to_compare(Some(&request))
+                    .map_err(value_error)?;
+                Ok(found.remove(0))
+            }
+            Err(_) => Ok(inputs::model(item)?.model),
+        })
+        .collect()
+}
+
+/// Several models fitted to the same records and ranked by AIC.
+#[pyfunction]
+#[pyo3(signature = (oscillator, models, records, fit = None))]
+pub fn compare<'py>(
+    py: Python<'py>,
+    oscillator: &Bound<'py, PyAny>,
+    models: Option<&Bound<'py, PyAny>>,
+    records: &Bound<'py, PyAny>,
+    fit: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let spec = spec_from(oscillator, None, fit, None)?;
+    let models = models_to_compare(&spec, models)?;
+    let records = inputs::records(records)?;
+    let report = run_job(py, move |hooks| {
+        compare_job(&spec, &models, &records, &hooks).map_err(job_error)
+    })?;
+    compare_dict(py, &report)
+}
+
+/// The energy-based friction force of every record (Eq. 7) against a reference: the model's
+/// force when a model is given, else a fitted Coulomb force.
+#[pyfunction]
+#[pyo3(signature = (oscillator, records, model = None, options = None))]
+pub fn energy<'py>(
+    py: Python<'py>,
+    oscillator: &Bound<'py, PyAny>,
+    records: &Bound<'py, PyAny>,
+    model: Option<&Bound<'py, PyAny>>,
+    options: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let model = model
+        .filter(|m| !m.is_none())
+        .map(inputs::model)
+        .transpose()?;
+    let spec = spec_from(oscillator, model, None, options)?;
+    let records = inputs::records(records)?;
+    let report = run_job(py, move |hooks| {
+        energy_job(&spec, &records, &hooks).map_err(job_error)
+    })?;
+    energy_dict(py, &report)
+}
+
+/// Runs a configuration file exactly as `frictionid <command> <config_path> --quiet [--out
+/// out]` does (the files are written) and returns its report.json.
+#[pyfunction]
+#[pyo3(signature = (config_path, command = "fit", out = None))]
+pub fn run<'py>(
+    py: Python<'py>,
+    config_path: PathBuf,
+    command: &str,
+    out: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyAny>> {
+    use frictionid_cli::args::OutputArgs;
+    use frictionid_cli::commands;
+    if command == "models" {
+        return models(py);
+    }
+    let output = OutputArgs {
+        out,
+        quiet: true,
+        json: false,
+    };
+    let dir = output.dir_for(&config_path, command);
+    let ran = py.detach(|| match command {
+        "fit" => commands::fit::run(&config_path, &output),
+        "compare" => commands::compare::run(&config_path, None, &output),
+        "energy" => commands::energy::run(&config_path, &output),
+        "simulate" => commands::simulate::run(&config_path, &output),
+        other => Err(anyhow::anyhow!(
+            "unknown command `{other}`; one of: simulate, fit, compare, energy, models"
+        )),
+    });
+    ran.map_err(|e| value_error(format!("{e:#}")))?;
+    let text = std::fs::read_to_string(dir.join("report.json"))
+        .map_err(|e| value_error(format!("{}: {e}", dir.join("report.json").display())))?;
+    py.import("json")?.call_method1("loads", (text,))
+}

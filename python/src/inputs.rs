@@ -1,0 +1,154 @@
+//! The engine's inputs from Python: the [`Spec`] from dicts (the configuration's tables) and
+//! [`Record`]s from dicts of arrays.
+
+use crate::convert::{to_f64_vec, to_json};
+use crate::errors::value_error;
+use frictionid_engine::record::{Channel, NormalForce, TimeBase};
+use frictionid_engine::spec::{EnergySpec, FitSpec, ModelSpec};
+use frictionid_engine::{Oscillator, Record, Spec};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use serde::de::DeserializeOwned;
+
+/// A table deserialized as the configuration's `[table]` would be; `None` gives the default.
+fn table<T: DeserializeOwned + Default>(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<T> {
+    match obj {
+        Some(o) if !o.is_none() => {
+            let json = to_json(o, name)?;
+            serde_json::from_value(json).map_err(|e| value_error(format!("[{name}]: {e}")))
+        }
+        _ => Ok(T::default()),
+    }
+}
+
+/// `[oscillator]`: mass, damping, stiffness, normal_force.
+pub fn oscillator(obj: &Bound<'_, PyAny>) -> PyResult<Oscillator> {
+    let json = to_json(obj, "oscillator")?;
+    serde_json::from_value(json).map_err(|e| value_error(format!("[oscillator]: {e}")))
+}
+
+/// A model: a `[model]` table (`{"type": "lugre", "sigma0": 2e5}`) or just its name.
+pub fn model(obj: &Bound<'_, PyAny>) -> PyResult<ModelSpec> {
+    let json = match obj.cast::<PyString>() {
+        Ok(name) => serde_json::json!({ "type": name.extract::<String>()? }),
+        Err(_) => to_json(obj, "model")?,
+    };
+    ModelSpec::from_json(&json).map_err(|e| value_error(format!("[model]: {e}")))
+}
+
+/// `[fit]` with its `options`.
+pub fn fit_spec(obj: Option<&Bound<'_, PyAny>>) -> PyResult<FitSpec> {
+    table(obj, "fit")
+}
+
+/// `[energy]`.
+pub fn energy_spec(obj: Option<&Bound<'_, PyAny>>) -> PyResult<EnergySpec> {
+    table(obj, "energy")
+}
+
+/// The checked spec (the `[fit]` names are checked against the model).
+pub fn spec(
+    oscillator: Oscillator,
+    model: Option<ModelSpec>,
+    fit: FitSpec,
+    energy: EnergySpec,
+) -> PyResult<Spec> {
+    Spec::new(oscillator, model, fit, None, energy).map_err(value_error)
+}
+
+/// The keys a record dict may have besides its channels.
+const RECORD_KEYS: [&str; 7] = ["name", "t", "time", "x0", "v0", "weight", "release_time"];
+
+/// The channel a record dict's key names (`v`, `x`, `a` as short names).
+fn channel_of(key: &str) -> Option<Channel> {
+    match key {
+        "v" => Some(Channel::Velocity),
+        "x" => Some(Channel::Displacement),
+        "a" => Some(Channel::Acceleration),
+        other => Channel::from_name(other),
+    }
+}
+
+/// An optional float key of a record dict.
+fn float_key(dict: &Bound<'_, PyDict>, key: &str, what: &str) -> PyResult<Option<f64>> {
+    match dict.get_item(key)? {
+        Some(v) if !v.is_none() => v
+            .extract::<f64>()
+            .map(Some)
+            .map_err(|_| value_error(format!("{what}: `{key}` must be a number"))),
+        _ => Ok(None),
+    }
+}
+
+/// The time stamps of a record dict (`t` or `time`), checked by the engine's time base.
+fn time_base(dict: &Bound<'_, PyDict>, what: &str) -> PyResult<TimeBase> {
+    let t = match (dict.get_item("t")?, dict.get_item("time")?) {
+        (Some(t), _) | (None, Some(t)) => t,
+        (None, None) => return Err(value_error(format!("{what}: missing `t` (time stamps, s)"))),
+    };
+    TimeBase::new(to_f64_vec(&t, &format!("{what}: t"))?)
+        .map_err(|e| value_error(format!("{what}: {e}")))
+}
+
+/// Adds the channel under `key` to `record` (a number is a constant normal force).
+fn add_channel(
+    record: Record,
+    key: &str,
+    value: &Bound<'_, PyAny>,
+    what: &str,
+) -> PyResult<Record> {
+    let channel = channel_of(key).ok_or_else(|| {
+        let known = Channel::ALL.map(Channel::name).join(", ");
+        value_error(format!(
+            "{what}: unknown key `{key}`; a record has t, x0, v0, name, weight, release_time \
+             and channels (v, x, a or {known})"
+        ))
+    })?;
+    if channel == Channel::NormalForce {
+        if let Ok(n) = value.extract::<f64>() {
+            let mut record = record;
+            record.set_normal_force(Some(NormalForce::Constant(n)));
+            return Ok(record);
+        }
+    }
+    let values = to_f64_vec(value, &format!("{what}: {key}"))?;
+    Ok(record.with_channel(channel, values))
+}
+
+/// One record from a dict: `t` and channels as arrays, `x0`, optional `name`, `v0`, `weight`.
+pub fn record(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<Record> {
+    let default_name = format!("record {}", index + 1);
+    let dict = obj
+        .cast::<PyDict>()
+        .map_err(|_| value_error(format!("{default_name}: expected a dict")))?;
+    let name = match dict.get_item("name")? {
+        Some(n) if !n.is_none() => n.str()?.to_string(),
+        _ => default_name,
+    };
+    let x0 = float_key(dict, "x0", &name)?
+        .ok_or_else(|| value_error(format!("{name}: missing `x0` (release displacement, m)")))?;
+    let mut record = Record::from_time_base(name.clone(), time_base(dict, &name)?);
+    record.x0 = x0;
+    record.v0 = float_key(dict, "v0", &name)?.unwrap_or(0.0);
+    record.weight = float_key(dict, "weight", &name)?.unwrap_or(1.0);
+    record.release_time = float_key(dict, "release_time", &name)?;
+    for (key, value) in dict.iter() {
+        let key: String = key.extract()?;
+        if !RECORD_KEYS.contains(&key.as_str()) {
+            record = add_channel(record, &key, &value, &name)?;
+        }
+    }
+    Ok(record)
+}
+
+/// Records from a list of dicts (at least one).
+pub fn records(obj: &Bound<'_, PyAny>) -> PyResult<Vec<Record>> {
+    let list: Vec<Bound<'_, PyAny>> = obj
+        .try_iter()
+        .map_err(|_| value_error("records: expected a list of dicts"))?
+        .collect::<PyResult<_>>()?;
+    if list.is_empty() {
+        return Err(value_error("records: no records given"));
+    }
+    list.iter().enumerate().map(|(i, r)| record(r, i)).collect()
+}

@@ -1,0 +1,140 @@
+//! Report values as Python dicts: the report.json structure (through the engine's serde
+//! form) plus numpy arrays for the series report.json leaves out.
+
+use crate::convert::{serialized, set_array};
+use frictionid_engine::identify::{FitResult, RecordFit};
+use frictionid_engine::report::{
+    CompareReport, EnergyRecord, EnergyReport, FitReport, SimulateReport,
+};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+/// The report's JSON form as a dict.
+fn report_dict<'py, T: serde::Serialize>(
+    py: Python<'py>,
+    report: &T,
+) -> PyResult<Bound<'py, PyDict>> {
+    Ok(serialized(py, report)?.cast_into::<PyDict>()?)
+}
+
+/// The list under `key` of `dict` (a report's `records` or `ranking`).
+fn list_at<'py>(dict: &Bound<'py, PyDict>, key: &str) -> PyResult<Bound<'py, PyList>> {
+    match dict.get_item(key)? {
+        Some(item) => Ok(item.cast_into::<PyList>()?),
+        None => Ok(PyList::empty(dict.py())),
+    }
+}
+
+/// `simulate`: the report's keys, then `t, x, v, a, force, energy`, the other energies,
+/// `energy_rate`, the internal states as `z1..zn` and `states` (a list of arrays), and
+/// `noisy_velocity` when one was made.
+pub fn simulate_dict<'py>(
+    py: Python<'py>,
+    report: &SimulateReport,
+) -> PyResult<Bound<'py, PyDict>> {
+    let dict = report_dict(py, report)?;
+    let traj = &report.trajectory;
+    for (key, values) in [
+        ("t", &traj.time),
+        ("x", &traj.x),
+        ("v", &traj.v),
+        ("a", &traj.a),
+        ("force", &traj.friction),
+        ("energy", &traj.energy),
+        ("kinetic", &traj.kinetic),
+        ("potential", &traj.potential),
+        ("stored", &traj.stored),
+        ("energy_rate", &report.energy_rate),
+    ] {
+        set_array(&dict, key, values)?;
+    }
+    let states = PyList::empty(py);
+    for (j, z) in traj.states.iter().enumerate() {
+        set_array(&dict, &format!("z{}", j + 1), z)?;
+        states.append(crate::convert::to_numpy(py, z))?;
+    }
+    dict.set_item("states", states)?;
+    if let Some(noisy) = &report.noisy_velocity {
+        set_array(&dict, "noisy_velocity", noisy)?;
+    }
+    Ok(dict)
+}
+
+/// Adds each record's series (`time`, `measured`, `fitted`, `energy_based_force`,
+/// `model_force`) to the record dicts of one fit.
+fn add_record_series(fit_dict: &Bound<'_, PyDict>, fit: &FitResult) -> PyResult<()> {
+    let records = list_at(fit_dict, "records")?;
+    for (item, r) in records.iter().zip(&fit.records) {
+        let d = item.cast_into::<PyDict>()?;
+        let RecordFit {
+            time,
+            measured,
+            fitted,
+            energy_based_force,
+            model_force,
+            ..
+        } = r;
+        for (key, values) in [
+            ("time", time),
+            ("measured", measured),
+            ("fitted", fitted),
+            ("energy_based_force", energy_based_force),
+            ("model_force", model_force),
+        ] {
+            set_array(&d, key, values)?;
+        }
+    }
+    Ok(())
+}
+
+/// `fit`: report.json's structure with the fitted series per record.
+pub fn fit_dict<'py>(py: Python<'py>, report: &FitReport) -> PyResult<Bound<'py, PyDict>> {
+    let dict = report_dict(py, report)?;
+    add_record_series(&dict, &report.fit)?;
+    Ok(dict)
+}
+
+/// `compare`: report.json's structure with the fitted series per record of every ranked fit.
+pub fn compare_dict<'py>(py: Python<'py>, report: &CompareReport) -> PyResult<Bound<'py, PyDict>> {
+    let dict = report_dict(py, report)?;
+    let ranking = list_at(&dict, "ranking")?;
+    for (item, fit) in ranking.iter().zip(&report.comparison.ranking) {
+        add_record_series(&item.cast_into::<PyDict>()?, fit)?;
+    }
+    Ok(dict)
+}
+
+/// The energy analysis's series of one record.
+fn add_energy_series(d: &Bound<'_, PyDict>, r: &EnergyRecord) -> PyResult<()> {
+    let a = &r.analysis;
+    for (key, values) in [
+        ("time", &a.time),
+        ("x", &a.x),
+        ("v", &a.v),
+        ("a", &a.a),
+        ("kinetic", &a.kinetic),
+        ("potential", &a.potential),
+        ("energy", &a.energy),
+        ("de_dt", &a.de_dt),
+        ("friction", &a.friction),
+    ] {
+        set_array(d, key, values)?;
+    }
+    if let Some(f) = &r.model_force {
+        set_array(d, "model_force", f)?;
+    }
+    Ok(())
+}
+
+/// `energy`: report.json's structure with the series of every record's analysis.
+pub fn energy_dict<'py>(py: Python<'py>, report: &EnergyReport) -> PyResult<Bound<'py, PyDict>> {
+    let dict = report_dict(py, report)?;
+    let records = list_at(&dict, "records")?;
+    for (item, r) in records.iter().zip(&report.records) {
+        add_energy_series(&item.cast_into::<PyDict>()?, r)?;
+    }
+    if let Some(name) = &report.reference_model {
+        dict.set_item("reference_model", name)?;
+    }
+    Ok(dict)
+}

@@ -1,0 +1,179 @@
+"""frictionid from Python, against independent oracles (closed forms, fixture truth, the CLI)."""
+
+import json
+import math
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import frictionid
+
+ROOT = Path(__file__).resolve().parents[2]
+FIXTURES = ROOT / "fixtures"
+FMM = {"mass": 10.391, "damping": 0.275, "stiffness": 1982.0, "normal_force": 14.5}
+PAPER = dict(FMM, normal_force=10.391 * 9.81)
+
+
+def coulomb_rest(osc, mu, x0):
+    """Rest position and half-cycles of a viscously damped oscillator with Coulomb friction,
+    released from rest: each half-cycle is a damped oscillation about +-F/k lasting pi/wd."""
+    m, c, k = osc["mass"], osc["damping"], osc["stiffness"]
+    force = mu * osc["normal_force"]
+    w = math.sqrt(k / m)
+    zeta = c / (2.0 * math.sqrt(k * m))
+    wd = w * math.sqrt(1.0 - zeta**2)
+    ratio = math.exp(-zeta * w * math.pi / wd)
+    x, half_cycles, t = x0, 0, 0.0
+    while abs(k * x) > force:
+        centre = math.copysign(force / k, x)
+        x = centre - (x - centre) * ratio
+        half_cycles += 1
+        t += math.pi / wd
+    return x, half_cycles, t
+
+
+def fixture_records(as_type=np.asarray):
+    records = []
+    for name, x0 in [("x10mm.csv", 0.010), ("x14mm.csv", 0.014), ("x22mm.csv", 0.022)]:
+        data = np.loadtxt(FIXTURES / name, delimiter=",", skiprows=2)
+        records.append({"name": name, "t": as_type(data[:, 0]), "v": as_type(data[:, 1]), "x0": x0})
+    return records
+
+
+def test_models_match_the_cli_listing():
+    models = frictionid.models()
+    names = [m["name"] for m in models]
+    assert "coulomb" in names and "lugre" in names
+    coulomb = models[names.index("coulomb")]
+    assert [p["name"] for p in coulomb["parameters"]] == ["mu"]
+
+
+def test_simulate_reproduces_the_exact_coulomb_rest_position():
+    rest, half_cycles, rest_time = coulomb_rest(PAPER, 0.24, 0.140)
+    assert half_cycles == 6
+    t = np.arange(0, 2001) * 1e-3
+    out = frictionid.simulate(PAPER, {"type": "coulomb", "mu": 0.24}, 0.140, t)
+    assert abs(out["final_displacement"] - rest) < 1e-9
+    assert abs(out["final_displacement"] - (-9.29682614e-3)) < 1e-9
+    assert out["half_cycles"] == half_cycles
+    assert abs(out["rest_time"] - rest_time) < 1e-6
+    for key in ["t", "x", "v", "a", "force", "energy"]:
+        assert isinstance(out[key], np.ndarray) and out[key].dtype == np.float64
+        assert out[key].shape == t.shape
+    assert np.array_equal(out["t"], t)
+    assert abs(out["x"][-1] - rest) < 1e-9
+    assert set(["events", "stats", "samples"]) <= set(out)
+
+
+def test_simulate_accepts_lists_and_float32_times():
+    model = {"type": "coulomb", "mu": 0.24}
+    t64 = np.linspace(0.0, 1.0, 101)
+    reference = frictionid.simulate(FMM, model, 0.014, t64)
+    from_list = frictionid.simulate(FMM, model, 0.014, t64.tolist())
+    assert np.array_equal(from_list["v"], reference["v"])
+    t32 = np.linspace(0.0, 1.0, 101, dtype=np.float32)
+    from_f32 = frictionid.simulate(FMM, model, 0.014, t32)
+    assert np.array_equal(from_f32["t"], t32.astype(np.float64))
+    assert from_f32["v"].dtype == np.float64
+
+
+def test_lugre_has_internal_states():
+    out = frictionid.simulate(FMM, {"type": "lugre"}, 0.014, np.linspace(0, 0.5, 51))
+    assert len(out["states"]) == 1 and np.array_equal(out["states"][0], out["z1"])
+
+
+def test_fit_recovers_the_fixture_truth():
+    out = frictionid.fit(FMM, {"type": "coulomb", "mu": 0.2}, fixture_records(), {"free": ["mu"]})
+    (mu,) = [p for p in out["parameters"] if p["name"] == "mu"]
+    assert abs(mu["value"] - 0.24) / 0.24 < 1e-3
+    assert mu["std_error"] > 0 and mu["ci95"][0] < mu["value"] < mu["ci95"][1]
+    assert out["converged"] and len(out["records"]) == 3
+    record = out["records"][1]
+    assert record["fitted"].shape == record["measured"].shape == record["time"].shape
+    assert record["file"] == "x14mm.csv"
+
+
+def test_fit_accepts_float32_and_list_records():
+    model = {"type": "coulomb", "mu": 0.2}
+    base = frictionid.fit(FMM, model, fixture_records()[:1])
+    f32 = frictionid.fit(FMM, model, fixture_records(lambda a: a.astype(np.float32))[:1])
+    lists = frictionid.fit(FMM, model, fixture_records(lambda a: a.tolist())[:1])
+    assert lists["parameters"] == base["parameters"]
+    assert abs(f32["parameters"][0]["value"] - base["parameters"][0]["value"]) < 1e-4
+
+
+def strip_series(value):
+    """A report without arrays, timings and the source's name (the parts that differ)."""
+    if isinstance(value, dict):
+        return {
+            k: strip_series(v)
+            for k, v in value.items()
+            if not isinstance(v, np.ndarray) and k not in ("wall_time_s", "config", "files")
+        }
+    if isinstance(value, list):
+        return [strip_series(v) for v in value]
+    return value
+
+
+def test_fit_of_three_records_is_identical_to_the_cli(tmp_path):
+    cli = frictionid.run(FIXTURES / "fmm-fit.toml", "fit", tmp_path / "run")
+    assert json.loads((tmp_path / "run" / "report.json").read_text()) == cli
+    py = frictionid.fit(
+        FMM, {"type": "coulomb", "mu": 0.2}, fixture_records(),
+        {"free": ["mu"], "bounds": {"mu": [0.0, 1.0]}},
+    )
+    assert strip_series(py) == strip_series(cli)
+    binary = ROOT / "target" / "debug" / "frictionid"
+    if binary.exists():
+        subprocess.run(
+            [binary, "fit", FIXTURES / "fmm-fit.toml", "--quiet", "--out", tmp_path / "bin"],
+            check=True,
+        )
+        from_binary = json.loads((tmp_path / "bin" / "report.json").read_text())
+        assert strip_series(from_binary) == strip_series(py)
+
+
+def test_compare_and_energy_return_reports():
+    records = fixture_records()[1:2]
+    out = frictionid.compare(FMM, ["coulomb", {"type": "stribeck"}], records)
+    assert out["command"] == "compare" and out["ranking"][0]["model"] in ("coulomb", "stribeck")
+    assert "fitted" in out["ranking"][0]["records"][0]
+    energy = frictionid.energy(FMM, records, model={"type": "coulomb", "mu": 0.24})
+    (record,) = energy["records"]
+    assert abs(record["reference"] - 0.24 * 14.5) < 1e-9
+    assert record["friction"].shape == record["time"].shape
+
+
+def test_bad_input_raises_value_error_with_the_cli_message(tmp_path):
+    with pytest.raises(ValueError, match=r"did you mean `coulomb`"):
+        frictionid.simulate(FMM, {"type": "colomb"}, 0.01, [0.0, 0.1])
+    with pytest.raises(ValueError, match=r"\[oscillator\]: missing field `mass`"):
+        frictionid.simulate({"damping": 0.2}, "coulomb", 0.01, [0.0, 0.1])
+    with pytest.raises(ValueError, match=r"3 time stamps but 2 velocities"):
+        frictionid.fit(FMM, "coulomb", [{"t": [0.0, 0.1, 0.2], "v": [0.0, 0.1], "x0": 0.01}])
+    with pytest.raises(ValueError, match=r"missing `x0`"):
+        frictionid.fit(FMM, "coulomb", [{"t": [0.0, 0.1], "v": [0.0, 0.1]}])
+    with pytest.raises(ValueError, match=r"unknown key `velocty`"):
+        frictionid.fit(FMM, "coulomb", [{"t": [0.0, 0.1], "velocty": [0.0, 0.1], "x0": 0.01}])
+    # The same mistake in a config file and in a dict: the CLI's message, after the file name.
+    config = (FIXTURES / "fmm-fit.toml").read_text().replace('free = ["mu"]', 'free = ["mu_"]')
+    path = tmp_path / "bad.toml"
+    path.write_text(config.replace('file = "', f'file = "{FIXTURES}/'))
+    with pytest.raises(ValueError) as from_run:
+        frictionid.run(path, "fit", tmp_path / "out")
+    with pytest.raises(ValueError) as from_dict:
+        frictionid.fit(FMM, "coulomb", fixture_records(), {"free": ["mu_"]})
+    assert "(did you mean `mu`?)" in str(from_dict.value)
+    assert str(from_run.value).endswith(str(from_dict.value))
+
+
+def test_a_failed_fit_raises_fit_error():
+    assert issubclass(frictionid.FitError, Exception)
+    t = np.linspace(0.0, 1.0, 1001)
+    flat = [{"t": t, "v": np.zeros_like(t), "x0": 0.01}]
+    with pytest.raises((frictionid.FitError, ValueError)) as caught:
+        frictionid.compare(FMM, ["coulomb"], flat, {"max_iterations": 0})
+    assert "\n" not in str(caught.value)
