@@ -150,7 +150,8 @@ fn a_very_stiff_bristle_model_ends_at_the_step_limit() {
         &opts,
     );
     match r {
-        Err(EngineError::Integration { reason, .. }) => {
+        Err(EngineError::Integration(failure)) => {
+            let reason = failure.to_string();
             assert!(reason.contains("max_steps"), "{reason}")
         }
         Err(e) => panic!("unexpected error: {e}"),

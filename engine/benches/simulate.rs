@@ -1,6 +1,6 @@
 //! Criterion benchmarks of the simulation engine: one run per registered model for the FMM case
-//! (N = 14.5 N, x0 = 22 mm, 2 s sampled at 1 kHz), the paper's 140 mm Coulomb case (N = m g,
-//! mu = 0.24) with Dopri5 and with the paper's Euler (T_n / 1e6), and the stiff bristle models
+//! (N = 14.5 N, x0 = 22 mm, 2 s sampled at 1 kHz, default Dopri5), the paper's 140 mm Coulomb case (N = m g, mu = 0.24)
+//! with Dopri5, the closed form and the paper's Euler (T_n / 1e6), and the stiff bristle models
 //! (sigma0 = 1e7 N/m). The RHS counts are printed once per case (stderr) for the README's
 //! performance table.
 
@@ -83,7 +83,14 @@ fn paper_140mm(c: &mut Criterion) {
     osc.normal_force = osc.mass * 9.81;
     let model = Coulomb { mu: 0.24 };
     let times = uniform_times(2.0, 1000.0);
-    let opts = SimOptions::default();
+    let opts = SimOptions {
+        integrator: Integrator::Dopri5,
+        ..SimOptions::default()
+    };
+    let exact = SimOptions {
+        integrator: Integrator::Exact,
+        ..SimOptions::default()
+    };
     let euler = SimOptions {
         integrator: Integrator::Euler {
             steps_per_period: 1e6,
@@ -91,9 +98,11 @@ fn paper_140mm(c: &mut Criterion) {
         ..SimOptions::default()
     };
     let mut group = c.benchmark_group("paper_140mm_coulomb");
-    let cases: [(&str, &[f64], &SimOptions); 3] = [
+    let cases: [(&str, &[f64], &SimOptions); 5] = [
         ("dopri5_events_only", &[], &opts),
         ("dopri5_2s_1kHz", &times, &opts),
+        ("exact_events_only", &[], &exact),
+        ("exact_2s_1kHz", &times, &exact),
         ("euler_1e6_2s_1kHz", &times, &euler),
     ];
     for (label, t, o) in cases {

@@ -212,6 +212,7 @@ fn energy_record(
     let reference = record_reference(given, model_force.as_deref(), &analysis.friction);
     Ok(EnergyRecord {
         file: record.name.clone(),
+        release_time: record.release_time,
         mean_abs_force: analysis.mean_abs_force,
         reference,
         percent_difference: percent_difference(analysis.mean_abs_force, reference),

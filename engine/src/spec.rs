@@ -367,6 +367,10 @@ pub enum IntegratorMethod {
     Dopri5,
     /// Fixed-step explicit Euler (for comparison only).
     Euler,
+    /// Closed form for laws affine in v, Dopri5 otherwise.
+    Auto,
+    /// The exact closed-form propagator (coulomb, viscous_coulomb, none).
+    Exact,
 }
 
 /// `[simulation.integrator]`: integrator choice and tolerances (engine defaults when absent).
@@ -397,6 +401,8 @@ impl IntegratorSpec {
         let defaults = SimOptions::default();
         let integrator = match self.method {
             IntegratorMethod::Dopri5 => Integrator::Dopri5,
+            IntegratorMethod::Auto => Integrator::Auto,
+            IntegratorMethod::Exact => Integrator::Exact,
             IntegratorMethod::Euler => Integrator::Euler {
                 steps_per_period: match (self.steps_per_period, &defaults.integrator) {
                     (Some(n), _) => n,

@@ -354,7 +354,7 @@ fn velocity_only_variant_matches_the_full_trajectory() {
 
 fn integration_time(e: EngineError) -> f64 {
     match e {
-        EngineError::Integration { time, .. } => time,
+        EngineError::Integration(failure) => failure.time(),
         other => panic!("expected an integration error, got {other}"),
     }
 }
@@ -521,4 +521,146 @@ fn euler_converges_to_the_adaptive_solution_for_every_model() {
             "{name}: {e4} -> {e5} is not first-order convergence"
         );
     }
+}
+
+/// The FMM rig at the three release amplitudes, and the paper's 140 mm case (N = m g).
+fn papers_cases() -> Vec<(Oscillator, f64, f64)> {
+    let fmm = Oscillator::fmm();
+    vec![
+        (fmm, 0.010, 0.24),
+        (fmm, 0.014, 0.24),
+        (fmm, 0.022, 0.24),
+        (paper_osc(), 0.140, 0.24),
+    ]
+}
+
+fn exact_opts() -> SimOptions {
+    SimOptions {
+        integrator: Integrator::Exact,
+        ..SimOptions::default()
+    }
+}
+
+#[test]
+fn exact_propagator_matches_the_closed_form_oracle_on_the_papers_cases() {
+    let times = uniform_times(2.0, 1000.0);
+    for (osc, x0, mu) in papers_cases() {
+        let model = Coulomb { mu };
+        let exact = coulomb_free_vibration(&osc, mu * osc.normal_force, x0, &times).unwrap();
+        let sim = simulate(
+            &osc,
+            &model,
+            &Initial::at_rest(x0),
+            2.0,
+            &times,
+            &exact_opts(),
+        )
+        .unwrap();
+        assert_eq!(sim.stats.rhs_evaluations, 0);
+        for i in 0..times.len() {
+            assert!(
+                (sim.x[i] - exact.x[i]).abs() < 1e-12,
+                "x0 {x0}: x at {}",
+                times[i]
+            );
+            assert!(
+                (sim.v[i] - exact.v[i]).abs() < 1e-11,
+                "x0 {x0}: v at {}",
+                times[i]
+            );
+        }
+        let turns: Vec<&frictionid_engine::Event> = sim
+            .events
+            .iter()
+            .filter(|e| e.kind == EventKind::TurningPoint)
+            .collect();
+        assert_eq!(turns.len(), exact.turning_times.len(), "x0 {x0}");
+        for (e, (&t, &x)) in turns
+            .iter()
+            .zip(exact.turning_times.iter().zip(&exact.turning_displacements))
+        {
+            assert!((e.time - t).abs() < 1e-12, "turning time {} vs {t}", e.time);
+            assert!(
+                (e.displacement - x).abs() < 1e-12,
+                "turning x {}",
+                e.displacement
+            );
+        }
+        let rest = sim.rest.expect("the mass comes to rest");
+        assert!((rest.time - exact.rest_time).abs() < 1e-12);
+        assert!((rest.displacement - exact.final_displacement).abs() < 1e-12);
+    }
+}
+
+/// A small deterministic generator for test cases (64-bit LCG, top 53 bits).
+struct Lcg(u64);
+
+impl Lcg {
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
+    }
+}
+
+#[test]
+fn exact_propagator_agrees_with_dopri5_on_random_cases() {
+    let mut rng = Lcg(2026);
+    for case in 0..40 {
+        let osc = Oscillator::new(
+            rng.uniform(0.5, 20.0),
+            rng.uniform(0.0, 5.0),
+            rng.uniform(200.0, 5000.0),
+            rng.uniform(1.0, 100.0),
+        )
+        .unwrap();
+        let json = if case % 3 == 0 {
+            serde_json::json!({ "type": "none" })
+        } else if case % 3 == 1 {
+            serde_json::json!({ "type": "coulomb", "mu": rng.uniform(0.01, 0.5) })
+        } else {
+            serde_json::json!({
+                "type": "viscous_coulomb",
+                "mu": rng.uniform(0.01, 0.5),
+                "viscous": rng.uniform(0.0, 5.0),
+            })
+        };
+        let model = frictionid_models::build_json(&json).unwrap().model;
+        let init = Initial::new(rng.uniform(-0.05, 0.05), rng.uniform(-0.3, 0.3));
+        let times = uniform_times(1.0, 500.0);
+        let run = |opts: &SimOptions| simulate(&osc, model.as_ref(), &init, 1.0, &times, opts);
+        let exact = run(&exact_opts()).unwrap();
+        let dopri = run(&SimOptions::default()).unwrap();
+        assert_eq!(exact.events.len(), dopri.events.len(), "case {case}");
+        for i in 0..times.len() {
+            assert!(
+                (exact.x[i] - dopri.x[i]).abs() < 1e-8,
+                "case {case} x at {}: {} vs {}",
+                times[i],
+                exact.x[i],
+                dopri.x[i]
+            );
+            assert!((exact.v[i] - dopri.v[i]).abs() < 1e-7, "case {case} v");
+        }
+    }
+}
+
+#[test]
+fn auto_uses_the_exact_propagator_only_where_it_applies() {
+    let osc = Oscillator::fmm();
+    let times = uniform_times(1.0, 100.0);
+    let auto = SimOptions {
+        integrator: Integrator::Auto,
+        ..SimOptions::default()
+    };
+    let at = Initial::at_rest(0.022);
+    let coulomb = simulate(&osc, &Coulomb { mu: 0.24 }, &at, 1.0, &times, &auto).unwrap();
+    assert_eq!(coulomb.stats.rhs_evaluations, 0);
+    let lugre = default_model("lugre").unwrap();
+    let dynamic = simulate(&osc, lugre.as_ref(), &at, 1.0, &times, &auto).unwrap();
+    assert!(dynamic.stats.rhs_evaluations > 0);
+    let forced = simulate(&osc, lugre.as_ref(), &at, 1.0, &times, &exact_opts()).unwrap_err();
+    assert!(matches!(forced, EngineError::InvalidInput(_)), "{forced}");
 }

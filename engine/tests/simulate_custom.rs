@@ -77,9 +77,10 @@ fn a_non_finite_force_is_an_error_with_the_time_reached() {
         };
         let err = simulate(&osc, &Broken, &Initial::at_rest(0.022), 1.0, &[0.5], &opts)
             .expect_err("a NaN force must fail");
-        let EngineError::Integration { time, reason } = &err else {
+        let EngineError::Integration(failure) = &err else {
             panic!("expected an integration error, got {err}");
         };
+        let (time, reason) = (failure.time(), failure.to_string());
         assert!(
             (time - t_break).abs() < 1e-3,
             "{integrator:?}: failed at {time}, the force breaks down at {t_break}: {reason}"

@@ -384,88 +384,106 @@ fn err<T>(column: usize, message: impl Into<String>) -> Result<T, Located> {
     })
 }
 
+/// The end of the run of characters from `i` on that satisfy `keep`.
+fn run_end(chars: &[char], mut i: usize, keep: impl Fn(char) -> bool) -> usize {
+    while chars.get(i).is_some_and(|&c| keep(c)) {
+        i += 1;
+    }
+    i
+}
+
+/// The end of a number's text starting at `start` (digits, a fraction, an exponent).
+fn number_end(chars: &[char], start: usize) -> Result<usize, Located> {
+    let digit_at = |j: usize| chars.get(j).is_some_and(char::is_ascii_digit);
+    let mut i = run_end(chars, start, |c| c.is_ascii_digit());
+    if chars.get(i) == Some(&'.') {
+        i = run_end(chars, i + 1, |c| c.is_ascii_digit());
+    }
+    if matches!(chars.get(i), Some('e' | 'E')) {
+        let sign = usize::from(matches!(chars.get(i + 1), Some('+' | '-')));
+        if digit_at(i + 1 + sign) {
+            i = run_end(chars, i + 1 + sign, |c| c.is_ascii_digit());
+        } else if sign == 1 {
+            return err(start + 1, "malformed number (exponent without digits)");
+        }
+    }
+    Ok(i)
+}
+
+/// The number starting at `start`, and where it ends.
+fn lex_number(chars: &[char], start: usize) -> Result<(Token, usize), Located> {
+    let col = start + 1;
+    let end = number_end(chars, start)?;
+    let s: String = chars.get(start..end).unwrap_or_default().iter().collect();
+    let value: f64 = match s.parse() {
+        Ok(v) => v,
+        Err(_) => return err(col, format!("malformed number `{s}`")),
+    };
+    if !value.is_finite() {
+        return err(col, format!("number `{s}` is out of range"));
+    }
+    let token = Token {
+        tok: Tok::Num(value),
+        col,
+        text: s,
+    };
+    Ok((token, end))
+}
+
+/// The name starting at `start`, and where it ends.
+fn lex_name(chars: &[char], start: usize) -> (Token, usize) {
+    let end = run_end(chars, start, |c| c.is_ascii_alphanumeric() || c == '_');
+    let s: String = chars.get(start..end).unwrap_or_default().iter().collect();
+    let token = Token {
+        tok: Tok::Name(s.clone()),
+        col: start + 1,
+        text: s,
+    };
+    (token, end)
+}
+
+/// The operator or bracket at `i`, and where it ends.
+fn lex_symbol(chars: &[char], i: usize) -> Result<(Token, usize), Located> {
+    let c = chars.get(i).copied().unwrap_or(' ');
+    let (tok, len) = match c {
+        '+' => (Tok::Plus, 1),
+        '-' => (Tok::Minus, 1),
+        '*' if chars.get(i + 1) == Some(&'*') => (Tok::Caret, 2),
+        '*' => (Tok::Star, 1),
+        '/' => (Tok::Slash, 1),
+        '^' => (Tok::Caret, 1),
+        '(' => (Tok::LParen, 1),
+        ')' => (Tok::RParen, 1),
+        ',' => (Tok::Comma, 1),
+        _ => return err(i + 1, format!("unexpected character `{c}`")),
+    };
+    let token = Token {
+        tok,
+        col: i + 1,
+        text: chars.get(i..i + len).unwrap_or_default().iter().collect(),
+    };
+    Ok((token, i + len))
+}
+
 fn lex(text: &str) -> Result<Vec<Token>, Located> {
     let chars: Vec<char> = text.chars().collect();
     let mut tokens = Vec::new();
     let mut i = 0;
     while let Some(&c) = chars.get(i) {
-        let col = i + 1;
         if c.is_whitespace() {
             i += 1;
             continue;
         }
-        let digit_at = |j: usize| chars.get(j).is_some_and(|d| d.is_ascii_digit());
-        if c.is_ascii_digit() || (c == '.' && digit_at(i + 1)) {
-            let start = i;
-            while digit_at(i) {
-                i += 1;
-            }
-            if chars.get(i) == Some(&'.') {
-                i += 1;
-                while digit_at(i) {
-                    i += 1;
-                }
-            }
-            if matches!(chars.get(i), Some('e' | 'E')) {
-                let sign = usize::from(matches!(chars.get(i + 1), Some('+' | '-')));
-                if digit_at(i + 1 + sign) {
-                    i += 1 + sign;
-                    while digit_at(i) {
-                        i += 1;
-                    }
-                } else if sign == 1 {
-                    return err(col, "malformed number (exponent without digits)");
-                }
-            }
-            let s: String = chars.get(start..i).unwrap_or_default().iter().collect();
-            let value: f64 = match s.parse() {
-                Ok(v) => v,
-                Err(_) => return err(col, format!("malformed number `{s}`")),
-            };
-            if !value.is_finite() {
-                return err(col, format!("number `{s}` is out of range"));
-            }
-            tokens.push(Token {
-                tok: Tok::Num(value),
-                col,
-                text: s,
-            });
-            continue;
-        }
-        if c.is_ascii_alphabetic() || c == '_' {
-            let start = i;
-            while chars
-                .get(i)
-                .is_some_and(|d| d.is_ascii_alphanumeric() || *d == '_')
-            {
-                i += 1;
-            }
-            let s: String = chars.get(start..i).unwrap_or_default().iter().collect();
-            tokens.push(Token {
-                tok: Tok::Name(s.clone()),
-                col,
-                text: s,
-            });
-            continue;
-        }
-        let (tok, len) = match c {
-            '+' => (Tok::Plus, 1),
-            '-' => (Tok::Minus, 1),
-            '*' if chars.get(i + 1) == Some(&'*') => (Tok::Caret, 2),
-            '*' => (Tok::Star, 1),
-            '/' => (Tok::Slash, 1),
-            '^' => (Tok::Caret, 1),
-            '(' => (Tok::LParen, 1),
-            ')' => (Tok::RParen, 1),
-            ',' => (Tok::Comma, 1),
-            _ => return err(col, format!("unexpected character `{c}`")),
+        let digit_next = chars.get(i + 1).is_some_and(char::is_ascii_digit);
+        let (token, end) = if c.is_ascii_digit() || (c == '.' && digit_next) {
+            lex_number(&chars, i)?
+        } else if c.is_ascii_alphabetic() || c == '_' {
+            lex_name(&chars, i)
+        } else {
+            lex_symbol(&chars, i)?
         };
-        tokens.push(Token {
-            tok,
-            col,
-            text: chars.get(i..i + len).unwrap_or_default().iter().collect(),
-        });
-        i += len;
+        tokens.push(token);
+        i = end;
     }
     tokens.push(Token {
         tok: Tok::End,

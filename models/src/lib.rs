@@ -9,10 +9,15 @@ pub mod builtin;
 pub mod error;
 pub mod formula;
 pub mod model;
+pub mod params;
 pub mod registry;
+pub mod start;
 pub mod suggest;
+pub mod testing;
 
 pub use builtin::*;
 pub use error::ModelError;
 pub use model::{check_bounds, check_len, clone_model, sgn, FrictionModel, GuessHint, ParamInfo};
+pub use params::{DeclaredParams, ParamSpec};
 pub use registry::{build_json, build_toml, default_model, listings, names, Built, ModelListing};
+pub use start::{StartContext, StribeckLevels};

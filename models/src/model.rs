@@ -161,6 +161,22 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
         self.force(v, &[], normal)
     }
 
+    /// The Jacobian of `state_derivative` with respect to the states, d(dz_i)/d(z_j), written
+    /// row-major into `jac` (n_states x n_states). The default differentiates numerically
+    /// (central differences, step cbrt(eps) max(|z_j|, 1e-6)); models with a closed form should
+    /// supply it (stiff integrators call this once per step).
+    fn state_jacobian(&self, v: f64, z: &[f64], normal: f64, jac: &mut [f64]) {
+        finite_difference_jacobian(self, v, z, normal, jac);
+    }
+
+    /// For static laws that are affine in the velocity within a sliding mode: `(a, b)` such
+    /// that `slip_force(v, direction, N) = a + b v` for every v in that mode (e.g. coulomb:
+    /// (direction mu N, 0); viscous_coulomb: (direction mu N, c_v)). The engine may then solve
+    /// each half-cycle in closed form. `None` (the default) when the law is not of that form.
+    fn affine_slip(&self, _direction: f64, _normal: f64) -> Option<(f64, f64)> {
+        None
+    }
+
     /// Steady-state friction curve F_ss(v) (the force at constant sliding velocity).
     fn steady_state(&self, v: f64, normal: f64) -> f64;
 
@@ -173,6 +189,16 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
     /// Sets data-driven initial values (levels from the energy estimate). Default: keep.
     fn apply_guess(&mut self, _hint: &GuessHint) {}
 
+    /// Takes the start of a staged fit from a fitted simpler model (see [`crate::start`]);
+    /// returns whether it did. Default: `false` (keep the values).
+    fn start_from(
+        &mut self,
+        _fitted: &dyn FrictionModel,
+        _ctx: &crate::start::StartContext,
+    ) -> bool {
+        false
+    }
+
     /// Checks every parameter against its physical bounds; returns warnings for values that
     /// are admissible but unusual (e.g. mu_s < mu_c).
     fn validate(&self) -> Result<Vec<String>, ModelError> {
@@ -182,6 +208,38 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
 }
 
 dyn_clone::clone_trait_object!(FrictionModel);
+
+/// Smallest state magnitude the finite-difference step of [`finite_difference_jacobian`] scales
+/// with (bristle deflections are often 1e-7..1e-5 m).
+const FD_STATE_FLOOR: f64 = 1e-6;
+
+/// The central-difference Jacobian of `model.state_derivative` with respect to the states
+/// (row-major into `jac`); the default of [`FrictionModel::state_jacobian`].
+pub fn finite_difference_jacobian<M: FrictionModel + ?Sized>(
+    model: &M,
+    v: f64,
+    z: &[f64],
+    normal: f64,
+    jac: &mut [f64],
+) {
+    let n = z.len();
+    let mut probe = z.to_vec();
+    let mut plus = vec![0.0; n];
+    let mut minus = vec![0.0; n];
+    for j in 0..n {
+        let step = f64::EPSILON.cbrt() * z[j].abs().max(FD_STATE_FLOOR);
+        probe[j] = z[j] + step;
+        model.state_derivative(v, &probe, normal, &mut plus);
+        probe[j] = z[j] - step;
+        model.state_derivative(v, &probe, normal, &mut minus);
+        probe[j] = z[j];
+        for i in 0..n {
+            if let Some(entry) = jac.get_mut(i * n + j) {
+                *entry = (plus[i] - minus[i]) / (2.0 * step);
+            }
+        }
+    }
+}
 
 /// Checks `values` against the bounds in `info`; the error names the model and parameter.
 pub fn check_bounds(model: &str, info: &[ParamInfo], values: &[f64]) -> Result<(), ModelError> {
@@ -225,4 +283,70 @@ pub fn sgn(v: f64) -> f64 {
 /// A boxed copy of a model behind a reference.
 pub fn clone_model(model: &(dyn FrictionModel + 'static)) -> Box<dyn FrictionModel> {
     dyn_clone::clone_box(model)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde::Deserialize;
+
+    /// z0' = v - 3 z0^2 + z1, z1' = N z0 z1 (Jacobian [[-6 z0, 1], [N z1, N z0]]).
+    #[derive(Debug, Clone, Default, Serialize, Deserialize)]
+    struct Quadratic;
+
+    #[typetag::serde(name = "model_rs_quadratic_test_law")]
+    impl FrictionModel for Quadratic {
+        fn name(&self) -> &'static str {
+            "model_rs_quadratic_test_law"
+        }
+        fn equation(&self) -> String {
+            String::new()
+        }
+        fn param_info(&self) -> Vec<ParamInfo> {
+            Vec::new()
+        }
+        fn params(&self) -> Vec<f64> {
+            Vec::new()
+        }
+        fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
+            check_len(self.name(), 0, values.len())
+        }
+        fn n_states(&self) -> usize {
+            2
+        }
+        fn state_derivative(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) {
+            dz[0] = v - 3.0 * z[0] * z[0] + z[1];
+            dz[1] = normal * z[0] * z[1];
+        }
+        fn force(&self, _v: f64, z: &[f64], _normal: f64) -> f64 {
+            z[0]
+        }
+        fn steady_state(&self, _v: f64, _normal: f64) -> f64 {
+            0.0
+        }
+    }
+
+    #[test]
+    fn default_state_jacobian_matches_the_hand_derivative() {
+        let normal = 14.5;
+        for z in [[0.3, -1.2], [2e-7, 5e-7], [0.0, 0.0], [-40.0, 3.0]] {
+            let mut jac = [0.0; 4];
+            Quadratic.state_jacobian(0.1, &z, normal, &mut jac);
+            let hand = [-6.0 * z[0], 1.0, normal * z[1], normal * z[0]];
+            // Central differences are exact on a quadratic up to round-off, about
+            // eps |f| / step <= 2e-16 * 0.1 / 6e-12 ~ 4e-6 at the smallest steps.
+            for (got, want) in jac.iter().zip(hand) {
+                assert!(
+                    (got - want).abs() <= 1e-5 * (1.0 + want.abs()),
+                    "z = {z:?}: {jac:?} vs {hand:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn laws_are_not_declared_affine_by_default() {
+        assert_eq!(Quadratic.affine_slip(1.0, 14.5), None);
+        assert_eq!(Quadratic.affine_slip(-1.0, 14.5), None);
+    }
 }

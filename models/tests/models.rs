@@ -28,12 +28,9 @@ fn registry_lists_the_built_in_models() {
     for l in listings() {
         let m = default_model(&l.name).unwrap();
         assert_eq!(m.name(), l.name);
-        assert_eq!(l.parameters.len(), m.params().len());
+        assert_eq!(l.parameters, m.param_info());
         // Defaults in the metadata are the defaults of the built instance, inside the bounds.
-        for (p, v) in l.parameters.iter().zip(m.params()) {
-            assert_eq!(p.default, v, "{}.{}", l.name, p.name);
-            assert!(p.admits(v));
-        }
+        testing::check_declarations(m.as_ref()).unwrap();
     }
 }
 
@@ -163,37 +160,13 @@ fn none_is_zero() {
     assert!(m.params().is_empty());
 }
 
-/// F(-v, -z) = -F(v, z) and dz(-v, -z) = -dz(v, z) for every registered model.
+/// F(-v, -z) = -F(v, z) and dz(-v, -z) = -dz(v, z) for every registered model (exactly, at
+/// the harness's velocities, states and normal forces).
 #[test]
 fn every_model_is_odd() {
-    let velocities = [0.0, 1e-15, 1e-9, 1e-4, 0.003, 0.01, 0.05, 0.4, 3.0];
     for name in names() {
         let m = default_model(&name).unwrap();
-        let ns = m.n_states();
-        for &v in &velocities {
-            for zs in [0.0, 1e-6, -3e-5, 2.0] {
-                let z = vec![zs; ns];
-                let zneg: Vec<f64> = z.iter().map(|x| -x).collect();
-                let f = m.force(v, &z, N);
-                let fneg = m.force(-v, &zneg, N);
-                assert!(
-                    close(fneg, -f, 1e-14),
-                    "{name}: F({v}) = {f}, F(-v) = {fneg}"
-                );
-                let (mut d, mut dneg) = (vec![0.0; ns], vec![0.0; ns]);
-                m.state_derivative(v, &z, N, &mut d);
-                m.state_derivative(-v, &zneg, N, &mut dneg);
-                for (a, b) in d.iter().zip(&dneg) {
-                    assert!(close(*b, -a, 1e-14), "{name}: dz");
-                }
-            }
-            let s = m.steady_state(v, N);
-            assert!(close(m.steady_state(-v, N), -s, 1e-14), "{name}: F_ss");
-            if m.static_limit(N).is_some() {
-                let sp = m.slip_force(v, 1.0, N);
-                assert!(close(m.slip_force(-v, -1.0, N), -sp, 1e-14), "{name}: slip");
-            }
-        }
+        testing::check_odd_symmetry(m.as_ref()).unwrap();
     }
 }
 
@@ -206,23 +179,13 @@ fn dynamic_steady_state_matches_the_fixed_point() {
     assert!(close(m.force(v, &[fc], N), m.steady_state(v, N), 1e-15));
 }
 
+/// JSON and TOML round trips with every parameter perturbed, so that the defaults cannot
+/// hide a lost field.
 #[test]
 fn every_model_round_trips_through_json_and_toml() {
     for name in names() {
-        let mut m = default_model(&name).unwrap();
-        // Perturb every parameter so the defaults cannot hide a lost field.
-        let p: Vec<f64> = m.params().iter().map(|x| x * 1.1 + 0.001).collect();
-        m.set_params(&p).unwrap();
-        let json = serde_json::to_string(&m).unwrap();
-        let back: Box<dyn FrictionModel> = serde_json::from_str(&json).unwrap();
-        assert_eq!(back.name(), name);
-        assert_eq!(back.params(), p, "{name} JSON");
-        let text = toml::to_string(&m).unwrap();
-        let table: toml::Value = toml::from_str(&text).unwrap();
-        let built = build_toml(&table).unwrap();
-        assert_eq!(built.model.params(), p, "{name} TOML: {text}");
-        let back2: Box<dyn FrictionModel> = toml::from_str(&text).unwrap();
-        assert_eq!(back2.params(), p);
+        let m = default_model(&name).unwrap();
+        testing::check_serde(m.as_ref()).unwrap();
     }
 }
 

@@ -30,12 +30,14 @@ pub fn run(
     let b = bar.clone();
     let seen = Mutex::new(BTreeSet::new());
     let on_progress = move |p: &frictionid_engine::identify::Progress| {
+        b.observe(p);
         // Advance once per model, when its first iteration reports.
-        if let Ok(mut s) = seen.lock() {
-            if s.insert(p.model.clone()) {
-                b.set_message(format!("fitting {}", p.model));
-                b.inc(1);
-            }
+        if seen
+            .lock()
+            .map(|mut s| s.insert(p.model.clone()))
+            .unwrap_or(false)
+        {
+            b.inc(1);
         }
     };
     let mut report = compare_job(&cfg.spec, &models, &inputs.records, &hooks(on_progress))

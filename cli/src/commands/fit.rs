@@ -25,8 +25,15 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
         &format!("fitting {}", model.model.name()),
     );
     let b = bar.clone();
-    let mut report =
-        fit_job(&cfg.spec, &inputs.records, &hooks(move |_| b.inc(1))).map_err(|e| cfg.error(e))?;
+    let mut report = fit_job(
+        &cfg.spec,
+        &inputs.records,
+        &hooks(move |p| {
+            b.observe(p);
+            b.inc(1);
+        }),
+    )
+    .map_err(|e| cfg.error(e))?;
     bar.finish();
     report.config = config.display().to_string();
 

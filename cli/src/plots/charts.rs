@@ -1,11 +1,12 @@
 //! The named charts: one function per kind of figure the reports show.
 
-use super::{draw, Figure, Panel, Series};
+use super::{draw, Figure, Panel, Series, XTicks};
 use crate::error::CliError;
 use frictionid_models::FrictionModel;
 use std::path::Path;
 
-/// Measured and fitted velocity of one record (the paper's Fig. 8).
+/// Measured and fitted velocity of one record (the paper's Fig. 8), and under it their
+/// difference, where an offset or a misfit shows.
 pub fn velocity_fit(
     path: &Path,
     record: &str,
@@ -14,11 +15,33 @@ pub fn velocity_fit(
     fitted: &[f64],
     model: &str,
 ) -> Result<(), CliError> {
-    let panel = Panel::new("velocity", "m/s")
-        .with(Series::solid("measured", time, measured))
-        .with(Series::dashed(format!("fitted ({model})"), time, fitted));
+    let residual: Vec<f64> = measured.iter().zip(fitted).map(|(m, f)| m - f).collect();
+    let color = super::model_color(model);
+    let fit_panel = Panel::new("velocity", "m/s")
+        .with(Series::solid("measured", time, measured).color(super::MEASURED))
+        .with(Series::dashed(format!("fitted ({model})"), time, fitted).color(color));
+    let residual_panel = Panel::new("residual measured - fitted", "m/s")
+        .with(Series::solid("", time, &residual).width(1).color(color))
+        .with_reference("", 0.0);
     let title = format!("{record}: measured and fitted velocity");
-    draw(path, &Figure::over_time(title, vec![panel]))
+    draw(
+        path,
+        &Figure::over_time(title, vec![fit_panel, residual_panel]),
+    )
+}
+
+/// Displacement in mm when it stays within +-0.1 m (records of a few mm), else in m.
+fn displacement_panel<'a>(time: &'a [f64], x: &'a [f64], scaled: &'a mut Vec<f64>) -> Panel<'a> {
+    let peak = x
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    if peak < 0.1 {
+        *scaled = x.iter().map(|v| v * 1e3).collect();
+        line_panel(("displacement", "mm"), "x", time, scaled)
+    } else {
+        line_panel(("displacement", "m"), "x", time, x)
+    }
 }
 
 /// A panel with one solid line `name` of `y` against `time`; `axis` is (quantity, unit).
@@ -34,8 +57,9 @@ pub fn displacement_velocity(
     x: &[f64],
     v: &[f64],
 ) -> Result<(), CliError> {
+    let mut mm = Vec::new();
     let panels = vec![
-        line_panel(("displacement", "m"), "x", time, x),
+        displacement_panel(time, x, &mut mm),
         line_panel(("velocity", "m/s"), "v", time, v),
     ];
     draw(path, &Figure::over_time(title, panels))
@@ -49,8 +73,9 @@ pub fn displacement_acceleration(
     x: &[f64],
     a: &[f64],
 ) -> Result<(), CliError> {
+    let mut mm = Vec::new();
     let panels = vec![
-        line_panel(("displacement", "m"), "x", time, x),
+        displacement_panel(time, x, &mut mm),
         line_panel(("acceleration", "m/s²"), "a", time, a),
     ];
     draw(path, &Figure::over_time(title, panels))
@@ -95,53 +120,60 @@ pub fn friction_force(
     draw(path, &Figure::over_time(title, vec![panel]))
 }
 
+/// Half-width of the linear region of the steady-state chart's velocity axis \[m/s\]: below
+/// the smallest Stribeck velocities (1e-3 m/s) and above a vibrometer's noise.
+pub const STEADY_STATE_LINEAR_WIDTH: f64 = 1e-4;
+
 /// The steady-state friction curves F_ss(v) of several models on one chart, for
-/// v in [-v_max, v_max].
+/// v in [-v_max, v_max] on a symmetric-log axis (linear within +-1e-4 m/s, then one decade
+/// per unit), so that Stribeck regions (1e-3 to 1e-2 m/s) are as wide as the sliding range.
+/// Each model keeps its colour ([`super::model_color`]).
 pub fn steady_state_curves(
     path: &Path,
     models: &[(&str, &dyn FrictionModel)],
     normal_force: f64,
     v_max: f64,
 ) -> Result<(), CliError> {
-    let n = 801;
-    let v_max = if v_max.is_finite() && v_max > 0.0 {
+    let n = 1601;
+    let w = STEADY_STATE_LINEAR_WIDTH;
+    let v_max = if v_max.is_finite() && v_max > w {
         v_max
     } else {
         0.1
     };
-    let v: Vec<f64> = (0..n)
-        .map(|i| -v_max + 2.0 * v_max * i as f64 / (n - 1) as f64)
+    let u_max = super::symlog(v_max, w);
+    let u: Vec<f64> = (0..n)
+        .map(|i| -u_max + 2.0 * u_max * i as f64 / (n - 1) as f64)
         .collect();
-    let curves: Vec<(String, Vec<f64>)> = models
+    let v: Vec<f64> = u.iter().map(|&ui| super::symlog_inverse(ui, w)).collect();
+    let curves: Vec<Vec<f64>> = models
         .iter()
-        .map(|(name, m)| {
-            (
-                name.to_string(),
-                v.iter()
-                    .map(|&vi| m.steady_state(vi, normal_force))
-                    .collect(),
-            )
+        .map(|(_, m)| {
+            v.iter()
+                .map(|&vi| m.steady_state(vi, normal_force))
+                .collect()
         })
         .collect();
     // Earlier curves are drawn wider and later ones dashed, so that coinciding curves
     // stay visible.
     let mut panel = Panel::new("steady-state friction force F_ss", "N");
-    for (i, (name, f)) in curves.iter().enumerate() {
+    for (i, ((name, _), f)) in models.iter().zip(&curves).enumerate() {
         let width = 5u32.saturating_sub(i as u32).max(2);
         let s = if i >= 3 {
-            Series::dashed(name.clone(), &v, f)
+            Series::dashed(*name, &u, f)
         } else {
-            Series::solid(name.clone(), &v, f)
+            Series::solid(*name, &u, f)
         };
-        panel = panel.with(s.width(width));
+        panel = panel.with(s.width(width).color(super::model_color(name)));
     }
     let fig = Figure {
         title: format!(
             "Steady-state friction curves (N = {} N)",
             crate::report::fmt_num(normal_force)
         ),
-        x_label: "sliding velocity".into(),
+        x_label: "sliding velocity (symmetric log scale)".into(),
         x_unit: "m/s".into(),
+        x_ticks: XTicks::SymLog { linear_width: w },
         panels: vec![panel],
     };
     draw(path, &fig)

@@ -20,17 +20,37 @@ use panel::{draw_panel, range};
 use plotters::prelude::*;
 use std::path::Path;
 
-/// Line colours (Tableau 10), cycled.
-pub(crate) const COLORS: [RGBColor; 8] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(23, 190, 207),
+/// The palette of every plot: Okabe and Ito's colour-blind-safe colours with a dark grey and
+/// a brown, and a darkened yellow; cycled by series, or fixed per model by
+/// [`model_color`].
+pub const PALETTE: [RGBColor; 10] = [
+    RGBColor(0, 114, 178),   // blue
+    RGBColor(213, 94, 0),    // vermillion
+    RGBColor(0, 158, 115),   // bluish green
+    RGBColor(230, 159, 0),   // orange
+    RGBColor(204, 121, 167), // reddish purple
+    RGBColor(86, 180, 233),  // sky blue
+    RGBColor(0, 0, 0),       // black
+    RGBColor(102, 102, 102), // dark grey
+    RGBColor(140, 86, 75),   // brown
+    RGBColor(160, 140, 0),   // dark yellow (Okabe-Ito yellow is faint on white)
 ];
+
+/// The colour of measured data.
+pub const MEASURED: RGBColor = RGBColor(0, 0, 0);
+
+/// The grey of reference levels (both signs of +-mu N alike).
+pub const REFERENCE_GREY: RGBColor = RGBColor(90, 90, 90);
+
+/// The fixed colour of a registered model: its position among the registered names, so a
+/// model has the same colour on every chart of every report.
+pub fn model_color(model: &str) -> RGBColor {
+    let names = frictionid_models::names();
+    let index = names.iter().position(|n| n == model).unwrap_or(names.len());
+    // Black is kept for measured data.
+    let colours: Vec<RGBColor> = PALETTE.into_iter().filter(|c| *c != MEASURED).collect();
+    colours[index % colours.len()]
+}
 
 /// One named line.
 #[derive(Debug, Clone)]
@@ -45,6 +65,8 @@ pub struct Series<'a> {
     pub dashed: bool,
     /// Line width in pixels.
     pub width: u32,
+    /// Colour; `None`: the palette colour of the series' position.
+    pub color: Option<RGBColor>,
 }
 
 impl<'a> Series<'a> {
@@ -56,6 +78,15 @@ impl<'a> Series<'a> {
             y,
             dashed: false,
             width: 2,
+            color: None,
+        }
+    }
+
+    /// The same line in `color`.
+    pub fn color(self, color: RGBColor) -> Self {
+        Self {
+            color: Some(color),
+            ..self
         }
     }
 
@@ -122,6 +153,40 @@ impl<'a> Panel<'a> {
     }
 }
 
+/// How the x axis is labelled.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum XTicks {
+    /// Linear values.
+    #[default]
+    Linear,
+    /// The x values are [`symlog`] coordinates with this linear width: ticks at the decades
+    /// (integer coordinates) labelled with the velocity they stand for.
+    SymLog {
+        /// The half-width of the linear region around zero.
+        linear_width: f64,
+    },
+}
+
+/// The symmetric-log coordinate of `v`: linear (`v / w`) for |v| <= w, then one unit per
+/// decade, `sign(v) (1 + log10(|v| / w))`; continuous and odd.
+pub fn symlog(v: f64, w: f64) -> f64 {
+    let a = v.abs() / w;
+    if a <= 1.0 {
+        v / w
+    } else {
+        v.signum() * (1.0 + a.log10())
+    }
+}
+
+/// The inverse of [`symlog`].
+pub fn symlog_inverse(u: f64, w: f64) -> f64 {
+    if u.abs() <= 1.0 {
+        u * w
+    } else {
+        u.signum() * w * 10f64.powf(u.abs() - 1.0)
+    }
+}
+
 /// A figure: a title, a shared x axis and one or more panels stacked vertically.
 #[derive(Debug, Clone)]
 pub struct Figure<'a> {
@@ -131,6 +196,8 @@ pub struct Figure<'a> {
     pub x_label: String,
     /// Unit of the x axis.
     pub x_unit: String,
+    /// How the x axis is labelled.
+    pub x_ticks: XTicks,
     /// The panels, top to bottom.
     pub panels: Vec<Panel<'a>>,
 }
@@ -142,6 +209,7 @@ impl<'a> Figure<'a> {
             title: title.into(),
             x_label: "time".into(),
             x_unit: "s".into(),
+            x_ticks: XTicks::Linear,
             panels,
         }
     }
@@ -189,6 +257,36 @@ mod tests {
     use super::*;
 
     #[test]
+    fn symlog_is_odd_continuous_and_inverted() {
+        let w = 1e-4;
+        for v in [-0.3, -1e-3, -1e-4, -3e-5, 0.0, 2e-5, 1e-4, 5e-3, 0.28] {
+            assert!((symlog(-v, w) + symlog(v, w)).abs() < 1e-12);
+            assert!((symlog_inverse(symlog(v, w), w) - v).abs() < 1e-12 * v.abs().max(1e-9));
+        }
+        assert!(
+            (symlog(1e-2, w) - 3.0).abs() < 1e-12,
+            "decades are integers"
+        );
+        assert!(
+            (symlog(w * (1.0 + 1e-12), w) - 1.0).abs() < 1e-9,
+            "continuous at w"
+        );
+    }
+
+    #[test]
+    fn models_keep_their_colour_and_colours_are_distinct() {
+        assert_eq!(model_color("coulomb"), model_color("coulomb"));
+        assert_ne!(model_color("coulomb"), MEASURED);
+        let names = frictionid_models::names();
+        let colors: Vec<RGBColor> = names.iter().map(|n| model_color(n)).collect();
+        for i in 0..colors.len().min(PALETTE.len() - 1) {
+            for j in 0..i {
+                assert_ne!(colors[i], colors[j], "{} and {}", names[i], names[j]);
+            }
+        }
+    }
+
+    #[test]
     fn segments_split_at_non_finite_values() {
         let x = [0.0, 1.0, 2.0, 3.0, 4.0];
         let y = [1.0, f64::NAN, 2.0, 3.0, f64::INFINITY];
@@ -223,6 +321,7 @@ mod tests {
             title: "T1".into(),
             x_label: "time".into(),
             x_unit: "s".into(),
+            x_ticks: XTicks::Linear,
             panels: vec![Panel::new("velocity", "m/s")
                 .with(Series::solid("measured", &t, &y1))
                 .with(Series::dashed("fitted", &t, &y2))

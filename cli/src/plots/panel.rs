@@ -1,6 +1,6 @@
 //! Drawing one panel of a figure: axes, lines, reference levels and the legend.
 
-use super::{Figure, Panel, COLORS};
+use super::{symlog_inverse, Figure, Panel, XTicks, PALETTE, REFERENCE_GREY};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -37,6 +37,25 @@ pub(super) fn tick(v: f64, span: f64) -> String {
         s.trim_end_matches('0').trim_end_matches('.').to_string()
     } else {
         s
+    }
+}
+
+/// Tick label of an x coordinate: linear, or on a symmetric-log axis the velocity of a
+/// decade (`1e-3`) and nothing between decades.
+fn x_tick(u: f64, span: f64, ticks: XTicks) -> String {
+    match ticks {
+        XTicks::Linear => tick(u, span),
+        XTicks::SymLog { linear_width } => {
+            if (u - u.round()).abs() > 1e-6 {
+                return String::new();
+            }
+            let v = symlog_inverse(u.round(), linear_width);
+            if v == 0.0 {
+                "0".into()
+            } else {
+                format!("{v:.0e}")
+            }
+        }
     }
 }
 
@@ -89,9 +108,9 @@ fn legend_entries(panel: &Panel<'_>) -> usize {
             .count()
 }
 
-/// A legend is drawn for more than one line, or any reference line.
+/// A legend is drawn for more than one labelled line, or any labelled reference line.
 fn shows_legend(panel: &Panel<'_>) -> bool {
-    legend_entries(panel) > 1 || !panel.reference.is_empty()
+    legend_entries(panel) > 1 || panel.reference.iter().any(|r| !r.label.is_empty())
 }
 
 /// The y range of the panel's lines and levels, padded; with a legend, extended upwards so
@@ -120,9 +139,13 @@ fn draw_mesh(
     spans: (f64, f64),
     is_last: bool,
 ) -> PlotResult<()> {
-    let x_fmt = |v: &f64| tick(*v, spans.0);
+    let x_fmt = |v: &f64| x_tick(*v, spans.0, fig.x_ticks);
     let y_fmt = |v: &f64| tick(*v, spans.1);
     let mut mesh = chart.configure_mesh();
+    if let XTicks::SymLog { .. } = fig.x_ticks {
+        // One label per decade: integer coordinates only.
+        mesh.x_labels(spans.0.ceil() as usize + 1);
+    }
     mesh.y_desc(axis_text(&panel.y_label, &panel.y_unit))
         .x_label_formatter(&x_fmt)
         .y_label_formatter(&y_fmt)
@@ -135,12 +158,22 @@ fn draw_mesh(
     mesh.draw().map_err(|e| e.to_string())
 }
 
+/// Where the two strokes of a 24 px legend swatch end and start: a gap for a dashed line,
+/// none for a solid one, so that the swatch is drawn like its line.
+fn swatch_gap(dashed: bool) -> (i32, i32) {
+    if dashed {
+        (9, 14)
+    } else {
+        (12, 12)
+    }
+}
+
 /// The panel's lines, broken at non-finite values, each labelled once in the legend.
-fn draw_lines(chart: &mut Chart<'_, '_>, panel: &Panel<'_>) -> PlotResult<()> {
+fn draw_lines<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, panel: &Panel<'_>) -> PlotResult<()> {
     for (i, s) in panel.series.iter().enumerate() {
-        let color = COLORS[i % COLORS.len()];
+        let color = s.color.unwrap_or(PALETTE[i % PALETTE.len()]);
         let style = color.stroke_width(s.width);
-        let width = s.width;
+        let (width, dashed) = (s.width, s.dashed);
         for (k, seg) in segments(s.x, s.y).into_iter().enumerate() {
             let anno = if s.dashed {
                 chart
@@ -152,8 +185,12 @@ fn draw_lines(chart: &mut Chart<'_, '_>, panel: &Panel<'_>) -> PlotResult<()> {
                     .map_err(|e| e.to_string())?
             };
             if k == 0 && !s.label.is_empty() {
+                let (end, start) = swatch_gap(dashed);
+                let st = color.stroke_width(width);
                 anno.label(s.label.clone()).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 22, y)], color.stroke_width(width))
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (end, 0)], st)
+                        + PathElement::new(vec![(start, 0), (23, 0)], st)
                 });
             }
         }
@@ -162,25 +199,23 @@ fn draw_lines(chart: &mut Chart<'_, '_>, panel: &Panel<'_>) -> PlotResult<()> {
 }
 
 /// Dashed horizontal reference levels across the whole x range.
-fn draw_references(
-    chart: &mut Chart<'_, '_>,
+fn draw_references<'a, 'b: 'a>(
+    chart: &mut Chart<'a, 'b>,
     panel: &Panel<'_>,
     x_range: (f64, f64),
 ) -> PlotResult<()> {
-    for (j, r) in panel.reference.iter().enumerate() {
-        let color = if j == 0 {
-            BLACK
-        } else {
-            RGBColor(110, 110, 110)
-        };
-        let style = color.stroke_width(1);
+    for r in &panel.reference {
+        let style = REFERENCE_GREY.stroke_width(1);
         let line = vec![(x_range.0, r.y), (x_range.1, r.y)];
         let anno = chart
             .draw_series(DashedLineSeries::new(line, 6, 4, style))
             .map_err(|e| e.to_string())?;
         if !r.label.is_empty() {
+            let (end, start) = swatch_gap(true);
             anno.label(r.label.clone()).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 8, y), (x + 14, y), (x + 22, y)], style)
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (end, 0)], style)
+                    + PathElement::new(vec![(start, 0), (23, 0)], style)
             });
         }
     }

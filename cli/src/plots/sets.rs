@@ -61,6 +61,22 @@ pub fn where_defined(model_force: &[f64], energy_force: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// `force` with a gap wherever the velocity `v` reverses between two samples, so that a
+/// trace is never joined across a reversal (where Eq. 7 jumps from +F to -F). Unchanged
+/// when the lengths differ.
+pub fn break_at_reversals(force: &[f64], v: &[f64]) -> Vec<f64> {
+    let mut out = force.to_vec();
+    if force.len() != v.len() {
+        return out;
+    }
+    for i in 1..v.len() {
+        if v[i] * v[i - 1] < 0.0 {
+            out[i] = f64::NAN;
+        }
+    }
+    out
+}
+
 /// `simulate`: displacement and velocity; energies and the dissipation rate.
 pub fn simulate_plots(out: &OutputDir, report: &SimulateReport) -> Result<Vec<String>, CliError> {
     let traj = &report.trajectory;
@@ -103,7 +119,8 @@ fn fit_force_plot(
     fit: &FitResult,
     r: &RecordFit,
 ) -> Result<(), CliError> {
-    let shown = where_defined(&r.model_force, &r.energy_based_force);
+    let energy = break_at_reversals(&r.energy_based_force, &r.measured);
+    let shown = where_defined(&r.model_force, &energy);
     let label = format!("model ({})", fit.model);
     let reference = r.energy_force.as_ref().map(|e| e.reference);
     let ref_label = reference
@@ -113,7 +130,7 @@ fn fit_force_plot(
         &out.path(name),
         &format!("{}: energy-based and model friction force", r.file),
         &r.time,
-        &r.energy_based_force,
+        &energy,
         Some((label.as_str(), shown.as_slice())),
         reference
             .filter(|x| x.is_finite())
@@ -211,16 +228,14 @@ fn energy_record_plots(
         .reference_model
         .as_ref()
         .map(|m| format!("model ({m})"));
-    let model_shown = r
-        .model_force
-        .as_ref()
-        .map(|f| where_defined(f, &a.friction));
+    let energy = break_at_reversals(&a.friction, &a.v);
+    let model_shown = r.model_force.as_ref().map(|f| where_defined(f, &energy));
     let ref_label = format!("reference ±{} N", fmt_num(r.reference));
     super::friction_force(
         &out.path(&ff),
         &format!("{}: friction force", r.file),
         &a.time,
-        &a.friction,
+        &energy,
         model_label.as_deref().zip(model_shown.as_deref()),
         Some((ref_label.as_str(), r.reference)).filter(|(_, v)| v.is_finite()),
     )?;
@@ -261,6 +276,16 @@ mod tests {
             unique_stems(&["data.csv", "data.csv"]),
             ["data_1", "data_2"]
         );
+    }
+
+    #[test]
+    fn traces_break_at_velocity_reversals() {
+        let f = [1.0, 1.0, -1.0, -1.0, 1.0];
+        let v = [0.2, 0.1, -0.1, -0.2, 0.1];
+        let b = break_at_reversals(&f, &v);
+        assert_eq!(b[..2], [1.0, 1.0]);
+        assert!(b[2].is_nan() && b[4].is_nan());
+        assert_eq!(b[3], -1.0);
     }
 
     #[test]

@@ -26,6 +26,10 @@ impl Separator {
             DataFormat::Whitespace => Separator::Whitespace,
             DataFormat::Csv => by_char.unwrap_or(Separator::Char(',')),
             _ => match by_char {
+                // Tabs separate names that hold spaces (`Time [s]`); otherwise any whitespace.
+                Some(Separator::Char('\t')) if tab_fields_hold_spaces(header) => {
+                    Separator::Char('\t')
+                }
                 Some(Separator::Char('\t')) | None => Separator::Whitespace,
                 Some(sep) => sep,
             },
@@ -38,6 +42,13 @@ impl Separator {
             Separator::Whitespace => line.split_whitespace().map(clean_field).collect(),
         }
     }
+}
+
+/// Whether a tab-separated header has a column name with a space inside.
+fn tab_fields_hold_spaces(header: &str) -> bool {
+    header
+        .split('\t')
+        .any(|f| f.trim().contains(char::is_whitespace))
 }
 
 fn clean_field(field: &str) -> &str {

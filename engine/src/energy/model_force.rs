@@ -15,8 +15,9 @@
 //! `state_derivative`, so every registered model works unchanged.
 
 use super::EnergyAnalysis;
-use crate::error::EngineError;
+use crate::error::{EngineError, IntegrationFailure};
 use crate::oscillator::Oscillator;
+use crate::simulate::{BogackiShampine, OdeSystem, StepOutcome, Stepper};
 use frictionid_models::FrictionModel;
 use serde::Serialize;
 
@@ -76,12 +77,23 @@ pub fn model_force_along(
     }
     let mut z = vec![0.0; ns];
     let mut out = Vec::with_capacity(v.len());
-    let mut stepper = Stepper::new(ns);
+    let mut stepper = BogackiShampine::new(ns, RTOL, ATOL);
     for i in 0..time.len() {
         if i > 0 {
-            let (t0, t1) = (time[i - 1], time[i]);
-            let (v0, v1) = (v[i - 1], v[i]);
-            stepper.advance(model, normal, &mut z, t0, t1, v0, v1)?;
+            let along = AlongMotion {
+                model,
+                normal,
+                t0: time[i - 1],
+                v0: v[i - 1],
+                v1: v[i],
+                span: time[i] - time[i - 1],
+            };
+            integrate_interval(&mut stepper, &along, &mut z).map_err(|failure| {
+                EngineError::StateIntegration {
+                    model: model.name().to_string(),
+                    failure,
+                }
+            })?;
         }
         out.push(model.force(v[i], &z, normal));
     }
@@ -133,116 +145,49 @@ pub fn force_residuals(
     })
 }
 
-/// Adaptive Bogacki-Shampine 3(2) integrator of z' = f(v(t), z) with v linear in t.
-struct Stepper {
-    h: f64,
-    steps: u64,
-    k: [Vec<f64>; 4],
-    tmp: Vec<f64>,
-    next: Vec<f64>,
+/// The states' equation along one sample interval: z' = f(v(t), z) with v linear from
+/// (t0, v0) to (t0 + span, v1).
+struct AlongMotion<'a> {
+    model: &'a dyn FrictionModel,
+    normal: f64,
+    t0: f64,
+    v0: f64,
+    v1: f64,
+    span: f64,
 }
 
-impl Stepper {
-    fn new(ns: usize) -> Self {
-        Self {
-            h: 0.0,
-            steps: 0,
-            k: [vec![0.0; ns], vec![0.0; ns], vec![0.0; ns], vec![0.0; ns]],
-            tmp: vec![0.0; ns],
-            next: vec![0.0; ns],
-        }
+impl OdeSystem for AlongMotion<'_> {
+    fn rhs(&self, t: f64, z: &[f64], dz: &mut [f64]) {
+        let v = self.v0 + (self.v1 - self.v0) * (t - self.t0) / self.span;
+        self.model.state_derivative(v, z, self.normal, dz);
     }
+}
 
-    #[allow(clippy::too_many_arguments)]
-    fn advance(
-        &mut self,
-        model: &dyn FrictionModel,
-        normal: f64,
-        z: &mut [f64],
-        t0: f64,
-        t1: f64,
-        v0: f64,
-        v1: f64,
-    ) -> Result<(), EngineError> {
-        let span = t1 - t0;
-        let vel = |t: f64| v0 + (v1 - v0) * (t - t0) / span;
-        let mut t = t0;
-        if self.h.is_nan() || self.h <= 0.0 || self.h > span {
-            self.h = span;
+/// Integrates the states `z` over one sample interval (the stepper keeps its step size
+/// across intervals).
+fn integrate_interval(
+    stepper: &mut BogackiShampine,
+    along: &AlongMotion<'_>,
+    z: &mut [f64],
+) -> Result<(), IntegrationFailure> {
+    stepper.reset(along, along.t0, z, along.t0 + along.span)?;
+    while !stepper.reached_end() {
+        if stepper.counts().attempts() >= MAX_SUBSTEPS {
+            return Err(IntegrationFailure::StepBudgetExceeded {
+                time: stepper.time(),
+                max_steps: MAX_SUBSTEPS,
+            });
         }
-        let [k1, k2, k3, k4] = &mut self.k;
-        model.state_derivative(vel(t), z, normal, k1);
-        while t < t1 {
-            let last = t + self.h >= t1 - 1e-12 * span;
-            let h = if last { t1 - t } else { self.h };
-            self.steps += 1;
-            if self.steps > MAX_SUBSTEPS {
-                return Err(EngineError::Integration {
-                    time: t,
-                    reason: format!(
-                        "model `{}`: more than {MAX_SUBSTEPS} sub-steps integrating its states \
-                         along the measured velocity",
-                        model.name()
-                    ),
-                });
-            }
-            for j in 0..z.len() {
-                self.tmp[j] = z[j] + 0.5 * h * k1[j];
-            }
-            model.state_derivative(vel(t + 0.5 * h), &self.tmp, normal, k2);
-            for j in 0..z.len() {
-                self.tmp[j] = z[j] + 0.75 * h * k2[j];
-            }
-            model.state_derivative(vel(t + 0.75 * h), &self.tmp, normal, k3);
-            for j in 0..z.len() {
-                self.next[j] =
-                    z[j] + h * (2.0 / 9.0 * k1[j] + 1.0 / 3.0 * k2[j] + 4.0 / 9.0 * k3[j]);
-            }
-            model.state_derivative(vel(t + h), &self.next, normal, k4);
-            let mut err: f64 = 0.0;
-            for j in 0..z.len() {
-                let low = z[j]
-                    + h * (7.0 / 24.0 * k1[j] + 0.25 * k2[j] + 1.0 / 3.0 * k3[j] + 0.125 * k4[j]);
-                let scale = ATOL + RTOL * z[j].abs().max(self.next[j].abs());
-                err = err.max((self.next[j] - low).abs() / scale);
-            }
-            if !err.is_finite() {
-                err = f64::INFINITY;
-            }
-            if err <= 1.0 {
-                t = if last { t1 } else { t + h };
-                z.copy_from_slice(&self.next);
-                k1.copy_from_slice(k4);
-                if !z.iter().all(|x| x.is_finite()) {
-                    return Err(EngineError::Integration {
-                        time: t,
-                        reason: format!("model `{}`: a state became non-finite", model.name()),
-                    });
-                }
-            }
-            let factor = if err == 0.0 {
-                5.0
-            } else {
-                (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 5.0)
-            };
-            let proposed = h * factor;
-            // Keep the step size learnt in the interval, unless the last (shortened) step
-            // was accepted: then carry the regular step into the next interval.
-            self.h = if last && err <= 1.0 && h < self.h {
-                self.h.max(proposed)
-            } else {
-                proposed
-            };
-            if self.h < 1e-14 * span.max(1e-300) {
-                return Err(EngineError::Integration {
-                    time: t,
-                    reason: format!(
-                        "model `{}`: step size underflow integrating its states",
-                        model.name()
-                    ),
-                });
-            }
+        // No events along a measured motion: the event function stays positive.
+        let outcome = stepper.step(along, |_| 1.0)?;
+        let state = stepper.state();
+        if outcome != StepOutcome::Rejected && state.iter().any(|x| !x.is_finite()) {
+            return Err(IntegrationFailure::NonFiniteState {
+                time: stepper.time(),
+                state: state.to_vec(),
+            });
         }
-        Ok(())
     }
+    z.copy_from_slice(stepper.state());
+    Ok(())
 }

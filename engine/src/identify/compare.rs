@@ -19,15 +19,45 @@ pub struct FailedFit {
     pub error: String,
 }
 
+/// Models whose AIC is within this of the best are indistinguishable on the data (Burnham
+/// and Anderson's rule of thumb: substantial support).
+pub const INDISTINGUISHABLE_DELTA_AIC: f64 = 2.0;
+
 /// Models ranked by AIC (best first), with BIC and RMS in each fit.
 #[derive(Debug, Clone, Serialize)]
 pub struct Comparison {
-    /// The fits, best (lowest AIC) first.
+    /// The fits, best (lowest AIC) first, each with its [`super::result::Rank`].
     pub ranking: Vec<FitResult>,
     /// Models whose fit failed.
     pub failed: Vec<FailedFit>,
+    /// What the ranking says (`None` when no model could be fitted).
+    pub verdict: Option<ComparisonVerdict>,
+    /// Models that did not converge, and failed fits, as sentences.
+    pub warnings: Vec<String>,
     /// Wall time of the whole comparison [s].
     pub wall_time_s: f64,
+}
+
+/// The verdict of a comparison: the best model, those the data cannot tell from it, and
+/// the simplest of these (fewest free parameters, then lowest AIC).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ComparisonVerdict {
+    /// The model with the lowest AIC.
+    pub best: String,
+    /// Every model within [`INDISTINGUISHABLE_DELTA_AIC`] of the best, best included.
+    pub indistinguishable: Vec<String>,
+    /// The simplest of `indistinguishable`: the model to report.
+    pub simplest: String,
+    /// One sentence for people.
+    pub message: String,
+}
+
+impl Comparison {
+    /// The verdict of the best fit (`None` when no model could be fitted): the CLI exits 2
+    /// when it did not converge.
+    pub fn best_verdict(&self) -> Option<super::result::Verdict> {
+        self.ranking.first().map(FitResult::verdict)
+    }
 }
 
 /// Fits every model in `models` to `records` (in parallel when `opts.parallel`) and ranks
@@ -73,9 +103,86 @@ pub fn compare(
         }
     }
     ranking.sort_by(|a, b| a.aic.total_cmp(&b.aic));
+    rank(&mut ranking);
+    let warnings = comparison_warnings(&ranking, &failed);
     Ok(Comparison {
+        verdict: verdict(&ranking),
         ranking,
         failed,
+        warnings,
         wall_time_s: clock.elapsed().as_secs_f64(),
     })
+}
+
+/// Sets every fit's delta AIC, Akaike weight and whether it is indistinguishable from the
+/// best; `ranking` is sorted by AIC.
+fn rank(ranking: &mut [FitResult]) {
+    let Some(best) = ranking.first().map(|f| f.aic) else {
+        return;
+    };
+    let relative: Vec<f64> = ranking
+        .iter()
+        .map(|f| (-(f.aic - best) / 2.0).exp())
+        .collect();
+    let total: f64 = relative.iter().sum();
+    for (fit, l) in ranking.iter_mut().zip(relative) {
+        let delta_aic = fit.aic - best;
+        fit.rank = Some(super::result::Rank {
+            delta_aic,
+            akaike_weight: l / total,
+            indistinguishable: delta_aic <= INDISTINGUISHABLE_DELTA_AIC,
+        });
+    }
+}
+
+fn is_indistinguishable(fit: &FitResult) -> bool {
+    fit.rank.is_some_and(|r| r.indistinguishable)
+}
+
+/// The best model, its indistinguishable rivals and the simplest of them.
+fn verdict(ranking: &[FitResult]) -> Option<ComparisonVerdict> {
+    let best = ranking.first()?;
+    let close: Vec<&FitResult> = ranking.iter().filter(|f| is_indistinguishable(f)).collect();
+    let simplest = close
+        .iter()
+        .min_by(|a, b| {
+            a.free_parameters
+                .cmp(&b.free_parameters)
+                .then(a.aic.total_cmp(&b.aic))
+        })
+        .map_or(best, |f| *f);
+    let names: Vec<String> = close.iter().map(|f| f.model.clone()).collect();
+    let message = if names.len() > 1 {
+        format!(
+            "{} are indistinguishable on this data (AIC within {INDISTINGUISHABLE_DELTA_AIC} of the best); the simplest is `{}`",
+            names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", "),
+            simplest.model
+        )
+    } else {
+        let margin = ranking
+            .get(1)
+            .map(|f| format!(" (next: `{}`, delta AIC {:.1})", f.model, f.aic - best.aic))
+            .unwrap_or_default();
+        format!("best: `{}`{margin}", best.model)
+    };
+    Some(ComparisonVerdict {
+        best: best.model.clone(),
+        indistinguishable: names,
+        simplest: simplest.model.clone(),
+        message,
+    })
+}
+
+/// A warning per model that did not converge.
+fn comparison_warnings(ranking: &[FitResult], failed: &[FailedFit]) -> Vec<String> {
+    let unconverged = ranking.iter().filter(|f| !f.converged).map(|f| {
+        format!(
+            "model `{}` did not converge ({}): its rank is not reliable",
+            f.model, f.termination
+        )
+    });
+    let failures = failed
+        .iter()
+        .map(|f| format!("model `{}` could not be fitted: {}", f.model, f.error));
+    unconverged.chain(failures).collect()
 }

@@ -36,6 +36,13 @@ pub struct EnergyForce {
     pub samples: usize,
     /// Mean friction force of the half-cycles (energy balance, no differentiation) [N].
     pub half_cycle_mean: f64,
+    /// The reference as a distance mean, comparable with the half-cycle estimate (energy
+    /// per distance): the model's sum |F| |v| / sum |v| over the samples compared, or the
+    /// given level [N].
+    pub half_cycle_reference: f64,
+    /// 100 (half_cycle_mean - half_cycle_reference) / half_cycle_reference (NaN without a
+    /// complete half-cycle).
+    pub half_cycle_percent_difference: f64,
 }
 
 /// Holds the energy-based force of `analysis` against `reference`.
@@ -49,7 +56,7 @@ pub fn energy_force_check(
     reference: ForceReference<'_>,
 ) -> Result<EnergyForce, EngineError> {
     let energy = &analysis.friction;
-    let (level, residual_rms, samples) = match reference {
+    let (level, distance_level, residual_rms, samples) = match reference {
         ForceReference::ModelForce(model) => {
             if model.len() != energy.len() {
                 return Err(EngineError::InvalidInput(format!(
@@ -59,9 +66,11 @@ pub fn energy_force_check(
                 )));
             }
             let (rms, used) = residual_rms(energy, model)?;
-            (mean_abs_where_defined(model, energy), rms, used)
+            let distance = distance_mean(model, energy, &analysis.v);
+            (mean_abs_where_defined(model, energy), distance, rms, used)
         }
         ForceReference::Level(level) => (
+            level,
             level,
             f64::NAN,
             energy.iter().filter(|f| f.is_finite()).count(),
@@ -74,31 +83,47 @@ pub fn energy_force_check(
         residual_rms,
         samples,
         half_cycle_mean: analysis.half_cycle_mean,
+        half_cycle_reference: distance_level,
+        half_cycle_percent_difference: percent_difference(analysis.half_cycle_mean, distance_level),
     })
 }
 
-/// RMS of energy minus model force over the samples where the energy force is defined, and
-/// their count.
+/// The distance mean sum |F| |v| / sum |v| of a model force over the samples where the
+/// energy-based force is defined (NaN when none is).
+fn distance_mean(model: &[f64], energy: &[f64], v: &[f64]) -> f64 {
+    let (work, distance) = model
+        .iter()
+        .zip(energy)
+        .zip(v)
+        .filter(|((m, e), _)| e.is_finite() && m.is_finite())
+        .fold((0.0, 0.0), |(w, d), ((m, _), v)| {
+            (w + m.abs() * v.abs(), d + v.abs())
+        });
+    if distance > 0.0 {
+        work / distance
+    } else {
+        f64::NAN
+    }
+}
+
+/// RMS of energy minus model force over the samples where both are defined, and their count.
 fn residual_rms(energy: &[f64], model: &[f64]) -> Result<(f64, usize), EngineError> {
-    let (sum, used) = energy
+    let residual: Vec<f64> = energy
         .iter()
         .zip(model)
-        .filter(|(e, _)| !e.is_nan())
         .map(|(e, m)| e - m)
         .filter(|r| !r.is_nan())
-        .fold((0.0, 0usize), |(s, n), r| (s + r * r, n + 1));
-    if used == 0 {
-        return Err(EngineError::InvalidInput(
+        .collect();
+    let rms = (residual.iter().map(|r| r * r).sum::<f64>() / residual.len() as f64).sqrt();
+    match (residual.len(), rms.is_finite()) {
+        (0, _) => Err(EngineError::InvalidInput(
             "no unmasked samples to compare the model force with".into(),
-        ));
-    }
-    let rms = (sum / used as f64).sqrt();
-    if !rms.is_finite() {
-        return Err(EngineError::InvalidInput(
+        )),
+        (_, false) => Err(EngineError::InvalidInput(
             "the model gives a non-finite force along the motion".into(),
-        ));
+        )),
+        (used, true) => Ok((rms, used)),
     }
-    Ok((rms, used))
 }
 
 #[cfg(test)]
@@ -126,6 +151,10 @@ mod tests {
         let ef = energy_force_check(&a, ForceReference::ModelForce(&fr.model_force)).unwrap();
         let mu_n = 0.24 * osc.normal_force;
         assert!((ef.reference - mu_n).abs() < 1e-12);
+        // Coulomb friction is the same at every speed: its distance mean is mu N too, and
+        // the half-cycle estimate (energy per distance) finds it.
+        assert!((ef.half_cycle_reference - mu_n).abs() < 1e-12);
+        assert!(ef.half_cycle_percent_difference.abs() < 0.5);
         assert!(
             ef.percent_difference.abs() < 1e-6,
             "{}",

@@ -2,15 +2,16 @@
 //! lays out the free parameters, runs the starts and turns the best one into a [`FitResult`]
 //! (statistics, per-record fits, the energy-balance check and the findings).
 
+use super::diagnostics;
 use super::energy_check::{energy_force_check, EnergyForce, ForceReference};
 use super::layout::{FreeParam, ParamKind};
 use super::options::{FitOptions, OscillatorParam};
 use super::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
 use super::problem::{FitProblem, ProblemParts, Realised};
-use super::residuals::{Residuals, VelocityResponse};
+use super::residuals::{NuisanceValues, Residuals, VelocityResponse};
 use super::setup::{build_layout, Layout};
 use super::starts::{fit_starting_points, run_starts, start_count, MultiStart, StartRun};
-use super::stats::{aic, bic, covariance, t_quantile_975, Covariance};
+use super::stats::{self, aic, bic, covariance, t_quantile_975, Covariance};
 use crate::energy::{analyze_record, model_force_along};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
@@ -20,7 +21,7 @@ use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use super::result::{Derived, FitResult, FittedParam, RecordFit};
+pub use super::result::{Derived, FitResult, FittedParam, Rank, RecordFit};
 pub use super::setup::guess_hint;
 pub use super::starts::{DEFAULT_STARTS, MAX_STARTS, PROMOTED_STARTS, SCREEN_ITERATIONS};
 
@@ -36,7 +37,7 @@ pub fn fit(
     records: &[Record],
     opts: &FitOptions,
 ) -> Result<FitResult, EngineError> {
-    let residuals = VelocityResponse::new(opts.velocity_offset, opts.time_shift);
+    let residuals = VelocityResponse::new(opts.velocity_offset, opts.time_shift, opts.x0);
     fit_with(Arc::new(residuals), osc, model, records, opts)
 }
 
@@ -136,6 +137,8 @@ struct Statistics {
     cov: Covariance,
     ssr: f64,
     t_quantile: f64,
+    /// Says how the standard errors were widened for autocorrelated residuals.
+    widening: Option<Finding>,
 }
 
 fn statistics<R: Residuals>(
@@ -146,7 +149,14 @@ fn statistics<R: Residuals>(
     let p_best = reference.physical(&best.u);
     let (jac, r) = reference.jacobian_physical(&p_best)?;
     let ssr = r.norm_squared();
-    let cov = covariance(&jac, ssr);
+    let mut cov = covariance(&jac, ssr);
+    let segments: Vec<usize> = reference
+        .records
+        .iter()
+        .enumerate()
+        .map(|(i, rec)| reference.residuals.residual_count(i, rec))
+        .collect();
+    let widening = widen_for_autocorrelation(&mut cov, &jac, r.as_slice(), &segments);
     let t_quantile = t_quantile_975(cov.dof);
     let world = reference.realise(&p_best)?;
     Ok(Statistics {
@@ -155,7 +165,64 @@ fn statistics<R: Residuals>(
         cov,
         ssr,
         t_quantile,
+        widening,
     })
+}
+
+/// Noise lag-1 correlation above which standard errors are checked for widening (white
+/// noise gives about 1/sqrt(n), far below).
+pub const AUTOCORRELATION_THRESHOLD: f64 = 0.1;
+
+/// Widens the covariance when the residuals are autocorrelated: each standard error becomes
+/// the larger of the classical and the Newey-West one (Bartlett lags covering the noise's
+/// correlation time), keeping the correlations. Returns the finding that says so.
+fn widen_for_autocorrelation(
+    cov: &mut Covariance,
+    jac: &DMatrix<f64>,
+    r: &[f64],
+    segments: &[usize],
+) -> Option<Finding> {
+    let mut start = 0;
+    let parts: Vec<Vec<f64>> = segments
+        .iter()
+        .map(|&len| {
+            let part = r[start..(start + len).min(r.len())].to_vec();
+            start += len;
+            part
+        })
+        .collect();
+    let phi = diagnostics::noise_correlation(&parts);
+    if phi <= AUTOCORRELATION_THRESHOLD
+        || cov.singular
+        || cov.residual_variance.is_nan()
+        || cov.residual_variance <= 0.0
+    {
+        return None;
+    }
+    let shortest = segments.iter().copied().min().unwrap_or(0);
+    let lags = ((5.0 * (1.0 + phi) / (1.0 - phi)).ceil() as usize).clamp(1, shortest / 4 + 1);
+    let bread = &cov.matrix / cov.residual_variance;
+    let hac = stats::newey_west(jac, r, segments, lags, &bread);
+    let p = cov.std_errors.len();
+    let factors: Vec<f64> = (0..p)
+        .map(|i| (hac[(i, i)] / cov.matrix[(i, i)]).sqrt())
+        .map(|f| if f.is_finite() { f.max(1.0) } else { 1.0 })
+        .collect();
+    for a in 0..p {
+        for b in 0..p {
+            cov.matrix[(a, b)] *= factors[a] * factors[b];
+        }
+        cov.std_errors[a] *= factors[a];
+    }
+    let widest = factors.iter().copied().fold(1.0, f64::max);
+    Some(Finding::new(
+        Check::NoiseCorrelation,
+        Status::Pass,
+        Some(widest),
+        format!(
+            "residuals are autocorrelated (noise lag-1 correlation {phi:.2}): standard errors widened by up to {widest:.2}x (Newey-West, {lags} lags)"
+        ),
+    ))
 }
 
 /// Statistics, per-record fits, the energy check and the findings at the best start.
@@ -167,16 +234,10 @@ fn finish<R: Residuals>(
     let params = &ctx.layout.params;
     let stats = statistics(ctx.reference, &runs.best)?;
     let mut simulations = runs.simulations + ctx.reference.simulations();
-    let mut findings = start_findings(&runs.outcomes);
-    findings.extend(correlation_findings(params, &stats.cov));
-    findings.extend(identifiability_findings(
-        &stats.cov,
-        ctx.opts,
-        ctx.layout.n_model_free(),
-    ));
     let fits = record_fits(ctx.reference, &stats.world, ctx.opts)?;
     simulations += ctx.reference.records.len() as u64;
-    findings.extend(fits.findings);
+    let parameters = parameter_entries(&stats, params);
+    let findings = diagnose(ctx, &runs, &stats, &parameters, &fits);
     let n_free = params.len();
     let samples = ctx.reference.n_residuals();
     let k = params.len();
@@ -187,7 +248,7 @@ fn finish<R: Residuals>(
         .collect();
     Ok(FitResult {
         model: stats.world.model.name().to_string(),
-        parameters: parameter_entries(&stats, params),
+        parameters,
         correlation_names: params.iter().map(|f| f.name.clone()).collect(),
         correlation: (0..k)
             .map(|a| (0..k).map(|b| stats.cov.correlation[(a, b)]).collect())
@@ -210,9 +271,43 @@ fn finish<R: Residuals>(
         diagnostics: findings,
         warnings,
         wall_time_s: clock.elapsed().as_secs_f64(),
+        rank: None,
         fitted_model: stats.world.model,
         oscillator: stats.world.oscillator,
     })
+}
+
+/// Every check of the fit, in report order.
+fn diagnose<R: Residuals>(
+    ctx: &FinishContext<'_, R>,
+    runs: &MultiStart,
+    stats: &Statistics,
+    parameters: &[FittedParam],
+    fits: &RecordFits,
+) -> Vec<Finding> {
+    let params = &ctx.layout.params;
+    let mut findings = vec![diagnostics::convergence(&runs.best.termination)];
+    findings.extend(start_findings(&runs.outcomes));
+    findings.extend(diagnostics::start_agreement(
+        &runs.outcomes,
+        runs.best.cost,
+        stats.cov.residual_variance,
+    ));
+    findings.extend(correlation_findings(params, &stats.cov));
+    findings.push(diagnostics::standard_errors(parameters, stats.cov.singular));
+    findings.extend(stats.widening.clone());
+    findings.extend(identifiability_findings(
+        ctx.opts,
+        ctx.layout.n_model_free(),
+    ));
+    findings.extend(diagnostics::parameters_at_bounds(params, &stats.p_best));
+    findings.extend(fits.findings.iter().cloned());
+    findings.push(diagnostics::residual_structure(
+        &fits.records,
+        &stats.world.oscillator,
+        ctx.opts.energy.velocity_threshold,
+    ));
+    findings
 }
 
 /// A warning per failed start: screening failures first, then failed continuations.
@@ -260,7 +355,7 @@ fn param_entry(
 ) -> FittedParam {
     let std_error = slot
         .and_then(|s| se.get(s).copied())
-        .filter(|s| s.is_finite());
+        .filter(|s| s.is_finite() && *s > 0.0);
     FittedParam {
         name: name.to_string(),
         value,
@@ -292,21 +387,9 @@ fn correlation_findings(params: &[FreeParam], cov: &Covariance) -> Vec<Finding> 
     out
 }
 
-/// Warnings for a rank-deficient Jacobian and for a free mass with anything that scales
-/// with it.
-fn identifiability_findings(
-    cov: &Covariance,
-    opts: &FitOptions,
-    n_model_free: usize,
-) -> Vec<Finding> {
+/// A warning for a free mass with anything that scales with it.
+fn identifiability_findings(opts: &FitOptions, n_model_free: usize) -> Vec<Finding> {
     let mut out = Vec::new();
-    if cov.singular {
-        out.push(Finding::warn(
-            Check::StandardErrors,
-            None,
-            "the Jacobian is rank-deficient: some free parameters are not separately identifiable from these records (no standard errors)".into(),
-        ));
-    }
     let osc_free = |q: OscillatorParam| opts.oscillator.contains(&q);
     if osc_free(OscillatorParam::Mass)
         && (osc_free(OscillatorParam::Stiffness)
@@ -352,9 +435,13 @@ fn record_fits<R: Residuals>(
             .sum();
         out.sum_sq += ss;
         out.n_total += measured.len();
-        let offset = world.nuisance[ri].offset;
-        let (energy_force, ebf, mf) = match energy_check(rec, offset, world, opts) {
-            Ok((ef, ebf, mf)) => (Some(ef), ebf, mf),
+        let nuisance = &world.nuisance[ri];
+        let (energy_force, ebf, mf) = match energy_check(rec, nuisance, world, opts) {
+            Ok((ef, ebf, mf)) => {
+                out.findings
+                    .push(diagnostics::energy_balance(&rec.name, &ef));
+                (Some(ef), ebf, mf)
+            }
             Err(e) => {
                 out.findings.push(Finding::warn(
                     Check::EnergyBalance,
@@ -366,7 +453,8 @@ fn record_fits<R: Residuals>(
         };
         out.records.push(RecordFit {
             file: rec.name.clone(),
-            x0: rec.x0,
+            x0: nuisance.x0_of(rec),
+            release_time: rec.release_time,
             samples: rec.len(),
             channel: problem.residuals.channel().to_string(),
             rms_residual: (ss / measured.len() as f64).sqrt(),
@@ -384,15 +472,17 @@ fn record_fits<R: Residuals>(
 /// The energy check of one record, its energy-based force and the model force along it.
 fn energy_check(
     rec: &Record,
-    offset: f64,
+    nuisance: &NuisanceValues,
     world: &Realised,
     opts: &FitOptions,
 ) -> Result<(EnergyForce, Vec<f64>, Vec<f64>), EngineError> {
-    // The energy analysis sees the measured velocity corrected by the fitted offset.
+    // The energy analysis sees the measured velocity corrected by the fitted offset, from the
+    // fitted release displacement.
     let mut corrected = rec.clone();
     for v in corrected.velocity_mut() {
-        *v -= offset;
+        *v -= nuisance.offset;
     }
+    corrected.x0 = nuisance.x0_of(rec);
     let osc = &world.oscillator;
     let analysis = analyze_record(&corrected, osc, &opts.energy)?;
     let model_force = model_force_along(world.model.as_ref(), osc, &analysis.time, &analysis.v)?;

@@ -16,6 +16,7 @@
 //!   `energy` command.
 
 pub mod compare;
+pub mod diagnostics;
 pub mod energy_check;
 pub mod fit;
 pub mod layout;
@@ -29,10 +30,11 @@ pub mod setup;
 pub mod starts;
 pub mod stats;
 
-pub use compare::{compare, Comparison, FailedFit};
+pub use compare::{compare, Comparison, ComparisonVerdict, FailedFit};
 pub use energy_check::{energy_force_check, EnergyForce, ForceReference};
 pub use fit::{fit, fit_with, guess_hint, Derived, FitResult, FittedParam, RecordFit};
 pub use lm::LevenbergMarquardt;
 pub use options::{FitOptions, OscillatorParam, Progress, ProgressFn};
 pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
 pub use residuals::{Evaluation, NuisanceKind, NuisanceValues, Residuals, VelocityResponse};
+pub use result::{Rank, Verdict};

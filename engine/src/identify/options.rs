@@ -77,7 +77,8 @@ pub struct FitOptions {
     /// Model parameters to fit, by name; `None`: every parameter not fixed by default.
     pub free: Option<Vec<String>>,
     /// Bounds by parameter name (model parameters, `mass`, `damping`, `stiffness`, `offset`,
-    /// `shift`); default: the model's physical bounds.
+    /// `shift`, `x0` in metres); default: the model's physical bounds, none for an offset, a
+    /// quarter of the natural period for a shift, 20 % of each record's x0 for x0.
     pub bounds: BTreeMap<String, (f64, f64)>,
     /// Data-driven initial values for the free model parameters (from the half-cycle energy
     /// estimate), except those named in `keep_initial`.
@@ -90,6 +91,8 @@ pub struct FitOptions {
     pub velocity_offset: bool,
     /// Fit a release-time shift per record.
     pub time_shift: bool,
+    /// Fit the release displacement x0 of each record, starting from its given value.
+    pub x0: bool,
     /// Number of starts; `None`: 1 when at most two model parameters are free, else
     /// [`super::starts::DEFAULT_STARTS`].
     pub multistart: Option<usize>,
@@ -117,6 +120,7 @@ impl Default for FitOptions {
             oscillator: Vec::new(),
             velocity_offset: false,
             time_shift: false,
+            x0: false,
             multistart: None,
             max_iterations: 200,
             tolerance: None,
@@ -141,6 +145,7 @@ impl std::fmt::Debug for FitOptions {
             .field("oscillator", &self.oscillator)
             .field("velocity_offset", &self.velocity_offset)
             .field("time_shift", &self.time_shift)
+            .field("x0", &self.x0)
             .field("multistart", &self.multistart)
             .field("max_iterations", &self.max_iterations)
             .field("parallel", &self.parallel)

@@ -167,6 +167,8 @@ pub enum Check {
     StartFailure,
     /// Whether the solver converged.
     Convergence,
+    /// Autocorrelated residuals and the widening of the standard errors it calls for.
+    NoiseCorrelation,
 }
 
 /// One diagnostic of a fit: a check, its status, the value it judged and a plain message.

@@ -31,6 +31,8 @@ pub enum NuisanceKind {
     VelocityOffset,
     /// The release instant relative to the record's first time stamp [s].
     ReleaseShift,
+    /// The displacement at release [m], when the record's x0 is known only approximately.
+    StartDisplacement,
 }
 
 impl NuisanceKind {
@@ -40,6 +42,7 @@ impl NuisanceKind {
         match self {
             Self::VelocityOffset => "offset",
             Self::ReleaseShift => "shift",
+            Self::StartDisplacement => "x0",
         }
     }
 
@@ -48,49 +51,73 @@ impl NuisanceKind {
         match self {
             Self::VelocityOffset => "m/s",
             Self::ReleaseShift => "s",
+            Self::StartDisplacement => "m",
         }
     }
 
-    /// The scale of its internal coordinate (it starts at 0, which gives none).
+    /// The scale of its internal coordinate when its start value is 0.
     pub fn typical(self) -> f64 {
         match self {
             Self::VelocityOffset => 1e-4,
             Self::ReleaseShift => 1e-3,
+            Self::StartDisplacement => 1e-3,
         }
     }
 
-    /// Bounds when the options give none.
-    pub fn default_bounds(self) -> (f64, f64) {
+    /// Bounds when the options give none: no bound for an offset; a quarter of the natural
+    /// period either way for a release shift (a later release is the next turning point's
+    /// business); x0 within 20 % of the record's value.
+    pub fn default_bounds(self, record: &Record, osc: &Oscillator) -> (f64, f64) {
         match self {
             Self::VelocityOffset => (f64::NEG_INFINITY, f64::INFINITY),
-            Self::ReleaseShift => (-0.1, 0.1),
+            Self::ReleaseShift => {
+                let quarter = 0.5 * std::f64::consts::PI / osc.omega_n();
+                (-quarter, quarter)
+            }
+            Self::StartDisplacement => {
+                let half_width = X0_RELATIVE_BOUND * record.x0.abs();
+                (record.x0 - half_width, record.x0 + half_width)
+            }
         }
     }
 
-    /// The value a fit starts from (before clipping to the bounds).
-    pub fn start(self) -> f64 {
-        0.0
+    /// The value a fit starts from (before clipping to the bounds): 0, or the record's x0.
+    pub fn start(self, record: &Record) -> f64 {
+        match self {
+            Self::VelocityOffset | Self::ReleaseShift => 0.0,
+            Self::StartDisplacement => record.x0,
+        }
     }
 
     /// Every kind, in the order a record's nuisance parameters are laid out.
-    pub const ALL: [NuisanceKind; 2] = [Self::VelocityOffset, Self::ReleaseShift];
+    pub const ALL: [NuisanceKind; 3] = [
+        Self::VelocityOffset,
+        Self::ReleaseShift,
+        Self::StartDisplacement,
+    ];
 }
 
-/// The nuisance values of one record (0 for those not fitted).
+/// Default half-width of the bounds of a fitted x0, relative to the record's value.
+pub const X0_RELATIVE_BOUND: f64 = 0.2;
+
+/// The nuisance values of one record (0, or the record's own x0, for those not fitted).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct NuisanceValues {
     /// Velocity offset [m/s].
     pub offset: f64,
     /// Release-time shift [s].
     pub shift: f64,
+    /// Fitted displacement at release [m] (`None`: the record's x0).
+    pub x0: Option<f64>,
 }
 
 impl NuisanceValues {
-    /// The value of `kind`.
-    pub fn get(&self, kind: NuisanceKind) -> f64 {
+    /// The value of `kind` (`None` for an x0 that is not fitted).
+    pub fn get(&self, kind: NuisanceKind) -> Option<f64> {
         match kind {
-            NuisanceKind::VelocityOffset => self.offset,
-            NuisanceKind::ReleaseShift => self.shift,
+            NuisanceKind::VelocityOffset => Some(self.offset),
+            NuisanceKind::ReleaseShift => Some(self.shift),
+            NuisanceKind::StartDisplacement => self.x0,
         }
     }
 
@@ -99,7 +126,13 @@ impl NuisanceValues {
         match kind {
             NuisanceKind::VelocityOffset => self.offset = value,
             NuisanceKind::ReleaseShift => self.shift = value,
+            NuisanceKind::StartDisplacement => self.x0 = Some(value),
         }
+    }
+
+    /// The release displacement of `record` with these values.
+    pub fn x0_of(&self, record: &Record) -> f64 {
+        self.x0.unwrap_or(record.x0)
     }
 }
 
@@ -201,28 +234,31 @@ pub struct VelocityResponse {
 }
 
 impl VelocityResponse {
-    /// A velocity response with a per-record velocity offset and/or release shift.
-    pub fn new(velocity_offset: bool, time_shift: bool) -> Self {
+    /// A velocity response with a per-record velocity offset, release shift and/or release
+    /// displacement.
+    pub fn new(velocity_offset: bool, time_shift: bool, x0: bool) -> Self {
         let nuisance = NuisanceKind::ALL
             .into_iter()
             .filter(|k| match k {
                 NuisanceKind::VelocityOffset => velocity_offset,
                 NuisanceKind::ReleaseShift => time_shift,
+                NuisanceKind::StartDisplacement => x0,
             })
             .collect();
         Self { nuisance }
     }
 
-    /// The simulated velocity of `record` at its time stamps, released `shift` seconds after
-    /// its first time stamp (samples before the release see the release velocity); no offset.
+    /// The simulated velocity of `record` at its time stamps, released from the nuisance
+    /// values' x0 `shift` seconds after its first time stamp (samples before the release see
+    /// the release velocity); no offset.
     pub fn simulate(
         &self,
         at: &Evaluation<'_>,
         record: &Record,
-        shift: f64,
+        nuisance: &NuisanceValues,
     ) -> Result<Vec<f64>, EngineError> {
         let t0 = record.time().first().copied().unwrap_or(0.0);
-        let release = t0 + shift;
+        let release = t0 + nuisance.shift;
         // Sample times on the simulation clock; samples before the release see the initial state.
         let first = record.time().partition_point(|&t| t < release);
         let times: Vec<f64> = record.time()[first..]
@@ -233,7 +269,7 @@ impl VelocityResponse {
         if let Some(&t_end) = times.last() {
             at.count_simulation();
             let init = Initial {
-                x0: record.x0,
+                x0: nuisance.x0_of(record),
                 v0: record.v0,
                 z0: None,
             };
@@ -281,7 +317,7 @@ impl Residuals for VelocityResponse {
         record: &Record,
         nuisance: &NuisanceValues,
     ) -> Result<Vec<f64>, EngineError> {
-        let mut v = self.simulate(at, record, nuisance.shift)?;
+        let mut v = self.simulate(at, record, nuisance)?;
         for x in &mut v {
             *x += nuisance.offset;
         }
@@ -307,14 +343,14 @@ mod tests {
             .v;
         let mut record = Record::new("r", time, vec![0.0; 400], 0.014);
         record.weight = 4.0;
-        let producer = VelocityResponse::new(true, false);
+        let producer = VelocityResponse::new(true, false, false);
         assert_eq!(producer.nuisance(), &[NuisanceKind::VelocityOffset]);
         let counter = AtomicU64::new(0);
         let sim = SimOptions::default();
         let at = Evaluation::new(&osc, &model, &sim, &counter);
         let nuisance = NuisanceValues {
             offset: 1e-3,
-            shift: 0.0,
+            ..NuisanceValues::default()
         };
         let r = producer.residuals(&at, 0, &record, &nuisance).unwrap();
         assert_eq!(counter.load(Ordering::Relaxed), 1);
@@ -332,8 +368,12 @@ mod tests {
         let counter = AtomicU64::new(0);
         let sim = SimOptions::default();
         let at = Evaluation::new(&osc, &model, &sim, &counter);
-        let v = VelocityResponse::new(false, true)
-            .simulate(&at, &record, 0.0305)
+        let shifted = NuisanceValues {
+            shift: 0.0305,
+            ..NuisanceValues::default()
+        };
+        let v = VelocityResponse::new(false, true, false)
+            .simulate(&at, &record, &shifted)
             .unwrap();
         assert!(v[..31].iter().all(|&x| x == 0.0));
         let shifted: Vec<f64> = time[31..].iter().map(|t| t - 0.0305).collect();
@@ -343,5 +383,19 @@ mod tests {
         for (got, e) in v[31..].iter().zip(&exact) {
             assert!((got - e).abs() < 1e-8, "{got} vs {e}");
         }
+    }
+
+    /// The default bounds: a quarter of the natural period 2 pi sqrt(m/k) for a shift, 20 %
+    /// of the stated x0 for x0.
+    #[test]
+    fn default_nuisance_bounds_come_from_the_record_and_the_oscillator() {
+        let osc = Oscillator::fmm();
+        let record = Record::new("r", vec![0.0, 1e-3], vec![0.0, 0.0], -0.014);
+        let quarter = 0.25 * 2.0 * std::f64::consts::PI * (osc.mass / osc.stiffness).sqrt();
+        let (lo, hi) = NuisanceKind::ReleaseShift.default_bounds(&record, &osc);
+        assert!((hi - quarter).abs() < 1e-12 && (lo + quarter).abs() < 1e-12);
+        let (lo, hi) = NuisanceKind::StartDisplacement.default_bounds(&record, &osc);
+        assert!((lo + 0.0168).abs() < 1e-12 && (hi + 0.0112).abs() < 1e-12);
+        assert_eq!(NuisanceKind::StartDisplacement.start(&record), -0.014);
     }
 }

@@ -1,7 +1,7 @@
 //! The values a fit returns.
 
 use super::energy_check::EnergyForce;
-use super::outcome::{as_display, Finding, StartOutcome, TerminationReason};
+use super::outcome::{as_display, worst_status, Finding, StartOutcome, Status, TerminationReason};
 use crate::oscillator::Oscillator;
 use frictionid_models::FrictionModel;
 use serde::Serialize;
@@ -30,6 +30,9 @@ pub struct RecordFit {
     pub file: String,
     /// Release displacement [m].
     pub x0: f64,
+    /// The release instant the record was cut at (`release = "auto"` or a time) \[s\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub release_time: Option<f64>,
     /// Samples.
     pub samples: usize,
     /// The quantity compared (`velocity`).
@@ -120,6 +123,49 @@ pub struct FitResult {
     pub warnings: Vec<String>,
     /// Wall time of the fit [s].
     pub wall_time_s: f64,
+    /// Its place in a model comparison (set by [`super::compare::compare`]; its keys join the
+    /// fit's in JSON).
+    #[serde(flatten)]
+    pub rank: Option<Rank>,
+}
+
+/// A fit's standing in a model comparison.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Rank {
+    /// AIC minus the best AIC (0 for the best).
+    pub delta_aic: f64,
+    /// exp(-delta_aic / 2), normalised over the ranking: the weight of evidence for this
+    /// model among those compared.
+    pub akaike_weight: f64,
+    /// Within [`super::compare::INDISTINGUISHABLE_DELTA_AIC`] of the best: the data do not
+    /// tell it from the best.
+    pub indistinguishable: bool,
+}
+
+/// What a fit's outcome means for whoever decides an exit status: the CLI maps `Ok` to 0,
+/// `NotConverged` to 2 and `DiagnosticFailed` to 3 (1 is an error, no result at all).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// Converged, and no diagnostic failed (warnings allowed).
+    Ok,
+    /// The solver did not converge.
+    NotConverged,
+    /// Converged, but at least one diagnostic failed.
+    DiagnosticFailed,
+}
+
+impl Verdict {
+    /// The verdict of a fit that `converged` with `findings`.
+    pub fn of(converged: bool, findings: &[Finding]) -> Self {
+        if !converged {
+            Self::NotConverged
+        } else if worst_status(findings) == Status::Fail {
+            Self::DiagnosticFailed
+        } else {
+            Self::Ok
+        }
+    }
 }
 
 /// A fit's parameter value by name (model or oscillator), for callers and tests.
@@ -135,5 +181,15 @@ impl FitResult {
     /// The parameter entry `name`.
     pub fn param(&self, name: &str) -> Option<&FittedParam> {
         self.parameters.iter().find(|p| p.name == name)
+    }
+
+    /// Converged and clean, not converged, or a diagnostic failed.
+    pub fn verdict(&self) -> Verdict {
+        Verdict::of(self.converged, &self.diagnostics)
+    }
+
+    /// The diagnostics that warn or fail.
+    pub fn problems(&self) -> impl Iterator<Item = &Finding> {
+        self.diagnostics.iter().filter(|f| f.status != Status::Pass)
     }
 }

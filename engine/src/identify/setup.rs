@@ -121,7 +121,7 @@ pub fn build_layout<R: Residuals + ?Sized>(
     }
     for (r, rec) in records.iter().enumerate() {
         for &kind in residuals.nuisance() {
-            let (param, x) = nuisance_param(kind, r, rec, opts);
+            let (param, x) = nuisance_param(kind, r, rec, osc, opts);
             layout.push(param, x);
         }
     }
@@ -253,20 +253,21 @@ fn nuisance_param(
     kind: NuisanceKind,
     r: usize,
     rec: &Record,
+    osc: &Oscillator,
     opts: &FitOptions,
 ) -> (FreeParam, f64) {
     let b = opts
         .bounds
         .get(kind.key())
         .copied()
-        .unwrap_or_else(|| kind.default_bounds());
+        .unwrap_or_else(|| kind.default_bounds(rec, osc));
     let param = FreeParam::linear(
         format!("{}[{}]", kind.key(), rec.name),
         kind.unit(),
         ParamKind::Nuisance { kind, record: r },
         b,
-        kind.start(),
+        kind.start(rec),
         kind.typical(),
     );
-    (param, kind.start().clamp(b.0, b.1))
+    (param, kind.start(rec).clamp(b.0, b.1))
 }

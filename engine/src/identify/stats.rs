@@ -111,6 +111,36 @@ pub fn covariance(j: &DMatrix<f64>, ssr: f64) -> Covariance {
     }
 }
 
+/// The Newey-West (HAC) covariance of a least-squares estimate under autocorrelated
+/// residuals: B S B n / (n - p) with the bread B = (JᵀJ)^-1 (`bread`) and the meat
+/// S = sum over lags |l| <= `lags` of (1 - |l| / (lags + 1)) sum_t g_t g_(t-l)ᵀ,
+/// g_t = J_t r_t, with pairs taken within each segment (record) of `segments` lengths only.
+pub fn newey_west(
+    j: &DMatrix<f64>,
+    r: &[f64],
+    segments: &[usize],
+    lags: usize,
+    bread: &DMatrix<f64>,
+) -> DMatrix<f64> {
+    let (n, p) = j.shape();
+    let scores = DMatrix::from_fn(n, p, |t, c| j[(t, c)] * r[t]);
+    let mut meat = scores.transpose() * &scores;
+    let mut start = 0;
+    for &len in segments {
+        let end = (start + len).min(n);
+        for l in 1..=lags.min(len.saturating_sub(1)) {
+            let w = 1.0 - l as f64 / (lags as f64 + 1.0);
+            let lead = scores.rows(start + l, end - start - l);
+            let lag = scores.rows(start, end - start - l);
+            let cross = lead.transpose() * lag;
+            meat += (&cross + cross.transpose()) * w;
+        }
+        start = end;
+    }
+    let dof = n.saturating_sub(p).max(1) as f64;
+    bread * meat * bread * (n as f64 / dof)
+}
+
 /// Akaike's information criterion for Gaussian least squares: n ln(SSR/n) + 2 p.
 pub fn aic(n: usize, ssr: f64, p: usize) -> f64 {
     let n = n as f64;
@@ -177,5 +207,30 @@ mod tests {
         let (n, ssr) = (100, 2.5);
         assert!((aic(n, ssr, 3) - (100.0 * (0.025f64).ln() + 6.0)).abs() < 1e-12);
         assert!((bic(n, ssr, 3) - (100.0 * (0.025f64).ln() + 3.0 * (100f64).ln())).abs() < 1e-12);
+    }
+
+    /// With white residuals and no lags, the Newey-West covariance is White's
+    /// heteroskedasticity-consistent one; for a constant-variance straight line it is close
+    /// to the classical one.
+    #[test]
+    fn newey_west_without_lags_is_whites_estimate() {
+        let n = 200;
+        let x: Vec<f64> = (0..n).map(|i| i as f64 / n as f64).collect();
+        let j = DMatrix::from_fn(n, 2, |r, c| if c == 0 { 1.0 } else { x[r] });
+        // Residuals +-1 alternating: white, unit variance.
+        let r: Vec<f64> = (0..n)
+            .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
+        let ssr = n as f64;
+        let cov = covariance(&j, ssr);
+        let bread = cov.matrix.clone() / cov.residual_variance;
+        let hac = newey_west(&j, &r, &[n], 0, &bread);
+        for i in 0..2 {
+            let ratio = hac[(i, i)] / cov.matrix[(i, i)];
+            assert!((ratio - 1.0).abs() < 0.05, "{ratio}");
+        }
+        // Alternating residuals are negatively correlated at lag 1: lags shrink the variance.
+        let with_lags = newey_west(&j, &r, &[n], 5, &bread);
+        assert!(with_lags[(0, 0)] < hac[(0, 0)]);
     }
 }

@@ -144,6 +144,14 @@ impl Record {
         self.normal_force.as_ref()
     }
 
+    /// The normal force acting on this record: its own (sampled or constant), else the
+    /// oscillator's `normal_force` as a constant.
+    pub fn normal_force_with(&self, osc: &crate::Oscillator) -> NormalForce {
+        self.normal_force
+            .clone()
+            .unwrap_or(NormalForce::Constant(osc.normal_force))
+    }
+
     /// Sets (or with `None` removes) the record's own normal force.
     pub fn set_normal_force(&mut self, normal_force: Option<NormalForce>) {
         self.normal_force = normal_force;
@@ -288,6 +296,12 @@ mod tests {
             vec![Channel::Velocity, Channel::Force, Channel::NormalForce]
         );
         assert_eq!(r.normal_force().map(|n| n.mean()), Some(5.5));
+        let osc = crate::Oscillator::fmm();
+        assert_eq!(r.normal_force_with(&osc).at(2), 6.0);
+        assert_eq!(
+            record().normal_force_with(&osc),
+            NormalForce::Constant(14.5)
+        );
         let tail = r.starting_at(2);
         assert_eq!(tail.time(), &[0.2, 0.3]);
         assert_eq!(tail.channel(Channel::NormalForce), Some(&[6.0, 6.0][..]));

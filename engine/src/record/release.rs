@@ -100,12 +100,10 @@ pub fn detect_release(time: &[f64], velocity: &[f64]) -> Option<f64> {
         &velocity[departure..anchor],
         level,
     );
-    let lower = time[departure.saturating_sub(1)];
-    Some(
-        t_rise
-            .unwrap_or(time[departure])
-            .clamp(lower, time[departure]),
-    )
+    // The rise starts before it leaves the noise band, but not before the rest began.
+    let (t_departure, t_anchor) = (time[departure], time[anchor]);
+    let lower = time[0].max(t_departure - (t_anchor - t_departure));
+    Some(t_rise.unwrap_or(t_departure).clamp(lower, t_departure))
 }
 
 /// The first index from which `hit` holds for [`SUSTAINED_SAMPLES`] samples in a row.

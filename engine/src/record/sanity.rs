@@ -157,24 +157,32 @@ fn robust_peak(v: &[f64]) -> f64 {
         .unwrap_or(0.0)
 }
 
-/// Twice the mean spacing of the velocity's sign changes (with a hysteresis of a tenth of the
-/// peak speed, so noise at rest does not count); `None` with fewer than three changes.
+/// Twice the median spacing of the velocity's zero crossings. A crossing counts when the
+/// velocity goes from beyond a tenth of the peak speed on one side to beyond it on the other
+/// (so noise at rest does not count); its time is the last sign change in between,
+/// interpolated. The median, because a lobe lost in that band doubles one spacing. `None` with
+/// fewer than three crossings.
 fn oscillation_period(time: &[f64], v: &[f64]) -> Option<f64> {
     let band = 0.1 * robust_peak(v);
-    let mut sign = 0.0;
-    let mut changes = Vec::new();
-    for (&t, &x) in time.iter().zip(v) {
-        if x.abs() <= band {
+    let mut side = 0.0;
+    let mut last_sign_change = None;
+    let mut crossings = Vec::new();
+    for i in 1..time.len().min(v.len()) {
+        let (t0, t1, v0, v1) = (time[i - 1], time[i], v[i - 1], v[i]);
+        if v0.signum() != v1.signum() && v1 != v0 {
+            last_sign_change = Some(t0 + (t1 - t0) * v0 / (v0 - v1));
+        }
+        if v1.abs() <= band {
             continue;
         }
-        let s = x.signum();
-        if sign != 0.0 && s != sign {
-            changes.push(t);
+        if side != 0.0 && v1.signum() != side {
+            crossings.extend(last_sign_change);
         }
-        sign = s;
+        side = v1.signum();
     }
-    let (first, last) = (changes.first()?, changes.last()?);
-    (changes.len() >= 3).then(|| 2.0 * (last - first) / (changes.len() - 1) as f64)
+    let mut gaps: Vec<f64> = crossings.windows(2).map(|w| w[1] - w[0]).collect();
+    gaps.sort_by(f64::total_cmp);
+    (gaps.len() >= 2).then(|| 2.0 * gaps[gaps.len() / 2])
 }
 
 #[cfg(test)]

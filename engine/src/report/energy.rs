@@ -35,6 +35,9 @@ pub struct EnergyReport {
 pub struct EnergyRecord {
     /// Record name (file as written).
     pub file: String,
+    /// The release instant the record was cut at (`release = "auto"` or a time) \[s\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub release_time: Option<f64>,
     /// Mean |F_f| of Eq. 7 over the unmasked samples \[N\].
     pub mean_abs_force: f64,
     /// The reference force \[N\] (NaN when there is none).

@@ -20,19 +20,37 @@
 //!   |v|. A motion whose swing between two turning points has fallen below `REST_SWING_ATOLS`
 //!   times the absolute tolerance is declared at rest (the integrator cannot resolve it).
 //!
-//! Two integrators: ode_solvers' adaptive Dormand-Prince 5(4) with its dense output
-//! ([`Integrator::Dopri5`], the default), and the paper's fixed-step explicit Euler with step
-//! T_n / n ([`Integrator::Euler`]), linearly interpolated between steps.
+//! # Driver and steppers
+//! One driver (`driver.rs`) owns the segments, the mode decisions, event location (Illinois on
+//! the dense output), sampling, budgets and statistics. The integrators implement the small
+//! [`Stepper`] trait (reset, one step reporting an event sign change, dense output, counters)
+//! over an [`OdeSystem`]: the adaptive Dormand-Prince 5(4) [`Dopri5`] ([`Integrator::Dopri5`],
+//! the default), the paper's fixed-step explicit Euler with step T_n / n [`Euler`]
+//! ([`Integrator::Euler`], linear between steps), and the Bogacki-Shampine 3(2)
+//! [`BogackiShampine`] that integrates model states along a measured motion
+//! (`energy::model_force_along`). A new integrator is one more `Stepper`.
 //!
 //! # Cost
 //! Dopri5 is explicit: for bristle models its step is bounded by stability, about
 //! 3.3 g(v) / (sigma0 |v|) while sliding. On the FMM case (2 s from 22 mm) LuGre and Dahl need
 //! about 1.5e4 RHS evaluations at sigma0 = 1e5 N/m but about 1e6 at sigma0 = 1e7 N/m; a stiff
-//! method would remove that bound. ode_solvers' stiffness abort is disabled so such runs finish.
+//! method would remove that bound. There is no stiffness abort: such runs finish.
 
+mod bogacki;
+mod closed_form;
 mod dopri;
+mod driver;
 mod euler;
 mod root;
+mod stepper;
+
+pub use bogacki::BogackiShampine;
+pub use closed_form::ClosedForm;
+pub use dopri::Dopri5;
+pub use euler::Euler;
+pub use stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper};
+
+use driver::Driver;
 
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
@@ -43,11 +61,16 @@ use serde::{Deserialize, Serialize};
 /// tolerances is declared at rest (smooth and dynamic models only).
 pub const REST_SWING_ATOLS: f64 = 10.0;
 
+/// Largest Dormand-Prince step, as a fraction of the undamped period (keeps one velocity zero
+/// per step).
+const H_MAX_PERIODS: f64 = 1.0 / 8.0;
+
 /// The time integrator.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 #[serde(tag = "method", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Integrator {
-    /// Adaptive Dormand-Prince 5(4) (ode_solvers) with dense output and event location.
+    /// Adaptive Dormand-Prince 5(4) with dense output and event location ([`Dopri5`]), the
+    /// default.
     #[default]
     Dopri5,
     /// The paper's fixed-step explicit Euler with step T_n / `steps_per_period` (paper: 1e6).
@@ -55,6 +78,11 @@ pub enum Integrator {
         /// Steps per undamped natural period T_n.
         steps_per_period: f64,
     },
+    /// The exact propagator ([`ClosedForm`]) for laws affine in v within each sliding mode
+    /// (coulomb, viscous_coulomb, none) on an underdamped oscillator; an error otherwise.
+    Exact,
+    /// The exact propagator where it applies, Dopri5 otherwise.
+    Auto,
 }
 
 /// Options of [`simulate`].
@@ -76,7 +104,8 @@ pub struct SimOptions {
 impl Default for SimOptions {
     /// Dopri5 with rtol = 2e-9 and atol = 1e-11. On the paper's Coulomb cases this reproduces
     /// the exact solution to about 3e-10 m (rest position and 1 kHz samples), 4e-9 m/s and
-    /// 6e-11 s (rest time) with about 2000 RHS evaluations for 6 half-cycles. Up to 20 million
+    /// 6e-11 s (rest time) with about 2000 RHS evaluations for 6 half-cycles (`Exact` or
+    /// `Auto`: to 1e-12 m with no RHS evaluation). Up to 20 million
     /// steps (a fit exploring very stiff bristle models should lower this) and 100 000 events.
     fn default() -> Self {
         Self {
@@ -419,6 +448,28 @@ impl Dynamics<'_> {
         *dv = self.accel(*x, *v, f);
     }
 
+    /// The segment's linear equation when the law is affine in v in direction `dir`.
+    pub fn affine_motion(&self, dir: f64) -> Option<AffineMotion> {
+        if self.law == Law::Dynamic {
+            return None;
+        }
+        let (offset, slope) = self.model.affine_slip(dir, self.normal)?;
+        Some(AffineMotion {
+            mass: self.mass,
+            damping: self.damping + slope,
+            stiffness: self.stiffness,
+            offset,
+        })
+    }
+
+    /// Whether every sliding mode of this law is solved in closed form.
+    pub fn closed_form_applies(&self) -> bool {
+        [1.0, -1.0].into_iter().all(|dir| {
+            self.affine_motion(dir)
+                .is_some_and(|m| ClosedForm::supports(&m))
+        })
+    }
+
     /// The mode at the start of a segment from state (x, v, z).
     pub fn start(&self, x: f64, v: f64, z: &[f64]) -> Start {
         if v != 0.0 {
@@ -450,125 +501,7 @@ impl Dynamics<'_> {
     }
 }
 
-/// Book-keeping shared by the integrators: sample cursor, events, rest and statistics.
-pub(crate) struct Driver<'s, R: Recorder> {
-    pub dynamics: Dynamics<'s>,
-    pub samples: &'s [f64],
-    pub next: usize,
-    pub rec: &'s mut R,
-    pub events: Vec<Event>,
-    pub rest: Option<Rest>,
-    pub stats: SimStats,
-    pub max_events: usize,
-    pub max_steps: u64,
-    /// Displacement at the previous turning point (or the release from rest).
-    pub last_turn: Option<f64>,
-    /// Swing below which smooth and dynamic motions are declared at rest.
-    pub rest_swing: f64,
-}
-
-impl<R: Recorder> Driver<'_, R> {
-    /// Samples not yet written whose time is <= `t`.
-    pub fn pending_until(&self, t: f64) -> usize {
-        self.samples
-            .get(self.next..)
-            .map_or(0, |rest| rest.iter().take_while(|&&ts| ts <= t).count())
-    }
-
-    /// Writes one sample of a moving state in direction `dir`.
-    pub fn write_moving(&mut self, t: f64, y: &[f64], dir: f64) {
-        if let [x, v, z @ ..] = y {
-            let f = self.dynamics.force(*v, z, dir);
-            let a = self.dynamics.accel(*x, *v, f);
-            self.rec.sample(t, *x, *v, z, a, f);
-        }
-        self.next += 1;
-    }
-
-    /// Fills every remaining sample with the state at rest `y` (v = 0, a = 0).
-    pub fn fill_rest(&mut self, y: &[f64]) {
-        if let [x, _, z @ ..] = y {
-            let f = -self.dynamics.stiffness * x;
-            while let Some(&ts) = self.samples.get(self.next) {
-                self.rec.sample(ts, *x, 0.0, z, 0.0, f);
-                self.next += 1;
-            }
-        }
-    }
-
-    /// Fills every remaining sample with the (moving) state `y` at the end time.
-    pub fn fill_end(&mut self, y: &[f64], dir: f64) {
-        while let Some(&ts) = self.samples.get(self.next) {
-            self.write_moving(ts, y, dir);
-        }
-    }
-
-    fn push_event(&mut self, time: f64, kind: EventKind, x: f64) -> Result<(), EngineError> {
-        if self.events.len() >= self.max_events {
-            return Err(EngineError::Integration {
-                time,
-                reason: format!(
-                    "more than max_events = {} events (the velocity keeps crossing zero; \
-                     raise max_events or end the simulation earlier)",
-                    self.max_events
-                ),
-            });
-        }
-        self.events.push(Event {
-            time,
-            kind,
-            displacement: x,
-        });
-        self.stats.events = self.events.len();
-        Ok(())
-    }
-
-    /// Records a turning point at (t, x).
-    pub fn turning_point(&mut self, t: f64, x: f64) -> Result<(), EngineError> {
-        self.push_event(t, EventKind::TurningPoint, x)
-    }
-
-    /// Decides the mode at time `t` for state `y` (a turning point or the start): returns the
-    /// slip direction, or `None` after recording the rest and filling the remaining samples.
-    pub fn decide(&mut self, t: f64, y: &[f64]) -> Result<Option<f64>, EngineError> {
-        let [x, v, z @ ..] = y else {
-            return Ok(None);
-        };
-        let mut start = self.dynamics.start(*x, *v, z);
-        if *v == 0.0 && !matches!(self.dynamics.law, Law::Switched { .. }) {
-            if let Some(prev) = self.last_turn {
-                if (x - prev).abs() < self.rest_swing {
-                    start = Start::Rest;
-                }
-            }
-        }
-        if *v == 0.0 {
-            self.last_turn = Some(*x);
-        }
-        match start {
-            Start::Slip(d) => Ok(Some(d)),
-            Start::Rest => {
-                self.push_event(t, EventKind::Stick, *x)?;
-                self.rest = Some(Rest {
-                    time: t,
-                    displacement: *x,
-                });
-                self.fill_rest(y);
-                Ok(None)
-            }
-        }
-    }
-
-    /// The error for a non-finite state.
-    pub fn non_finite(t: f64, y: &[f64]) -> EngineError {
-        EngineError::Integration {
-            time: t,
-            reason: format!("the state became non-finite ([x, v, z...] = {y:?})"),
-        }
-    }
-}
-
-/// Validates the inputs and runs the chosen integrator.
+/// Validates the inputs, builds the driver and runs it over the chosen stepper.
 pub(crate) fn run<R: Recorder>(
     osc: &Oscillator,
     model: &dyn FrictionModel,
@@ -583,27 +516,13 @@ pub(crate) fn run<R: Recorder>(
     let y0 = initial_state(model, init)?;
     check_times(t_end, sample_times)?;
     check_options(opts)?;
-    let law = if model.n_states() > 0 {
-        Law::Dynamic
-    } else {
-        match model.static_limit(osc.normal_force) {
-            Some(limit) if limit.is_finite() && limit >= 0.0 => Law::Switched { limit },
-            Some(limit) => {
-                return Err(EngineError::InvalidInput(format!(
-                    "model `{}` reports a static limit of {limit} N",
-                    model.name()
-                )))
-            }
-            None => Law::Smooth,
-        }
-    };
     let dynamics = Dynamics {
         mass: osc.mass,
         damping: osc.damping,
         stiffness: osc.stiffness,
         normal: osc.normal_force,
         model,
-        law,
+        law: classify_law(model, osc.normal_force)?,
     };
     let mut driver = Driver {
         dynamics,
@@ -618,20 +537,60 @@ pub(crate) fn run<R: Recorder>(
         last_turn: None,
         rest_swing: REST_SWING_ATOLS * opts.atol,
     };
-    match opts.integrator {
-        Integrator::Dopri5 => dopri::run(&mut driver, &y0, t_end, opts, osc.natural_period())?,
-        Integrator::Euler { steps_per_period } => euler::run(
-            &mut driver,
-            y0,
-            t_end,
-            osc.natural_period() / steps_per_period,
-        )?,
+    let period = osc.natural_period();
+    match resolve_method(opts.integrator, &dynamics)? {
+        Integrator::Exact => driver.run(&mut ClosedForm::new(), &y0, t_end)?,
+        Integrator::Euler { steps_per_period } => {
+            let mut stepper = Euler::new(y0.len(), period / steps_per_period);
+            driver.run(&mut stepper, &y0, t_end)?;
+        }
+        Integrator::Dopri5 | Integrator::Auto => {
+            let h_max = period * H_MAX_PERIODS;
+            let mut stepper = Dopri5::new(y0.len(), opts.rtol, opts.atol, h_max);
+            driver.run(&mut stepper, &y0, t_end)?;
+        }
     }
     Ok(RunOutput {
         events: driver.events,
         rest: driver.rest,
         stats: driver.stats,
     })
+}
+
+/// The concrete method for `requested`: `Auto` picks the exact propagator where it applies,
+/// Dopri5 otherwise; `Exact` where it does not apply is an input error.
+fn resolve_method(
+    requested: Integrator,
+    dynamics: &Dynamics<'_>,
+) -> Result<Integrator, EngineError> {
+    match requested {
+        Integrator::Auto if dynamics.closed_form_applies() => Ok(Integrator::Exact),
+        Integrator::Auto => Ok(Integrator::Dopri5),
+        Integrator::Exact if !dynamics.closed_form_applies() => {
+            Err(EngineError::InvalidInput(format!(
+                "integrator `exact` needs a law affine in v within each sliding mode \
+                 (coulomb, viscous_coulomb, none) and an underdamped oscillator; model `{}` \
+                 does not qualify here",
+                dynamics.model.name()
+            )))
+        }
+        other => Ok(other),
+    }
+}
+
+/// How the engine treats `model`'s law: dynamic, switched (with its static limit) or smooth.
+fn classify_law(model: &dyn FrictionModel, normal: f64) -> Result<Law, EngineError> {
+    if model.n_states() > 0 {
+        return Ok(Law::Dynamic);
+    }
+    match model.static_limit(normal) {
+        Some(limit) if limit.is_finite() && limit >= 0.0 => Ok(Law::Switched { limit }),
+        Some(limit) => Err(EngineError::InvalidInput(format!(
+            "model `{}` reports a static limit of {limit} N",
+            model.name()
+        ))),
+        None => Ok(Law::Smooth),
+    }
 }
 
 fn initial_state(model: &dyn FrictionModel, init: &Initial) -> Result<Vec<f64>, EngineError> {

@@ -6,10 +6,13 @@
 //! |---|---|---|---|---|---|
 //! | `mu_c` | 1 | 0.2 | [0, 10] | free | Coulomb (kinetic) friction coefficient |
 //! | `mu_s` | 1 | 0.3 | [0, 10] | free | static (breakaway) friction coefficient |
-//! | `v_s` | m/s | 0.01 | (0, 100] | free | Stribeck velocity of the Gaussian dip |
-//! | `viscous` | N s/m | 0.5 | [0, inf] | free | viscous slope at the reference speed |
+//! | `v_s` | m/s | 0.01 | (0, 100] | free | Stribeck velocity |
+//! | `viscous` | N s/m | 0.5 | [0, inf) | free | viscous slope at the reference speed |
 //! | `alpha` | 1 | 1 | (0, 5] | free | velocity exponent of the viscous term |
-//! | `v_ref` | m/s | 0.1 | (0, 100] | fixed | reference speed of the viscous term |
+//! | `v_ref` | m/s | 0.1 | (0, 100] | fixed | reference speed of the viscous term (redundant with viscous: fixed) |
+//!
+//! `v_s` is the Stribeck velocity of the Gaussian dip. The table above is rendered from the
+//! declarations in `declare_params!` below (a test checks it).
 //!
 //! The viscous term is written about a reference speed so that `viscous` keeps the unit
 //! N s/m for every exponent: at |v| = v_ref it is `viscous * v_ref`, and with alpha = 1 it is
@@ -31,45 +34,43 @@
 //! with supplemental fluid dampers", The Structural Design of Tall Buildings 2(2), 93-132, 1993.
 
 use frictionid_models::{
-    check_bounds, check_len, sgn, FrictionModel, GuessHint, ModelError, ParamInfo,
+    check_bounds, mu_s_warning, sgn, FrictionModel, GuessHint, ModelError, StribeckLevels,
 };
-use serde::{Deserialize, Serialize};
 
 /// The registry name of the model.
 pub const NAME: &str = "stribeck_power";
 
-/// Gaussian Stribeck friction plus a power-law viscous force.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct StribeckPower {
-    /// Coulomb coefficient.
-    pub mu_c: f64,
-    /// Static coefficient.
-    pub mu_s: f64,
-    /// Stribeck velocity [m/s].
-    pub v_s: f64,
-    /// Viscous slope at the reference speed [N s/m].
-    pub viscous: f64,
-    /// Velocity exponent of the viscous term.
-    pub alpha: f64,
-    /// Reference speed of the viscous term [m/s].
-    pub v_ref: f64,
-}
-
-impl Default for StribeckPower {
-    fn default() -> Self {
-        Self {
-            mu_c: 0.2,
-            mu_s: 0.3,
-            v_s: 0.01,
-            viscous: 0.5,
-            alpha: 1.0,
-            v_ref: 0.1,
-        }
+frictionid_models::declare_params! {
+    /// Gaussian Stribeck friction plus a power-law viscous force.
+    pub struct StribeckPower {
+        mu_c: new("1", 0.2, (0.0, 10.0), "Coulomb (kinetic) friction coefficient"),
+        mu_s: new("1", 0.3, (0.0, 10.0), "static (breakaway) friction coefficient"),
+        v_s: positive("m/s", 0.01, 100.0, "Stribeck velocity"),
+        viscous: non_negative("N s/m", 0.5, "viscous slope at the reference speed"),
+        alpha: positive("1", 1.0, 5.0, "velocity exponent of the viscous term"),
+        v_ref: positive(
+            "m/s",
+            0.1,
+            100.0,
+            "reference speed of the viscous term (redundant with viscous: fixed)"
+        )
+        .fixed(),
     }
 }
 
 impl StribeckPower {
+    /// The parameters the committed fixtures (`fixtures/sim-*.toml`) were simulated with.
+    pub fn fixture_truth() -> Self {
+        Self {
+            mu_c: 0.2,
+            mu_s: 0.3,
+            v_s: 0.02,
+            viscous: 4.0,
+            alpha: 1.6,
+            v_ref: 0.1,
+        }
+    }
+
     /// The dry coefficient mu_c + (mu_s - mu_c) exp(-(v / v_s)^2).
     pub fn coefficient(&self, v: f64) -> f64 {
         let r = v / self.v_s;
@@ -84,82 +85,10 @@ impl StribeckPower {
 
 #[typetag::serde(name = "stribeck_power")]
 impl FrictionModel for StribeckPower {
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn equation(&self) -> String {
-        "F = sgn(v) (N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)) + viscous v_ref |v/v_ref|^alpha)"
-            .into()
-    }
-
-    fn param_info(&self) -> Vec<ParamInfo> {
-        vec![
-            ParamInfo::new(
-                "mu_c",
-                "1",
-                0.2,
-                (0.0, 10.0),
-                "Coulomb (kinetic) friction coefficient",
-            ),
-            ParamInfo::new(
-                "mu_s",
-                "1",
-                0.3,
-                (0.0, 10.0),
-                "static (breakaway) friction coefficient",
-            ),
-            ParamInfo::positive("v_s", "m/s", 0.01, 100.0, "Stribeck velocity"),
-            ParamInfo::new(
-                "viscous",
-                "N s/m",
-                0.5,
-                (0.0, f64::INFINITY),
-                "viscous slope at the reference speed",
-            ),
-            ParamInfo::positive(
-                "alpha",
-                "1",
-                1.0,
-                5.0,
-                "velocity exponent of the viscous term",
-            ),
-            ParamInfo::positive(
-                "v_ref",
-                "m/s",
-                0.1,
-                100.0,
-                "reference speed of the viscous term (redundant with viscous: fixed)",
-            )
-            .fixed(),
-        ]
-    }
-
-    fn params(&self) -> Vec<f64> {
-        vec![
-            self.mu_c,
-            self.mu_s,
-            self.v_s,
-            self.viscous,
-            self.alpha,
-            self.v_ref,
-        ]
-    }
-
-    fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
-        check_len(NAME, 6, values.len())?;
-        if let [mu_c, mu_s, v_s, viscous, alpha, v_ref] = *values {
-            *self = Self {
-                mu_c,
-                mu_s,
-                v_s,
-                viscous,
-                alpha,
-                v_ref,
-            };
-        }
-        Ok(())
-    }
+    frictionid_models::declared_param_methods!(
+        name: NAME,
+        equation: "F = sgn(v) (N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)) + viscous v_ref |v/v_ref|^alpha)",
+    );
 
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         sgn(v) * (normal * self.coefficient(v) + self.viscous_force(v))
@@ -180,22 +109,14 @@ impl FrictionModel for StribeckPower {
     }
 
     fn apply_guess(&mut self, hint: &GuessHint) {
-        let v = hint.typical_velocity.max(1e-6);
-        self.mu_c = 0.9 * hint.mu;
-        self.mu_s = 1.2 * hint.mu;
-        self.v_s = 0.2 * v;
-        self.viscous = 0.05 * hint.mu * hint.normal_force / v;
+        let levels = StribeckLevels::guess(hint);
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.viscous = levels.viscous;
     }
-
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(NAME, &self.param_info(), &self.params())?;
-        let mut warnings = Vec::new();
-        if self.mu_s < self.mu_c {
-            warnings.push(format!(
-                "model `{NAME}`: mu_s = {} is below mu_c = {} (friction rises with speed near zero)",
-                self.mu_s, self.mu_c
-            ));
-        }
-        Ok(warnings)
+        Ok(mu_s_warning(NAME, self.mu_s, self.mu_c))
     }
 }

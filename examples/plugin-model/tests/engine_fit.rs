@@ -7,18 +7,6 @@ use frictionid_engine::{Oscillator, Record};
 use frictionid_plugin_example::StribeckPower;
 use std::path::Path;
 
-/// The truth of `fixtures/sim-*.toml`.
-fn truth() -> StribeckPower {
-    StribeckPower {
-        mu_c: 0.2,
-        mu_s: 0.3,
-        v_s: 0.02,
-        viscous: 4.0,
-        alpha: 1.6,
-        v_ref: 0.1,
-    }
-}
-
 fn fixture_records() -> Vec<Record> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures");
     [
@@ -54,7 +42,7 @@ fn engine_fit_recovers_the_fixture_truth() {
         "rms {}",
         r.rms_residual
     );
-    let truth = truth();
+    let truth = StribeckPower::fixture_truth();
     let expected = [
         ("mu_c", truth.mu_c, 0.01),
         ("mu_s", truth.mu_s, 0.01),

@@ -2,7 +2,7 @@
 //! `stribeck` model at alpha = 1, odd symmetry, the set-valued static part, and its
 //! registration in the typetag registry of a binary that links this crate.
 
-use frictionid_models::{build_json, names, FrictionModel, ModelError, Stribeck};
+use frictionid_models::{build_json, names, testing, FrictionModel, ModelError, Stribeck};
 use frictionid_plugin_example::{StribeckPower, NAME};
 
 const N: f64 = 14.5;
@@ -14,14 +14,7 @@ fn close(a: f64, b: f64, tol: f64) -> bool {
 }
 
 fn model() -> StribeckPower {
-    StribeckPower {
-        mu_c: 0.2,
-        mu_s: 0.3,
-        v_s: 0.02,
-        viscous: 4.0,
-        alpha: 1.6,
-        v_ref: 0.1,
-    }
+    StribeckPower::fixture_truth()
 }
 
 #[test]
@@ -130,7 +123,7 @@ fn the_linked_plugin_is_in_the_registry() {
 }
 
 #[test]
-fn params_round_trip_and_serde() {
+fn params_declarations() {
     let mut m = StribeckPower::default();
     let names: Vec<String> = m.param_info().into_iter().map(|p| p.name).collect();
     assert_eq!(names, ["mu_c", "mu_s", "v_s", "viscous", "alpha", "v_ref"]);
@@ -146,9 +139,30 @@ fn params_round_trip_and_serde() {
             ..
         })
     ));
-    let boxed: Box<dyn FrictionModel> = Box::new(m.clone());
-    let json = serde_json::to_value(&boxed).unwrap();
-    assert_eq!(json["type"], "stribeck_power");
-    let back: Box<dyn FrictionModel> = serde_json::from_value(json).unwrap();
-    assert_eq!(back.params(), m.params());
+}
+
+/// The invariants every model satisfies (`frictionid_models::testing`): registration, the
+/// parameter vector and its bounds, JSON/TOML round trips, finite and exactly odd forces, a
+/// dissipative law, the slip direction of the set-valued part.
+#[test]
+fn passes_the_model_harness() {
+    for m in [
+        StribeckPower::default(),
+        model(),
+        StribeckPower {
+            alpha: 0.3,
+            ..model()
+        },
+    ] {
+        testing::assert_model(&m);
+    }
+}
+
+/// The parameter table in the module documentation is rendered from the declarations.
+#[test]
+fn documentation_table_matches_the_declarations() {
+    let source = include_str!("../src/stribeck_power.rs");
+    if let Some(table) = testing::doc_table_mismatch(source, &model().param_info()) {
+        panic!("the documentation should contain\n{table}");
+    }
 }

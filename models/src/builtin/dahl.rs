@@ -3,11 +3,13 @@
 //! dF/dt = sigma0 v |1 - F sgn(v) / (mu_c N)|^alpha sgn(1 - F sgn(v) / (mu_c N)); the friction
 //! force is the internal state F.
 //!
-//! | parameter | unit | default | bounds | meaning |
-//! |---|---|---|---|---|
-//! | `sigma0` | N/m | 1e5 | (0, 1e12] | rest stiffness (slope of F against displacement at F = 0) |
-//! | `mu_c` | 1 | 0.2 | (0, 10] | Coulomb friction coefficient (the force saturates at mu_c N) |
-//! | `alpha` | 1 | 1 | (0, 10] | shape exponent of the hysteresis loop |
+//! | parameter | unit | default | bounds | fit | meaning |
+//! |---|---|---|---|---|---|
+//! | `sigma0` | N/m | 1e5 | (0, 1e12] | free | rest stiffness of the contact |
+//! | `mu_c` | 1 | 0.2 | (0, 10] | free | Coulomb friction coefficient |
+//! | `alpha` | 1 | 1 | (0, 10] | free | shape exponent of the hysteresis |
+//!
+//! The rest stiffness sigma0 is the slope of F against the displacement at F = 0.
 //!
 //! Stored energy: F^2 / (2 sigma0) (exact for alpha = 1: the model then dissipates
 //! F^2 |v| / (mu_c N) >= 0).
@@ -15,59 +17,25 @@
 //! Reference: P. R. Dahl, "A solid friction model", Technical Report TOR-0158(3107-18)-1,
 //! The Aerospace Corporation, 1968.
 
-use crate::error::ModelError;
-use crate::model::{check_len, sgn, FrictionModel, GuessHint, ParamInfo};
-use serde::{Deserialize, Serialize};
+use crate::model::{sgn, FrictionModel, GuessHint};
+use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
-/// Dahl's dynamic friction model with the friction force as internal state.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct Dahl {
-    /// Rest stiffness [N/m].
-    pub sigma0: f64,
-    /// Coulomb coefficient.
-    pub mu_c: f64,
-    /// Shape exponent.
-    pub alpha: f64,
-}
-
-impl Default for Dahl {
-    fn default() -> Self {
-        Self {
-            sigma0: 1e5,
-            mu_c: 0.2,
-            alpha: 1.0,
-        }
+crate::declare_params! {
+    /// Dahl's dynamic friction model with the friction force as internal state.
+    pub struct Dahl {
+        sigma0: positive("N/m", 1e5, 1e12, "rest stiffness of the contact"),
+        mu_c: positive("1", 0.2, 10.0, "Coulomb friction coefficient"),
+        alpha: positive("1", 1.0, 10.0, "shape exponent of the hysteresis"),
     }
 }
 
 #[typetag::serde(name = "dahl")]
 impl FrictionModel for Dahl {
-    fn name(&self) -> &'static str {
-        "dahl"
-    }
-    fn equation(&self) -> String {
-        "dF/dt = sigma0 v |1 - F sgn(v)/(mu_c N)|^alpha sgn(1 - F sgn(v)/(mu_c N)), friction = F"
-            .into()
-    }
-    fn param_info(&self) -> Vec<ParamInfo> {
-        vec![
-            ParamInfo::positive("sigma0", "N/m", 1e5, 1e12, "rest stiffness of the contact"),
-            ParamInfo::positive("mu_c", "1", 0.2, 10.0, "Coulomb friction coefficient"),
-            ParamInfo::positive("alpha", "1", 1.0, 10.0, "shape exponent of the hysteresis"),
-        ]
-    }
-    fn params(&self) -> Vec<f64> {
-        vec![self.sigma0, self.mu_c, self.alpha]
-    }
-    fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
-        check_len(self.name(), 3, values.len())?;
-        // Indexing below is in range: check_len has just verified the length.
-        self.sigma0 = values[0];
-        self.mu_c = values[1];
-        self.alpha = values[2];
-        Ok(())
-    }
+    crate::declared_param_methods!(
+        name: "dahl",
+        equation: "dF/dt = sigma0 v |1 - F sgn(v)/(mu_c N)|^alpha sgn(1 - F sgn(v)/(mu_c N)), friction = F",
+    );
+
     fn n_states(&self) -> usize {
         1
     }
@@ -84,6 +52,30 @@ impl FrictionModel for Dahl {
             0.0
         };
     }
+    /// d(dF/dt)/dF = -sigma0 |v| alpha |r|^(alpha - 1) / (mu_c N), r = 1 - F sgn(v) / (mu_c N);
+    /// 0 without normal load. At r = 0 with alpha < 1 the derivative is unbounded: there
+    /// the finite-difference default gives a finite slope instead.
+    fn state_jacobian(&self, v: f64, z: &[f64], normal: f64, jac: &mut [f64]) {
+        let (Some(&f), Some(j)) = (z.first(), jac.first_mut()) else {
+            return;
+        };
+        let fc = self.mu_c * normal;
+        if fc <= 0.0 || v == 0.0 {
+            *j = 0.0;
+            return;
+        }
+        let r = 1.0 - f * sgn(v) / fc;
+        if r == 0.0 && self.alpha < 1.0 {
+            crate::model::finite_difference_jacobian(self, v, z, normal, jac);
+            return;
+        }
+        let slope = if self.alpha == 1.0 {
+            1.0
+        } else {
+            self.alpha * r.abs().powf(self.alpha - 1.0)
+        };
+        *j = -self.sigma0 * v.abs() * slope / fc;
+    }
     fn force(&self, _v: f64, z: &[f64], _normal: f64) -> f64 {
         z.first().copied().unwrap_or(0.0)
     }
@@ -97,6 +89,16 @@ impl FrictionModel for Dahl {
     fn apply_guess(&mut self, hint: &GuessHint) {
         self.mu_c = hint.mu;
         // Presliding displacements of dry contacts are typically a few tens of micrometres.
-        self.sigma0 = (hint.mu * hint.normal_force / 2e-5).max(1.0);
+        self.sigma0 = (hint.mu * hint.normal_force / TYPICAL_PRESLIDING_DISPLACEMENT).max(1.0);
+    }
+    /// The Coulomb level of the fitted model and the rest stiffness that reaches it at the
+    /// presliding displacement.
+    fn start_from(&mut self, fitted: &dyn FrictionModel, ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.mu_c = levels.mu_c;
+        self.sigma0 = ctx.stiffness_for(levels.mu_c * ctx.normal_force);
+        true
     }
 }

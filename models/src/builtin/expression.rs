@@ -42,6 +42,7 @@
 use crate::error::ModelError;
 use crate::formula::{self, Formula, Parsed};
 use crate::model::{check_bounds, check_len, FrictionModel, GuessHint, ParamInfo};
+use crate::params::ParamSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -138,102 +139,149 @@ impl Expression {
     }
 }
 
+/// The parameters of the default law `mu * N * tanh(v / eps)`: values, bounds and units
+/// (a config's `params`, `bounds` and `units` override them).
+const DEFAULT_PARAMS: [ParamSpec; 2] = [
+    ParamSpec::new("mu", "1", 0.2, (0.0, 10.0), "friction coefficient"),
+    ParamSpec::new(
+        "eps",
+        "m/s",
+        1e-4,
+        (1e-9, 1.0),
+        "velocity scale of the tanh",
+    ),
+];
+
+fn bad_key(key: &str, message: String) -> ModelError {
+    ModelError::BadKey {
+        model: MODEL.into(),
+        key: key.into(),
+        message,
+    }
+}
+
+/// The config with the default law filled in where it gives no formula.
+fn with_default_law(mut cfg: ExpressionConfig) -> (String, ExpressionConfig) {
+    match cfg.force.take() {
+        Some(force) => (force, cfg),
+        None => {
+            let mut defaults = ExpressionConfig::default();
+            for spec in DEFAULT_PARAMS {
+                let name = spec.name.to_string();
+                defaults.params.insert(name.clone(), spec.default);
+                defaults
+                    .bounds
+                    .insert(name.clone(), [spec.lower, spec.upper]);
+                defaults.units.insert(name, spec.unit.to_string());
+            }
+            defaults.params.extend(cfg.params);
+            defaults.bounds.extend(cfg.bounds);
+            defaults.units.extend(cfg.units);
+            (DEFAULT_FORCE.to_string(), defaults)
+        }
+    }
+}
+
+/// Every name of `params` is a valid, unreserved name that the formula uses.
+fn check_param_names(
+    cfg: &ExpressionConfig,
+    parsed: &Parsed,
+    force: &str,
+) -> Result<(), ModelError> {
+    for name in cfg.params.keys() {
+        if name == "v" || name == "N" || formula::is_reserved(name) {
+            return Err(bad_key(
+                "params",
+                format!("`{name}` is reserved (v, N and function names cannot be parameters)"),
+            ));
+        }
+        if !formula::is_identifier(name) {
+            return Err(bad_key(
+                "params",
+                format!(
+                    "`{name}` is not a valid name (a letter or `_`, then letters, digits or `_`)"
+                ),
+            ));
+        }
+        if !parsed.variables().iter().any(|(n, _)| n == name) {
+            return Err(bad_key(
+                "params",
+                format!("parameter `{name}` does not appear in the formula `{force}`"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// `bounds` and `units` name only parameters, and every bound is ordered.
+fn check_bounds_and_units(cfg: &ExpressionConfig) -> Result<(), ModelError> {
+    for (key, names) in [
+        ("bounds", cfg.bounds.keys().collect::<Vec<_>>()),
+        ("units", cfg.units.keys().collect::<Vec<_>>()),
+    ] {
+        if let Some(name) = names.into_iter().find(|n| !cfg.params.contains_key(*n)) {
+            return Err(bad_key(
+                key,
+                format!("`{name}` is not a parameter of the formula"),
+            ));
+        }
+    }
+    for (name, [lo, hi]) in &cfg.bounds {
+        if lo.is_nan() || hi.is_nan() || lo > hi {
+            return Err(bad_key(
+                "bounds",
+                format!("bounds of `{name}` must be [lower, upper] with lower <= upper, got [{lo}, {hi}]"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The parameters in order of first appearance in the formula.
+fn ordered_params(parsed: &Parsed, mut cfg: ExpressionConfig) -> Vec<Param> {
+    let mut params = Vec::new();
+    for (name, _) in parsed.variables() {
+        if name == "v" || name == "N" {
+            continue;
+        }
+        if let Some(value) = cfg.params.remove(name) {
+            params.push(Param {
+                name: name.clone(),
+                value,
+                bounds: cfg.bounds.remove(name),
+                unit: cfg.units.remove(name),
+            });
+        }
+    }
+    params
+}
+
+/// The formula compiled over (v, N, params...), and its switched form with sign(v) replaced
+/// by the slip direction (an extra last variable) when it has sign(v).
+fn compile(parsed: &Parsed, params: &[Param]) -> Result<(Formula, Option<Formula>), ModelError> {
+    let mut variables = vec!["v", "N"];
+    variables.extend(params.iter().map(|p| p.name.as_str()));
+    let compiled = parsed.compile(&variables)?;
+    if !parsed.has_sign_of("v") {
+        return Ok((compiled, None));
+    }
+    variables.push(DIRECTION);
+    let switched = parsed
+        .with_sign_of_replaced("v", DIRECTION)
+        .compile(&variables)?;
+    Ok((compiled, Some(switched)))
+}
+
 impl TryFrom<ExpressionConfig> for Expression {
     type Error = ModelError;
 
     fn try_from(cfg: ExpressionConfig) -> Result<Self, ModelError> {
-        let bad = |key: &str, message: String| ModelError::BadKey {
-            model: MODEL.into(),
-            key: key.into(),
-            message,
-        };
-        let (force, mut values, mut bounds, mut units) = match cfg.force {
-            Some(f) => (f, cfg.params, cfg.bounds, cfg.units),
-            None => {
-                // The default law, with any given values overriding its defaults.
-                let mut p = BTreeMap::from([("mu".to_string(), 0.2), ("eps".to_string(), 1e-4)]);
-                let mut b = BTreeMap::from([
-                    ("mu".to_string(), [0.0, 10.0]),
-                    ("eps".to_string(), [1e-9, 1.0]),
-                ]);
-                let mut u = BTreeMap::from([
-                    ("mu".to_string(), "1".to_string()),
-                    ("eps".to_string(), "m/s".to_string()),
-                ]);
-                p.extend(cfg.params);
-                b.extend(cfg.bounds);
-                u.extend(cfg.units);
-                (DEFAULT_FORCE.to_string(), p, b, u)
-            }
-        };
+        let (force, cfg) = with_default_law(cfg);
         let parsed: Parsed = formula::parse(&force)?;
-        for name in values.keys() {
-            if name == "v" || name == "N" || formula::is_reserved(name) {
-                return Err(bad(
-                    "params",
-                    format!("`{name}` is reserved (v, N and function names cannot be parameters)"),
-                ));
-            }
-            if !formula::is_identifier(name) {
-                return Err(bad(
-                    "params",
-                    format!("`{name}` is not a valid name (a letter or `_`, then letters, digits or `_`)"),
-                ));
-            }
-            if !parsed.variables().iter().any(|(n, _)| n == name) {
-                return Err(bad(
-                    "params",
-                    format!("parameter `{name}` does not appear in the formula `{force}`"),
-                ));
-            }
-        }
-        for (key, names) in [
-            ("bounds", bounds.keys().collect::<Vec<_>>()),
-            ("units", units.keys().collect::<Vec<_>>()),
-        ] {
-            if let Some(name) = names.into_iter().find(|n| !values.contains_key(*n)) {
-                return Err(bad(
-                    key,
-                    format!("`{name}` is not a parameter of the formula"),
-                ));
-            }
-        }
-        for (name, [lo, hi]) in &bounds {
-            if lo.is_nan() || hi.is_nan() || lo > hi {
-                return Err(bad(
-                    "bounds",
-                    format!("bounds of `{name}` must be [lower, upper] with lower <= upper, got [{lo}, {hi}]"),
-                ));
-            }
-        }
-        // Parameters in order of first appearance in the formula.
-        let mut params = Vec::new();
-        for (name, _) in parsed.variables() {
-            if name == "v" || name == "N" {
-                continue;
-            }
-            if let Some(value) = values.remove(name) {
-                params.push(Param {
-                    name: name.clone(),
-                    value,
-                    bounds: bounds.remove(name),
-                    unit: units.remove(name),
-                });
-            }
-        }
-        let mut variables = vec!["v", "N"];
-        variables.extend(params.iter().map(|p| p.name.as_str()));
-        let compiled = parsed.compile(&variables)?;
-        let switched = if parsed.has_sign_of("v") {
-            variables.push(DIRECTION);
-            Some(
-                parsed
-                    .with_sign_of_replaced("v", DIRECTION)
-                    .compile(&variables)?,
-            )
-        } else {
-            None
-        };
+        check_param_names(&cfg, &parsed, &force)?;
+        check_bounds_and_units(&cfg)?;
+        let params = ordered_params(&parsed, cfg);
+        let (compiled, switched) = compile(&parsed, &params)?;
         Ok(Self {
             force,
             params,

@@ -7,17 +7,24 @@
 //! dz_i/dt = v (1 - max(0, sgn(v) rho_i)^m),
 //! F = sum_i (k_i z_i + sigma_i dz_i/dt) + viscous v.
 //!
-//! | parameter | unit | default | bounds | meaning |
-//! |---|---|---|---|---|
-//! | `k_1` ... `k_n` | N/m | 1e5, 3.3e4, 1.1e4, ... (each a third of the previous) | (0, 1e12] | element stiffness |
-//! | `w_1` ... `w_n` | 1 | 1/n | [0, 1] | element weight: its fraction of the sliding force |
-//! | `sigma_1` ... `sigma_n` | N s/m | 0 | [0, inf) | element damping |
-//! | `mu_c` | 1 | 0.2 | [0, 10] | Coulomb friction coefficient |
-//! | `mu_s` | 1 | 0.3 | [0, 10] | static friction coefficient |
-//! | `v_s` | m/s | 0.01 | (0, 100] | Stribeck velocity |
-//! | `delta` | 1 | 2 | (0, 10] | Stribeck shape exponent (usually fixed) |
-//! | `sharpness` | 1 | 2 | [1, 20] | exponent m of the element's stick-to-slip transition (usually fixed) |
-//! | `viscous` | N s/m | 0.5 | [0, inf) | viscous friction coefficient |
+//! Per element i (1 to n):
+//!
+//! | parameter | unit | default | bounds | fit | meaning |
+//! |---|---|---|---|---|---|
+//! | `k_i` | N/m | 1e5, 3.3e4, 1.1e4, ... (each a third of the previous) | (0, 1e12] | free | stiffness of element i |
+//! | `w_i` | 1 | 1/n | [0, 1] | free | weight of element i (its fraction of the sliding force) |
+//! | `sigma_i` | N s/m | 0 | [0, inf) | free | damping of element i |
+//!
+//! Shared:
+//!
+//! | parameter | unit | default | bounds | fit | meaning |
+//! |---|---|---|---|---|---|
+//! | `mu_c` | 1 | 0.2 | [0, 10] | free | Coulomb friction coefficient |
+//! | `mu_s` | 1 | 0.3 | [0, 10] | free | static friction coefficient |
+//! | `v_s` | m/s | 0.01 | (0, 100] | free | Stribeck velocity |
+//! | `delta` | 1 | 2 | (0, 10] | free | Stribeck shape exponent (usually fixed) |
+//! | `sharpness` | 1 | 2 | [1, 20] | free | exponent of the element's stick-to-slip transition (usually fixed) |
+//! | `viscous` | N s/m | 0.5 | [0, inf) | free | viscous friction coefficient |
 //!
 //! The parameters are flattened in this order: all stiffnesses, all weights, all dampings,
 //! then the six shared ones. The default model has three elements with equal weights; at the
@@ -81,6 +88,8 @@
 use crate::builtin::stribeck::mu_s_warning;
 use crate::error::ModelError;
 use crate::model::{check_bounds, check_len, sgn, FrictionModel, GuessHint, ParamInfo};
+use crate::params::ParamSpec;
+use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 use serde::de::{self, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -89,6 +98,54 @@ const MODEL: &str = "gms";
 pub const MAX_ELEMENTS: usize = 100;
 const DEFAULT_ELEMENTS: usize = 3;
 const FIRST_STIFFNESS: f64 = 1e5;
+
+/// The declarations of the per-element parameters, in vector order (each repeated for every
+/// element; `{i}` is the element number, the defaults are those of `Gms::with_elements`).
+const ELEMENT_PARAMS: [ParamSpec; 3] = [
+    ParamSpec::positive(
+        "k_{i}",
+        "N/m",
+        FIRST_STIFFNESS,
+        1e12,
+        "stiffness of element {i}",
+    ),
+    ParamSpec::new(
+        "w_{i}",
+        "1",
+        1.0,
+        (0.0, 1.0),
+        "weight of element {i} (its fraction of the sliding force)",
+    ),
+    ParamSpec::non_negative("sigma_{i}", "N s/m", 0.0, "damping of element {i}"),
+];
+
+/// The declarations of the shared parameters, after the element ones in vector order.
+const SHARED_PARAMS: [ParamSpec; 6] = [
+    ParamSpec::new(
+        "mu_c",
+        "1",
+        0.2,
+        (0.0, 10.0),
+        "Coulomb friction coefficient",
+    ),
+    ParamSpec::new("mu_s", "1", 0.3, (0.0, 10.0), "static friction coefficient"),
+    ParamSpec::positive("v_s", "m/s", 0.01, 100.0, "Stribeck velocity"),
+    ParamSpec::positive(
+        "delta",
+        "1",
+        2.0,
+        10.0,
+        "Stribeck shape exponent (usually fixed)",
+    ),
+    ParamSpec::new(
+        "sharpness",
+        "1",
+        2.0,
+        (1.0, 20.0),
+        "exponent of the element's stick-to-slip transition (usually fixed)",
+    ),
+    ParamSpec::non_negative("viscous", "N s/m", 0.5, "viscous friction coefficient"),
+];
 
 /// One Maxwell-slip element.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -139,12 +196,36 @@ impl Gms {
                     damping: 0.0,
                 })
                 .collect(),
-            mu_c: 0.2,
-            mu_s: 0.3,
-            v_s: 0.01,
-            delta: 2.0,
-            sharpness: 2.0,
-            viscous: 0.5,
+            mu_c: SHARED_PARAMS[0].default,
+            mu_s: SHARED_PARAMS[1].default,
+            v_s: SHARED_PARAMS[2].default,
+            delta: SHARED_PARAMS[3].default,
+            sharpness: SHARED_PARAMS[4].default,
+            viscous: SHARED_PARAMS[5].default,
+        }
+    }
+
+    /// The metadata of the six shared parameters (the last six of `param_info`).
+    pub fn shared_param_info() -> Vec<ParamInfo> {
+        crate::params::infos(&SHARED_PARAMS)
+    }
+
+    /// Takes the levels mu_c, mu_s, v_s and delta (when given) and viscous.
+    fn set_levels(&mut self, levels: &StribeckLevels) {
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.delta = levels.delta.unwrap_or(self.delta);
+        self.viscous = levels.viscous;
+    }
+
+    /// Scales the element stiffnesses, keeping their ratios, to the total `target` [N/m].
+    fn scale_stiffness(&mut self, target: f64) {
+        let total: f64 = self.elements.iter().map(|e| e.stiffness).sum();
+        if total > 0.0 && total.is_finite() {
+            for e in &mut self.elements {
+                e.stiffness *= target / total;
+            }
         }
     }
 
@@ -154,26 +235,48 @@ impl Gms {
             * (self.mu_c + (self.mu_s - self.mu_c) * (-(v / self.v_s).abs().powf(self.delta)).exp())
     }
 
-    /// The element law dz/dt = v (1 - max(0, sgn(v) rho)^m).
-    fn z_dot(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
+    /// The element's sliding force w s and its load sgn(v) k z / (w s): how far the motion
+    /// loads the element towards its sliding force in the direction of motion (unloading, v
+    /// against the deflection, is purely elastic). `None` for a frozen element (no sliding
+    /// force).
+    fn element_load(e: &GmsElement, v: f64, z: f64, s: f64) -> Option<(f64, f64)> {
         let limit = e.weight * s;
         if limit <= 0.0 {
-            // No sliding force: the element is frozen.
-            return 0.0;
+            return None;
         }
         let rho = e.stiffness * z / limit;
-        // How far the motion loads the element towards its sliding force in the direction of
-        // motion; unloading (v against the deflection) is purely elastic.
-        let load = if v >= 0.0 { rho } else { -rho };
-        if load > 0.0 {
-            let p = if self.sharpness == 1.0 {
-                load
-            } else {
-                load.powf(self.sharpness)
-            };
-            v * (1.0 - p)
-        } else {
-            v
+        Some((limit, if v >= 0.0 { rho } else { -rho }))
+    }
+
+    /// The element law dz/dt = v (1 - max(0, sgn(v) rho)^m).
+    fn z_dot(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
+        match Self::element_load(e, v, z, s) {
+            None => 0.0,
+            Some((_, load)) if load > 0.0 => {
+                let p = if self.sharpness == 1.0 {
+                    load
+                } else {
+                    load.powf(self.sharpness)
+                };
+                v * (1.0 - p)
+            }
+            Some(_) => v,
+        }
+    }
+
+    /// d(dz/dt)/dz of the element law: -|v| m load^(m-1) k / (w s) while loading
+    /// (load > 0), 0 while unloading and for a frozen element.
+    fn z_dot_slope(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
+        match Self::element_load(e, v, z, s) {
+            Some((limit, load)) if load > 0.0 => {
+                let power = if self.sharpness == 1.0 {
+                    1.0
+                } else {
+                    self.sharpness * load.powf(self.sharpness - 1.0)
+                };
+                -v.abs() * power * e.stiffness / limit
+            }
+            _ => 0.0,
         }
     }
 }
@@ -287,68 +390,92 @@ impl Default for GmsConfig {
     }
 }
 
-impl TryFrom<GmsConfig> for Gms {
-    type Error = ModelError;
+fn bad_key(key: &str, message: String) -> ModelError {
+    ModelError::BadKey {
+        model: MODEL.into(),
+        key: key.into(),
+        message,
+    }
+}
 
-    fn try_from(cfg: GmsConfig) -> Result<Self, ModelError> {
-        let bad = |key: &str, message: String| ModelError::BadKey {
-            model: MODEL.into(),
-            key: key.into(),
-            message,
-        };
-        let lists = [
-            ("stiffness", &cfg.stiffness),
-            ("weights", &cfg.weights),
-            ("damping", &cfg.damping),
-        ];
-        // The element count and the key it came from.
-        let (n, source) = match cfg.elements {
+impl GmsConfig {
+    /// The per-element lists with their keys.
+    fn lists(&self) -> [(&'static str, &Option<PerElement>); 3] {
+        [
+            ("stiffness", &self.stiffness),
+            ("weights", &self.weights),
+            ("damping", &self.damping),
+        ]
+    }
+
+    /// The element count and the key it came from (`elements`, else the first list, else
+    /// the default).
+    fn element_count(&self) -> (usize, &'static str) {
+        match self.elements {
             Some(n) => (n, "elements"),
-            None => lists
+            None => self
+                .lists()
                 .iter()
                 .find_map(|(key, l)| l.as_ref().and_then(PerElement::len).map(|n| (n, *key)))
                 .unwrap_or((DEFAULT_ELEMENTS, "the default")),
-        };
+        }
+    }
+
+    /// Checks the element count and that every list has one value per element.
+    fn checked_element_count(&self) -> Result<usize, ModelError> {
+        let (n, source) = self.element_count();
         if n == 0 || n > MAX_ELEMENTS {
-            return Err(bad(
+            return Err(bad_key(
                 source,
                 format!("the model needs 1 to {MAX_ELEMENTS} elements, got {n}"),
             ));
         }
-        for (key, l) in lists {
+        let source = if source == "the default" {
+            source.to_string()
+        } else {
+            format!("`{source}`")
+        };
+        for (key, l) in self.lists() {
             if let Some(len) = l.as_ref().and_then(PerElement::len) {
                 if len != n {
-                    return Err(bad(
+                    return Err(bad_key(
                         key,
                         format!(
-                            "has {len} values but the model has {n} elements (from {}); give one \
-                             value per element or a single number for all",
-                            if source == "the default" {
-                                source.to_string()
-                            } else {
-                                format!("`{source}`")
-                            }
+                            "has {len} values but the model has {n} elements (from {source}); give \
+                             one value per element or a single number for all"
                         ),
                     ));
                 }
             }
         }
-        let defaults = Gms::with_elements(n);
+        Ok(n)
+    }
+
+    /// The `n` elements: the given values, else the defaults of `Gms::with_elements(n)`.
+    fn elements(&self, n: usize) -> Vec<GmsElement> {
         let pick = |l: &Option<PerElement>, i: usize, default: f64| {
             l.as_ref().and_then(|l| l.get(i)).unwrap_or(default)
         };
-        let elements = defaults
+        Gms::with_elements(n)
             .elements
             .iter()
             .enumerate()
             .map(|(i, d)| GmsElement {
-                stiffness: pick(&cfg.stiffness, i, d.stiffness),
-                weight: pick(&cfg.weights, i, d.weight),
-                damping: pick(&cfg.damping, i, d.damping),
+                stiffness: pick(&self.stiffness, i, d.stiffness),
+                weight: pick(&self.weights, i, d.weight),
+                damping: pick(&self.damping, i, d.damping),
             })
-            .collect();
+            .collect()
+    }
+}
+
+impl TryFrom<GmsConfig> for Gms {
+    type Error = ModelError;
+
+    fn try_from(cfg: GmsConfig) -> Result<Self, ModelError> {
+        let n = cfg.checked_element_count()?;
         Ok(Self {
-            elements,
+            elements: cfg.elements(n),
             mu_c: cfg.mu_c,
             mu_s: cfg.mu_s,
             v_s: cfg.v_s,
@@ -389,75 +516,22 @@ impl FrictionModel for Gms {
     fn param_info(&self) -> Vec<ParamInfo> {
         let n = self.elements.len();
         let d = Gms::with_elements(n);
-        let mut info = Vec::with_capacity(3 * n + 6);
-        for (i, e) in d.elements.iter().enumerate() {
-            info.push(ParamInfo::positive(
-                &format!("k_{}", i + 1),
-                "N/m",
-                e.stiffness,
-                1e12,
-                &format!("stiffness of element {}", i + 1),
-            ));
-        }
-        for (i, e) in d.elements.iter().enumerate() {
-            info.push(ParamInfo::new(
-                &format!("w_{}", i + 1),
-                "1",
-                e.weight,
-                (0.0, 1.0),
-                &format!(
-                    "weight of element {} (its fraction of the sliding force)",
-                    i + 1
-                ),
-            ));
-        }
-        for (i, e) in d.elements.iter().enumerate() {
-            info.push(ParamInfo::new(
-                &format!("sigma_{}", i + 1),
-                "N s/m",
-                e.damping,
-                (0.0, f64::INFINITY),
-                &format!("damping of element {}", i + 1),
-            ));
-        }
-        info.extend([
-            ParamInfo::new(
-                "mu_c",
-                "1",
-                d.mu_c,
-                (0.0, 10.0),
-                "Coulomb friction coefficient",
-            ),
-            ParamInfo::new(
-                "mu_s",
-                "1",
-                d.mu_s,
-                (0.0, 10.0),
-                "static friction coefficient",
-            ),
-            ParamInfo::positive("v_s", "m/s", d.v_s, 100.0, "Stribeck velocity"),
-            ParamInfo::positive(
-                "delta",
-                "1",
-                d.delta,
-                10.0,
-                "Stribeck shape exponent (usually fixed)",
-            ),
-            ParamInfo::new(
-                "sharpness",
-                "1",
-                d.sharpness,
-                (1.0, 20.0),
-                "exponent of the element's stick-to-slip transition (usually fixed)",
-            ),
-            ParamInfo::new(
-                "viscous",
-                "N s/m",
-                d.viscous,
-                (0.0, f64::INFINITY),
-                "viscous friction coefficient",
-            ),
-        ]);
+        let element_values: [fn(&GmsElement) -> f64; 3] =
+            [|e| e.stiffness, |e| e.weight, |e| e.damping];
+        let mut info: Vec<ParamInfo> = ELEMENT_PARAMS
+            .iter()
+            .zip(element_values)
+            .flat_map(|(spec, value)| {
+                d.elements.iter().enumerate().map(move |(i, e)| {
+                    let number = (i + 1).to_string();
+                    spec.with_default(value(e)).info_named(
+                        &spec.name.replace("{i}", &number),
+                        &spec.description.replace("{i}", &number),
+                    )
+                })
+            })
+            .collect();
+        info.extend(Gms::shared_param_info());
         info
     }
     fn params(&self) -> Vec<f64> {
@@ -508,6 +582,18 @@ impl FrictionModel for Gms {
             *d = self.z_dot(e, v, zi, s);
         }
     }
+    /// Diagonal: each element's rate depends on its own deflection only (see
+    /// `Gms::z_dot_slope`).
+    fn state_jacobian(&self, v: f64, z: &[f64], normal: f64, jac: &mut [f64]) {
+        let n = self.elements.len();
+        jac.iter_mut().for_each(|j| *j = 0.0);
+        let s = self.s(v, normal);
+        for (i, (e, &zi)) in self.elements.iter().zip(z).enumerate() {
+            if let Some(j) = jac.get_mut(i * n + i) {
+                *j = self.z_dot_slope(e, v, zi, s);
+            }
+        }
+    }
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
         let s = self.s(v, normal);
         let elements: f64 = self
@@ -538,28 +624,40 @@ impl FrictionModel for Gms {
             .sum()
     }
     fn apply_guess(&mut self, hint: &GuessHint) {
-        let v = hint.typical_velocity.max(1e-6);
-        self.mu_c = 0.9 * hint.mu;
-        self.mu_s = 1.2 * hint.mu;
-        self.v_s = 0.2 * v;
-        self.viscous = 0.05 * hint.mu * hint.normal_force / v;
+        let levels = StribeckLevels::guess(hint);
+        self.set_levels(&levels);
         // Keep the ratios of the stiffnesses; scale the total presliding stiffness to a
         // breakaway displacement of about 20 micrometres (as the LuGre guess).
-        let total: f64 = self.elements.iter().map(|e| e.stiffness).sum();
-        let target = (hint.mu * hint.normal_force / 2e-5).max(1.0);
-        if total > 0.0 && total.is_finite() {
-            for e in &mut self.elements {
-                e.stiffness *= target / total;
-            }
+        self.scale_stiffness(
+            (hint.mu * hint.normal_force / TYPICAL_PRESLIDING_DISPLACEMENT).max(1.0),
+        );
+    }
+    /// The fitted Stribeck curve shared by the elements (weights rescaled to sum to 1, so
+    /// that the model slides at exactly that curve), the total stiffness from the presliding
+    /// displacement at the Coulomb level, the stiffness ratios kept.
+    fn start_from(&mut self, fitted: &dyn FrictionModel, ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.set_levels(&levels);
+        let total_weight: f64 = self.elements.iter().map(|e| e.weight).sum();
+        let equal = 1.0 / self.elements.len().max(1) as f64;
+        for e in &mut self.elements {
+            e.weight = if total_weight > 0.0 {
+                e.weight / total_weight
+            } else {
+                equal
+            };
         }
+        self.scale_stiffness(ctx.stiffness_for(levels.mu_c * ctx.normal_force));
+        true
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         if self.elements.is_empty() {
-            return Err(ModelError::BadKey {
-                model: MODEL.into(),
-                key: "elements".into(),
-                message: "the model needs at least one element".into(),
-            });
+            return Err(bad_key(
+                "elements",
+                "the model needs at least one element".into(),
+            ));
         }
         check_bounds(self.name(), &self.param_info(), &self.params())?;
         let mut warnings = mu_s_warning(self.name(), self.mu_s, self.mu_c);

@@ -3,14 +3,14 @@
 //! dz/dt = v - sigma0 |v| z / g(v),  g(v) = N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)),
 //! F = sigma0 z + sigma1 dz/dt + sigma2 v
 //!
-//! | parameter | unit | default | bounds | meaning |
-//! |---|---|---|---|---|
-//! | `sigma0` | N/m | 1e5 | (0, 1e12] | bristle stiffness |
-//! | `sigma1` | N s/m | 300 | [0, inf) | bristle damping |
-//! | `sigma2` | N s/m | 0.5 | [0, inf) | viscous friction coefficient |
-//! | `mu_c` | 1 | 0.2 | (0, 10] | Coulomb friction coefficient |
-//! | `mu_s` | 1 | 0.3 | (0, 10] | static friction coefficient |
-//! | `v_s` | m/s | 0.01 | (0, 100] | Stribeck velocity |
+//! | parameter | unit | default | bounds | fit | meaning |
+//! |---|---|---|---|---|---|
+//! | `sigma0` | N/m | 1e5 | (0, 1e12] | free | bristle stiffness |
+//! | `sigma1` | N s/m | 300 | [0, inf) | free | bristle damping |
+//! | `sigma2` | N s/m | 0.5 | [0, inf) | free | viscous friction coefficient |
+//! | `mu_c` | 1 | 0.2 | (0, 10] | free | Coulomb friction coefficient |
+//! | `mu_s` | 1 | 0.3 | (0, 10] | free | static friction coefficient |
+//! | `v_s` | m/s | 0.01 | (0, 100] | free | Stribeck velocity |
 //!
 //! Stored energy: sigma0 z^2 / 2. mu_s < mu_c is admissible but reported as a warning.
 //!
@@ -19,37 +19,18 @@
 
 use crate::builtin::stribeck::mu_s_warning;
 use crate::error::ModelError;
-use crate::model::{check_bounds, check_len, sgn, FrictionModel, GuessHint, ParamInfo};
-use serde::{Deserialize, Serialize};
+use crate::model::{check_bounds, sgn, FrictionModel, GuessHint};
+use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
-/// The LuGre bristle model with the Stribeck curve of Canudas de Wit et al. (1995).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct LuGre {
-    /// Bristle stiffness [N/m].
-    pub sigma0: f64,
-    /// Bristle damping [N s/m].
-    pub sigma1: f64,
-    /// Viscous coefficient [N s/m].
-    pub sigma2: f64,
-    /// Coulomb coefficient.
-    pub mu_c: f64,
-    /// Static coefficient.
-    pub mu_s: f64,
-    /// Stribeck velocity [m/s].
-    pub v_s: f64,
-}
-
-impl Default for LuGre {
-    fn default() -> Self {
-        Self {
-            sigma0: 1e5,
-            sigma1: 300.0,
-            sigma2: 0.5,
-            mu_c: 0.2,
-            mu_s: 0.3,
-            v_s: 0.01,
-        }
+crate::declare_params! {
+    /// The LuGre bristle model with the Stribeck curve of Canudas de Wit et al. (1995).
+    pub struct LuGre {
+        sigma0: positive("N/m", 1e5, 1e12, "bristle stiffness"),
+        sigma1: non_negative("N s/m", 300.0, "bristle damping"),
+        sigma2: non_negative("N s/m", 0.5, "viscous friction coefficient"),
+        mu_c: positive("1", 0.2, 10.0, "Coulomb friction coefficient"),
+        mu_s: positive("1", 0.3, 10.0, "static friction coefficient"),
+        v_s: positive("m/s", 0.01, 100.0, "Stribeck velocity"),
     }
 }
 
@@ -73,61 +54,28 @@ impl LuGre {
 
 #[typetag::serde(name = "lugre")]
 impl FrictionModel for LuGre {
-    fn name(&self) -> &'static str {
-        "lugre"
-    }
-    fn equation(&self) -> String {
-        "dz/dt = v - sigma0 |v| z / g(v), g(v) = N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)), F = sigma0 z + sigma1 dz/dt + sigma2 v".into()
-    }
-    fn param_info(&self) -> Vec<ParamInfo> {
-        vec![
-            ParamInfo::positive("sigma0", "N/m", 1e5, 1e12, "bristle stiffness"),
-            ParamInfo::new(
-                "sigma1",
-                "N s/m",
-                300.0,
-                (0.0, f64::INFINITY),
-                "bristle damping",
-            ),
-            ParamInfo::new(
-                "sigma2",
-                "N s/m",
-                0.5,
-                (0.0, f64::INFINITY),
-                "viscous friction coefficient",
-            ),
-            ParamInfo::positive("mu_c", "1", 0.2, 10.0, "Coulomb friction coefficient"),
-            ParamInfo::positive("mu_s", "1", 0.3, 10.0, "static friction coefficient"),
-            ParamInfo::positive("v_s", "m/s", 0.01, 100.0, "Stribeck velocity"),
-        ]
-    }
-    fn params(&self) -> Vec<f64> {
-        vec![
-            self.sigma0,
-            self.sigma1,
-            self.sigma2,
-            self.mu_c,
-            self.mu_s,
-            self.v_s,
-        ]
-    }
-    fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
-        check_len(self.name(), 6, values.len())?;
-        // Indexing below is in range: check_len has just verified the length.
-        self.sigma0 = values[0];
-        self.sigma1 = values[1];
-        self.sigma2 = values[2];
-        self.mu_c = values[3];
-        self.mu_s = values[4];
-        self.v_s = values[5];
-        Ok(())
-    }
+    crate::declared_param_methods!(
+        name: "lugre",
+        equation: "dz/dt = v - sigma0 |v| z / g(v), g(v) = N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)), F = sigma0 z + sigma1 dz/dt + sigma2 v",
+    );
+
     fn n_states(&self) -> usize {
         1
     }
     fn state_derivative(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) {
         if let (Some(&z0), Some(d)) = (z.first(), dz.first_mut()) {
             *d = self.z_dot(v, z0, normal);
+        }
+    }
+    /// d(dz/dt)/dz = -sigma0 |v| / g(v) (0 without normal load).
+    fn state_jacobian(&self, v: f64, _z: &[f64], normal: f64, jac: &mut [f64]) {
+        if let Some(j) = jac.first_mut() {
+            let g = self.g(v, normal);
+            *j = if g > 0.0 {
+                -self.sigma0 * v.abs() / g
+            } else {
+                0.0
+            };
         }
     }
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
@@ -142,15 +90,30 @@ impl FrictionModel for LuGre {
         0.5 * self.sigma0 * z0 * z0
     }
     fn apply_guess(&mut self, hint: &GuessHint) {
-        let v = hint.typical_velocity.max(1e-6);
-        self.mu_c = 0.9 * hint.mu;
-        self.mu_s = 1.2 * hint.mu;
+        let levels = StribeckLevels::guess(hint);
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.sigma2 = levels.viscous;
         // Stribeck velocities are typically a few percent of the sliding speeds of a free
         // vibration; bristle damping a fraction of the critical damping of the bristle mode.
-        self.v_s = 0.05 * v;
-        self.sigma0 = (hint.mu * hint.normal_force / 2e-5).max(1.0);
+        self.v_s = 0.05 * hint.typical_velocity.max(1e-6);
+        self.sigma0 = (hint.mu * hint.normal_force / TYPICAL_PRESLIDING_DISPLACEMENT).max(1.0);
         self.sigma1 = 0.25 * (self.sigma0 * hint.mass).sqrt();
-        self.sigma2 = 0.05 * hint.mu * hint.normal_force / v;
+    }
+    /// The Stribeck levels (sliding at the fitted curve, which LuGre's Gaussian dip
+    /// reproduces exactly for delta = 2), the bristle stiffness from the presliding
+    /// displacement at the Coulomb level, the bristle damping at its critical value.
+    fn start_from(&mut self, fitted: &dyn FrictionModel, ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.sigma2 = levels.viscous;
+        self.sigma0 = ctx.stiffness_for(levels.mu_c * ctx.normal_force);
+        self.sigma1 = ctx.critical_damping(self.sigma0);
+        true
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(self.name(), &self.param_info(), &self.params())?;

@@ -2,14 +2,14 @@
 //!
 //! F = g1 (tanh(g2 v) - tanh(g3 v)) + g4 tanh(g5 v) + g6 v
 //!
-//! | parameter | unit | default | bounds | meaning |
-//! |---|---|---|---|---|
-//! | `g1` | N | 1.9 | [0, inf) | amplitude of the Stribeck term |
-//! | `g2` | s/m | 200 | [0, inf) | rise rate of the Stribeck term |
-//! | `g3` | s/m | 20 | [0, inf) | decay rate of the Stribeck term (g3 < g2) |
-//! | `g4` | N | 2.9 | [0, inf) | Coulomb level |
-//! | `g5` | s/m | 1000 | [0, inf) | steepness of the smoothed Coulomb term |
-//! | `g6` | N s/m | 0.5 | [0, inf) | viscous friction coefficient |
+//! | parameter | unit | default | bounds | fit | meaning |
+//! |---|---|---|---|---|---|
+//! | `g1` | N | 1.9 | [0, inf) | free | amplitude of the Stribeck term |
+//! | `g2` | s/m | 200 | [0, inf) | free | rise rate of the Stribeck term |
+//! | `g3` | s/m | 20 | [0, inf) | free | decay rate of the Stribeck term (g3 < g2) |
+//! | `g4` | N | 2.9 | [0, inf) | free | Coulomb level |
+//! | `g5` | s/m | 1000 | [0, inf) | free | steepness of the smoothed Coulomb term |
+//! | `g6` | N s/m | 0.5 | [0, inf) | free | viscous friction coefficient |
 //!
 //! g4 tanh(g5 v) is a smoothed Coulomb force; g1 (tanh(g2 v) - tanh(g3 v)) is a bump that
 //! vanishes at rest and at high speed and peaks in between (the Stribeck effect) when
@@ -26,107 +26,27 @@
 //! Intelligent Mechatronics (AIM), Monterey, 2005, pp. 600-605.
 
 use crate::error::ModelError;
-use crate::model::{check_bounds, check_len, FrictionModel, GuessHint, ParamInfo};
-use serde::{Deserialize, Serialize};
+use crate::model::{check_bounds, FrictionModel, GuessHint};
 
-/// Makkar et al.'s smooth friction law with Stribeck, Coulomb and viscous terms.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct Makkar {
-    /// Stribeck amplitude \[N\].
-    pub g1: f64,
-    /// Stribeck rise rate [s/m].
-    pub g2: f64,
-    /// Stribeck decay rate [s/m].
-    pub g3: f64,
-    /// Coulomb level \[N\].
-    pub g4: f64,
-    /// Coulomb steepness [s/m].
-    pub g5: f64,
-    /// Viscous coefficient [N s/m].
-    pub g6: f64,
-}
-
-impl Default for Makkar {
-    fn default() -> Self {
-        Self {
-            g1: 1.9,
-            g2: 200.0,
-            g3: 20.0,
-            g4: 2.9,
-            g5: 1000.0,
-            g6: 0.5,
-        }
+crate::declare_params! {
+    /// Makkar et al.'s smooth friction law with Stribeck, Coulomb and viscous terms.
+    pub struct Makkar {
+        g1: non_negative("N", 1.9, "amplitude of the Stribeck term"),
+        g2: non_negative("s/m", 200.0, "rise rate of the Stribeck term"),
+        g3: non_negative("s/m", 20.0, "decay rate of the Stribeck term (g3 < g2)"),
+        g4: non_negative("N", 2.9, "Coulomb level"),
+        g5: non_negative("s/m", 1000.0, "steepness of the smoothed Coulomb term"),
+        g6: non_negative("N s/m", 0.5, "viscous friction coefficient"),
     }
 }
 
 #[typetag::serde(name = "makkar")]
 impl FrictionModel for Makkar {
-    fn name(&self) -> &'static str {
-        "makkar"
-    }
-    fn equation(&self) -> String {
-        "F = g1 (tanh(g2 v) - tanh(g3 v)) + g4 tanh(g5 v) + g6 v".into()
-    }
-    fn param_info(&self) -> Vec<ParamInfo> {
-        let d = Self::default();
-        let inf = f64::INFINITY;
-        vec![
-            ParamInfo::new(
-                "g1",
-                "N",
-                d.g1,
-                (0.0, inf),
-                "amplitude of the Stribeck term",
-            ),
-            ParamInfo::new(
-                "g2",
-                "s/m",
-                d.g2,
-                (0.0, inf),
-                "rise rate of the Stribeck term",
-            ),
-            ParamInfo::new(
-                "g3",
-                "s/m",
-                d.g3,
-                (0.0, inf),
-                "decay rate of the Stribeck term (g3 < g2)",
-            ),
-            ParamInfo::new("g4", "N", d.g4, (0.0, inf), "Coulomb level"),
-            ParamInfo::new(
-                "g5",
-                "s/m",
-                d.g5,
-                (0.0, inf),
-                "steepness of the smoothed Coulomb term",
-            ),
-            ParamInfo::new(
-                "g6",
-                "N s/m",
-                d.g6,
-                (0.0, inf),
-                "viscous friction coefficient",
-            ),
-        ]
-    }
-    fn params(&self) -> Vec<f64> {
-        vec![self.g1, self.g2, self.g3, self.g4, self.g5, self.g6]
-    }
-    fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
-        check_len(self.name(), 6, values.len())?;
-        if let [g1, g2, g3, g4, g5, g6] = *values {
-            *self = Self {
-                g1,
-                g2,
-                g3,
-                g4,
-                g5,
-                g6,
-            };
-        }
-        Ok(())
-    }
+    crate::declared_param_methods!(
+        name: "makkar",
+        equation: "F = g1 (tanh(g2 v) - tanh(g3 v)) + g4 tanh(g5 v) + g6 v",
+    );
+
     fn force(&self, v: f64, _z: &[f64], _normal: f64) -> f64 {
         self.g1 * ((self.g2 * v).tanh() - (self.g3 * v).tanh())
             + self.g4 * (self.g5 * v).tanh()

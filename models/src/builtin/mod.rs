@@ -17,5 +17,5 @@ pub use gms::{Gms, GmsConfig, GmsElement, PerElement, MAX_ELEMENTS};
 pub use lugre::LuGre;
 pub use makkar::Makkar;
 pub use none::NoFriction;
-pub use stribeck::Stribeck;
+pub use stribeck::{mu_s_warning, Stribeck};
 pub use viscous_coulomb::ViscousCoulomb;

@@ -1,14 +1,14 @@
 //! Stribeck friction with viscous term.
 //!
-//! F = N (mu_c + (mu_s - mu_c) exp(-|v / v_s|^delta)) sgn(v) + b v
+//! F = N (mu_c + (mu_s - mu_c) exp(-|v / v_s|^delta)) sgn(v) + viscous v
 //!
-//! | parameter | unit | default | bounds | meaning |
-//! |---|---|---|---|---|
-//! | `mu_c` | 1 | 0.2 | [0, 10] | Coulomb (kinetic) friction coefficient |
-//! | `mu_s` | 1 | 0.3 | [0, 10] | static (breakaway) friction coefficient |
-//! | `v_s` | m/s | 0.01 | (0, 100] | Stribeck velocity |
-//! | `delta` | 1 | 2 | (0, 10] | Stribeck shape exponent (usually fixed) |
-//! | `viscous` | N s/m | 0.5 | [0, inf) | viscous friction coefficient b |
+//! | parameter | unit | default | bounds | fit | meaning |
+//! |---|---|---|---|---|---|
+//! | `mu_c` | 1 | 0.2 | [0, 10] | free | Coulomb (kinetic) friction coefficient |
+//! | `mu_s` | 1 | 0.3 | [0, 10] | free | static (breakaway) friction coefficient |
+//! | `v_s` | m/s | 0.01 | (0, 100] | free | Stribeck velocity |
+//! | `delta` | 1 | 2 | (0, 10] | fixed | Stribeck shape exponent (usually fixed) |
+//! | `viscous` | N s/m | 0.5 | [0, inf) | free | viscous friction coefficient |
 //!
 //! The breakaway limit used to decide sticking is mu_s N. mu_s < mu_c is admissible but
 //! reported as a warning.
@@ -17,38 +17,30 @@
 //! Z. VDI 46, 1902; the exponential form as in Armstrong-Hélouvry et al., Automatica 30(7), 1994.
 
 use crate::error::ModelError;
-use crate::model::{check_bounds, check_len, sgn, FrictionModel, GuessHint, ParamInfo};
-use serde::{Deserialize, Serialize};
+use crate::model::{check_bounds, sgn, FrictionModel, GuessHint};
+use crate::start::{StartContext, StribeckLevels};
 
-/// Static friction law with a Stribeck dip between static and Coulomb levels.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct Stribeck {
-    /// Coulomb coefficient.
-    pub mu_c: f64,
-    /// Static coefficient.
-    pub mu_s: f64,
-    /// Stribeck velocity [m/s].
-    pub v_s: f64,
-    /// Shape exponent.
-    pub delta: f64,
-    /// Viscous coefficient [N s/m].
-    pub viscous: f64,
-}
-
-impl Default for Stribeck {
-    fn default() -> Self {
-        Self {
-            mu_c: 0.2,
-            mu_s: 0.3,
-            v_s: 0.01,
-            delta: 2.0,
-            viscous: 0.5,
-        }
+crate::declare_params! {
+    /// Static friction law with a Stribeck dip between static and Coulomb levels.
+    pub struct Stribeck {
+        mu_c: new("1", 0.2, (0.0, 10.0), "Coulomb (kinetic) friction coefficient"),
+        mu_s: new("1", 0.3, (0.0, 10.0), "static (breakaway) friction coefficient"),
+        v_s: positive("m/s", 0.01, 100.0, "Stribeck velocity"),
+        delta: positive("1", 2.0, 10.0, "Stribeck shape exponent (usually fixed)").fixed(),
+        viscous: non_negative("N s/m", 0.5, "viscous friction coefficient"),
     }
 }
 
 impl Stribeck {
+    /// Takes the levels mu_c, mu_s, v_s and delta (when given) and viscous.
+    fn set_levels(&mut self, levels: &StribeckLevels) {
+        self.mu_c = levels.mu_c;
+        self.mu_s = levels.mu_s;
+        self.v_s = levels.v_s.unwrap_or(self.v_s);
+        self.delta = levels.delta.unwrap_or(self.delta);
+        self.viscous = levels.viscous;
+    }
+
     /// The velocity-dependent coefficient mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta).
     pub fn coefficient(&self, v: f64) -> f64 {
         self.mu_c + (self.mu_s - self.mu_c) * (-(v / self.v_s).abs().powf(self.delta)).exp()
@@ -57,59 +49,11 @@ impl Stribeck {
 
 #[typetag::serde(name = "stribeck")]
 impl FrictionModel for Stribeck {
-    fn name(&self) -> &'static str {
-        "stribeck"
-    }
-    fn equation(&self) -> String {
-        "F = N (mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta)) sgn(v) + viscous v".into()
-    }
-    fn param_info(&self) -> Vec<ParamInfo> {
-        vec![
-            ParamInfo::new(
-                "mu_c",
-                "1",
-                0.2,
-                (0.0, 10.0),
-                "Coulomb (kinetic) friction coefficient",
-            ),
-            ParamInfo::new(
-                "mu_s",
-                "1",
-                0.3,
-                (0.0, 10.0),
-                "static (breakaway) friction coefficient",
-            ),
-            ParamInfo::positive("v_s", "m/s", 0.01, 100.0, "Stribeck velocity"),
-            ParamInfo::positive(
-                "delta",
-                "1",
-                2.0,
-                10.0,
-                "Stribeck shape exponent (usually fixed)",
-            )
-            .fixed(),
-            ParamInfo::new(
-                "viscous",
-                "N s/m",
-                0.5,
-                (0.0, f64::INFINITY),
-                "viscous friction coefficient",
-            ),
-        ]
-    }
-    fn params(&self) -> Vec<f64> {
-        vec![self.mu_c, self.mu_s, self.v_s, self.delta, self.viscous]
-    }
-    fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
-        check_len(self.name(), 5, values.len())?;
-        // Indexing below is in range: check_len has just verified the length.
-        self.mu_c = values[0];
-        self.mu_s = values[1];
-        self.v_s = values[2];
-        self.delta = values[3];
-        self.viscous = values[4];
-        Ok(())
-    }
+    crate::declared_param_methods!(
+        name: "stribeck",
+        equation: "F = N (mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta)) sgn(v) + viscous v",
+    );
+
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         normal * self.coefficient(v) * sgn(v) + self.viscous * v
     }
@@ -123,11 +67,14 @@ impl FrictionModel for Stribeck {
         self.force(v, &[], normal)
     }
     fn apply_guess(&mut self, hint: &GuessHint) {
-        let v = hint.typical_velocity.max(1e-6);
-        self.mu_c = 0.9 * hint.mu;
-        self.mu_s = 1.2 * hint.mu;
-        self.v_s = 0.2 * v;
-        self.viscous = 0.05 * hint.mu * hint.normal_force / v;
+        self.set_levels(&StribeckLevels::guess(hint));
+    }
+    fn start_from(&mut self, fitted: &dyn FrictionModel, _ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.set_levels(&levels);
+        true
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(self.name(), &self.param_info(), &self.params())?;
@@ -135,8 +82,9 @@ impl FrictionModel for Stribeck {
     }
 }
 
-/// The warning for a static coefficient below the kinetic one.
-pub(crate) fn mu_s_warning(model: &str, mu_s: f64, mu_c: f64) -> Vec<String> {
+/// The warning of `validate` for a static coefficient below the kinetic one (none when
+/// mu_s >= mu_c), for every model with both levels.
+pub fn mu_s_warning(model: &str, mu_s: f64, mu_c: f64) -> Vec<String> {
     if mu_s < mu_c {
         vec![format!(
             "model `{model}`: mu_s = {mu_s} is below mu_c = {mu_c} (friction rises with speed near zero)"

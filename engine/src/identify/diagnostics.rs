@@ -1,0 +1,582 @@
+//! Diagnostics on every fit: each check turns part of a fit into a [`Finding`] with a pass,
+//! warn or fail status, so that a result that cannot be trusted says so.
+//!
+//! - Energy balance: the model's mean force against the energy-based estimates (Eq. 7, time
+//!   mean, and the half-cycle estimate, a distance mean): warn above
+//!   [`ENERGY_WARN_PERCENT`], fail above [`ENERGY_FAIL_PERCENT`].
+//! - Residual structure: residuals locked to the motion (correlated with sgn v or x, repeating
+//!   with the oscillation period, or with a mean) betray a wrong model, an offset or a missed
+//!   release. Significance is judged with the effective sample size of autocorrelated
+//!   residuals, so coloured measurement noise alone (correlated over short lags only) passes
+//!   or at most warns; a failure also needs a large effect ([`STRUCTURE_FAIL_EFFECT`]).
+//! - Parameters at a bound, standard errors that cannot be computed, starts that disagree,
+//!   non-convergence.
+
+use super::energy_check::EnergyForce;
+use super::layout::FreeParam;
+use super::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
+use super::result::{FittedParam, RecordFit};
+use crate::energy::cumulative_trapezoid;
+use crate::oscillator::Oscillator;
+
+/// An energy-balance difference above this many percent warns.
+pub const ENERGY_WARN_PERCENT: f64 = 5.0;
+/// An energy-balance difference above this many percent fails.
+pub const ENERGY_FAIL_PERCENT: f64 = 20.0;
+/// A residual-structure statistic (in standard errors under no structure, with the effective
+/// sample size) above this warns.
+pub const STRUCTURE_WARN_Z: f64 = 4.0;
+/// ... and above this fails, when the effect is also at least [`STRUCTURE_FAIL_EFFECT`].
+pub const STRUCTURE_FAIL_Z: f64 = 5.0;
+/// The smallest correlation (or mean / RMS) that fails the residual-structure check.
+pub const STRUCTURE_FAIL_EFFECT: f64 = 0.3;
+/// A converged start whose SSR exceeds the best by more than this many residual variances
+/// ended in a different minimum.
+pub const START_DISAGREEMENT: f64 = 4.0;
+
+fn status_of(value: f64, warn: f64, fail: f64) -> Status {
+    if value > fail {
+        Status::Fail
+    } else if value > warn {
+        Status::Warn
+    } else {
+        Status::Pass
+    }
+}
+
+/// The energy-balance finding of one record: the larger of the Eq. 7 and the half-cycle
+/// differences (in percent) decides.
+pub fn energy_balance(record: &str, ef: &EnergyForce) -> Finding {
+    let eq7 = ef.percent_difference.abs();
+    let half = ef.half_cycle_percent_difference.abs();
+    let worst = [eq7, half]
+        .into_iter()
+        .filter(|d| !d.is_nan())
+        .fold(f64::NAN, f64::max);
+    let status = if worst.is_nan() {
+        Status::Warn
+    } else {
+        status_of(worst, ENERGY_WARN_PERCENT, ENERGY_FAIL_PERCENT)
+    };
+    let message = format!(
+        "record `{record}`: energy-based friction force differs from the model's by {:.1} % (Eq. 7 mean {:.4} N vs {:.4} N) and {:.1} % (half-cycle mean {:.4} N vs {:.4} N){}",
+        ef.percent_difference,
+        ef.mean_abs,
+        ef.reference,
+        ef.half_cycle_percent_difference,
+        ef.half_cycle_mean,
+        ef.half_cycle_reference,
+        match status {
+            Status::Pass => "",
+            Status::Warn => ": the fitted law does not quite dissipate the energy the record loses",
+            Status::Fail => ": the fitted law does not explain the energy the record loses (wrong units, model, offset or release?)",
+        }
+    );
+    Finding::new(Check::EnergyBalance, status, Some(worst), message)
+}
+
+/// Lag-`lag` autocorrelation of the residual segments (pairs within a segment only).
+fn autocorrelation(segments: &[Vec<f64>], lag: usize) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for s in segments {
+        den += s.iter().map(|r| r * r).sum::<f64>();
+        num += s
+            .iter()
+            .zip(s.iter().skip(lag))
+            .map(|(a, b)| a * b)
+            .sum::<f64>();
+    }
+    if den > 0.0 {
+        num / den
+    } else {
+        0.0
+    }
+}
+
+/// The lag-1 correlation phi of the noise in the residuals, assuming AR(1) noise, from the
+/// residuals' first differences (for AR(1), their lag-1 autocorrelation is -(1 - phi) / 2).
+/// Differencing removes the slow, motion-locked part, which would otherwise pass for
+/// strongly coloured noise and hide itself.
+pub(crate) fn noise_correlation(segments: &[Vec<f64>]) -> f64 {
+    let differences: Vec<Vec<f64>> = segments
+        .iter()
+        .map(|s| s.windows(2).map(|w| w[1] - w[0]).collect())
+        .collect();
+    (1.0 + 2.0 * autocorrelation(&differences, 1)).clamp(0.0, 0.999)
+}
+
+/// Pearson correlation of pooled, already demeaned series.
+fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let sab: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+    let saa: f64 = a.iter().map(|x| x * x).sum();
+    let sbb: f64 = b.iter().map(|y| y * y).sum();
+    if saa > 0.0 && sbb > 0.0 {
+        sab / (saa * sbb).sqrt()
+    } else {
+        0.0
+    }
+}
+
+fn demeaned(v: &[f64]) -> Vec<f64> {
+    let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+    v.iter().map(|x| x - mean).collect()
+}
+
+/// The moving part of a record fit: from its first sample to the last one whose fitted speed
+/// exceeds `threshold`.
+struct Moving {
+    residual: Vec<f64>,
+    sign: Vec<f64>,
+    x: Vec<f64>,
+    period_samples: usize,
+}
+
+fn moving_part(r: &RecordFit, osc: &Oscillator, threshold: f64) -> Option<Moving> {
+    let end = r.fitted.iter().rposition(|v| v.abs() > threshold)? + 1;
+    if end < 3 || r.time.len() < end || r.measured.len() < end {
+        return None;
+    }
+    let residual: Vec<f64> = (0..end).map(|i| r.fitted[i] - r.measured[i]).collect();
+    let x = cumulative_trapezoid(&r.time[..end], &r.fitted[..end], r.x0);
+    let dt = (r.time[end - 1] - r.time[0]) / (end - 1) as f64;
+    let wd = osc.omega_n() * (1.0 - osc.damping_ratio().powi(2)).max(0.0).sqrt();
+    let period = 2.0 * std::f64::consts::PI / wd / dt;
+    Some(Moving {
+        residual: demeaned(&residual),
+        sign: demeaned(
+            &r.fitted[..end]
+                .iter()
+                .map(|v| v.signum())
+                .collect::<Vec<_>>(),
+        ),
+        x: demeaned(&x),
+        period_samples: if period.is_finite() && period >= 1.0 {
+            period.round() as usize
+        } else {
+            0
+        },
+    })
+}
+
+/// One statistic of the residual-structure check.
+struct Statistic {
+    name: &'static str,
+    effect: f64,
+    z: f64,
+}
+
+/// Residual structure over all records: correlation with sgn(v) and with x, autocorrelation
+/// at one oscillation period (on the moving parts), and the residual mean (whole records).
+/// `threshold` is the speed below which the mass counts as at rest.
+pub fn residual_structure(records: &[RecordFit], osc: &Oscillator, threshold: f64) -> Finding {
+    let moving: Vec<Moving> = records
+        .iter()
+        .filter_map(|r| moving_part(r, osc, threshold))
+        .collect();
+    let residuals: Vec<Vec<f64>> = moving.iter().map(|m| m.residual.clone()).collect();
+    let n = residuals.iter().map(Vec::len).sum::<usize>() as f64;
+    if n < 10.0 {
+        return Finding::new(
+            Check::ResidualStructure,
+            Status::Pass,
+            None,
+            "too few moving samples to judge the residual structure".into(),
+        );
+    }
+    // AR(1) effective sample sizes: for a correlation with a smooth regressor and for an
+    // autocorrelation coefficient.
+    let phi = noise_correlation(&residuals);
+    let n_eff = (n * (1.0 - phi) / (1.0 + phi)).max(3.0);
+    let n_eff_acf = (n * (1.0 - phi * phi) / (1.0 + phi * phi)).max(3.0);
+    let pooled = |f: fn(&Moving) -> &Vec<f64>| -> Vec<f64> {
+        moving.iter().flat_map(|m| f(m).iter().copied()).collect()
+    };
+    let all_residuals = pooled(|m| &m.residual);
+    let mut stats = Vec::new();
+    for (name, series) in [("sgn(v)", pooled(|m| &m.sign)), ("x", pooled(|m| &m.x))] {
+        let rho = correlation(&all_residuals, &series);
+        stats.push(Statistic {
+            name,
+            effect: rho.abs(),
+            z: rho.abs() * n_eff.sqrt(),
+        });
+    }
+    if let Some(lag) = moving
+        .iter()
+        .map(|m| m.period_samples)
+        .min()
+        .filter(|&l| l > 0)
+    {
+        let rho = autocorrelation(&residuals, lag);
+        stats.push(Statistic {
+            name: "the oscillation period",
+            effect: rho,
+            z: rho * n_eff_acf.sqrt(),
+        });
+    }
+    stats.push(mean_statistic(records, phi));
+    structure_finding(&stats)
+}
+
+/// The residual mean over whole records, relative to the residual RMS.
+fn mean_statistic(records: &[RecordFit], phi: f64) -> Statistic {
+    let residual: Vec<f64> = records
+        .iter()
+        .flat_map(|r| r.fitted.iter().zip(&r.measured).map(|(f, m)| f - m))
+        .collect();
+    let n = residual.len().max(1) as f64;
+    let mean = residual.iter().sum::<f64>() / n;
+    let rms = (residual.iter().map(|r| r * r).sum::<f64>() / n).sqrt();
+    let n_eff = (n * (1.0 - phi) / (1.0 + phi)).max(3.0);
+    let effect = if rms > 0.0 { mean.abs() / rms } else { 0.0 };
+    Statistic {
+        name: "a constant (their mean)",
+        effect,
+        z: effect * n_eff.sqrt(),
+    }
+}
+
+fn structure_finding(stats: &[Statistic]) -> Finding {
+    let status_of = |s: &Statistic| {
+        if s.z > STRUCTURE_FAIL_Z && s.effect >= STRUCTURE_FAIL_EFFECT {
+            Status::Fail
+        } else if s.z > STRUCTURE_WARN_Z {
+            Status::Warn
+        } else {
+            Status::Pass
+        }
+    };
+    let status = stats.iter().map(status_of).max().unwrap_or(Status::Pass);
+    let value = stats.iter().map(|s| s.effect).fold(0.0, f64::max);
+    let flagged: Vec<String> = stats
+        .iter()
+        .filter(|s| status_of(s) != Status::Pass)
+        .map(|s| format!("{} ({:.2}, {:.1} standard errors)", s.name, s.effect, s.z))
+        .collect();
+    let message = if flagged.is_empty() {
+        "residuals show no structure locked to the motion".to_string()
+    } else {
+        format!(
+            "residuals are locked to the motion: they follow {}; a wrong friction law, an unmodelled offset or a missed release leaves such a pattern",
+            flagged.join(", ")
+        )
+    };
+    Finding::new(Check::ResidualStructure, status, Some(value), message)
+}
+
+/// A warning per free parameter that ended at one of its (finite) bounds.
+pub fn parameters_at_bounds(layout: &[FreeParam], values: &[f64]) -> Vec<Finding> {
+    let mut out = Vec::new();
+    for (f, &p) in layout.iter().zip(values) {
+        let u = f.to_internal(p);
+        let (lo, hi) = f.internal_bounds();
+        let near = |b: f64| b.is_finite() && (u - b).abs() <= 1e-6 * b.abs().max(1.0);
+        let which = if near(lo) {
+            ("lower", f.lower)
+        } else if near(hi) {
+            ("upper", f.upper)
+        } else {
+            continue;
+        };
+        out.push(Finding::warn(
+            Check::ParameterAtBound,
+            Some(p),
+            format!(
+                "`{}` = {p:e} {} is at its {} bound: the data push it further (check the units, the model and the bounds)",
+                f.name, f.unit, which.0
+            ),
+        ));
+    }
+    out
+}
+
+/// Whether every free parameter has a standard error; a rank-deficient Jacobian is named as
+/// such.
+pub fn standard_errors(parameters: &[FittedParam], singular: bool) -> Finding {
+    let missing: Vec<&str> = parameters
+        .iter()
+        .filter(|p| p.free && p.std_error.is_none())
+        .map(|p| p.name.as_str())
+        .collect();
+    if singular {
+        return Finding::warn(
+            Check::StandardErrors,
+            None,
+            "the Jacobian is rank-deficient: some free parameters are not separately identifiable from these records (no standard errors)".into(),
+        );
+    }
+    if missing.is_empty() {
+        return Finding::new(
+            Check::StandardErrors,
+            Status::Pass,
+            None,
+            "standard errors computed for every free parameter".into(),
+        );
+    }
+    Finding::warn(
+        Check::StandardErrors,
+        Some(missing.len() as f64),
+        format!(
+            "no standard error for {}: the data do not constrain them at the optimum",
+            missing
+                .iter()
+                .map(|n| format!("`{n}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    )
+}
+
+/// Whether converged starts agree on the minimum: a start that converged with an SSR more
+/// than [`START_DISAGREEMENT`] residual variances above the best found another minimum.
+/// `None` for a single start.
+pub fn start_agreement(
+    outcomes: &[StartOutcome],
+    best_cost: f64,
+    residual_variance: f64,
+) -> Option<Finding> {
+    if outcomes.len() < 2 {
+        return None;
+    }
+    let worse: Vec<(usize, f64)> = outcomes
+        .iter()
+        .filter_map(|o| match o {
+            StartOutcome::Finished {
+                start,
+                cost,
+                termination,
+                ..
+            } if termination.is_converged() => {
+                Some((*start, 2.0 * (cost - best_cost) / residual_variance))
+            }
+            _ => None,
+        })
+        .filter(|(_, d)| *d > START_DISAGREEMENT)
+        .collect();
+    if worse.is_empty() {
+        return Some(Finding::new(
+            Check::StartAgreement,
+            Status::Pass,
+            Some(0.0),
+            "no converged start ended in a worse minimum".into(),
+        ));
+    }
+    Some(Finding::warn(
+        Check::StartAgreement,
+        Some(worse.len() as f64),
+        format!(
+            "{} converged start(s) ended in a worse minimum (start {}): the problem has several minima; the best was kept (more starts may find a better one)",
+            worse.len(),
+            worse
+                .iter()
+                .map(|(s, _)| s.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    ))
+}
+
+/// Pass when the solver converged, else fail.
+pub fn convergence(termination: &TerminationReason) -> Finding {
+    if termination.is_converged() {
+        Finding::new(
+            Check::Convergence,
+            Status::Pass,
+            None,
+            termination.to_string(),
+        )
+    } else {
+        Finding::new(
+            Check::Convergence,
+            Status::Fail,
+            None,
+            format!("the fit did not converge ({termination})"),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exact::coulomb_free_vibration;
+    use crate::identify::layout::ParamKind;
+    use rand::rngs::StdRng;
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+
+    const NOISE: f64 = 2e-4;
+
+    fn exact_v(osc: &Oscillator, mu: f64, time: &[f64]) -> Vec<f64> {
+        coulomb_free_vibration(osc, mu * osc.normal_force, 0.014, time)
+            .unwrap()
+            .v
+    }
+
+    /// AR(1) noise of stationary standard deviation `sd` and lag-1 correlation `phi`.
+    fn ar1_noise(n: usize, sd: f64, phi: f64, seed: u64) -> Vec<f64> {
+        let mut rng = StdRng::seed_from_u64(seed);
+        let innovation = Normal::new(0.0, sd * (1.0 - phi * phi).sqrt()).unwrap();
+        let mut e = Normal::new(0.0, sd).unwrap().sample(&mut rng);
+        (0..n)
+            .map(|_| {
+                let out = e;
+                e = phi * e + innovation.sample(&mut rng);
+                out
+            })
+            .collect()
+    }
+
+    /// A record fit whose model is Coulomb with `mu_fit` and whose measurement is the exact
+    /// Coulomb motion with `mu_true` plus `noise` plus `offset`.
+    fn record_fit(mu_true: f64, mu_fit: f64, noise: &[f64], offset: f64) -> RecordFit {
+        let osc = Oscillator::fmm();
+        let time: Vec<f64> = (0..noise.len()).map(|i| i as f64 * 1e-3).collect();
+        let truth = exact_v(&osc, mu_true, &time);
+        let fitted = exact_v(&osc, mu_fit, &time);
+        let measured = truth
+            .iter()
+            .zip(noise)
+            .map(|(v, e)| v + e + offset)
+            .collect();
+        RecordFit {
+            file: "r".into(),
+            x0: 0.014,
+            release_time: None,
+            samples: time.len(),
+            channel: "velocity".into(),
+            rms_residual: 0.0,
+            energy_force: None,
+            time,
+            measured,
+            fitted,
+            energy_based_force: Vec::new(),
+            model_force: Vec::new(),
+        }
+    }
+
+    fn structure(fits: &[RecordFit]) -> Finding {
+        residual_structure(fits, &Oscillator::fmm(), 1e-3)
+    }
+
+    #[test]
+    fn white_noise_around_the_right_model_passes() {
+        for seed in 0..5 {
+            let fit = record_fit(0.24, 0.24, &ar1_noise(2000, NOISE, 0.0, seed), 0.0);
+            let f = structure(&[fit]);
+            assert_eq!(f.status, Status::Pass, "seed {seed}: {}", f.message);
+        }
+    }
+
+    /// Coloured noise (correlated over a few tens of samples) around the right model warns at
+    /// most, however strongly coloured.
+    #[test]
+    fn coloured_noise_around_the_right_model_never_fails() {
+        for (seed, phi) in [(1, 0.5), (2, 0.9), (3, 0.97), (4, 0.99), (5, 0.95)] {
+            let fit = record_fit(0.24, 0.24, &ar1_noise(2000, NOISE, phi, seed), 0.0);
+            let f = structure(&[fit]);
+            assert_ne!(f.status, Status::Fail, "phi {phi}: {}", f.message);
+        }
+    }
+
+    #[test]
+    fn a_wrong_friction_level_or_an_offset_fails() {
+        let noise = ar1_noise(2000, NOISE, 0.0, 9);
+        let wrong = structure(&[record_fit(0.24, 0.20, &noise, 0.0)]);
+        assert_eq!(wrong.status, Status::Fail, "{}", wrong.message);
+        let offset = structure(&[record_fit(0.24, 0.24, &noise, 3e-3)]);
+        assert_eq!(offset.status, Status::Fail, "{}", offset.message);
+        assert!(offset.message.contains("mean"), "{}", offset.message);
+    }
+
+    fn energy_force(eq7: f64, half: f64) -> EnergyForce {
+        EnergyForce {
+            mean_abs: 3.48 * (1.0 + eq7 / 100.0),
+            reference: 3.48,
+            percent_difference: eq7,
+            residual_rms: 0.1,
+            samples: 100,
+            half_cycle_mean: 3.48 * (1.0 + half / 100.0),
+            half_cycle_reference: 3.48,
+            half_cycle_percent_difference: half,
+        }
+    }
+
+    #[test]
+    fn energy_balance_thresholds_are_five_and_twenty_percent() {
+        let status = |eq7, half| energy_balance("r", &energy_force(eq7, half)).status;
+        assert_eq!(status(1.0, -2.0), Status::Pass);
+        assert_eq!(status(-6.0, 1.0), Status::Warn);
+        assert_eq!(status(1.0, 12.0), Status::Warn);
+        assert_eq!(status(38112.0, 1.0), Status::Fail);
+        assert_eq!(status(1.0, f64::NAN), Status::Pass);
+        let f = energy_balance("x14.csv", &energy_force(-25.0, 3.0));
+        assert_eq!(f.value, Some(25.0));
+        assert!(f.message.contains("x14.csv"));
+    }
+
+    #[test]
+    fn a_parameter_at_its_bound_warns() {
+        let mu = FreeParam::linear("mu".into(), "1", ParamKind::Model(0), (0.0, 5.0), 0.3, 1.0);
+        assert_eq!(
+            parameters_at_bounds(std::slice::from_ref(&mu), &[0.24]).len(),
+            0
+        );
+        let at = parameters_at_bounds(std::slice::from_ref(&mu), &[5.0]);
+        assert_eq!(at.len(), 1);
+        assert_eq!(at[0].status, Status::Warn);
+        assert!(at[0].message.contains("upper"));
+        let log = FreeParam {
+            log: true,
+            lower: 1e-3,
+            ..mu
+        };
+        assert!(parameters_at_bounds(&[log], &[1e-3])[0]
+            .message
+            .contains("lower"));
+    }
+
+    #[test]
+    fn missing_standard_errors_warn_and_computed_ones_pass() {
+        let p = |name: &str, se: Option<f64>| FittedParam {
+            name: name.into(),
+            value: 1.0,
+            std_error: se,
+            ci95: None,
+            unit: "1".into(),
+            free: true,
+        };
+        let ok = standard_errors(&[p("mu", Some(0.01))], false);
+        assert_eq!(ok.status, Status::Pass);
+        let missing = standard_errors(&[p("mu", None), p("v_s", Some(1.0))], false);
+        assert_eq!(missing.status, Status::Warn);
+        assert!(missing.message.contains("`mu`") && !missing.message.contains("v_s"));
+        assert_eq!(standard_errors(&[], true).status, Status::Warn);
+    }
+
+    #[test]
+    fn a_start_converged_in_a_worse_minimum_warns() {
+        let finished = |start, cost| StartOutcome::Finished {
+            start,
+            cost,
+            iterations: 10,
+            termination: TerminationReason::GradientBelowTolerance,
+        };
+        // Residual variance 1e-8: SSR 2 * 1e-6 above the best is 200 variances.
+        let agree = start_agreement(&[finished(0, 1.0), finished(1, 1.0 + 1e-9)], 1.0, 1e-8);
+        assert_eq!(agree.unwrap().status, Status::Pass);
+        let worse = start_agreement(&[finished(0, 1.0), finished(1, 1.0 + 1e-6)], 1.0, 1e-8);
+        assert_eq!(worse.unwrap().status, Status::Warn);
+        assert!(start_agreement(&[finished(0, 1.0)], 1.0, 1e-8).is_none());
+    }
+
+    #[test]
+    fn non_convergence_fails() {
+        let f = convergence(&TerminationReason::IterationLimit { limit: 3 });
+        assert_eq!(f.status, Status::Fail);
+        assert!(f.message.contains("iteration limit (3) reached"));
+        assert_eq!(
+            convergence(&TerminationReason::StepBelowTolerance).status,
+            Status::Pass
+        );
+    }
+}

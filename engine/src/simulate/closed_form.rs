@@ -1,0 +1,235 @@
+//! The exact propagator for laws affine in the velocity within a sliding mode
+//! ([`frictionid_models::FrictionModel::affine_slip`]: F = a + b v): in each segment
+//! m x'' + (c + b) x' + k x + a = 0 is a damped harmonic motion about x_eq = -a / k with the
+//! closed-form solution
+//!
+//! u(tau) = e^(-sigma tau) (A cos(w_d tau) + B sin(w_d tau)),  u = x - x_eq,
+//! v(tau) = e^(-sigma tau) (v0 cos(w_d tau) - D sin(w_d tau)),
+//!
+//! sigma = (c + b) / 2m, w_d = sqrt(k/m - sigma^2), A = u0, B = (v0 + sigma u0) / w_d,
+//! D = (w0^2 u0 + sigma v0) / w_d. No ODE is solved: a "step" jumps to just past the next zero
+//! of v (where the driver polishes the turning point on this closed form to 1e-13 s) or to the
+//! end time, and samples on a uniform grid follow by the recurrence
+//! (P, Q) <- e^(-sigma dt) (P cos(w_d dt) - Q sin(w_d dt), Q cos(w_d dt) + P sin(w_d dt)) for
+//! P = e^(-sigma tau) cos(w_d tau), Q = e^(-sigma tau) sin(w_d tau).
+//! Underdamped modes only (sigma < w0); the driver falls back to an ODE stepper otherwise.
+
+use super::stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper};
+use crate::error::IntegrationFailure;
+use std::cell::Cell;
+use std::f64::consts::PI;
+
+/// How far past a zero of v a step ends, as a fraction of the half period: enough for v to
+/// take the new sign well above round-off, small against any sample spacing.
+const PAST_ZERO: f64 = 1e-9;
+
+/// The closed form of one segment.
+#[derive(Debug, Clone, Copy, Default)]
+struct Mode {
+    t0: f64,
+    x_eq: f64,
+    sigma: f64,
+    omega_d: f64,
+    a: f64,
+    b: f64,
+    v0: f64,
+    d: f64,
+}
+
+impl Mode {
+    /// (x, v) from the rotating pair P = e^(-sigma tau) cos, Q = e^(-sigma tau) sin.
+    #[inline]
+    fn state_at_pq(&self, p: f64, q: f64) -> (f64, f64) {
+        (
+            self.x_eq + self.a * p + self.b * q,
+            self.v0 * p - self.d * q,
+        )
+    }
+
+    /// (P, Q) at time t.
+    #[inline]
+    fn pq(&self, t: f64) -> (f64, f64) {
+        let tau = t - self.t0;
+        let e = (-self.sigma * tau).exp();
+        let (s, c) = (self.omega_d * tau).sin_cos();
+        (e * c, e * s)
+    }
+
+    /// The first tau > 0 where v = 0 (v ~ cos(w_d tau + phi)), as a phase in (0, pi].
+    fn first_zero_phase(&self) -> f64 {
+        let phi = self.d.atan2(self.v0);
+        let theta = (0.5 * PI - phi).rem_euclid(PI);
+        if theta > 0.0 {
+            theta
+        } else {
+            PI
+        }
+    }
+}
+
+/// The last sample evaluated and the rotation of the last sample spacing.
+#[derive(Debug, Clone, Copy)]
+struct Recurrence {
+    t: f64,
+    p: f64,
+    q: f64,
+    dt: f64,
+    rot_c: f64,
+    rot_s: f64,
+}
+
+/// The exact propagator as a [`Stepper`] over `[x, v]`.
+#[derive(Debug, Clone, Default)]
+pub struct ClosedForm {
+    mode: Mode,
+    t: f64,
+    t_prev: f64,
+    t_end: f64,
+    /// Phase w_d tau of the next candidate zero of v.
+    next_phase: f64,
+    y: [f64; 2],
+    cache: Cell<Option<Recurrence>>,
+    counts: StepCounts,
+}
+
+impl ClosedForm {
+    /// A closed-form propagator (the motion comes from the system at each reset).
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Whether the segment `motion` is solved in closed form (underdamped).
+    pub fn supports(motion: &AffineMotion) -> bool {
+        let w0_sq = motion.stiffness / motion.mass;
+        let sigma = 0.5 * (motion.damping) / motion.mass;
+        motion.mass > 0.0 && motion.stiffness > 0.0 && sigma >= 0.0 && sigma * sigma < w0_sq
+    }
+
+    /// (P, Q) at `t`, by one rotation from the last evaluation when `t` is one sample spacing
+    /// after it (uniform grids), directly otherwise.
+    fn pq_at(&self, t: f64) -> (f64, f64) {
+        if let Some(r) = self.cache.get() {
+            let step = t - r.t;
+            if step == 0.0 {
+                return (r.p, r.q);
+            }
+            if (step - r.dt).abs() <= 8.0 * f64::EPSILON * t.abs().max(1.0) {
+                let e = r.rot_c;
+                let p = e * r.p - r.rot_s * r.q;
+                let q = e * r.q + r.rot_s * r.p;
+                self.cache.set(Some(Recurrence { t, p, q, ..r }));
+                return (p, q);
+            }
+            let (p, q) = self.mode.pq(t);
+            let decay = (-self.mode.sigma * step).exp();
+            let (s, c) = (self.mode.omega_d * step).sin_cos();
+            self.cache.set(Some(Recurrence {
+                t,
+                p,
+                q,
+                dt: step,
+                rot_c: decay * c,
+                rot_s: decay * s,
+            }));
+            return (p, q);
+        }
+        let (p, q) = self.mode.pq(t);
+        self.cache.set(Some(Recurrence {
+            t,
+            p,
+            q,
+            dt: f64::NAN,
+            rot_c: 0.0,
+            rot_s: 0.0,
+        }));
+        (p, q)
+    }
+}
+
+impl Stepper for ClosedForm {
+    fn reset<S: OdeSystem>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        t_end: f64,
+    ) -> Result<(), IntegrationFailure> {
+        let unavailable = IntegrationFailure::ClosedFormUnavailable { time: t };
+        let Some(motion) = system.affine_motion() else {
+            return Err(unavailable);
+        };
+        let (&[x0, v0], true) = (y, Self::supports(&motion)) else {
+            return Err(unavailable);
+        };
+        let w0_sq = motion.stiffness / motion.mass;
+        let sigma = 0.5 * motion.damping / motion.mass;
+        let omega_d = (w0_sq - sigma * sigma).sqrt();
+        let x_eq = -motion.offset / motion.stiffness;
+        let u0 = x0 - x_eq;
+        self.mode = Mode {
+            t0: t,
+            x_eq,
+            sigma,
+            omega_d,
+            a: u0,
+            b: (v0 + sigma * u0) / omega_d,
+            v0,
+            d: (w0_sq * u0 + sigma * v0) / omega_d,
+        };
+        self.next_phase = self.mode.first_zero_phase();
+        self.t = t;
+        self.t_prev = t;
+        self.t_end = t_end;
+        self.y = [x0, v0];
+        self.cache.set(None);
+        Ok(())
+    }
+
+    fn step<S: OdeSystem>(
+        &mut self,
+        _system: &S,
+        event: impl Fn(&[f64]) -> f64,
+    ) -> Result<StepOutcome, IntegrationFailure> {
+        let candidate = self.mode.t0 + (self.next_phase + PAST_ZERO * PI) / self.mode.omega_d;
+        self.next_phase += PI;
+        let t_next = candidate.min(self.t_end);
+        let (p, q) = self.mode.pq(t_next);
+        let (x, v) = self.mode.state_at_pq(p, q);
+        self.t_prev = self.t;
+        self.t = t_next;
+        self.y = [x, v];
+        self.counts.accepted += 1;
+        Ok(StepOutcome::Accepted {
+            crossed: event(&self.y) <= 0.0,
+        })
+    }
+
+    fn time(&self) -> f64 {
+        self.t
+    }
+
+    fn previous_time(&self) -> f64 {
+        self.t_prev
+    }
+
+    fn state(&self) -> &[f64] {
+        &self.y
+    }
+
+    fn reached_end(&self) -> bool {
+        self.t >= self.t_end
+    }
+
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        let (p, q) = self.pq_at(t.clamp(self.t_prev, self.t));
+        let (x, v) = self.mode.state_at_pq(p, q);
+        if let [xo, vo, ..] = out {
+            *xo = x;
+            *vo = v;
+        }
+    }
+
+    fn counts(&self) -> StepCounts {
+        self.counts
+    }
+}

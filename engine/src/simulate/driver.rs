@@ -1,0 +1,297 @@
+//! The simulation driver: segments between turning points, the mode decision at each of them
+//! (slip+, slip-, stick), event location on the stepper's dense output, sampling onto the
+//! output grid, budgets and statistics. Any [`Stepper`] plugs in.
+
+use super::root::illinois;
+use super::stepper::{AffineMotion, OdeSystem, StepOutcome, Stepper};
+use super::{Dynamics, Event, EventKind, Law, Recorder, Rest, SimStats, Start};
+use crate::error::{EngineError, IntegrationFailure};
+
+/// Width of the final bracket of a turning point's time [s].
+pub(crate) const EVENT_TOL: f64 = 1e-13;
+
+/// The equation of motion within one segment: slip direction `dir` fixed.
+struct Segment<'a> {
+    dynamics: Dynamics<'a>,
+    dir: f64,
+}
+
+impl OdeSystem for Segment<'_> {
+    #[inline]
+    fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
+        self.dynamics.rhs(y, dy, self.dir);
+    }
+
+    fn affine_motion(&self) -> Option<AffineMotion> {
+        self.dynamics.affine_motion(self.dir)
+    }
+}
+
+/// How a segment ended.
+enum SegmentEnd {
+    /// The end time was reached while moving.
+    Finished,
+    /// The velocity reached zero at this time.
+    Turn(f64),
+}
+
+/// Book-keeping of a run: sample cursor, events, rest and statistics.
+pub(crate) struct Driver<'s, R: Recorder> {
+    pub dynamics: Dynamics<'s>,
+    pub samples: &'s [f64],
+    pub next: usize,
+    pub rec: &'s mut R,
+    pub events: Vec<Event>,
+    pub rest: Option<Rest>,
+    pub stats: SimStats,
+    pub max_events: usize,
+    pub max_steps: u64,
+    /// Displacement at the previous turning point (or the release from rest).
+    pub last_turn: Option<f64>,
+    /// Swing below which smooth and dynamic motions are declared at rest.
+    pub rest_swing: f64,
+}
+
+impl<R: Recorder> Driver<'_, R> {
+    /// Runs the whole simulation from `y0` at t = 0 to `t_end` with `stepper`.
+    pub fn run<S: Stepper>(
+        &mut self,
+        stepper: &mut S,
+        y0: &[f64],
+        t_end: f64,
+    ) -> Result<(), EngineError> {
+        let result = self.run_segments(stepper, y0, t_end);
+        let counts = stepper.counts();
+        self.stats.rhs_evaluations = counts.rhs_evaluations;
+        self.stats.steps = counts.accepted;
+        self.stats.rejected_steps = counts.rejected;
+        result
+    }
+
+    fn run_segments<S: Stepper>(
+        &mut self,
+        stepper: &mut S,
+        y0: &[f64],
+        t_end: f64,
+    ) -> Result<(), EngineError> {
+        let mut t = 0.0;
+        let mut y = y0.to_vec();
+        // Below this remaining time a segment is not started (the step would underflow).
+        let tiny = 1e-13 * (1.0 + t_end);
+        loop {
+            let Some(dir) = self.decide(t, &y)? else {
+                return Ok(());
+            };
+            if t_end - t <= tiny {
+                self.fill_end(&y, dir);
+                return Ok(());
+            }
+            let segment = Segment {
+                dynamics: self.dynamics,
+                dir,
+            };
+            stepper.reset(&segment, t, &y, t_end)?;
+            match self.advance(stepper, &segment, &mut y, t_end)? {
+                SegmentEnd::Finished => return Ok(()),
+                SegmentEnd::Turn(t_e) => {
+                    if let Some(v) = y.get_mut(1) {
+                        *v = 0.0;
+                    }
+                    self.turning_point(t_e, y.first().copied().unwrap_or(0.0))?;
+                    t = t_e;
+                }
+            }
+        }
+    }
+
+    /// Steps through one segment, writing its samples; at a turning point leaves the state
+    /// there in `y`.
+    fn advance<S: Stepper>(
+        &mut self,
+        stepper: &mut S,
+        segment: &Segment<'_>,
+        y: &mut [f64],
+        t_end: f64,
+    ) -> Result<SegmentEnd, EngineError> {
+        let dir = segment.dir;
+        let event = |state: &[f64]| dir * state.get(1).copied().unwrap_or(0.0);
+        loop {
+            if stepper.counts().attempts() >= self.max_steps {
+                return Err(IntegrationFailure::StepBudgetExceeded {
+                    time: stepper.time(),
+                    max_steps: self.max_steps,
+                }
+                .into());
+            }
+            let StepOutcome::Accepted { crossed } = stepper.step(segment, event)? else {
+                continue;
+            };
+            if stepper.state().iter().any(|v| !v.is_finite()) {
+                return Err(IntegrationFailure::NonFiniteState {
+                    time: stepper.time(),
+                    state: stepper.state().to_vec(),
+                }
+                .into());
+            }
+            if crossed {
+                let t_e = self.locate_turn(stepper, &event, y)?;
+                self.write_samples(stepper, t_e, dir, y);
+                stepper.interpolate(t_e, y);
+                return Ok(SegmentEnd::Turn(t_e));
+            }
+            if stepper.reached_end() {
+                self.write_samples(stepper, t_end, dir, y);
+                y.copy_from_slice(stepper.state());
+                self.fill_end(y, dir);
+                return Ok(SegmentEnd::Finished);
+            }
+            self.write_samples(stepper, stepper.time(), dir, y);
+        }
+    }
+
+    /// The time of the zero of the event function inside the last step.
+    fn locate_turn<S: Stepper>(
+        &self,
+        stepper: &S,
+        event: &impl Fn(&[f64]) -> f64,
+        buf: &mut [f64],
+    ) -> Result<f64, EngineError> {
+        let lo = stepper.previous_time();
+        let g = |t: f64| {
+            stepper.interpolate(t, buf);
+            Some(event(buf))
+        };
+        locate(g, lo, stepper.time())
+            .ok_or_else(|| IntegrationFailure::EventNotLocated { time: lo }.into())
+    }
+
+    /// Writes the samples with time <= `until` from the dense output of the last step.
+    fn write_samples<S: Stepper>(&mut self, stepper: &S, until: f64, dir: f64, buf: &mut [f64]) {
+        let n = self.pending_until(until);
+        for _ in 0..n {
+            let Some(&ts) = self.samples.get(self.next) else {
+                break;
+            };
+            stepper.interpolate(ts, buf);
+            self.write_moving(ts, buf, dir);
+        }
+    }
+
+    /// Samples not yet written whose time is <= `t`.
+    fn pending_until(&self, t: f64) -> usize {
+        self.samples
+            .get(self.next..)
+            .map_or(0, |rest| rest.iter().take_while(|&&ts| ts <= t).count())
+    }
+
+    /// Writes one sample of a moving state in direction `dir`.
+    fn write_moving(&mut self, t: f64, y: &[f64], dir: f64) {
+        if let [x, v, z @ ..] = y {
+            let f = self.dynamics.force(*v, z, dir);
+            let a = self.dynamics.accel(*x, *v, f);
+            self.rec.sample(t, *x, *v, z, a, f);
+        }
+        self.next += 1;
+    }
+
+    /// Fills every remaining sample with the state at rest `y` (v = 0, a = 0).
+    fn fill_rest(&mut self, y: &[f64]) {
+        if let [x, _, z @ ..] = y {
+            let f = -self.dynamics.stiffness * x;
+            while let Some(&ts) = self.samples.get(self.next) {
+                self.rec.sample(ts, *x, 0.0, z, 0.0, f);
+                self.next += 1;
+            }
+        }
+    }
+
+    /// Fills every remaining sample with the (moving) state `y` at the end time.
+    fn fill_end(&mut self, y: &[f64], dir: f64) {
+        while let Some(&ts) = self.samples.get(self.next) {
+            self.write_moving(ts, y, dir);
+        }
+    }
+
+    fn push_event(&mut self, time: f64, kind: EventKind, x: f64) -> Result<(), EngineError> {
+        if self.events.len() >= self.max_events {
+            return Err(IntegrationFailure::EventBudgetExceeded {
+                time,
+                max_events: self.max_events,
+            }
+            .into());
+        }
+        self.events.push(Event {
+            time,
+            kind,
+            displacement: x,
+        });
+        self.stats.events = self.events.len();
+        Ok(())
+    }
+
+    /// Records a turning point at (t, x).
+    fn turning_point(&mut self, t: f64, x: f64) -> Result<(), EngineError> {
+        self.push_event(t, EventKind::TurningPoint, x)
+    }
+
+    /// Decides the mode at time `t` for state `y` (a turning point or the start): returns the
+    /// slip direction, or `None` after recording the rest and filling the remaining samples.
+    fn decide(&mut self, t: f64, y: &[f64]) -> Result<Option<f64>, EngineError> {
+        let [x, v, z @ ..] = y else {
+            return Ok(None);
+        };
+        let mut start = self.dynamics.start(*x, *v, z);
+        if *v == 0.0 && !matches!(self.dynamics.law, Law::Switched { .. }) {
+            if let Some(prev) = self.last_turn {
+                if (x - prev).abs() < self.rest_swing {
+                    start = Start::Rest;
+                }
+            }
+        }
+        if *v == 0.0 {
+            self.last_turn = Some(*x);
+        }
+        match start {
+            Start::Slip(d) => Ok(Some(d)),
+            Start::Rest => {
+                self.push_event(t, EventKind::Stick, *x)?;
+                self.rest = Some(Rest {
+                    time: t,
+                    displacement: *x,
+                });
+                self.fill_rest(y);
+                Ok(None)
+            }
+        }
+    }
+}
+
+/// Locates the zero of `g` in (lo, hi] where g(hi) <= 0. At the start of a segment g(lo) may
+/// be 0; a point with g > 0 is then searched on a geometric grid towards `lo`.
+fn locate(mut g: impl FnMut(f64) -> Option<f64>, lo: f64, hi: f64) -> Option<f64> {
+    let g_hi = g(hi)?;
+    if g_hi == 0.0 {
+        return Some(hi);
+    }
+    let mut a = lo;
+    let mut g_a = g(lo)?;
+    if g_a <= 0.0 {
+        let mut s = hi - lo;
+        let mut found = false;
+        for _ in 0..60 {
+            s *= 0.5;
+            let tt = lo + s;
+            let gt = g(tt)?;
+            if gt > 0.0 {
+                a = tt;
+                g_a = gt;
+                found = true;
+                break;
+            }
+        }
+        if !found {
+            return Some(lo);
+        }
+    }
+    illinois(&mut g, a, g_a, hi, g_hi, EVENT_TOL)
+}

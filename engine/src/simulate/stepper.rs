@@ -1,0 +1,218 @@
+//! The seam between the simulation driver and the time integrators.
+//!
+//! A [`Stepper`] advances an [`OdeSystem`] one step at a time and keeps the dense output of its
+//! last accepted step; it knows nothing of segments, modes, sticking or sample grids. The
+//! driver (`super::driver`) owns those: it resets the stepper at the start of each segment,
+//! asks for steps until one reports that the event function changed sign or the end time is
+//! reached, locates the event on the dense output and writes the samples. This is the split of
+//! diffsol's `OdeSolverMethod` (a method implements `step`, `interpolate` and statistics; the
+//! solve loop and root finding live apart), written for small dense systems.
+
+use crate::error::IntegrationFailure;
+
+/// A first-order system y' = f(t, y).
+pub trait OdeSystem {
+    /// Writes f(t, y) into `dy` (same length as `y`).
+    fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]);
+
+    /// When y = [x, v] obeys a linear oscillator equation (see [`AffineMotion`]): its
+    /// coefficients, for closed-form propagation. `None` (the default) otherwise.
+    fn affine_motion(&self) -> Option<AffineMotion> {
+        None
+    }
+}
+
+/// A segment of motion m x'' + damping x' + stiffness x + offset = 0 with y = [x, v] (a friction
+/// law affine in v within a sliding mode, F = offset + b v, adds b to the damping).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AffineMotion {
+    /// Mass [kg].
+    pub mass: f64,
+    /// Total viscous coefficient [N s/m].
+    pub damping: f64,
+    /// Stiffness [N/m].
+    pub stiffness: f64,
+    /// Constant force [N].
+    pub offset: f64,
+}
+
+/// The outcome of one attempted step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepOutcome {
+    /// The step was rejected by the error control; the stepper retries with a smaller step.
+    Rejected,
+    /// The step was accepted. `crossed`: the event function is <= 0 at the new time (it was
+    /// positive inside the segment, so it changed sign within this step or ended on zero).
+    Accepted {
+        /// Whether the event function ended the step at or below zero.
+        crossed: bool,
+    },
+}
+
+/// Work counters of a stepper, summed since it was built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct StepCounts {
+    /// Right-hand-side evaluations.
+    pub rhs_evaluations: u64,
+    /// Accepted steps.
+    pub accepted: u64,
+    /// Rejected steps.
+    pub rejected: u64,
+}
+
+impl StepCounts {
+    /// Accepted plus rejected steps (what the step budget counts).
+    pub fn attempts(&self) -> u64 {
+        self.accepted + self.rejected
+    }
+}
+
+/// A one-step time integrator with dense output.
+///
+/// Contract: after [`reset`](Stepper::reset) at (t, y) with an end time, each call of
+/// [`step`](Stepper::step) attempts one step that never passes the end time; after an accepted
+/// step [`time`](Stepper::time) and [`state`](Stepper::state) are the new point and
+/// [`interpolate`](Stepper::interpolate) evaluates the dense output anywhere in
+/// [`previous_time`](Stepper::previous_time) ..= `time`. Counters survive resets.
+pub trait Stepper {
+    /// Restarts at state `y` at time `t`, integrating towards `t_end` (> t). Errors: the
+    /// stepper cannot integrate this system (e.g. the closed form needs an affine motion).
+    fn reset<S: OdeSystem>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        t_end: f64,
+    ) -> Result<(), IntegrationFailure>;
+
+    /// Attempts one step. `event` is the event function of the state; it is positive at the
+    /// start of the segment's interior. Errors: the step size became too small.
+    fn step<S: OdeSystem>(
+        &mut self,
+        system: &S,
+        event: impl Fn(&[f64]) -> f64,
+    ) -> Result<StepOutcome, IntegrationFailure>;
+
+    /// The time of the current state.
+    fn time(&self) -> f64;
+
+    /// The time at the start of the last accepted step (the reset time before any step).
+    fn previous_time(&self) -> f64;
+
+    /// The current state.
+    fn state(&self) -> &[f64];
+
+    /// Whether the current time is the end time given to `reset`.
+    fn reached_end(&self) -> bool;
+
+    /// The dense output of the last accepted step at time `t` (clamped to the step) into `out`.
+    fn interpolate(&self, t: f64, out: &mut [f64]);
+
+    /// Work counters since the stepper was built.
+    fn counts(&self) -> StepCounts;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{BogackiShampine, Dopri5, Euler};
+    use super::*;
+
+    /// y' = -lambda y.
+    struct Decay(f64);
+
+    impl OdeSystem for Decay {
+        fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
+            for (d, &v) in dy.iter_mut().zip(y) {
+                *d = -self.0 * v;
+            }
+        }
+    }
+
+    /// x' = v, v' = -x: x = cos t, v = -sin t from (1, 0).
+    struct Harmonic;
+
+    impl OdeSystem for Harmonic {
+        fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
+            dy[0] = y[1];
+            dy[1] = -y[0];
+        }
+    }
+
+    /// Steps to the end time, checking the dense output against `exact` inside every step.
+    fn run_to_end<S: Stepper>(
+        stepper: &mut S,
+        system: &impl OdeSystem,
+        exact: impl Fn(f64) -> f64,
+        dense_tol: f64,
+    ) -> f64 {
+        let mut out = [0.0];
+        let mut worst: f64 = 0.0;
+        while !stepper.reached_end() {
+            if let Ok(StepOutcome::Accepted { .. }) = stepper.step(system, |_| 1.0) {
+                let mid = 0.5 * (stepper.previous_time() + stepper.time());
+                stepper.interpolate(mid, &mut out);
+                worst = worst.max((out[0] - exact(mid)).abs());
+            }
+        }
+        assert!(worst < dense_tol, "dense output error {worst}");
+        stepper.state()[0]
+    }
+
+    #[test]
+    fn dopri5_integrates_exponential_decay_and_its_dense_output() {
+        let mut s = Dopri5::new(1, 1e-10, 1e-12, 1.0);
+        assert!(s.reset(&Decay(2.0), 0.0, &[1.0], 1.5).is_ok());
+        let end = run_to_end(&mut s, &Decay(2.0), |t| (-2.0 * t).exp(), 1e-9);
+        assert_eq!(s.time(), 1.5);
+        assert!((end - (-3.0f64).exp()).abs() < 1e-10, "{end}");
+        let c = s.counts();
+        // Two RHS for the starting step, six per attempt (first same as last).
+        assert_eq!(c.rhs_evaluations, 2 + 6 * c.attempts());
+    }
+
+    #[test]
+    fn dopri5_reports_the_step_where_the_velocity_changes_sign() {
+        let mut s = Dopri5::new(2, 1e-9, 1e-12, 0.5);
+        assert!(s.reset(&Harmonic, 0.0, &[1.0, 0.0], 10.0).is_ok());
+        // v = -sin t < 0 on (0, pi): the event function -v is positive until pi.
+        loop {
+            match s.step(&Harmonic, |y| -y[1]) {
+                Ok(StepOutcome::Accepted { crossed: true }) => break,
+                Ok(_) => assert!(s.time() < std::f64::consts::PI),
+                Err(e) => panic!("{e}"),
+            }
+        }
+        let pi = std::f64::consts::PI;
+        assert!(s.previous_time() < pi && pi <= s.time());
+        let mut y = [0.0; 2];
+        s.interpolate(pi, &mut y);
+        assert!((y[0] + 1.0).abs() < 1e-8 && y[1].abs() < 1e-8, "{y:?}");
+    }
+
+    #[test]
+    fn euler_takes_fixed_steps_and_interpolates_linearly() {
+        let mut s = Euler::new(1, 0.1);
+        assert!(s.reset(&Decay(1.0), 0.0, &[1.0], 1.0).is_ok());
+        let mut steps = 0;
+        while !s.reached_end() {
+            assert!(s.step(&Decay(1.0), |_| 1.0).is_ok());
+            steps += 1;
+        }
+        assert_eq!(steps, 10);
+        assert!((s.state()[0] - 0.9f64.powi(10)).abs() < 1e-14);
+        let mut y = [0.0];
+        s.interpolate(0.95, &mut y);
+        let expected = 0.5 * (0.9f64.powi(9) + 0.9f64.powi(10));
+        assert!((y[0] - expected).abs() < 1e-14, "{}", y[0]);
+        assert_eq!(s.counts().rhs_evaluations, 10);
+    }
+
+    #[test]
+    fn bogacki_shampine_integrates_exponential_decay_and_its_dense_output() {
+        let mut s = BogackiShampine::new(1, 1e-8, 1e-12);
+        assert!(s.reset(&Decay(2.0), 0.0, &[1.0], 1.5).is_ok());
+        let end = run_to_end(&mut s, &Decay(2.0), |t| (-2.0 * t).exp(), 1e-6);
+        assert_eq!(s.time(), 1.5);
+        assert!((end - (-3.0f64).exp()).abs() < 1e-7, "{end}");
+    }
+}

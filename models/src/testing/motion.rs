@@ -1,0 +1,193 @@
+//! The invariants of a model in motion: a free vibration of an oscillator with the model as
+//! its friction contact. This crate has no solver, so the caller supplies one through
+//! [`Simulator`] (a few lines over the engine's `simulate`; see
+//! `examples/plugin-model/tests/invariants.rs`), and these checks judge what it returns:
+//!
+//! - [`check_energy_never_increases`]: KE + PE + stored never rises for a passive model, and a
+//!   set-valued law comes to rest within its breakaway limit, |k x| <= limit;
+//! - [`check_mirror_symmetry`]: the release from -x0 gives -x(t), -v(t) and -F(t);
+//! - [`check_integrators_agree`]: the paper's fixed-step Euler converges to the adaptive
+//!   solution at first order (ten times the steps, about a tenth of the error).
+
+use super::{ensure, fail, Check, Model, Outcome};
+
+/// Which integrator a release uses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Integration {
+    /// The engine's default adaptive solver.
+    Adaptive,
+    /// Fixed-step explicit Euler with this many steps per undamped natural period.
+    Euler {
+        /// Steps per natural period.
+        steps_per_period: f64,
+    },
+}
+
+/// A simulated release, sampled at common times (every release of one check uses the same
+/// sampling).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Motion {
+    /// Sample times \[s\].
+    pub time: Vec<f64>,
+    /// Displacement \[m\].
+    pub x: Vec<f64>,
+    /// Velocity [m/s].
+    pub v: Vec<f64>,
+    /// Friction force \[N\].
+    pub friction: Vec<f64>,
+    /// Kinetic + potential + stored energy \[J\].
+    pub total_energy: Vec<f64>,
+    /// Where the mass came to rest for good, if it did.
+    pub rest_displacement: Option<f64>,
+    /// Number of events (turning points, sticks, ...).
+    pub events: usize,
+}
+
+/// An oscillator and a solver: releases a mass from rest with a given friction model.
+pub trait Simulator {
+    /// The spring stiffness [N/m].
+    fn stiffness(&self) -> f64;
+    /// The normal force of the contact \[N\].
+    fn normal_force(&self) -> f64;
+    /// Releases the mass from rest at `x0` and simulates until `t_end`, sampled at fixed
+    /// times (the same for every call with the same `t_end`).
+    fn release(
+        &self,
+        model: &Model,
+        x0: f64,
+        t_end: f64,
+        integration: Integration,
+    ) -> Result<Motion, String>;
+}
+
+fn release(
+    sim: &dyn Simulator,
+    model: &Model,
+    x0: f64,
+    t_end: f64,
+    integration: Integration,
+) -> Result<Motion, super::Violation> {
+    sim.release(model, x0, t_end, integration)
+        .map_err(|e| super::Violation {
+            model: model.name().to_string(),
+            check: Check::Simulates,
+            message: format!("release from {x0} m with {integration:?}: {e}"),
+        })
+}
+
+/// Energy never increases (to 1e-9 of the initial energy per sample) over a release from
+/// each of `releases` until `t_end`; a set-valued law comes to rest within its breakaway
+/// limit.
+pub fn check_energy_never_increases(
+    sim: &dyn Simulator,
+    model: &Model,
+    releases: &[f64],
+    t_end: f64,
+) -> Outcome {
+    for &x0 in releases {
+        let m = release(sim, model, x0, t_end, Integration::Adaptive)?;
+        let scale = m.total_energy.first().copied().unwrap_or(0.0);
+        for (i, w) in m.total_energy.windows(2).enumerate() {
+            ensure(
+                model,
+                Check::EnergyNeverIncreases,
+                w[1] - w[0] <= 1e-9 * scale,
+                || {
+                    format!(
+                        "from {x0} m: energy rises by {:e} J at t = {}",
+                        w[1] - w[0],
+                        m.time.get(i + 1).copied().unwrap_or(f64::NAN)
+                    )
+                },
+            )?;
+        }
+        check_rest_within_limit(sim, model, x0, &m)?;
+    }
+    Ok(())
+}
+
+fn check_rest_within_limit(sim: &dyn Simulator, model: &Model, x0: f64, m: &Motion) -> Outcome {
+    let Some(limit) = model.static_limit(sim.normal_force()) else {
+        return Ok(());
+    };
+    let Some(rest) = m.rest_displacement else {
+        return fail(
+            model,
+            Check::RestWithinStaticLimit,
+            format!("a set-valued law released from {x0} m does not come to rest"),
+        );
+    };
+    let spring = sim.stiffness() * rest.abs();
+    ensure(
+        model,
+        Check::RestWithinStaticLimit,
+        spring <= limit + 1e-9,
+        || {
+            format!(
+                "from {x0} m: rest at {rest} m, spring force {spring} N above the limit {limit} N"
+            )
+        },
+    )
+}
+
+/// The release from -x0 mirrors the release from x0: x and v to 1e-12, the friction force to
+/// 1e-9, the same number of events and the same rest (or none).
+pub fn check_mirror_symmetry(sim: &dyn Simulator, model: &Model, x0: f64, t_end: f64) -> Outcome {
+    let a = release(sim, model, x0, t_end, Integration::Adaptive)?;
+    let b = release(sim, model, -x0, t_end, Integration::Adaptive)?;
+    for i in 0..a.x.len().min(b.x.len()) {
+        let mirrored = (a.x[i] + b.x[i]).abs() < 1e-12
+            && (a.v[i] + b.v[i]).abs() < 1e-12
+            && (a.friction[i] + b.friction[i]).abs() < 1e-9;
+        ensure(model, Check::MirrorSymmetry, mirrored, || {
+            format!(
+                "at t = {}: x = {}, v = {}, F = {} but mirrored {}, {}, {}",
+                a.time[i], a.x[i], a.v[i], a.friction[i], b.x[i], b.v[i], b.friction[i]
+            )
+        })?;
+    }
+    let same = a.x.len() == b.x.len()
+        && a.events == b.events
+        && a.rest_displacement.is_some() == b.rest_displacement.is_some();
+    ensure(model, Check::MirrorSymmetry, same, || {
+        format!(
+            "{} vs {} samples, {} vs {} events, rest {:?} vs {:?}",
+            a.x.len(),
+            b.x.len(),
+            a.events,
+            b.events,
+            a.rest_displacement,
+            b.rest_displacement
+        )
+    })
+}
+
+/// Fixed-step Euler with 1e4 and 1e5 steps per period converges to the adaptive solution at
+/// first order: the larger error is below 2e-5 m and below a fifth of the smaller one's.
+pub fn check_integrators_agree(sim: &dyn Simulator, model: &Model, x0: f64, t_end: f64) -> Outcome {
+    let reference = release(sim, model, x0, t_end, Integration::Adaptive)?;
+    let error = |steps_per_period: f64| -> Result<f64, super::Violation> {
+        let euler = release(
+            sim,
+            model,
+            x0,
+            t_end,
+            Integration::Euler { steps_per_period },
+        )?;
+        Ok(euler
+            .x
+            .iter()
+            .zip(&reference.x)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max))
+    };
+    let (e4, e5) = (error(1e4)?, error(1e5)?);
+    ensure(
+        model,
+        Check::IntegratorsAgree,
+        e5 < 2e-5 && e5 < 0.2 * e4,
+        || {
+            format!("max |x_euler - x_adaptive|: {e4:e} m at 1e4 steps, {e5:e} m at 1e5 steps per period")
+        },
+    )
+}
