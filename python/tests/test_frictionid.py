@@ -126,8 +126,9 @@ def test_fit_of_three_records_is_identical_to_the_cli(tmp_path):
         {"free": ["mu"], "bounds": {"mu": [0.0, 1.0]}},
     )
     assert strip_series(py) == strip_series(cli)
-    binary = ROOT / "target" / "debug" / "frictionid"
-    if binary.exists():
+    # The CLI binary itself, when named (.ci/run names the one `cargo test` just built).
+    binary = os.environ.get("FRICTIONID_BIN")
+    if binary:
         subprocess.run(
             [binary, "fit", FIXTURES / "fmm-fit.toml", "--quiet", "--out", tmp_path / "bin"],
             check=True,
