@@ -33,6 +33,8 @@ pub use error::CliError;
 
 /// Exit code of a fit that ran but did not converge.
 pub const EXIT_NOT_CONVERGED: u8 = 2;
+/// Exit code of a fit that converged but failed a diagnostic (report written).
+pub const EXIT_DIAGNOSTIC_FAILED: u8 = 3;
 /// Exit code of any error.
 pub const EXIT_ERROR: u8 = 1;
 
@@ -93,6 +95,7 @@ where
     match std::panic::catch_unwind(|| run(cli)) {
         Ok(Ok(Outcome::Done)) => ExitCode::SUCCESS,
         Ok(Ok(Outcome::NotConverged)) => ExitCode::from(EXIT_NOT_CONVERGED),
+        Ok(Ok(Outcome::DiagnosticFailed)) => ExitCode::from(EXIT_DIAGNOSTIC_FAILED),
         Ok(Err(e)) => {
             let _ = writeln!(std::io::stderr(), "error: {}", one_line(&format!("{e:#}")));
             ExitCode::from(EXIT_ERROR)

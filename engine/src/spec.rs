@@ -226,6 +226,7 @@ impl Spec {
             oscillator: extras.oscillator.clone(),
             velocity_offset: extras.velocity_offset,
             time_shift: extras.time_shift,
+            x0: extras.x0,
             multistart: extras.multistart,
             max_iterations: self.fit.max_iterations.unwrap_or(defaults.max_iterations),
             tolerance: self.fit.tolerance.or(defaults.tolerance),
@@ -302,6 +303,8 @@ pub struct FitExtras {
     pub velocity_offset: bool,
     /// Fit a release-time shift per record.
     pub time_shift: bool,
+    /// Fit the release displacement x0 of each record, starting from its given value.
+    pub x0: bool,
     /// Number of starts (default: 1, or 4 when more than two model parameters are free).
     pub multistart: Option<usize>,
     /// Data-driven initial values for parameters the model table does not give (default true).

@@ -6,6 +6,7 @@ use crate::args::OutputArgs;
 use crate::plots::sets::{fit_record_plots, steady_state_plot};
 use crate::report::OutputDir;
 use frictionid_engine::jobs::compare_job;
+use frictionid_engine::report::Verdict;
 use std::collections::BTreeSet;
 use std::path::Path;
 use std::sync::Mutex;
@@ -61,5 +62,11 @@ pub fn run(
             f.model, f.error
         ));
     }
-    Ok(Outcome::Done)
+    for w in &report.comparison.warnings {
+        warn(w);
+    }
+    Ok(report
+        .comparison
+        .best_verdict()
+        .map_or(Outcome::Done, |v| Outcome::from(Verdict::from(v))))
 }

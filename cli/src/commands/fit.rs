@@ -57,5 +57,8 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
             report.fit.termination
         ));
     }
+    if outcome == Outcome::DiagnosticFailed {
+        warn("a diagnostic of the fit failed (see `diagnostics` in the report); exit code 3");
+    }
     Ok(outcome)
 }

@@ -27,6 +27,8 @@ pub enum Outcome {
     Done,
     /// A fit ran to its end without converging (its report is written): exit code 2.
     NotConverged,
+    /// A fit converged but a diagnostic failed (its report is written): exit code 3.
+    DiagnosticFailed,
 }
 
 impl From<Verdict> for Outcome {
@@ -34,6 +36,7 @@ impl From<Verdict> for Outcome {
         match v {
             Verdict::Done => Self::Done,
             Verdict::NotConverged => Self::NotConverged,
+            Verdict::DiagnosticFailed => Self::DiagnosticFailed,
         }
     }
 }

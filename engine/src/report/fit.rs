@@ -161,13 +161,9 @@ pub fn oscillator_table(fit: &FitResult) -> Table {
 }
 
 impl FitReport {
-    /// Done, or not converged.
+    /// Done, not converged, or a failed diagnostic (the fit's own verdict).
     pub fn verdict(&self) -> Verdict {
-        if self.fit.converged {
-            Verdict::Done
-        } else {
-            Verdict::NotConverged
-        }
+        self.fit.verdict().into()
     }
 
     fn statistics_text(&self) -> String {

@@ -88,6 +88,18 @@ pub enum Verdict {
     Done,
     /// A fit ran to its end without converging (its report is complete).
     NotConverged,
+    /// A fit converged but one of its diagnostics failed (its report says which).
+    DiagnosticFailed,
+}
+
+impl From<crate::identify::Verdict> for Verdict {
+    fn from(v: crate::identify::Verdict) -> Self {
+        match v {
+            crate::identify::Verdict::Ok => Self::Done,
+            crate::identify::Verdict::NotConverged => Self::NotConverged,
+            crate::identify::Verdict::DiagnosticFailed => Self::DiagnosticFailed,
+        }
+    }
 }
 
 /// Renders a "## Files" section (shared by the report values).
