@@ -10,7 +10,7 @@ use frictionid_engine::{analyze_record, EnergyOptions, EngineError, Oscillator, 
 use frictionid_models::formula::MAX_FORMULA_CHARS;
 use frictionid_models::{build_json, Coulomb, LuGre};
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// A fresh scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {
@@ -27,6 +27,12 @@ fn csv(time: &[f64], velocity: &[f64]) -> String {
         let _ = writeln!(s, "{t},{v}");
     }
     s
+}
+
+/// Writes the samples as a CSV file at `path` and returns the error reading it back gives.
+fn read_error(path: &Path, time: &[f64], velocity: &[f64]) -> DataError {
+    std::fs::write(path, csv(time, velocity)).expect("write");
+    read_record(path, &ReadOptions::default()).unwrap_err()
 }
 
 fn one_line(e: &impl std::fmt::Display) -> String {
@@ -94,15 +100,9 @@ fn a_huge_header_gives_a_short_error() {
 
 fn fmm_record(model: &dyn frictionid_models::FrictionModel, x0: f64) -> Record {
     let times = uniform_times(1.0, 500.0);
-    let traj = simulate(
-        &Oscillator::fmm(),
-        model,
-        &Initial::at_rest(x0),
-        1.0,
-        &times,
-        &SimOptions::default(),
-    )
-    .expect("simulation");
+    let (osc, opts) = (Oscillator::fmm(), SimOptions::default());
+    let start = Initial::at_rest(x0);
+    let traj = simulate(&osc, model, &start, 1.0, &times, &opts).expect("simulation");
     Record::new("fmm", times, traj.v, x0)
 }
 
@@ -244,9 +244,7 @@ fn duplicate_and_gapped_time_stamps_name_their_line() {
     // Duplicate at sample 50 (file line 52: header on line 1, samples from line 2).
     let mut dup = time.clone();
     dup[51] = dup[50];
-    let path = dir.join("dup.csv");
-    std::fs::write(&path, csv(&dup, &v)).expect("write");
-    let e = read_record(&path, &ReadOptions::default()).unwrap_err();
+    let e = read_error(&dir.join("dup.csv"), &dup, &v);
     assert!(
         matches!(e, DataError::NotIncreasing { line: 53, .. }),
         "{e}"
@@ -256,9 +254,7 @@ fn duplicate_and_gapped_time_stamps_name_their_line() {
     for t in time.iter_mut().skip(60) {
         *t += 0.005;
     }
-    let path = dir.join("gap.csv");
-    std::fs::write(&path, csv(&time, &v)).expect("write");
-    let e = read_record(&path, &ReadOptions::default()).unwrap_err();
+    let e = read_error(&dir.join("gap.csv"), &time, &v);
     assert!(
         matches!(e, DataError::UnevenSampling { line: 62, .. }),
         "{e}"

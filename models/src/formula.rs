@@ -550,31 +550,34 @@ impl Parser {
     fn sum(&mut self) -> Result<Node, Located> {
         let col = self.peek().col;
         self.enter(col)?;
-        let mut left = self.product()?;
-        loop {
-            let kind = match self.peek().tok {
-                Tok::Plus => BinKind::Add,
-                Tok::Minus => BinKind::Sub,
-                _ => break,
-            };
-            self.bump();
-            let right = self.product()?;
-            left = Node::Bin(kind, Box::new(left), Box::new(right));
-        }
+        let sum = self.left_assoc(Self::product, |tok| match tok {
+            Tok::Plus => Some(BinKind::Add),
+            Tok::Minus => Some(BinKind::Sub),
+            _ => None,
+        })?;
         self.depth -= 1;
-        Ok(left)
+        Ok(sum)
     }
 
     fn product(&mut self) -> Result<Node, Located> {
-        let mut left = self.unary()?;
-        loop {
-            let kind = match self.peek().tok {
-                Tok::Star => BinKind::Mul,
-                Tok::Slash => BinKind::Div,
-                _ => break,
-            };
+        self.left_assoc(Self::unary, |tok| match tok {
+            Tok::Star => Some(BinKind::Mul),
+            Tok::Slash => Some(BinKind::Div),
+            _ => None,
+        })
+    }
+
+    /// A left-associative chain `operand (op operand)*`, where `op_of` names the operators
+    /// of this precedence level.
+    fn left_assoc(
+        &mut self,
+        operand: fn(&mut Self) -> Result<Node, Located>,
+        op_of: fn(&Tok) -> Option<BinKind>,
+    ) -> Result<Node, Located> {
+        let mut left = operand(self)?;
+        while let Some(kind) = op_of(&self.peek().tok) {
             self.bump();
-            let right = self.unary()?;
+            let right = operand(self)?;
             left = Node::Bin(kind, Box::new(left), Box::new(right));
         }
         Ok(left)

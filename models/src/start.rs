@@ -104,6 +104,16 @@ impl StribeckLevels {
         })
     }
 
+    /// Writes the levels into a Stribeck-curve model's `[mu_c, mu_s, v_s, delta, viscous]`,
+    /// keeping its own `v_s` and `delta` where the levels have none.
+    pub(crate) fn write_into(&self, [mu_c, mu_s, v_s, delta, viscous]: [&mut f64; 5]) {
+        *mu_c = self.mu_c;
+        *mu_s = self.mu_s;
+        *v_s = self.v_s.unwrap_or(*v_s);
+        *delta = self.delta.unwrap_or(*delta);
+        *viscous = self.viscous;
+    }
+
     /// The static coefficient, never below the Coulomb one (a fit that ended with
     /// mu_s < mu_c starts the next stage at the flat curve instead).
     pub fn mu_s_at_least_mu_c(&self) -> f64 {

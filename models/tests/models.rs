@@ -9,6 +9,14 @@ fn close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * (1.0 + b.abs())
 }
 
+/// Runs `check` on the default instance of every registered model.
+fn check_every_model(check: fn(&testing::Model) -> Result<(), testing::Violation>) {
+    for name in names() {
+        let m = default_model(&name).unwrap();
+        check(m.as_ref()).unwrap();
+    }
+}
+
 #[test]
 fn registry_lists_the_built_in_models() {
     assert_eq!(
@@ -164,10 +172,7 @@ fn none_is_zero() {
 /// the harness's velocities, states and normal forces).
 #[test]
 fn every_model_is_odd() {
-    for name in names() {
-        let m = default_model(&name).unwrap();
-        testing::check_odd_symmetry(m.as_ref()).unwrap();
-    }
+    check_every_model(testing::check_odd_symmetry);
 }
 
 /// The steady state of a dynamic model equals its force at the state where dz/dt = 0.
@@ -183,10 +188,7 @@ fn dynamic_steady_state_matches_the_fixed_point() {
 /// hide a lost field.
 #[test]
 fn every_model_round_trips_through_json_and_toml() {
-    for name in names() {
-        let m = default_model(&name).unwrap();
-        testing::check_serde(m.as_ref()).unwrap();
-    }
+    check_every_model(testing::check_serde);
 }
 
 #[test]

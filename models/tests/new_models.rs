@@ -19,6 +19,11 @@ fn close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * (1.0 + b.abs())
 }
 
+/// The one-line message of the error `toml_model(text)` must give.
+fn toml_error(text: &str) -> String {
+    toml_model(text).unwrap_err().to_string()
+}
+
 fn toml_model(text: &str) -> Result<Built, ModelError> {
     let t: toml::Value = toml::from_str(text).map_err(|e| ModelError::Invalid(e.to_string()))?;
     build_toml(&t)
@@ -88,7 +93,8 @@ fn makkar_is_odd_and_its_defaults_fit_the_fmm_scale() {
 #[test]
 fn makkar_params_metadata_and_warning() {
     let mut m = Makkar::default();
-    let names: Vec<String> = m.param_info().into_iter().map(|p| p.name).collect();
+    let info = m.param_info();
+    let names: Vec<&str> = info.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["g1", "g2", "g3", "g4", "g5", "g6"]);
     let units: Vec<String> = m.param_info().into_iter().map(|p| p.unit).collect();
     assert_eq!(units, ["N", "s/m", "s/m", "N", "s/m", "N s/m"]);
@@ -303,19 +309,13 @@ fn gms_without_element_damping_never_creates_energy() {
 
 #[test]
 fn gms_is_odd() {
+    let element = |stiffness, weight, damping| GmsElement {
+        stiffness,
+        weight,
+        damping,
+    };
     let m = Gms {
-        elements: vec![
-            GmsElement {
-                stiffness: 3e5,
-                weight: 0.6,
-                damping: 5.0,
-            },
-            GmsElement {
-                stiffness: 2e4,
-                weight: 0.4,
-                damping: 0.0,
-            },
-        ],
+        elements: vec![element(3e5, 0.6, 5.0), element(2e4, 0.4, 0.0)],
         sharpness: 3.0,
         ..Gms::default()
     };
@@ -412,16 +412,12 @@ fn gms_config_errors_name_the_key() {
         assert!(msg.contains(needle), "{text}: {msg}");
         assert!(!msg.contains('\n'));
     }
-    let e = toml_model("type = \"gms\"\nstifness = 1e5")
-        .unwrap_err()
-        .to_string();
+    let e = toml_error("type = \"gms\"\nstifness = 1e5");
     assert!(
         e.contains("unknown parameter `stifness`") && e.contains("did you mean `stiffness`"),
         "{e}"
     );
-    let e = toml_model("type = \"gms\"\nweights = \"equal\"")
-        .unwrap_err()
-        .to_string();
+    let e = toml_error("type = \"gms\"\nweights = \"equal\"");
     assert!(
         e.contains("a number (for all elements) or a list of numbers"),
         "{e}"
@@ -494,13 +490,11 @@ fn expression_viscous_and_stribeck_laws_match_the_built_in_models() {
     let st = Stribeck::default();
     let es = expr(
         "N * (mu_c + (mu_s - mu_c) * exp(-abs(v / v_s)^delta)) * sgn(v) + viscous * v",
-        &[
-            ("mu_c", st.mu_c),
-            ("mu_s", st.mu_s),
-            ("v_s", st.v_s),
-            ("delta", st.delta),
-            ("viscous", st.viscous),
-        ],
+        &st.param_info()
+            .iter()
+            .map(|p| p.name.as_str())
+            .zip(st.params())
+            .collect::<Vec<_>>(),
     );
     assert_eq!(e.static_limit(N), vc.static_limit(N));
     assert!(close(
@@ -660,7 +654,7 @@ fn expression_parse_errors_point_at_the_column() {
         ("1e+ * v", 1),
     ] {
         let text = format!("type = \"expression\"\nforce = \"{formula}\"\nparams = {{ mu = 0.2 }}");
-        let msg = toml_model(&text).unwrap_err().to_string();
+        let msg = toml_error(&text);
         assert!(
             msg.contains(&format!("at column {column} of `{formula}`")),
             "{formula}: {msg}"
@@ -704,12 +698,10 @@ fn expression_unknown_and_unused_names_are_errors() {
         let text = format!(
             "type = \"expression\"\nforce = \"mu * N * sign(v)\"\nparams = {{ mu = 0.2 }}\n{extra}"
         );
-        let msg = toml_model(&text).unwrap_err().to_string();
+        let msg = toml_error(&text);
         assert!(msg.contains(&format!("key `{key}`")), "{msg}");
     }
-    let msg = toml_model("type = \"expression\"\nforce = \"v\"\nparam = { mu = 1 }")
-        .unwrap_err()
-        .to_string();
+    let msg = toml_error("type = \"expression\"\nforce = \"v\"\nparam = { mu = 1 }");
     assert!(
         msg.contains("unknown parameter `param`") && msg.contains("did you mean `params`"),
         "{msg}"

@@ -36,9 +36,6 @@ impl FrictionModel for Dahl {
         equation: "dF/dt = sigma0 v |1 - F sgn(v)/(mu_c N)|^alpha sgn(1 - F sgn(v)/(mu_c N)), friction = F",
     );
 
-    fn n_states(&self) -> usize {
-        1
-    }
     fn state_derivative(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) {
         let (Some(&f), Some(d)) = (z.first(), dz.first_mut()) else {
             return;
@@ -51,6 +48,9 @@ impl FrictionModel for Dahl {
             // No normal load: no friction can build up.
             0.0
         };
+    }
+    fn n_states(&self) -> usize {
+        1
     }
     /// d(dF/dt)/dF = -sigma0 |v| alpha |r|^(alpha - 1) / (mu_c N), r = 1 - F sgn(v) / (mu_c N);
     /// 0 without normal load. At r = 0 with alpha < 1 the derivative is unbounded: there

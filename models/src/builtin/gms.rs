@@ -172,10 +172,10 @@ pub struct Gms {
     pub v_s: f64,
     /// Stribeck shape exponent.
     pub delta: f64,
-    /// Transition exponent m of the element law.
-    pub sharpness: f64,
     /// Viscous coefficient [N s/m].
     pub viscous: f64,
+    /// Transition exponent m of the element law.
+    pub sharpness: f64,
 }
 
 /// Default stiffness of element `i` (0-based): 1e5 N/m, each next one a third of the previous,
@@ -212,11 +212,15 @@ impl Gms {
 
     /// Takes the levels mu_c, mu_s, v_s and delta (when given) and viscous.
     fn set_levels(&mut self, levels: &StribeckLevels) {
-        self.mu_c = levels.mu_c;
-        self.mu_s = levels.mu_s;
-        self.v_s = levels.v_s.unwrap_or(self.v_s);
-        self.delta = levels.delta.unwrap_or(self.delta);
-        self.viscous = levels.viscous;
+        let Self {
+            mu_c,
+            mu_s,
+            v_s,
+            delta,
+            viscous,
+            ..
+        } = self;
+        levels.write_into([mu_c, mu_s, v_s, delta, viscous]);
     }
 
     /// Scales the element stiffnesses, keeping their ratios, to the total `target` [N/m].

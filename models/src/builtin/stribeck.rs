@@ -34,11 +34,15 @@ crate::declare_params! {
 impl Stribeck {
     /// Takes the levels mu_c, mu_s, v_s and delta (when given) and viscous.
     fn set_levels(&mut self, levels: &StribeckLevels) {
-        self.mu_c = levels.mu_c;
-        self.mu_s = levels.mu_s;
-        self.v_s = levels.v_s.unwrap_or(self.v_s);
-        self.delta = levels.delta.unwrap_or(self.delta);
-        self.viscous = levels.viscous;
+        let Self {
+            mu_c,
+            mu_s,
+            v_s,
+            delta,
+            viscous,
+            ..
+        } = self;
+        levels.write_into([mu_c, mu_s, v_s, delta, viscous]);
     }
 
     /// The velocity-dependent coefficient mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta).
