@@ -384,3 +384,33 @@ fn standard_errors_are_widened_for_coloured_noise() {
         "reported {reported} vs spread {spread}"
     );
 }
+
+/// mu is proportional to 1/N for a Coulomb fit (the data fix mu N): a normal force known to
+/// 1 % gives mu a normal_force component of 1 % of mu; the total adds it in quadrature to
+/// the data's standard error.
+#[test]
+fn a_one_percent_normal_force_uncertainty_gives_one_percent_of_mu() {
+    use frictionid_engine::identify::PropertyUncertainty;
+    let osc = Oscillator::fmm();
+    let recs = records(&osc, &Coulomb { mu: 0.24 }, NOISE, 121);
+    let plain = fit(&osc, &Coulomb::default(), &recs, &FitOptions::default()).unwrap();
+    let opts = FitOptions {
+        uncertainty: PropertyUncertainty {
+            normal_force: 0.01 * osc.normal_force,
+            ..PropertyUncertainty::default()
+        },
+        ..FitOptions::default()
+    };
+    let r = fit(&osc, &Coulomb::default(), &recs, &opts).unwrap();
+    let mu = r.param("mu").unwrap();
+    let c = mu.std_error_components.unwrap();
+    assert!(rel(c.normal_force, 0.01 * mu.value) < 0.05, "{c:?}");
+    assert_eq!(c.mass, 0.0);
+    let data = plain.param("mu").unwrap().std_error.unwrap();
+    assert!(rel(c.data.unwrap(), data) < 1e-6);
+    let total = (data * data + c.normal_force * c.normal_force).sqrt();
+    assert!(rel(mu.std_error.unwrap(), total) < 1e-6);
+    assert_eq!(c.dominant(), "normal_force");
+    let json = serde_json::to_value(mu).unwrap();
+    assert!(json["std_error_components"]["normal_force"].is_number());
+}

@@ -56,8 +56,8 @@ fn lost_worker(payload: Box<dyn Any + Send>) -> PyErr {
 }
 
 /// Runs `job` on a worker thread with the GIL released; the calling thread checks for
-/// signals every [`SIGNAL_POLL`]. On Ctrl-C the job is cancelled, joined, and the signal's
-/// exception (`KeyboardInterrupt`) raised.
+/// signals every [`SIGNAL_POLL`]. On Ctrl-C the job is cancelled (it ends at its next solver
+/// iteration) and the signal's exception (`KeyboardInterrupt`) raised at once.
 fn run_job<T: Send + 'static>(
     py: Python<'_>,
     job: impl FnOnce(Hooks) -> PyResult<T> + Send + 'static,
@@ -65,7 +65,7 @@ fn run_job<T: Send + 'static>(
     let cancel = Arc::new(AtomicBool::new(false));
     let hooks = cancellable_hooks(cancel.clone());
     let (tx, rx) = mpsc::channel();
-    let worker = std::thread::spawn(move || {
+    std::thread::spawn(move || {
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| job(hooks)));
         let _ = tx.send(outcome);
     });
@@ -86,8 +86,9 @@ fn run_job<T: Send + 'static>(
             }
             Err(RecvTimeoutError::Timeout) => {
                 if let Err(signal) = py.check_signals() {
+                    // The worker stops at its next solver iteration; the caller need not
+                    // wait for it (one iteration of a stiff model can take seconds).
                     cancel.store(true, Ordering::Relaxed);
-                    let _ = py.detach(|| worker.join());
                     return Err(signal);
                 }
             }

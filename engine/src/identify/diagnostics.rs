@@ -544,6 +544,7 @@ mod tests {
             ci95: None,
             unit: "1".into(),
             free: true,
+            std_error_components: None,
         };
         let ok = standard_errors(&[p("mu", Some(0.01))], false);
         assert_eq!(ok.status, Status::Pass);

@@ -2,6 +2,7 @@
 //! lays out the free parameters, runs the starts and turns the best one into a [`FitResult`]
 //! (statistics, per-record fits, the energy-balance check and the findings).
 
+use super::budget::{apply_budget, Refit};
 use super::diagnostics;
 use super::energy_check::{energy_force_check, EnergyForce, ForceReference};
 use super::layout::{FreeParam, ParamKind};
@@ -85,7 +86,19 @@ pub fn fit_with<R: Residuals + 'static>(
             n_starts
         },
     };
-    finish(&context, runs, clock)
+    let mut result = finish(&context, runs, clock)?;
+    if opts.uncertainty.any() {
+        let refit = Refit {
+            residuals: residuals.clone(),
+            osc,
+            opts,
+        };
+        apply_budget(&mut result, &refit, |r, o, m, op| {
+            fit_with(r, o, m, records, op)
+        })?;
+        result.wall_time_s = clock.elapsed().as_secs_f64();
+    }
+    Ok(result)
 }
 
 /// The model, the oscillator and every record are valid, and there is a record.
@@ -363,6 +376,7 @@ fn param_entry(
         ci95: std_error.map(|s| [value - tq * s, value + tq * s]),
         unit: unit.to_string(),
         free: slot.is_some(),
+        std_error_components: None,
     }
 }
 

@@ -15,6 +15,7 @@
 //! - [`energy_check::energy_force_check`]: the energy-balance check, shared with the
 //!   `energy` command.
 
+pub mod budget;
 pub mod compare;
 pub mod diagnostics;
 pub mod energy_check;
@@ -30,6 +31,7 @@ pub mod setup;
 pub mod starts;
 pub mod stats;
 
+pub use budget::{PropertyUncertainty, StdErrorComponents};
 pub use compare::{compare, Comparison, ComparisonVerdict, FailedFit};
 pub use energy_check::{energy_force_check, EnergyForce, ForceReference};
 pub use fit::{fit, fit_with, guess_hint, Derived, FitResult, FittedParam, RecordFit};

@@ -1,5 +1,6 @@
 //! What a fit varies and how.
 
+use super::budget::PropertyUncertainty;
 use crate::energy::EnergyOptions;
 use crate::simulate::SimOptions;
 use serde::{Deserialize, Serialize};
@@ -93,6 +94,9 @@ pub struct FitOptions {
     pub time_shift: bool,
     /// Fit the release displacement x0 of each record, starting from its given value.
     pub x0: bool,
+    /// One standard deviation of the oscillator's properties, propagated into every fitted
+    /// parameter's standard error (see [`super::budget`]).
+    pub uncertainty: PropertyUncertainty,
     /// Number of starts; `None`: 1 when at most two model parameters are free, else
     /// [`super::starts::DEFAULT_STARTS`].
     pub multistart: Option<usize>,
@@ -121,6 +125,7 @@ impl Default for FitOptions {
             velocity_offset: false,
             time_shift: false,
             x0: false,
+            uncertainty: PropertyUncertainty::default(),
             multistart: None,
             max_iterations: 200,
             tolerance: None,
@@ -146,6 +151,7 @@ impl std::fmt::Debug for FitOptions {
             .field("velocity_offset", &self.velocity_offset)
             .field("time_shift", &self.time_shift)
             .field("x0", &self.x0)
+            .field("uncertainty", &self.uncertainty)
             .field("multistart", &self.multistart)
             .field("max_iterations", &self.max_iterations)
             .field("parallel", &self.parallel)

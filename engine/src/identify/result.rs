@@ -1,5 +1,6 @@
 //! The values a fit returns.
 
+use super::budget::StdErrorComponents;
 use super::energy_check::EnergyForce;
 use super::outcome::{as_display, worst_status, Finding, StartOutcome, Status, TerminationReason};
 use crate::oscillator::Oscillator;
@@ -21,6 +22,10 @@ pub struct FittedParam {
     pub unit: String,
     /// Whether it was fitted.
     pub free: bool,
+    /// The parts of `std_error` when the oscillator's properties are uncertain (then
+    /// `std_error` is their total).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub std_error_components: Option<StdErrorComponents>,
 }
 
 /// The fit of one record.
