@@ -7,7 +7,9 @@
 //! sequence of sample intervals costs what the states' dynamics need, not a fresh start each.
 //! Dense output: the cubic Hermite interpolant through both ends of the step.
 
-use super::stepper::{OdeSystem, StepCounts, StepOutcome, Stepper};
+use super::stepper::{
+    current_point_accessors, OdeSystem, StepCounts, StepOutcome, StepResult, Stepper,
+};
 use crate::error::IntegrationFailure;
 
 /// Bogacki-Shampine 3(2) with error control and cubic Hermite dense output.
@@ -98,13 +100,9 @@ impl BogackiShampine {
 }
 
 impl Stepper for BogackiShampine {
-    fn reset<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        t: f64,
-        y: &[f64],
-        t_end: f64,
-    ) -> Result<(), IntegrationFailure> {
+    current_point_accessors!();
+
+    fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()> {
         self.span = t_end - t;
         if self.h.is_nan() || self.h <= 0.0 || self.h > self.span {
             self.h = self.span;
@@ -125,7 +123,7 @@ impl Stepper for BogackiShampine {
         &mut self,
         system: &S,
         event: impl Fn(&[f64]) -> f64,
-    ) -> Result<StepOutcome, IntegrationFailure> {
+    ) -> StepResult<StepOutcome> {
         let last = self.t + self.h >= self.t_end - 1e-12 * self.span;
         let h = if last { self.t_end - self.t } else { self.h };
         let err = self.attempt(system, h);
@@ -156,24 +154,10 @@ impl Stepper for BogackiShampine {
             });
         }
         Ok(if accepted {
-            StepOutcome::Accepted {
-                crossed: event(&self.y) <= 0.0,
-            }
+            StepOutcome::accepted(event(&self.y))
         } else {
             StepOutcome::Rejected
         })
-    }
-
-    fn time(&self) -> f64 {
-        self.t
-    }
-
-    fn previous_time(&self) -> f64 {
-        self.t_prev
-    }
-
-    fn state(&self) -> &[f64] {
-        &self.y
     }
 
     fn reached_end(&self) -> bool {
@@ -196,9 +180,5 @@ impl Stepper for BogackiShampine {
         for (j, o) in out.iter_mut().enumerate() {
             *o = h00 * self.y_prev[j] + h10 * h * f0[j] + h01 * self.y[j] + h11 * h * f1[j];
         }
-    }
-
-    fn counts(&self) -> StepCounts {
-        self.counts
     }
 }

@@ -14,7 +14,9 @@
 //! P = e^(-sigma tau) cos(w_d tau), Q = e^(-sigma tau) sin(w_d tau).
 //! Underdamped modes only (sigma < w0); the driver falls back to an ODE stepper otherwise.
 
-use super::stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper};
+use super::stepper::{
+    current_point_accessors, AffineMotion, OdeSystem, StepCounts, StepOutcome, StepResult, Stepper,
+};
 use crate::error::IntegrationFailure;
 use std::cell::Cell;
 use std::f64::consts::PI;
@@ -147,13 +149,9 @@ impl ClosedForm {
 }
 
 impl Stepper for ClosedForm {
-    fn reset<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        t: f64,
-        y: &[f64],
-        t_end: f64,
-    ) -> Result<(), IntegrationFailure> {
+    current_point_accessors!();
+
+    fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()> {
         let unavailable = IntegrationFailure::ClosedFormUnavailable { time: t };
         let Some(motion) = system.affine_motion() else {
             return Err(unavailable);
@@ -189,7 +187,7 @@ impl Stepper for ClosedForm {
         &mut self,
         _system: &S,
         event: impl Fn(&[f64]) -> f64,
-    ) -> Result<StepOutcome, IntegrationFailure> {
+    ) -> StepResult<StepOutcome> {
         let candidate = self.mode.t0 + (self.next_phase + PAST_ZERO * PI) / self.mode.omega_d;
         self.next_phase += PI;
         let t_next = candidate.min(self.t_end);
@@ -199,21 +197,7 @@ impl Stepper for ClosedForm {
         self.t = t_next;
         self.y = [x, v];
         self.counts.accepted += 1;
-        Ok(StepOutcome::Accepted {
-            crossed: event(&self.y) <= 0.0,
-        })
-    }
-
-    fn time(&self) -> f64 {
-        self.t
-    }
-
-    fn previous_time(&self) -> f64 {
-        self.t_prev
-    }
-
-    fn state(&self) -> &[f64] {
-        &self.y
+        Ok(StepOutcome::accepted(event(&self.y)))
     }
 
     fn reached_end(&self) -> bool {
@@ -227,9 +211,5 @@ impl Stepper for ClosedForm {
             *xo = x;
             *vo = v;
         }
-    }
-
-    fn counts(&self) -> StepCounts {
-        self.counts
     }
 }

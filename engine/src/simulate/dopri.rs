@@ -14,7 +14,9 @@
 //! `engine/tests/identify.rs` (`lugre_fit_reaches_the_noise_level`) into another local minimum
 //! (rms 3.7e-4 instead of about 2e-4 m/s): that fit is sensitive at the round-off level.
 
-use super::stepper::{OdeSystem, StepCounts, StepOutcome, Stepper};
+use super::stepper::{
+    current_point_accessors, OdeSystem, StepCounts, StepOutcome, StepResult, Stepper,
+};
 use crate::error::IntegrationFailure;
 
 /// Stage times c_i.
@@ -277,13 +279,9 @@ impl Dopri5 {
 }
 
 impl Stepper for Dopri5 {
-    fn reset<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        t: f64,
-        y: &[f64],
-        t_end: f64,
-    ) -> Result<(), IntegrationFailure> {
+    current_point_accessors!();
+
+    fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()> {
         self.t = t;
         self.t_prev = t;
         self.t_end = t_end;
@@ -302,7 +300,7 @@ impl Stepper for Dopri5 {
         &mut self,
         system: &S,
         event: impl Fn(&[f64]) -> f64,
-    ) -> Result<StepOutcome, IntegrationFailure> {
+    ) -> StepResult<StepOutcome> {
         if 0.1 * self.h.abs() <= f64::EPSILON * self.t.abs() {
             return Err(IntegrationFailure::StepSizeTooSmall {
                 time: self.t,
@@ -325,21 +323,7 @@ impl Stepper for Dopri5 {
         }
         self.counts.accepted += 1;
         self.accept(h);
-        Ok(StepOutcome::Accepted {
-            crossed: event(&self.y) <= 0.0,
-        })
-    }
-
-    fn time(&self) -> f64 {
-        self.t
-    }
-
-    fn previous_time(&self) -> f64 {
-        self.t_prev
-    }
-
-    fn state(&self) -> &[f64] {
-        &self.y
+        Ok(StepOutcome::accepted(event(&self.y)))
     }
 
     fn reached_end(&self) -> bool {
@@ -364,9 +348,5 @@ impl Stepper for Dopri5 {
             let r = c1[i] + r * theta1;
             *o = c0[i] + r * theta;
         }
-    }
-
-    fn counts(&self) -> StepCounts {
-        self.counts
     }
 }

@@ -3,8 +3,9 @@
 //! time). Its dense output is the straight line between the step's ends, so turning points and
 //! samples are interpolated linearly.
 
-use super::stepper::{OdeSystem, StepCounts, StepOutcome, Stepper};
-use crate::error::IntegrationFailure;
+use super::stepper::{
+    current_point_accessors, OdeSystem, StepCounts, StepOutcome, StepResult, Stepper,
+};
 
 /// Fixed-step explicit Euler.
 #[derive(Debug, Clone)]
@@ -40,13 +41,9 @@ impl Euler {
 }
 
 impl Stepper for Euler {
-    fn reset<S: OdeSystem>(
-        &mut self,
-        _system: &S,
-        t: f64,
-        y: &[f64],
-        t_end: f64,
-    ) -> Result<(), IntegrationFailure> {
+    current_point_accessors!();
+
+    fn reset<S: OdeSystem>(&mut self, _: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()> {
         self.t_seg = t;
         self.steps_in_segment = 0;
         self.t = t;
@@ -61,7 +58,7 @@ impl Stepper for Euler {
         &mut self,
         system: &S,
         event: impl Fn(&[f64]) -> f64,
-    ) -> Result<StepOutcome, IntegrationFailure> {
+    ) -> StepResult<StepOutcome> {
         self.steps_in_segment += 1;
         let t_next = (self.t_seg + self.steps_in_segment as f64 * self.h).min(self.t_end);
         let hs = t_next - self.t;
@@ -74,21 +71,7 @@ impl Stepper for Euler {
         self.t = t_next;
         self.counts.accepted += 1;
         self.counts.rhs_evaluations += 1;
-        Ok(StepOutcome::Accepted {
-            crossed: event(&self.y) <= 0.0,
-        })
-    }
-
-    fn time(&self) -> f64 {
-        self.t
-    }
-
-    fn previous_time(&self) -> f64 {
-        self.t_prev
-    }
-
-    fn state(&self) -> &[f64] {
-        &self.y
+        Ok(StepOutcome::accepted(event(&self.y)))
     }
 
     fn reached_end(&self) -> bool {
@@ -104,9 +87,5 @@ impl Stepper for Euler {
         for ((o, &a0), &a1) in out.iter_mut().zip(&self.y_prev).zip(&self.y) {
             *o = a0 + frac * (a1 - a0);
         }
-    }
-
-    fn counts(&self) -> StepCounts {
-        self.counts
     }
 }

@@ -49,6 +49,42 @@ pub enum StepOutcome {
     },
 }
 
+impl StepOutcome {
+    /// An accepted step whose event function ends at `event_value` (crossed when it is <= 0).
+    pub fn accepted(event_value: f64) -> Self {
+        StepOutcome::Accepted {
+            crossed: event_value <= 0.0,
+        }
+    }
+}
+
+/// What the fallible [`Stepper`] operations return.
+pub type StepResult<T> = Result<T, IntegrationFailure>;
+
+/// Implements the [`Stepper`] accessors `time`, `previous_time`, `state` and `counts` for a
+/// stepper that keeps its current time in `t`, the previous one in `t_prev`, the state in `y`
+/// and its work counters in `counts`.
+macro_rules! current_point_accessors {
+    () => {
+        fn time(&self) -> f64 {
+            self.t
+        }
+
+        fn previous_time(&self) -> f64 {
+            self.t_prev
+        }
+
+        fn state(&self) -> &[f64] {
+            &self.y
+        }
+
+        fn counts(&self) -> StepCounts {
+            self.counts
+        }
+    };
+}
+pub(crate) use current_point_accessors;
+
 /// Work counters of a stepper, summed since it was built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct StepCounts {
@@ -77,13 +113,7 @@ impl StepCounts {
 pub trait Stepper {
     /// Restarts at state `y` at time `t`, integrating towards `t_end` (> t). Errors: the
     /// stepper cannot integrate this system (e.g. the closed form needs an affine motion).
-    fn reset<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        t: f64,
-        y: &[f64],
-        t_end: f64,
-    ) -> Result<(), IntegrationFailure>;
+    fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()>;
 
     /// Attempts one step. `event` is the event function of the state; it is positive at the
     /// start of the segment's interior. Errors: the step size became too small.
@@ -91,7 +121,7 @@ pub trait Stepper {
         &mut self,
         system: &S,
         event: impl Fn(&[f64]) -> f64,
-    ) -> Result<StepOutcome, IntegrationFailure>;
+    ) -> StepResult<StepOutcome>;
 
     /// The time of the current state.
     fn time(&self) -> f64;
