@@ -66,6 +66,43 @@ fn final_state(traj: &Trajectory) -> (f64, Option<f64>) {
     }
 }
 
+/// The simulate report of a trajectory from `init` (duration and sample rate taken from its
+/// sample times; no noise). Shared by [`simulate_job`] and the Python module.
+pub fn simulate_report(
+    osc: Oscillator,
+    model: Box<dyn FrictionModel>,
+    init: &Initial,
+    traj: Trajectory,
+    wall_time_s: f64,
+) -> SimulateReport {
+    let (final_displacement, rest_time) = final_state(&traj);
+    let duration = traj.time.last().copied().unwrap_or(0.0);
+    let samples = traj.time.len();
+    SimulateReport {
+        command: "simulate".into(),
+        config: String::new(),
+        oscillator: osc,
+        model,
+        x0: init.x0,
+        v0: init.v0,
+        duration,
+        sample_rate: samples.saturating_sub(1) as f64 / duration,
+        samples,
+        final_displacement,
+        rest_time,
+        half_cycles: traj.half_cycles(),
+        events: traj.events.clone(),
+        stats: traj.stats,
+        wall_time_s,
+        noise: None,
+        seed: None,
+        files: Vec::new(),
+        energy_rate: energy_rate(osc.mass, osc.stiffness, &traj.x, &traj.v, &traj.a),
+        trajectory: traj,
+        noisy_velocity: None,
+    }
+}
+
 /// `simulate`: one free vibration of the spec's model from `[simulation]`, with a noisy
 /// velocity record when the spec asks for noise.
 pub fn simulate_job(spec: &Spec) -> Result<SimulateReport, JobError> {
@@ -89,35 +126,18 @@ pub fn simulate_job(spec: &Spec) -> Result<SimulateReport, JobError> {
     )
     .map_err(JobError::Simulation)?;
     let wall_time_s = started.elapsed().as_secs_f64();
-    let (final_displacement, rest_time) = final_state(&traj);
     let noisy_velocity = sim.noise.map(|sigma| {
         let mut noisy = traj.v.clone();
         add_gaussian_noise(&mut noisy, sigma, sim.seed);
         noisy
     });
-    Ok(SimulateReport {
-        command: "simulate".into(),
-        config: String::new(),
-        oscillator: *osc,
-        model: model.clone(),
-        x0: sim.x0,
-        v0: sim.v0,
-        duration: sim.duration,
-        sample_rate: sim.sample_rate,
-        samples: traj.time.len(),
-        final_displacement,
-        rest_time,
-        half_cycles: traj.half_cycles(),
-        events: traj.events.clone(),
-        stats: traj.stats,
-        wall_time_s,
-        noise: sim.noise,
-        seed: sim.noise.map(|_| sim.seed),
-        files: Vec::new(),
-        energy_rate: energy_rate(osc.mass, osc.stiffness, &traj.x, &traj.v, &traj.a),
-        trajectory: traj,
-        noisy_velocity,
-    })
+    let mut report = simulate_report(*osc, model.clone(), &init, traj, wall_time_s);
+    report.sample_rate = sim.sample_rate;
+    report.duration = sim.duration;
+    report.noise = sim.noise;
+    report.seed = sim.noise.map(|_| sim.seed);
+    report.noisy_velocity = noisy_velocity;
+    Ok(report)
 }
 
 /// `fit`: the spec's model fitted to `records`; parameters the model table gives start from

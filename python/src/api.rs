@@ -8,12 +8,12 @@ use crate::convert::{serialized, to_f64_vec, to_json};
 use crate::errors::{engine_error, job_error, value_error};
 use crate::inputs;
 use crate::outputs::{compare_dict, energy_dict, fit_dict, simulate_dict};
-use frictionid_engine::jobs::{compare_job, energy_job, energy_rate, fit_job};
+use frictionid_engine::jobs::{compare_job, energy_job, fit_job, simulate_report};
 use frictionid_engine::record::TimeBase;
-use frictionid_engine::report::{ModelsReport, SimulateReport};
+use frictionid_engine::report::ModelsReport;
 use frictionid_engine::simulate::{simulate as simulate_trajectory, Initial};
 use frictionid_engine::spec::{Hooks, IntegratorSpec, ModelSpec};
-use frictionid_engine::{Oscillator, Spec, Trajectory};
+use frictionid_engine::Spec;
 use frictionid_models::FrictionModel;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
@@ -119,46 +119,6 @@ fn simulate_options(
     let integrator =
         serde_json::from_value(json).map_err(|e| value_error(format!("options: {e}")))?;
     Ok((integrator, z0))
-}
-
-/// The simulate report of a trajectory sampled at arbitrary times (the same value the
-/// `simulate` job returns for a uniform grid).
-fn simulate_report(
-    osc: Oscillator,
-    model: Box<dyn FrictionModel>,
-    init: &Initial,
-    traj: Trajectory,
-    wall_time_s: f64,
-) -> SimulateReport {
-    let (final_displacement, rest_time) = match &traj.rest {
-        Some(r) => (r.displacement, Some(r.time)),
-        None => (traj.x.last().copied().unwrap_or(f64::NAN), None),
-    };
-    let duration = traj.time.last().copied().unwrap_or(0.0);
-    let samples = traj.time.len();
-    SimulateReport {
-        command: "simulate".into(),
-        config: String::new(),
-        oscillator: osc,
-        model,
-        x0: init.x0,
-        v0: init.v0,
-        duration,
-        sample_rate: samples.saturating_sub(1) as f64 / duration,
-        samples,
-        final_displacement,
-        rest_time,
-        half_cycles: traj.half_cycles(),
-        events: traj.events.clone(),
-        stats: traj.stats,
-        wall_time_s,
-        noise: None,
-        seed: None,
-        files: Vec::new(),
-        energy_rate: energy_rate(osc.mass, osc.stiffness, &traj.x, &traj.v, &traj.a),
-        trajectory: traj,
-        noisy_velocity: None,
-    }
 }
 
 /// One free vibration released at `x0` (and `v0`), sampled at the times `t`.
