@@ -108,6 +108,9 @@ impl Render for CompareReport {
                 Role::Brief,
             );
         }
+        if let Some(verdict) = &c.verdict {
+            sink.paragraph(&format!("verdict: {}", verdict.message), Role::Brief);
+        }
         sink.heading(2, "Parameters", Role::Detail);
         for f in &c.ranking {
             sink.heading(3, &f.model, Role::Detail);
