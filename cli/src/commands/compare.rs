@@ -6,7 +6,6 @@ use crate::args::OutputArgs;
 use crate::plots::sets::{fit_record_plots, steady_state_plot};
 use crate::report::OutputDir;
 use frictionid_engine::jobs::compare_job;
-use frictionid_engine::report::Verdict;
 use std::collections::BTreeSet;
 use std::path::Path;
 use std::sync::Mutex;
@@ -55,7 +54,7 @@ pub fn run(
     files.extend(steady_state_plot(&out, "steady_state_curves.svg", ranking)?);
     files.extend(REPORT_FILES.map(String::from));
     report.files = files;
-    publish(&out, &report, output)?;
+    publish(&out, &report, output, config)?;
     for f in &report.comparison.failed {
         warn(&format!(
             "model `{}` could not be fitted: {}",
@@ -68,5 +67,5 @@ pub fn run(
     Ok(report
         .comparison
         .best_verdict()
-        .map_or(Outcome::Done, |v| Outcome::from(Verdict::from(v))))
+        .map_or(Outcome::Done, Outcome::from))
 }

@@ -20,6 +20,6 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
     let mut files = energy_plots(&out, &report)?;
     files.extend(REPORT_FILES.map(String::from));
     report.files = files;
-    publish(&out, &report, output)?;
+    publish(&out, &report, output, config)?;
     Ok(Outcome::Done)
 }

@@ -46,7 +46,7 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
     )?);
     files.extend(REPORT_FILES.map(String::from));
     report.files = files;
-    publish(&out, &report, output)?;
+    publish(&out, &report, output, config)?;
     for w in &report.fit.warnings {
         warn(w);
     }

@@ -12,12 +12,14 @@ use crate::error::CliError;
 use crate::progress::Progress;
 use crate::report::OutputDir;
 use crate::terminal::TerminalWriter;
+use frictionid_engine::report::html::{HtmlWriter, Page};
 use frictionid_engine::report::json::to_json_text;
 use frictionid_engine::report::markdown::MarkdownWriter;
 use frictionid_engine::report::{Render, Verdict};
 use frictionid_engine::spec::Hooks;
 use serde::Serialize;
 use std::io::Write;
+use std::path::Path;
 use std::sync::Arc;
 
 /// How a command ended.
@@ -34,11 +36,27 @@ pub enum Outcome {
 impl From<Verdict> for Outcome {
     fn from(v: Verdict) -> Self {
         match v {
-            Verdict::Done => Self::Done,
+            Verdict::Ok => Self::Done,
             Verdict::NotConverged => Self::NotConverged,
             Verdict::DiagnosticFailed => Self::DiagnosticFailed,
         }
     }
+}
+
+/// report.html of `report`: the plots written in `out` inline, `config` echoed.
+fn html_page(out: &OutputDir, report: &dyn Render, config: &Path) -> String {
+    let config_text = std::fs::read_to_string(config).ok();
+    let config_name = config.display().to_string();
+    let plot = |name: &str| {
+        name.ends_with(".svg")
+            .then(|| std::fs::read_to_string(out.path(name)).ok())
+            .flatten()
+    };
+    let page = Page {
+        plot: &plot,
+        config: config_text.as_deref().map(|t| (config_name.as_str(), t)),
+    };
+    HtmlWriter::render(report, &page)
 }
 
 /// Prints `text` to stdout unless `--quiet`, ignoring a closed pipe.
@@ -100,19 +118,22 @@ pub fn hooks(
 }
 
 /// The names of the report files, listed last in a report's `files`.
-pub const REPORT_FILES: [&str; 2] = ["report.md", "report.json"];
+pub const REPORT_FILES: [&str; 3] = ["report.html", "report.md", "report.json"];
 
-/// Writes report.md and then report.json (its presence means the run completed), prints the
-/// terminal summary (or, with `--json`, report.json) and the output directory.
+/// Writes report.html, report.md and then report.json (its presence means the run
+/// completed), prints the terminal summary (or, with `--json`, report.json) and the output
+/// directory. `config` is echoed in report.html.
 pub fn publish<R: Render + Serialize>(
     out: &OutputDir,
     report: &R,
     output: &OutputArgs,
+    config: &Path,
 ) -> anyhow::Result<()> {
     let json = to_json_text(report).map_err(|e| CliError::Write {
         path: out.path("report.json"),
         reason: e.to_string(),
     })?;
+    out.write_text("report.html", &html_page(out, report, config))?;
     out.write_text("report.md", &MarkdownWriter::render(report))?;
     out.write_text("report.json", &json)?;
     say(

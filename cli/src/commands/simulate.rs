@@ -70,6 +70,6 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
     files.extend(simulate_plots(&out, &report)?);
     files.extend(REPORT_FILES.map(String::from));
     report.files = files;
-    publish(&out, &report, output)?;
+    publish(&out, &report, output, config)?;
     Ok(Outcome::Done)
 }

@@ -1,8 +1,8 @@
 //! The report of `compare`: several models fitted to the same records, ranked by AIC.
 
-use super::fit::{fit_json, parameter_table};
-use super::format::{fmt_criterion, fmt_num};
-use super::{render_files, Render, Role, Sink, Table};
+use super::fit::{fit_json, parameter_table, verdict_line};
+use super::format::{fmt_criterion, fmt_num, fmt_opt};
+use super::{render_files, Render, Role, Sink, Status, Table};
 use crate::identify::{Comparison, FitResult};
 use serde::ser::SerializeMap;
 use serde::{Serialize, Serializer};
@@ -30,11 +30,13 @@ impl Serialize for CompareReport {
             .map(fit_json)
             .collect::<Result<Vec<_>, _>>()
             .map_err(serde::ser::Error::custom)?;
-        let mut map = serializer.serialize_map(Some(6))?;
+        let mut map = serializer.serialize_map(Some(8))?;
         map.serialize_entry("command", "compare")?;
         map.serialize_entry("config", &self.config)?;
         map.serialize_entry("ranking", &ranking)?;
+        map.serialize_entry("verdict", &c.verdict)?;
         map.serialize_entry("failed", &c.failed)?;
+        map.serialize_entry("warnings", &c.warnings)?;
         map.serialize_entry("wall_time_s", &c.wall_time_s)?;
         map.serialize_entry("files", &self.files)?;
         map.end()
@@ -42,6 +44,20 @@ impl Serialize for CompareReport {
 }
 
 impl CompareReport {
+    /// The comparison's verdict sentence, with the status of the best fit (`None` when no
+    /// model could be fitted).
+    pub fn verdict_line(&self) -> Option<(Status, String)> {
+        let best = self.best()?;
+        let (status, best_text) = verdict_line(best);
+        let ranking = self.comparison.verdict.as_ref().map_or(String::new(), |v| {
+            format!("{}. ", v.message.trim_end_matches('.'))
+        });
+        Some((
+            status,
+            format!("{ranking}The best fit (`{}`): {best_text}", best.model),
+        ))
+    }
+
     /// The best fit (lowest AIC), if any model could be fitted.
     pub fn best(&self) -> Option<&FitResult> {
         self.comparison.ranking.first()
@@ -61,6 +77,7 @@ impl CompareReport {
                     f.model.clone(),
                     fmt_criterion(f.aic),
                     fmt_criterion(f.aic - best_aic),
+                    fmt_opt(f.rank.as_ref().map(|r| r.akaike_weight)),
                     fmt_criterion(f.bic),
                     fmt_num(f.rms_residual),
                     f.free_parameters.to_string(),
@@ -74,6 +91,7 @@ impl CompareReport {
                 "model",
                 "AIC",
                 "dAIC",
+                "Akaike weight",
                 "BIC",
                 "rms residual [m/s]",
                 "free",
@@ -97,6 +115,9 @@ impl Render for CompareReport {
             ),
             Role::Detail,
         );
+        if let Some((status, text)) = self.verdict_line() {
+            sink.verdict(status, &text);
+        }
         sink.table(&self.ranking_table(), Role::Summary);
         if let Some(best) = self.best() {
             sink.paragraph(
@@ -115,6 +136,10 @@ impl Render for CompareReport {
         for f in &c.ranking {
             sink.heading(3, &f.model, Role::Detail);
             sink.table(&parameter_table(f), Role::Detail);
+        }
+        if !c.warnings.is_empty() {
+            sink.heading(2, "Warnings", Role::Detail);
+            sink.list(&c.warnings, Role::Detail);
         }
         if !c.failed.is_empty() {
             sink.heading(2, "Failed", Role::Detail);

@@ -1,9 +1,10 @@
 //! The report of `fit`: one model fitted to the records, with the energy-based force check.
 
 use super::format::{
-    fmt_criterion, fmt_estimate, fmt_num, fmt_percent, fmt_std_error, fmt_to_error,
+    fmt_criterion, fmt_estimate, fmt_num, fmt_opt, fmt_percent, fmt_std_error, fmt_to_error,
+    serialized_name,
 };
-use super::{render_files, Render, Role, Sink, Table, Verdict};
+use super::{render_files, Render, Role, Sink, Status, Table, Verdict};
 use crate::identify::FitResult;
 use serde::{Serialize, Serializer};
 
@@ -80,6 +81,60 @@ pub fn parameter_table(fit: &FitResult) -> Table {
         ],
         rows,
     )
+}
+
+/// A fit's verdict as one sentence, and its status (the worst of convergence and the
+/// diagnostics).
+pub fn verdict_line(fit: &FitResult) -> (Status, String) {
+    let problems = |status: Status| -> Vec<String> {
+        fit.diagnostics
+            .iter()
+            .filter(|d| d.status == status)
+            .map(|d| format!("`{}`", serialized_name(&d.check)))
+            .collect()
+    };
+    match fit.verdict() {
+        Verdict::NotConverged => (
+            Status::Fail,
+            format!(
+                "not converged ({}): the values below are where the solver stopped.",
+                fit.termination
+            ),
+        ),
+        Verdict::DiagnosticFailed => (
+            Status::Fail,
+            format!(
+                "converged, but a diagnostic failed ({}): read the diagnostics before using the values.",
+                problems(Status::Fail).join(", ")
+            ),
+        ),
+        Verdict::Ok => match problems(Status::Warn) {
+            warned if warned.is_empty() => {
+                (Status::Pass, "converged; every diagnostic passed.".into())
+            }
+            warned => (
+                Status::Warn,
+                format!("converged, with warnings ({}).", warned.join(", ")),
+            ),
+        },
+    }
+}
+
+/// Every diagnostic of a fit: check, status, the value judged and the message.
+pub fn diagnostics_table(fit: &FitResult) -> Table {
+    let rows = fit
+        .diagnostics
+        .iter()
+        .map(|d| {
+            vec![
+                serialized_name(&d.check),
+                serialized_name(&d.status),
+                fmt_opt(d.value),
+                d.message.clone(),
+            ]
+        })
+        .collect();
+    Table::new(&["check", "status", "value", "message"], rows)
 }
 
 /// The per-record table of a fit: residual and the energy-based force check.
@@ -163,7 +218,7 @@ pub fn oscillator_table(fit: &FitResult) -> Table {
 impl FitReport {
     /// Done, not converged, or a failed diagnostic (the fit's own verdict).
     pub fn verdict(&self) -> Verdict {
-        self.fit.verdict().into()
+        self.fit.verdict()
     }
 
     fn statistics_text(&self) -> String {
@@ -209,6 +264,10 @@ impl Render for FitReport {
             ),
             Role::Detail,
         );
+        let (status, verdict) = verdict_line(f);
+        sink.verdict(status, &verdict);
+        sink.heading(2, "Diagnostics", Role::Detail);
+        sink.table(&diagnostics_table(f), Role::Detail);
         sink.heading(2, "Parameters", Role::Detail);
         sink.table(&parameter_table(f), Role::Summary);
         sink.heading(2, "Oscillator", Role::Detail);
@@ -217,10 +276,6 @@ impl Render for FitReport {
         sink.table(&record_table(f), Role::Summary);
         sink.paragraph(&self.statistics_text(), Role::Detail);
         sink.paragraph(&self.terminal_text(), Role::Brief);
-        if !f.warnings.is_empty() {
-            sink.heading(2, "Warnings", Role::Detail);
-            sink.list(&f.warnings, Role::Detail);
-        }
         render_files(sink, &self.files);
     }
 }

@@ -171,6 +171,15 @@ pub fn fmt_estimate(x: f64, se: Option<f64>) -> String {
     }
 }
 
+/// The name a unit-like enum value has in report.json (its serde name, e.g. `pass`,
+/// `energy_balance`), so every writer spells it the same way.
+pub fn serialized_name<T: serde::Serialize>(value: &T) -> String {
+    match serde_json::to_value(value) {
+        Ok(serde_json::Value::String(s)) => s,
+        _ => "-".into(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,7 +5,7 @@
 //! serializable (its JSON form is report.json, see [`json::to_json`]) and implements
 //! [`Render`]: it pushes its document, block by block, into a [`Sink`]. Every writer is a
 //! sink (the idea of ripgrep's `Sink` and printers): [`markdown::MarkdownWriter`] here, a
-//! terminal summary in the CLI, HTML next. A new writer implements [`Sink`] and needs no
+//! terminal summary in the CLI, [`html::HtmlWriter`] (report.html). A new writer implements [`Sink`] and needs no
 //! change to the reports.
 //!
 //! Inline code in text is written between backticks (`` `x14mm.csv` ``); writers render it
@@ -15,6 +15,7 @@ pub mod compare;
 pub mod energy;
 pub mod fit;
 pub mod format;
+pub mod html;
 pub mod json;
 pub mod markdown;
 pub mod models;
@@ -66,6 +67,12 @@ pub trait Sink {
     fn heading(&mut self, level: usize, text: &str, role: Role);
     /// A paragraph of text.
     fn paragraph(&mut self, text: &str, role: Role);
+    /// A result's verdict (`status` the worst of its checks), with what it rests on (shown near the top of a full report).
+    /// Writers without their own way of showing it write a paragraph.
+    fn verdict(&mut self, status: Status, text: &str) {
+        let _ = status;
+        self.paragraph(&format!("Verdict: {text}"), Role::Detail);
+    }
     /// A table.
     fn table(&mut self, table: &Table, role: Role);
     /// A bulleted list.
@@ -80,27 +87,10 @@ pub trait Render {
     fn render(&self, sink: &mut dyn Sink);
 }
 
-/// Whether a command's result can be trusted as it stands; decides the exit code of a front
-/// end.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Verdict {
-    /// The command ran and its result stands.
-    Done,
-    /// A fit ran to its end without converging (its report is complete).
-    NotConverged,
-    /// A fit converged but one of its diagnostics failed (its report says which).
-    DiagnosticFailed,
-}
-
-impl From<crate::identify::Verdict> for Verdict {
-    fn from(v: crate::identify::Verdict) -> Self {
-        match v {
-            crate::identify::Verdict::Ok => Self::Done,
-            crate::identify::Verdict::NotConverged => Self::NotConverged,
-            crate::identify::Verdict::DiagnosticFailed => Self::DiagnosticFailed,
-        }
-    }
-}
+pub use crate::identify::outcome::Status;
+/// Whether a command's result can be trusted as it stands (the fit's verdict; a command
+/// without a fit is `Ok`); decides the exit code of a front end.
+pub use crate::identify::Verdict;
 
 /// Renders a "## Files" section (shared by the report values).
 fn render_files(sink: &mut dyn Sink, files: &[String]) {

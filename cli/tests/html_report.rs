@@ -1,0 +1,152 @@
+//! report.html of every report command: a well-formed, self-contained HTML document (checked
+//! with html5gum, a WHATWG-conformant tokenizer) that shows the report's content and its
+//! plots inline and loads nothing from outside the file.
+
+use assert_cmd::Command;
+use html5gum::{Token, Tokenizer};
+use std::path::{Path, PathBuf};
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
+}
+
+/// Runs `frictionid <command> <config> --out <fresh dir> --quiet` and returns report.html.
+fn report_html(command: &str, config: &str, extra: &[&str]) -> String {
+    let out =
+        std::env::temp_dir().join(format!("frictionid-html-{command}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let o = Command::new(env!("CARGO_BIN_EXE_frictionid"))
+        .arg(command)
+        .arg(fixtures().join(config))
+        .args(extra)
+        .arg("--out")
+        .arg(&out)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{command}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    std::fs::read_to_string(out.join("report.html")).unwrap()
+}
+
+/// Elements HTML closes without an end tag.
+const VOID: [&str; 6] = ["meta", "br", "hr", "img", "input", "link"];
+/// Elements that load or run something from elsewhere.
+const FORBIDDEN: [&str; 7] = [
+    "script", "link", "img", "iframe", "object", "embed", "image",
+];
+
+/// The document's structure as the tokenizer sees it: start tags in order, with every parse
+/// error, unbalanced end tag and outside reference reported.
+fn check_document(html: &str) -> Vec<String> {
+    let mut open: Vec<String> = Vec::new();
+    let mut seen = Vec::new();
+    for token in Tokenizer::new(html) {
+        let Ok(token) = token;
+        match token {
+            Token::Error(e) => panic!("HTML parse error: {e:?}"),
+            Token::StartTag(tag) => {
+                let name = String::from_utf8_lossy(&tag.name).to_string();
+                assert!(!FORBIDDEN.contains(&name.as_str()), "<{name}> in the page");
+                for (key, value) in &tag.attributes {
+                    let key = String::from_utf8_lossy(key).to_lowercase();
+                    let value = String::from_utf8_lossy(value).to_lowercase();
+                    assert!(
+                        !matches!(key.as_str(), "src" | "href" | "xlink:href" | "srcset"),
+                        "<{name} {key}=\"{value}\"> refers to another resource"
+                    );
+                    assert!(!value.contains("url("), "<{name} {key}> loads {value}");
+                }
+                if !tag.self_closing && !VOID.contains(&name.as_str()) {
+                    open.push(name.clone());
+                }
+                seen.push(name);
+            }
+            Token::EndTag(tag) => {
+                let name = String::from_utf8_lossy(&tag.name).to_string();
+                assert_eq!(
+                    open.pop().as_deref(),
+                    Some(name.as_str()),
+                    "unbalanced </{name}>"
+                );
+            }
+            Token::String(text) => {
+                let text = String::from_utf8_lossy(&text).to_lowercase();
+                assert!(
+                    !text.contains("@import") && !text.contains("url("),
+                    "styles load something from elsewhere"
+                );
+            }
+            _ => {}
+        }
+    }
+    assert!(open.is_empty(), "elements left open: {open:?}");
+    seen
+}
+
+fn count(tags: &[String], name: &str) -> usize {
+    tags.iter().filter(|t| *t == name).count()
+}
+
+#[test]
+fn fit_report_html_has_verdict_parameters_plots_and_config() {
+    let html = report_html("fit", "fmm-fit.toml", &[]);
+    let tags = check_document(&html);
+    assert!(html.starts_with("<!DOCTYPE html>"));
+    assert_eq!(count(&tags, "html"), 1);
+    // Verdict and diagnostics come before the parameter table.
+    let verdict = html.find("class=\"verdict").expect("verdict");
+    let diagnostics = html.find("<h2>Diagnostics</h2>").expect("diagnostics");
+    let parameters = html.find("<h2>Parameters</h2>").expect("parameters");
+    assert!(verdict < diagnostics && diagnostics < parameters);
+    assert!(html.contains("<td>mu</td>"), "the fitted parameter");
+    // Seven plots (velocity fit and friction force per record, steady state), all inline.
+    assert_eq!(count(&tags, "svg"), 7);
+    assert!(html.contains("<h2>Configuration</h2>"));
+    assert!(html.contains("[oscillator]"), "the config echoed");
+    assert!(html.contains(&format!("frictionid {}", env!("CARGO_PKG_VERSION"))));
+}
+
+#[test]
+fn compare_report_html_ranks_the_models_and_names_the_verdict() {
+    let html = report_html(
+        "compare",
+        "fmm-compare.toml",
+        &["--models", "coulomb,viscous_coulomb,none"],
+    );
+    let tags = check_document(&html);
+    assert!(html.contains("Akaike weight"));
+    assert!(html.contains("<td>coulomb</td>") && html.contains("<td>none</td>"));
+    assert!(html.contains("class=\"verdict"));
+    assert!(count(&tags, "svg") >= 1);
+}
+
+#[test]
+fn energy_and_simulate_report_html_are_self_contained_pages_with_plots() {
+    for (command, config) in [
+        ("energy", "fmm-energy.toml"),
+        ("simulate", "paper-140mm.toml"),
+    ] {
+        let html = report_html(command, config, &[]);
+        let tags = check_document(&html);
+        assert!(count(&tags, "svg") >= 1, "{command}: no inline plot");
+        assert!(count(&tags, "table") >= 1, "{command}: no table");
+    }
+}
+
+#[test]
+#[should_panic(expected = "unbalanced")]
+fn the_checker_catches_misnested_elements() {
+    check_document("<!DOCTYPE html><html><body><p><b></p></b></body></html>");
+}
+
+#[test]
+#[should_panic(expected = "refers to another resource")]
+fn the_checker_catches_outside_references() {
+    check_document(
+        "<!DOCTYPE html><html><body><a href=\"https://example.org\">x</a></body></html>",
+    );
+}
