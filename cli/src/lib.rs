@@ -20,6 +20,7 @@ pub mod plots;
 pub mod progress;
 pub mod report;
 pub mod terminal;
+pub mod testing;
 
 use args::{Cli, Command};
 use clap::Parser;

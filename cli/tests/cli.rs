@@ -3,26 +3,11 @@
 //! no panic and no report.json.
 
 use assert_cmd::Command;
-use std::path::{Path, PathBuf};
+use frictionid_cli::testing::{fixtures_dir, scratch_dir, FMM_OSCILLATOR};
 
 fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
 }
-
-fn fixtures() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
-}
-
-/// A fresh, empty scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("frictionid-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-const OSC: &str =
-    "[oscillator]\nmass = 10.391\ndamping = 0.275\nstiffness = 1982.0\nnormal_force = 14.5\n";
 
 fn csv(n: usize) -> String {
     let mut s = String::from("# a test record\ntime,velocity\n");
@@ -36,7 +21,7 @@ fn csv(n: usize) -> String {
 /// Runs `frictionid <cmd> CONFIG --out DIR` on a config written into a scratch directory
 /// (with the given data files) and checks the failure contract; returns the stderr line.
 fn fails(name: &str, cmd: &str, config: &str, files: &[(&str, &str)]) -> String {
-    let dir = scratch(name);
+    let dir = scratch_dir("cli", name);
     std::fs::write(dir.join("c.toml"), config).unwrap();
     for (f, text) in files {
         std::fs::write(dir.join(f), text).unwrap();
@@ -62,7 +47,7 @@ fn fails(name: &str, cmd: &str, config: &str, files: &[(&str, &str)]) -> String 
 }
 
 fn with_record(extra: &str) -> String {
-    format!("{OSC}[model]\ntype = \"coulomb\"\n[[records]]\nfile = \"r.csv\"\nx0 = 0.014\n{extra}")
+    format!("{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\n[[records]]\nfile = \"r.csv\"\nx0 = 0.014\n{extra}")
 }
 
 #[test]
@@ -140,7 +125,7 @@ fn usage_error_is_not_the_non_convergence_code() {
 
 #[test]
 fn missing_config_file() {
-    let dir = scratch("missing-config");
+    let dir = scratch_dir("cli", "missing-config");
     let o = frictionid()
         .args(["fit", "nope.toml", "--out"])
         .arg(dir.join("out"))
@@ -212,7 +197,7 @@ fn uneven_sampling_and_too_few_samples() {
 
 #[test]
 fn bad_toml_names_line_and_column() {
-    let cfg = format!("{OSC}[model]\ntype = \"coulomb\nmu = 0.2\n");
+    let cfg = format!("{FMM_OSCILLATOR}[model]\ntype = \"coulomb\nmu = 0.2\n");
     let e = fails("toml", "fit", &cfg, &[]);
     assert!(e.contains("c.toml:7:"), "{e}");
 }
@@ -232,7 +217,7 @@ fn unknown_key_suggests_the_nearest() {
     let e = fails(
         "key2",
         "simulate",
-        &format!("{OSC}[simulaton]\nx0 = 0.1\n"),
+        &format!("{FMM_OSCILLATOR}[simulaton]\nx0 = 0.1\n"),
         &[],
     );
     assert!(
@@ -246,7 +231,7 @@ fn unknown_model_and_parameter_suggest_the_nearest() {
     let e = fails(
         "model",
         "fit",
-        &format!("{OSC}[model]\ntype = \"stribek\"\n"),
+        &format!("{FMM_OSCILLATOR}[model]\ntype = \"stribek\"\n"),
         &[],
     );
     assert!(
@@ -256,7 +241,7 @@ fn unknown_model_and_parameter_suggest_the_nearest() {
     let e = fails(
         "param",
         "fit",
-        &format!("{OSC}[model]\ntype = \"stribeck\"\nmu_d = 0.3\n"),
+        &format!("{FMM_OSCILLATOR}[model]\ntype = \"stribeck\"\nmu_d = 0.3\n"),
         &[],
     );
     assert!(e.contains("unknown parameter `mu_d`"), "{e}");
@@ -264,7 +249,7 @@ fn unknown_model_and_parameter_suggest_the_nearest() {
 
 #[test]
 fn missing_x0_is_named() {
-    let cfg = format!("{OSC}[[records]]\nfile = \"r.csv\"\n");
+    let cfg = format!("{FMM_OSCILLATOR}[[records]]\nfile = \"r.csv\"\n");
     let e = fails("x0", "fit", &cfg, &[("r.csv", &csv(20))]);
     assert!(
         e.ends_with(
@@ -272,7 +257,8 @@ fn missing_x0_is_named() {
         ),
         "{e}"
     );
-    let cfg = format!("{OSC}[model]\ntype = \"coulomb\"\n[simulation]\nduration = 1.0\n");
+    let cfg =
+        format!("{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\n[simulation]\nduration = 1.0\n");
     let e = fails("x0-sim", "simulate", &cfg, &[]);
     assert!(e.contains("[simulation]: missing `x0`"), "{e}");
 }
@@ -282,7 +268,7 @@ fn out_of_bounds_parameter_is_an_error() {
     let e = fails(
         "bounds",
         "fit",
-        &format!("{OSC}[model]\ntype = \"coulomb\"\nmu = -0.1\n"),
+        &format!("{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\nmu = -0.1\n"),
         &[],
     );
     assert!(
@@ -303,7 +289,7 @@ fn fixture_configs_parse() {
         "fmm-compare.toml",
         "fmm-energy.toml",
     ] {
-        let c = frictionid_cli::Config::load(&fixtures().join(f)).unwrap();
+        let c = frictionid_cli::Config::load(&fixtures_dir().join(f)).unwrap();
         assert!(c.spec.oscillator.mass > 0.0, "{f}");
     }
 }
@@ -313,21 +299,21 @@ fn simulate_and_energy_name_what_they_need() {
     let e = fails(
         "no-sim",
         "simulate",
-        &format!("{OSC}[model]\ntype = \"coulomb\"\n"),
+        &format!("{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\n"),
         &[],
     );
     assert!(e.contains("simulate needs a [simulation] table"), "{e}");
     let e = fails(
         "no-model",
         "simulate",
-        &format!("{OSC}[simulation]\nx0 = 0.01\nduration = 1.0\n"),
+        &format!("{FMM_OSCILLATOR}[simulation]\nx0 = 0.01\nduration = 1.0\n"),
         &[],
     );
     assert!(e.contains("simulate needs a [model] table"), "{e}");
     let e = fails(
         "no-records",
         "energy",
-        &format!("{OSC}[model]\ntype = \"coulomb\"\n"),
+        &format!("{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\n"),
         &[],
     );
     assert!(

@@ -2,21 +2,11 @@
 //! N = 14.5 N; see fixtures/README.md), and their failure modes.
 
 use assert_cmd::Command;
-use std::path::{Path, PathBuf};
+use frictionid_cli::testing::{fixtures_dir, read_report, scratch_dir};
+use std::path::Path;
 
 fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
-}
-
-fn fixtures() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("frictionid-fc-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 fn run_json(args: &[&str], out: &Path) -> (std::process::Output, serde_json::Value) {
@@ -27,10 +17,7 @@ fn run_json(args: &[&str], out: &Path) -> (std::process::Output, serde_json::Val
         .arg("--json")
         .output()
         .unwrap();
-    let v =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap_or_default())
-            .unwrap_or(serde_json::Value::Null);
-    (o, v)
+    (o, read_report(out))
 }
 
 const TRUTH_MU: f64 = 0.24;
@@ -38,8 +25,8 @@ const MU_N: f64 = TRUTH_MU * 14.5;
 
 #[test]
 fn fit_recovers_the_fixture_truth_and_writes_every_output() {
-    let out = scratch("fit");
-    let cfg = fixtures().join("fmm-fit.toml");
+    let out = scratch_dir("fc", "fit");
+    let cfg = fixtures_dir().join("fmm-fit.toml");
     let (o, r) = run_json(&["fit", cfg.to_str().unwrap()], &out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let stdout: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
@@ -103,8 +90,8 @@ fn fit_recovers_the_fixture_truth_and_writes_every_output() {
 
 #[test]
 fn compare_ranks_the_classical_models() {
-    let out = scratch("compare");
-    let cfg = fixtures().join("fmm-compare.toml");
+    let out = scratch_dir("fc", "compare");
+    let cfg = fixtures_dir().join("fmm-compare.toml");
     let (o, r) = run_json(
         &[
             "compare",
@@ -135,8 +122,8 @@ fn compare_ranks_the_classical_models() {
 
 #[test]
 fn compare_rejects_an_unknown_model_with_a_suggestion() {
-    let out = scratch("compare-bad");
-    let cfg = fixtures().join("fmm-compare.toml");
+    let out = scratch_dir("fc", "compare-bad");
+    let cfg = fixtures_dir().join("fmm-compare.toml");
     let o = frictionid()
         .args([
             "compare",
@@ -160,10 +147,13 @@ fn compare_rejects_an_unknown_model_with_a_suggestion() {
 
 #[test]
 fn a_fit_that_does_not_converge_exits_2_with_its_report() {
-    let dir = scratch("noconv");
-    let text = std::fs::read_to_string(fixtures().join("fmm-fit.toml"))
+    let dir = scratch_dir("fc", "noconv");
+    let text = std::fs::read_to_string(fixtures_dir().join("fmm-fit.toml"))
         .unwrap()
-        .replace("file = \"", &format!("file = \"{}/", fixtures().display()))
+        .replace(
+            "file = \"",
+            &format!("file = \"{}/", fixtures_dir().display()),
+        )
         .replace("[fit]\n", "[fit]\nmax_iterations = 1\n");
     let cfg = dir.join("fit.toml");
     std::fs::write(&cfg, text).unwrap();
@@ -181,8 +171,7 @@ fn a_fit_that_does_not_converge_exits_2_with_its_report() {
     );
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("did not converge"), "{e}");
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let r: serde_json::Value = read_report(&out);
     assert_eq!(r["converged"], false);
     assert!(r["termination"]
         .as_str()
@@ -192,10 +181,13 @@ fn a_fit_that_does_not_converge_exits_2_with_its_report() {
 
 #[test]
 fn unknown_fit_option_is_named() {
-    let dir = scratch("fitopt");
-    let text = std::fs::read_to_string(fixtures().join("fmm-fit.toml"))
+    let dir = scratch_dir("fc", "fitopt");
+    let text = std::fs::read_to_string(fixtures_dir().join("fmm-fit.toml"))
         .unwrap()
-        .replace("file = \"", &format!("file = \"{}/", fixtures().display()))
+        .replace(
+            "file = \"",
+            &format!("file = \"{}/", fixtures_dir().display()),
+        )
         + "\n[fit.options]\nvelocity_ofset = true\n";
     let cfg = dir.join("fit.toml");
     std::fs::write(&cfg, text).unwrap();
@@ -215,10 +207,13 @@ fn unknown_fit_option_is_named() {
 
 #[test]
 fn energy_without_a_model_takes_its_reference_from_a_coulomb_fit() {
-    let dir = scratch("energy-fit");
-    let text = std::fs::read_to_string(fixtures().join("fmm-compare.toml"))
+    let dir = scratch_dir("fc", "energy-fit");
+    let text = std::fs::read_to_string(fixtures_dir().join("fmm-compare.toml"))
         .unwrap()
-        .replace("file = \"", &format!("file = \"{}/", fixtures().display()));
+        .replace(
+            "file = \"",
+            &format!("file = \"{}/", fixtures_dir().display()),
+        );
     let cfg = dir.join("energy.toml");
     std::fs::write(&cfg, text).unwrap();
     let out = dir.join("out");
@@ -238,10 +233,13 @@ fn energy_without_a_model_takes_its_reference_from_a_coulomb_fit() {
 
 #[test]
 fn expression_sign_law_fits_the_same_mu_as_coulomb() {
-    let dir = scratch("expr");
-    let base = std::fs::read_to_string(fixtures().join("fmm-fit.toml"))
+    let dir = scratch_dir("fc", "expr");
+    let base = std::fs::read_to_string(fixtures_dir().join("fmm-fit.toml"))
         .unwrap()
-        .replace("file = \"", &format!("file = \"{}/", fixtures().display()));
+        .replace(
+            "file = \"",
+            &format!("file = \"{}/", fixtures_dir().display()),
+        );
     let expr = base.replace(
         "type = \"coulomb\"\nmu = 0.2               # initial value",
         "type = \"expression\"\nforce = \"mu * N * sign(v)\"\nparams = { mu = 0.2 }",

@@ -3,24 +3,14 @@
 //! dataset 58 twins (written by pyuff) against their CSV record.
 
 use assert_cmd::Command;
+use frictionid_cli::testing::{fixtures_dir, read_report, scratch_dir};
 use frictionid_engine::data::{read_record, Channel, ReadOptions};
 use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::Oscillator;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
-}
-
-fn fixtures() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("frictionid-fx-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 fn paper_oscillator() -> Oscillator {
@@ -29,10 +19,10 @@ fn paper_oscillator() -> Oscillator {
 
 /// Runs `simulate` on a fixture config and returns report.json.
 fn simulate(config: &str, name: &str) -> (serde_json::Value, PathBuf) {
-    let out = scratch(name);
+    let out = scratch_dir("fx", name);
     let o = frictionid()
         .arg("simulate")
-        .arg(fixtures().join(config))
+        .arg(fixtures_dir().join(config))
         .arg("--out")
         .arg(&out)
         .arg("--json")
@@ -40,8 +30,7 @@ fn simulate(config: &str, name: &str) -> (serde_json::Value, PathBuf) {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let stdout: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let file: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let file: serde_json::Value = read_report(&out);
     assert_eq!(stdout, file, "--json prints report.json");
     (file, out)
 }
@@ -119,7 +108,7 @@ fn fmm_records_match_their_documented_truth() {
         ("x14mm.csv", 0.014),
         ("x22mm.csv", 0.022),
     ] {
-        let r = read_record(&fixtures().join(file), &ReadOptions::default()).unwrap();
+        let r = read_record(&fixtures_dir().join(file), &ReadOptions::default()).unwrap();
         assert_eq!(r.len(), 2001, "{file}");
         assert!((r.time()[2000] - 2.0).abs() < 1e-12);
         let exact = coulomb_free_vibration(&osc, 0.24 * 14.5, x0, r.time()).unwrap();
@@ -142,7 +131,8 @@ fn simulate_with_noise_writes_a_record_usable_in_records() {
     let (r, out) = simulate("fmm-sim-14mm.toml", "n14");
     assert_eq!(r["noise"].as_f64(), Some(2e-4));
     let rec = read_record(&out.join("record.csv"), &ReadOptions::default()).unwrap();
-    let committed = read_record(&fixtures().join("x14mm.csv"), &ReadOptions::default()).unwrap();
+    let committed =
+        read_record(&fixtures_dir().join("x14mm.csv"), &ReadOptions::default()).unwrap();
     // Same config and seed: the committed fixture is reproduced.
     assert_eq!(rec.time(), committed.time());
     let worst = rec
@@ -157,9 +147,9 @@ fn simulate_with_noise_writes_a_record_usable_in_records() {
 
 #[test]
 fn uff_twins_read_to_the_csv_record() {
-    let csv = read_record(&fixtures().join("x14mm.csv"), &ReadOptions::default()).unwrap();
+    let csv = read_record(&fixtures_dir().join("x14mm.csv"), &ReadOptions::default()).unwrap();
     for (file, rel) in [("x14mm.uff", 1e-11), ("x14mm-single.uff", 1e-5)] {
-        let uff = read_record(&fixtures().join(file), &ReadOptions::default()).unwrap();
+        let uff = read_record(&fixtures_dir().join(file), &ReadOptions::default()).unwrap();
         assert_eq!(uff.len(), csv.len(), "{file}");
         for (a, b) in uff.time().iter().zip(csv.time()) {
             assert!((a - b).abs() < 1e-12, "{file}: t {a} vs {b}");
@@ -177,12 +167,12 @@ fn uff_twins_read_to_the_csv_record() {
 
 #[test]
 fn uff_record_in_a_config_reads_like_its_csv_twin() {
-    let dir = scratch("uffcfg");
+    let dir = scratch_dir("fx", "uffcfg");
     let cfg = format!(
         "[oscillator]\nmass = 10.391\ndamping = 0.275\nstiffness = 1982.0\nnormal_force = 14.5\n\
          [[records]]\nfile = \"{}\"\nx0 = 0.014\n[[records]]\nfile = \"{}\"\nx0 = 0.014\nformat = \"uff58\"\n",
-        fixtures().join("x14mm.csv").display(),
-        fixtures().join("x14mm.uff").display()
+        fixtures_dir().join("x14mm.csv").display(),
+        fixtures_dir().join("x14mm.uff").display()
     );
     let path = dir.join("c.toml");
     std::fs::write(&path, cfg).unwrap();
@@ -198,10 +188,10 @@ fn uff_record_in_a_config_reads_like_its_csv_twin() {
 /// documented truth) to within 1 %.
 #[test]
 fn energy_recovers_the_true_friction_force() {
-    let out = scratch("energy");
+    let out = scratch_dir("fx", "energy");
     let o = frictionid()
         .arg("energy")
-        .arg(fixtures().join("fmm-energy.toml"))
+        .arg(fixtures_dir().join("fmm-energy.toml"))
         .arg("--out")
         .arg(&out)
         .arg("--quiet")
@@ -209,8 +199,7 @@ fn energy_recovers_the_true_friction_force() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(o.stdout.is_empty(), "--quiet prints nothing");
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let r: serde_json::Value = read_report(&out);
     assert_eq!(r["command"], "energy");
     let recs = r["records"].as_array().unwrap();
     let names: Vec<&str> = recs.iter().map(|x| x["file"].as_str().unwrap()).collect();

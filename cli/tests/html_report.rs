@@ -3,21 +3,15 @@
 //! plots inline and loads nothing from outside the file.
 
 use assert_cmd::Command;
+use frictionid_cli::testing::{fixtures_dir, scratch_dir};
 use html5gum::{Token, Tokenizer};
-use std::path::{Path, PathBuf};
-
-fn fixtures() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
-}
 
 /// Runs `frictionid <command> <config> --out <fresh dir> --quiet` and returns report.html.
 fn report_html(command: &str, config: &str, extra: &[&str]) -> String {
-    let out =
-        std::env::temp_dir().join(format!("frictionid-html-{command}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
+    let out = scratch_dir("html", command);
     let o = Command::new(env!("CARGO_BIN_EXE_frictionid"))
         .arg(command)
-        .arg(fixtures().join(config))
+        .arg(fixtures_dir().join(config))
         .args(extra)
         .arg("--out")
         .arg(&out)

@@ -2,25 +2,12 @@
 //! distinct plot files when record file names collide.
 
 use assert_cmd::Command;
-use std::path::{Path, PathBuf};
+use frictionid_cli::testing::{fixtures_dir, read_report, scratch_dir, FMM_OSCILLATOR};
+use std::path::Path;
 
 fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
 }
-
-fn fixtures() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("frictionid-out-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-const OSC: &str =
-    "[oscillator]\nmass = 10.391\ndamping = 0.275\nstiffness = 1982.0\nnormal_force = 14.5\n";
 
 fn run_in(dir: &Path, args: &[&str]) {
     let o = frictionid()
@@ -47,11 +34,11 @@ fn files_in(dir: &Path) -> Vec<String> {
 
 #[test]
 fn default_output_directories_of_the_commands_are_disjoint() {
-    let dir = scratch("layout");
+    let dir = scratch_dir("out", "layout");
     let cfg = format!(
-        "{OSC}[model]\ntype = \"coulomb\"\nmu = 0.2\n[simulation]\nx0 = 0.014\nduration = 1.0\n\
+        "{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\nmu = 0.2\n[simulation]\nx0 = 0.014\nduration = 1.0\n\
          [[records]]\nfile = \"{}\"\nx0 = 0.014\n",
-        fixtures().join("x14mm.csv").display()
+        fixtures_dir().join("x14mm.csv").display()
     );
     std::fs::write(dir.join("rig.toml"), cfg).unwrap();
     for cmd in ["simulate", "fit", "energy"] {
@@ -86,13 +73,17 @@ fn default_output_directories_of_the_commands_are_disjoint() {
 
 #[test]
 fn records_with_the_same_file_name_get_distinct_plots() {
-    let dir = scratch("same-name");
+    let dir = scratch_dir("out", "same-name");
     for sub in ["a", "b"] {
         std::fs::create_dir_all(dir.join(sub)).unwrap();
-        std::fs::copy(fixtures().join("x14mm.csv"), dir.join(sub).join("data.csv")).unwrap();
+        std::fs::copy(
+            fixtures_dir().join("x14mm.csv"),
+            dir.join(sub).join("data.csv"),
+        )
+        .unwrap();
     }
     let cfg = format!(
-        "{OSC}[[records]]\nfile = \"a/data.csv\"\nx0 = 0.014\n[[records]]\nfile = \"b/data.csv\"\nx0 = 0.014\n\
+        "{FMM_OSCILLATOR}[[records]]\nfile = \"a/data.csv\"\nx0 = 0.014\n[[records]]\nfile = \"b/data.csv\"\nx0 = 0.014\n\
          [energy]\nreference_force = 3.48\n"
     );
     std::fs::write(dir.join("two.toml"), cfg).unwrap();
@@ -104,8 +95,7 @@ fn records_with_the_same_file_name_get_distinct_plots() {
             "{stem}"
         );
     }
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let r: serde_json::Value = read_report(&out);
     let files: Vec<&str> = r["files"]
         .as_array()
         .unwrap()

@@ -11,7 +11,7 @@ use frictionid_engine::{
     analyze_record, analyze_states, force_residuals, model_force_along, percent_difference,
     simulate, Differentiator, EnergyOptions, EngineError, Initial, Oscillator, Record, SimOptions,
 };
-use frictionid_models::{Coulomb, Dahl, FrictionModel, LuGre, ModelError, ParamInfo};
+use frictionid_models::{Coulomb, Dahl, FrictionModel, LuGre};
 use serde::{Deserialize, Serialize};
 
 const MU: f64 = 0.24;
@@ -26,6 +26,39 @@ fn mu_n() -> f64 {
 fn exact(x0: f64) -> ExactCoulomb {
     let times = uniform_times(2.0, 1000.0);
     coulomb_free_vibration(&Oscillator::fmm(), mu_n(), x0, &times).expect("exact solution")
+}
+
+/// The FMM release from rest at `x0` simulated by the engine (default options, 1 kHz for
+/// `duration` s) and the energy analysis of its exact states.
+fn simulated_states(
+    model: &dyn FrictionModel,
+    x0: f64,
+    duration: f64,
+) -> (
+    frictionid_engine::Trajectory,
+    frictionid_engine::EnergyAnalysis,
+) {
+    let osc = Oscillator::fmm();
+    let times = uniform_times(duration, 1000.0);
+    let traj = simulate(
+        &osc,
+        model,
+        &Initial::at_rest(x0),
+        duration,
+        &times,
+        &SimOptions::default(),
+    )
+    .expect("simulation");
+    let an = analyze_states(
+        &osc,
+        &traj.time,
+        &traj.x,
+        &traj.v,
+        &traj.a,
+        &Default::default(),
+    )
+    .expect("states");
+    (traj, an)
 }
 
 fn record(x0: f64, noise: f64, seed: u64) -> Record {
@@ -123,26 +156,8 @@ fn exact_states_give_mu_n_to_one_part_per_million() {
 #[test]
 fn engine_simulated_records_and_states() {
     let osc = Oscillator::fmm();
-    let times = uniform_times(2.0, 1000.0);
     for x0 in X0S {
-        let traj = simulate(
-            &osc,
-            &Coulomb { mu: MU },
-            &Initial::at_rest(x0),
-            2.0,
-            &times,
-            &SimOptions::default(),
-        )
-        .expect("simulation");
-        let an = analyze_states(
-            &osc,
-            &traj.time,
-            &traj.x,
-            &traj.v,
-            &traj.a,
-            &Default::default(),
-        )
-        .expect("states");
+        let (traj, an) = simulated_states(&Coulomb { mu: MU }, x0, 2.0);
         let (e7, hc) = (
             an.mean_abs_force / mu_n() - 1.0,
             an.half_cycle_mean / mu_n() - 1.0,
@@ -614,21 +629,11 @@ struct Lag {
 
 #[typetag::serde(name = "energy_test_lag")]
 impl FrictionModel for Lag {
-    fn name(&self) -> &'static str {
-        "energy_test_lag"
-    }
-    fn equation(&self) -> String {
-        "z' = (v - z)/tau, F = gain z".into()
-    }
-    fn param_info(&self) -> Vec<ParamInfo> {
-        Vec::new()
-    }
-    fn params(&self) -> Vec<f64> {
-        vec![self.tau, self.gain]
-    }
-    fn set_params(&mut self, _values: &[f64]) -> Result<(), ModelError> {
-        Ok(())
-    }
+    frictionid_models::declared_param_methods!(
+        name: "energy_test_lag",
+        equation: "z' = (v - z)/tau, F = gain z",
+        no_params
+    );
     fn n_states(&self) -> usize {
         1
     }
@@ -828,25 +833,7 @@ fn lugre_residuals_on_a_simulated_motion() {
         mu_s: 0.3,
         ..LuGre::default()
     };
-    let times = uniform_times(1.0, 1000.0);
-    let traj = simulate(
-        &osc,
-        &model,
-        &Initial::at_rest(0.014),
-        1.0,
-        &times,
-        &SimOptions::default(),
-    )
-    .expect("simulation");
-    let an = analyze_states(
-        &osc,
-        &traj.time,
-        &traj.x,
-        &traj.v,
-        &traj.a,
-        &Default::default(),
-    )
-    .expect("states");
+    let (traj, an) = simulated_states(&model, 0.014, 1.0);
     for (f, g) in an.friction.iter().zip(&traj.friction) {
         if !f.is_nan() {
             assert!((f - g).abs() < 1e-6 * mu_n(), "{f} vs {g}");

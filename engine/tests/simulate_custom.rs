@@ -5,7 +5,7 @@
 
 use frictionid_engine::synthetic::uniform_times;
 use frictionid_engine::{simulate, EngineError, Initial, Integrator, Oscillator, SimOptions};
-use frictionid_models::{sgn, Dahl, FrictionModel, ModelError, ParamInfo};
+use frictionid_models::{sgn, Dahl, FrictionModel};
 use serde::{Deserialize, Serialize};
 
 /// Viscous friction that breaks down (NaN) below v = -0.1 m/s.
@@ -14,21 +14,11 @@ struct Broken;
 
 #[typetag::serde(name = "broken_test_law")]
 impl FrictionModel for Broken {
-    fn name(&self) -> &'static str {
-        "broken_test_law"
-    }
-    fn equation(&self) -> String {
-        "F = v (NaN for v < -0.1)".into()
-    }
-    fn param_info(&self) -> Vec<ParamInfo> {
-        Vec::new()
-    }
-    fn params(&self) -> Vec<f64> {
-        Vec::new()
-    }
-    fn set_params(&mut self, _values: &[f64]) -> Result<(), ModelError> {
-        Ok(())
-    }
+    frictionid_models::declared_param_methods!(
+        name: "broken_test_law",
+        equation: "F = v (NaN for v < -0.1)",
+        no_params
+    );
     fn force(&self, v: f64, _z: &[f64], _normal: f64) -> f64 {
         if v < -0.1 {
             f64::NAN
@@ -99,21 +89,11 @@ struct TripleDahl {
 
 #[typetag::serde(name = "triple_dahl_test_law")]
 impl FrictionModel for TripleDahl {
-    fn name(&self) -> &'static str {
-        "triple_dahl_test_law"
-    }
-    fn equation(&self) -> String {
-        "F = z1 + z2 + z3, dzi/dt = s v (1 - 3 zi sgn(v) / (mu_c N))".into()
-    }
-    fn param_info(&self) -> Vec<ParamInfo> {
-        Vec::new()
-    }
-    fn params(&self) -> Vec<f64> {
-        Vec::new()
-    }
-    fn set_params(&mut self, _values: &[f64]) -> Result<(), ModelError> {
-        Ok(())
-    }
+    frictionid_models::declared_param_methods!(
+        name: "triple_dahl_test_law",
+        equation: "F = z1 + z2 + z3, dzi/dt = s v (1 - 3 zi sgn(v) / (mu_c N))",
+        no_params
+    );
     fn n_states(&self) -> usize {
         3
     }

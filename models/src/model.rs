@@ -296,21 +296,11 @@ mod tests {
 
     #[typetag::serde(name = "model_rs_quadratic_test_law")]
     impl FrictionModel for Quadratic {
-        fn name(&self) -> &'static str {
-            "model_rs_quadratic_test_law"
-        }
-        fn equation(&self) -> String {
-            String::new()
-        }
-        fn param_info(&self) -> Vec<ParamInfo> {
-            Vec::new()
-        }
-        fn params(&self) -> Vec<f64> {
-            Vec::new()
-        }
-        fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError> {
-            check_len(self.name(), 0, values.len())
-        }
+        crate::declared_param_methods!(
+            name: "model_rs_quadratic_test_law",
+            equation: "",
+            no_params
+        );
         fn n_states(&self) -> usize {
             2
         }

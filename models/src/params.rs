@@ -253,9 +253,28 @@ pub trait DeclaredParams {
 
 /// Writes `param_info`, `params` and `set_params` of a [`DeclaredParams`] model inside its
 /// `impl FrictionModel` block; with `name: "..."` and `equation: "..."` also `name` (which
-/// must equal the typetag name) and `equation`.
+/// must equal the typetag name) and `equation`. A law without parameters (a test law, a
+/// fixed reference law) writes `name: "...", equation: "...", no_params` instead and needs
+/// no declaration.
 #[macro_export]
 macro_rules! declared_param_methods {
+    (name: $name:expr, equation: $equation:expr, no_params $(,)?) => {
+        fn name(&self) -> &'static str {
+            $name
+        }
+        fn equation(&self) -> ::std::string::String {
+            ::std::string::String::from($equation)
+        }
+        fn param_info(&self) -> ::std::vec::Vec<$crate::ParamInfo> {
+            ::std::vec::Vec::new()
+        }
+        fn params(&self) -> ::std::vec::Vec<f64> {
+            ::std::vec::Vec::new()
+        }
+        fn set_params(&mut self, values: &[f64]) -> ::core::result::Result<(), $crate::ModelError> {
+            $crate::check_len($name, 0, values.len())
+        }
+    };
     (name: $name:expr, equation: $equation:expr $(,)?) => {
         fn name(&self) -> &'static str {
             $name

@@ -8,6 +8,7 @@
 //! compare).
 
 use assert_cmd::Command;
+use frictionid_cli::testing::{read_report, scratch_dir, FMM_OSCILLATOR};
 use frictionid_models::FrictionModel;
 use frictionid_plugin_example::StribeckPower;
 use std::path::{Path, PathBuf};
@@ -18,14 +19,6 @@ fn plugin() -> Command {
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures")
-}
-
-/// A fresh, empty scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("frictionid-plugin-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 /// Runs the plugin binary and returns its stdout; fails the test on a non-zero exit.
@@ -59,16 +52,18 @@ fn csv_columns(path: &Path, names: &[&str]) -> Vec<Vec<f64>> {
     cols
 }
 
-const OSC: &str =
-    "[oscillator]\nmass = 10.391\ndamping = 0.275\nstiffness = 1982.0\nnormal_force = 14.5\n";
 const SIM: &str = "[simulation]\nx0 = 0.014\nduration = 2.0\nsample_rate = 1000.0\n";
 
 /// Simulates `model` (a TOML `[model]` body) from the FMM stage at 14 mm; returns the
 /// output directory.
 fn simulate(name: &str, model: &str) -> PathBuf {
-    let dir = scratch(name);
+    let dir = scratch_dir("plugin", name);
     let config = dir.join("c.toml");
-    std::fs::write(&config, format!("{OSC}\n[model]\n{model}\n\n{SIM}")).unwrap();
+    std::fs::write(
+        &config,
+        format!("{FMM_OSCILLATOR}\n[model]\n{model}\n\n{SIM}"),
+    )
+    .unwrap();
     let out = dir.join("out");
     run_ok(&[
         "simulate".as_ref(),
@@ -155,10 +150,7 @@ fn simulate_at_alpha_one_reproduces_the_builtin_stribeck() {
         assert!((a[1][i] - b[1][i]).abs() < 1e-9, "x at t = {}", a[0][i]);
         assert!((a[2][i] - b[2][i]).abs() < 1e-8, "v at t = {}", a[0][i]);
     }
-    let report = |d: &Path| -> serde_json::Value {
-        serde_json::from_str(&std::fs::read_to_string(d.join("report.json")).unwrap()).unwrap()
-    };
-    let (ra, rb) = (report(&plugin), report(&builtin));
+    let (ra, rb) = (read_report(&plugin), read_report(&builtin));
     assert_eq!(ra["half_cycles"], rb["half_cycles"]);
     let (ta, tb) = (
         ra["rest_time"].as_f64().unwrap(),
@@ -177,8 +169,7 @@ fn simulate_of_the_fixture_truth_dissipates_and_sticks_within_the_static_limit()
     for w in e.windows(2) {
         assert!(w[1] <= w[0] + 1e-12, "{} -> {}", w[0], w[1]);
     }
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value = read_report(&out);
     // At rest the spring force is within the breakaway limit mu_s N = 4.35 N.
     let rest = report["final_displacement"].as_f64().unwrap();
     assert!(1982.0 * rest.abs() <= 0.3 * 14.5 + 1e-9, "rest at {rest}");
@@ -252,7 +243,7 @@ fn check_recovers_truth(fit: &serde_json::Value) {
 
 #[test]
 fn fit_recovers_the_parameters_the_fixture_was_made_with() {
-    let out = scratch("fit").join("out");
+    let out = scratch_dir("plugin", "fit").join("out");
     run_ok(&[
         "fit".as_ref(),
         fixtures().join("fit.toml").as_os_str(),
@@ -260,8 +251,7 @@ fn fit_recovers_the_parameters_the_fixture_was_made_with() {
         out.as_os_str(),
         "--quiet".as_ref(),
     ]);
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value = read_report(&out);
     assert_eq!(report["command"], "fit");
     check_recovers_truth(&report);
     assert_eq!(report["records"].as_array().unwrap().len(), 3);
@@ -269,7 +259,7 @@ fn fit_recovers_the_parameters_the_fixture_was_made_with() {
 
 #[test]
 fn compare_ranks_the_plugin_model_above_coulomb() {
-    let out = scratch("compare").join("out");
+    let out = scratch_dir("plugin", "compare").join("out");
     run_ok(&[
         "compare".as_ref(),
         fixtures().join("compare.toml").as_os_str(),
@@ -279,8 +269,7 @@ fn compare_ranks_the_plugin_model_above_coulomb() {
         out.as_os_str(),
         "--quiet".as_ref(),
     ]);
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value = read_report(&out);
     assert_eq!(report["failed"].as_array().map(Vec::len), Some(0));
     let ranking = report["ranking"].as_array().unwrap();
     let order: Vec<&str> = ranking
