@@ -135,6 +135,32 @@ fn write_mm_per_s(record: &Record, dir: &Path, file: &str) {
     std::fs::write(dir.join(file), text).expect("write record");
 }
 
+/// A Coulomb release (mu 0.24) from `x0` on the FMM rig with the lab's defects after
+/// `rest` s of pre-trigger rest, `duration` s at `rate` Hz after the release, written by
+/// [`write_mm_per_s`] as `file` in `dir`; returns the record written (in SI units).
+fn lab_export(
+    dir: &Path,
+    file: &str,
+    x0: f64,
+    duration: f64,
+    rate: f64,
+    rest: f64,
+    seed: u64,
+) -> Record {
+    let truth = defective_record(
+        &Oscillator::fmm(),
+        &Coulomb { mu: 0.24 },
+        x0,
+        duration,
+        rate,
+        &defects(rest),
+        seed,
+    )
+    .expect("synthetic record");
+    write_mm_per_s(&truth, dir, file);
+    truth
+}
+
 fn defects(rest: f64) -> Defects {
     Defects {
         rest,
@@ -159,18 +185,8 @@ fn auto_release_finds_the_known_release_after_a_noisy_pre_trigger_rest() {
         .into_iter()
         .enumerate()
     {
-        let truth = defective_record(
-            &osc,
-            &Coulomb { mu: 0.24 },
-            x0,
-            1.0,
-            5000.0,
-            &defects(rest),
-            i as u64,
-        )
-        .expect("synthetic record");
         let file = format!("r{i}.csv");
-        write_mm_per_s(&truth, &dir, &file);
+        let truth = lab_export(&dir, &file, x0, 1.0, 5000.0, rest, i as u64);
         let entry = RecordSource {
             file: Some(file.clone()),
             x0: Some(x0),
@@ -201,17 +217,7 @@ fn auto_release_finds_the_known_release_after_a_noisy_pre_trigger_rest() {
 fn a_release_time_in_seconds_cuts_there_and_a_record_without_rest_is_kept_whole() {
     let osc = Oscillator::fmm();
     let dir = scratch("given");
-    let truth = defective_record(
-        &osc,
-        &Coulomb { mu: 0.24 },
-        0.014,
-        1.0,
-        1000.0,
-        &defects(0.3),
-        9,
-    )
-    .unwrap();
-    write_mm_per_s(&truth, &dir, "r.csv");
+    lab_export(&dir, "r.csv", 0.014, 1.0, 1000.0, 0.3, 9);
     let entry = RecordSource {
         file: Some("r.csv".into()),
         x0: Some(0.014),
@@ -236,17 +242,7 @@ fn a_release_time_in_seconds_cuts_there_and_a_record_without_rest_is_kept_whole(
         "{e}"
     );
     // No rest: "auto" keeps every sample.
-    let moving = defective_record(
-        &osc,
-        &Coulomb { mu: 0.24 },
-        0.014,
-        1.0,
-        1000.0,
-        &defects(0.0),
-        3,
-    )
-    .unwrap();
-    write_mm_per_s(&moving, &dir, "m.csv");
+    let moving = lab_export(&dir, "m.csv", 0.014, 1.0, 1000.0, 0.0, 3);
     let auto = RecordSource {
         file: Some("m.csv".into()),
         release: Some(Release::Auto),
@@ -284,17 +280,7 @@ fn record_defaults_give_keys_once_and_a_record_s_own_key_wins() {
 fn unit_mistakes_are_errors_naming_the_record_the_ratio_and_the_key() {
     let osc = Oscillator::fmm();
     let dir = scratch("units");
-    let truth = defective_record(
-        &osc,
-        &Coulomb { mu: 0.24 },
-        0.014,
-        2.0,
-        1000.0,
-        &defects(0.0),
-        5,
-    )
-    .unwrap();
-    write_mm_per_s(&truth, &dir, "x14.csv");
+    lab_export(&dir, "x14.csv", 0.014, 2.0, 1000.0, 0.0, 5);
     let entry = RecordSource {
         file: Some("x14.csv".into()),
         x0: Some(0.014),
