@@ -8,7 +8,8 @@ use serde::ser::SerializeMap;
 use serde::{Serialize, Serializer};
 
 /// A model comparison. report.json holds `ranking` (each fit as in the fit report),
-/// `failed`, `wall_time_s`, `command`, `config` and `files`.
+/// `verdict` (see [`crate::identify::ComparisonVerdict`]), `failed`, `wall_time_s`, `command`,
+/// `config` and `files`.
 #[derive(Debug, Clone)]
 pub struct CompareReport {
     /// The configuration the run came from, as the front end names it.
@@ -30,10 +31,11 @@ impl Serialize for CompareReport {
             .map(fit_json)
             .collect::<Result<Vec<_>, _>>()
             .map_err(serde::ser::Error::custom)?;
-        let mut map = serializer.serialize_map(Some(6))?;
+        let mut map = serializer.serialize_map(Some(7))?;
         map.serialize_entry("command", "compare")?;
         map.serialize_entry("config", &self.config)?;
         map.serialize_entry("ranking", &ranking)?;
+        map.serialize_entry("verdict", &c.verdict)?;
         map.serialize_entry("failed", &c.failed)?;
         map.serialize_entry("wall_time_s", &c.wall_time_s)?;
         map.serialize_entry("files", &self.files)?;
