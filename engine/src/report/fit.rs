@@ -281,7 +281,8 @@ impl Render for FitReport {
             sink.paragraph(
                 "Standard error of each fitted parameter from the data and from the stated \
                  standard deviation of each oscillator property (refits at +-1 sigma); the \
-                 total is their root sum of squares and gives the 95 % interval.",
+                 total is their root sum of squares and gives the 95 % interval (`-`: a \
+                 property known exactly).",
                 Role::Detail,
             );
             sink.table(&budget, Role::Detail);
