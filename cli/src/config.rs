@@ -6,6 +6,8 @@
 //! damping = 0.275               # N s/m
 //! stiffness = 1982.0            # N/m
 //! normal_force = 14.5           # N
+//! mass_std = 0.0049             # optional: one standard deviation of mass, damping,
+//! stiffness_std = 1.3           # stiffness or normal_force (the uncertainty budget)
 //!
 //! [model]                       # a registered friction model and its parameter values
 //! type = "coulomb"
@@ -39,8 +41,10 @@
 
 use crate::error::CliError;
 use frictionid_engine::record::RecordSource;
-use frictionid_engine::spec::{EnergySpec, FitSpec, ModelSpec, SimulationSpec, Spec, SpecError};
-use frictionid_engine::{Oscillator, Record};
+use frictionid_engine::spec::{
+    EnergySpec, FitSpec, ModelSpec, OscillatorSpec, SimulationSpec, Spec, SpecError,
+};
+use frictionid_engine::Record;
 use frictionid_models::build_toml;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -73,7 +77,7 @@ pub use frictionid_engine::record::source::ResolvedSource as RecordConfig;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawConfig {
-    oscillator: Option<Oscillator>,
+    oscillator: Option<OscillatorSpec>,
     model: Option<toml::Table>,
     fit: Option<FitSpec>,
     simulation: Option<SimulationSpec>,
@@ -245,9 +249,6 @@ impl Config {
         let oscillator = raw.oscillator.ok_or_else(|| {
             cfg_err("missing table [oscillator] (mass, damping, stiffness, normal_force)".into())
         })?;
-        oscillator
-            .validate()
-            .map_err(|e| cfg_err(format!("[oscillator]: {e}")))?;
         let model = raw.model.map(model_spec).transpose().map_err(cfg_err)?;
         let spec = Spec::new(
             oscillator,
@@ -319,6 +320,8 @@ impl Config {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use frictionid_engine::identify::PropertyUncertainty;
+    use frictionid_engine::Oscillator;
 
     const OSC: &str =
         "[oscillator]\nmass = 10.391\ndamping = 0.275\nstiffness = 1982.0\nnormal_force = 14.5\n";
@@ -384,6 +387,57 @@ mod tests {
             .to_string();
         assert!(
             e.contains("`integratr` in [simulation] (did you mean `integrator`?)"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn oscillator_standard_deviations_reach_the_fit_options() {
+        let c = Config::parse(
+            Path::new("c.toml"),
+            &format!("{OSC}mass_std = 0.0049\nstiffness_std = 1.3\nnormal_force_std = 0.145\n"),
+        )
+        .unwrap();
+        let expected = PropertyUncertainty {
+            mass: 0.0049,
+            damping: 0.0,
+            stiffness: 1.3,
+            normal_force: 0.145,
+        };
+        assert_eq!(c.spec.uncertainty, expected);
+        assert_eq!(c.spec.oscillator, Oscillator::fmm());
+        let hooks = frictionid_engine::spec::Hooks::default();
+        assert_eq!(c.spec.fit_options(&[], &hooks).uncertainty, expected);
+        // Absent: known exactly, as before.
+        let plain = parse("").unwrap();
+        assert!(!plain.spec.uncertainty.any());
+    }
+
+    #[test]
+    fn bad_oscillator_standard_deviations_are_one_line_errors_naming_the_key() {
+        for (line, key) in [
+            ("mass_std = -0.1", "mass_std"),
+            ("damping_std = nan", "damping_std"),
+            ("stiffness_std = inf", "stiffness_std"),
+            ("normal_force_std = -1e-3", "normal_force_std"),
+        ] {
+            let e = Config::parse(Path::new("c.toml"), &format!("{OSC}{line}\n"))
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with("c.toml:"), "{e}");
+            assert!(
+                e.contains(&format!(
+                    "[oscillator]: invalid oscillator: `{key}` must be finite and >= 0"
+                )),
+                "{e}"
+            );
+            assert!(!e.contains('\n'), "{e}");
+        }
+        let e = parse("mas_std = 0.1\n").unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "dir/c.toml:6:1: unknown key `mas_std` in [oscillator] (did you mean `mass_std`?)"
+            ),
             "{e}"
         );
     }

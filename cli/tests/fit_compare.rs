@@ -88,6 +88,52 @@ fn fit_recovers_the_fixture_truth_and_writes_every_output() {
     assert!(md.contains("| mu "), "{md}");
 }
 
+/// mu is proportional to 1/N (the records fix mu N), so a normal force known to 1 % gives
+/// mu's standard error a `normal_force` component of 1 % of mu; the total adds it in
+/// quadrature to the data's part and gives the interval; report.md names the dominant source.
+#[test]
+fn a_normal_force_uncertainty_in_the_config_reaches_every_fitted_parameter() {
+    let out = scratch_dir("fc", "budget");
+    let mut config = std::fs::read_to_string(fixtures_dir().join("fmm-fit.toml")).unwrap();
+    config = config.replace(
+        "normal_force = 14.5",
+        "normal_force = 14.5\nnormal_force_std = 0.145",
+    );
+    for x in ["x10mm.csv", "x14mm.csv", "x22mm.csv"] {
+        let path = fixtures_dir().join(x).display().to_string();
+        config = config.replace(&format!("\"{x}\""), &format!("{path:?}"));
+    }
+    let cfg = out.join("budget.toml");
+    std::fs::write(&cfg, config).unwrap();
+    let (o, r) = run_json(&["fit", cfg.to_str().unwrap()], &out.join("out"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let p = &r["parameters"][0];
+    assert_eq!(p["name"], "mu");
+    let c = &p["std_error_components"];
+    let part = |k: &str| c[k].as_f64().unwrap_or_else(|| panic!("{k}: {c}"));
+    let (data, normal_force) = (part("data"), part("normal_force"));
+    let ratio = normal_force / (0.01 * TRUTH_MU);
+    eprintln!("normal_force component / (0.01 mu) = {ratio}");
+    assert!((ratio - 1.0).abs() < 0.05, "{c}");
+    for k in ["mass", "damping", "stiffness"] {
+        assert_eq!(part(k), 0.0, "{k}");
+    }
+    let total = p["std_error"].as_f64().unwrap();
+    assert!((total - data.hypot(normal_force)).abs() < 1e-9 * total);
+    let mu = p["value"].as_f64().unwrap();
+    let ci = p["ci95"].as_array().unwrap();
+    let half = (ci[1].as_f64().unwrap() - ci[0].as_f64().unwrap()) / 2.0;
+    assert!(
+        (half / total - 1.96).abs() < 1e-2,
+        "{ci:?} for {mu} +- {total}"
+    );
+    let md = std::fs::read_to_string(out.join("out/report.md")).unwrap();
+    assert!(md.contains("dominant source"), "{md}");
+    assert!(md.contains("Uncertainty budget"), "{md}");
+    let row = md.lines().find(|l| l.starts_with("| mu ")).unwrap();
+    assert!(row.trim_end().ends_with("| normal_force |"), "{row}");
+}
+
 #[test]
 fn compare_ranks_the_classical_models() {
     let out = scratch_dir("fc", "compare");
@@ -116,6 +162,24 @@ fn compare_ranks_the_classical_models() {
     let coulomb = ranking.iter().find(|f| f["model"] == "coulomb").unwrap();
     let mu = coulomb["parameters"][0]["value"].as_f64().unwrap();
     assert!((mu - TRUTH_MU).abs() / TRUTH_MU < 1e-3);
+    // Akaike weights exp(-delta/2), normalised: they sum to 1.
+    let best = aics[0];
+    let mut sum = 0.0;
+    for (f, aic) in ranking.iter().zip(&aics) {
+        let delta = f["delta_aic"].as_f64().unwrap();
+        assert!((delta - (aic - best)).abs() < 1e-9, "{f}");
+        sum += f["akaike_weight"].as_f64().unwrap();
+    }
+    assert!((sum - 1.0).abs() < 1e-9, "weights sum to {sum}");
+    // The truth is Coulomb: the verdict names it, or says that the top models cannot be told
+    // apart on this data (the nested viscous_coulomb law fits the same records as well).
+    let verdict = &r["verdict"];
+    let simplest = verdict["simplest"].as_str().unwrap();
+    let tied = verdict["indistinguishable"].as_array().unwrap();
+    assert!(
+        simplest == "coulomb" || (tied.len() > 1 && tied.iter().any(|m| m == "coulomb")),
+        "{verdict}"
+    );
     assert!(out.join("steady_state_curves.svg").is_file());
     assert!(out.join("best_x10mm_velocity_fit.svg").is_file());
 }

@@ -9,7 +9,7 @@ use crate::energy::{
     EnergyOptions,
 };
 use crate::error::EngineError;
-use crate::identify::{compare, fit, FitOptions, FitResult};
+use crate::identify::{compare, fit, FitOptions, FitResult, PropertyUncertainty};
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use crate::report::{CompareReport, EnergyRecord, EnergyReport, FitReport, SimulateReport};
@@ -196,7 +196,11 @@ pub fn reference_model(
         return Ok(None);
     }
     let coulomb = Coulomb::default();
-    let opts: FitOptions = spec.fit_options(&[], hooks);
+    // Only the fitted values are used: no uncertainty budget.
+    let opts = FitOptions {
+        uncertainty: PropertyUncertainty::default(),
+        ..spec.fit_options(&[], hooks)
+    };
     let fitted: FitResult =
         fit(&spec.oscillator, &coulomb, records, &opts).map_err(JobError::ReferenceFit)?;
     Ok(Some(fitted.fitted_model))

@@ -12,7 +12,7 @@
 
 use crate::data::MAX_SAMPLES;
 use crate::energy::{Differentiator, EnergyOptions};
-use crate::identify::{FitOptions, OscillatorParam, ProgressFn};
+use crate::identify::{FitOptions, OscillatorParam, ProgressFn, PropertyUncertainty};
 use crate::oscillator::Oscillator;
 use crate::simulate::{Integrator, SimOptions};
 use frictionid_models::suggest::did_you_mean;
@@ -78,6 +78,9 @@ pub enum SpecError {
         /// Every registered name, comma-separated.
         known: String,
     },
+    /// An oscillator property or its standard deviation out of range.
+    #[error("[oscillator]: {0}")]
+    Oscillator(String),
     /// A model error.
     #[error(transparent)]
     Model(#[from] ModelError),
@@ -110,11 +113,103 @@ impl std::fmt::Debug for Hooks {
     }
 }
 
+/// `[oscillator]`: the oscillator's properties and, optionally, one standard deviation of
+/// each (`mass_std`, `damping_std`, `stiffness_std`, `normal_force_std`; SI units, 0 when
+/// absent: known exactly), which the uncertainty budget propagates into every fitted
+/// parameter. Deserialized through [`OscillatorInput`], which checks every value.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "OscillatorInput", into = "OscillatorInput")]
+pub struct OscillatorSpec {
+    /// The nominal properties.
+    pub oscillator: Oscillator,
+    /// Their standard deviations.
+    pub uncertainty: PropertyUncertainty,
+}
+
+/// `[oscillator]` as written; [`OscillatorSpec`] is built from it.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OscillatorInput {
+    mass: f64,
+    damping: f64,
+    stiffness: f64,
+    normal_force: f64,
+    #[serde(default)]
+    mass_std: f64,
+    #[serde(default)]
+    damping_std: f64,
+    #[serde(default)]
+    stiffness_std: f64,
+    #[serde(default)]
+    normal_force_std: f64,
+}
+
+impl TryFrom<OscillatorInput> for OscillatorSpec {
+    type Error = SpecError;
+
+    fn try_from(o: OscillatorInput) -> Result<Self, SpecError> {
+        let spec = Self {
+            oscillator: Oscillator {
+                mass: o.mass,
+                damping: o.damping,
+                stiffness: o.stiffness,
+                normal_force: o.normal_force,
+            },
+            uncertainty: PropertyUncertainty {
+                mass: o.mass_std,
+                damping: o.damping_std,
+                stiffness: o.stiffness_std,
+                normal_force: o.normal_force_std,
+            },
+        };
+        spec.validate()?;
+        Ok(spec)
+    }
+}
+
+impl From<OscillatorSpec> for OscillatorInput {
+    fn from(o: OscillatorSpec) -> Self {
+        let (p, u) = (o.oscillator, o.uncertainty);
+        Self {
+            mass: p.mass,
+            damping: p.damping,
+            stiffness: p.stiffness,
+            normal_force: p.normal_force,
+            mass_std: u.mass,
+            damping_std: u.damping,
+            stiffness_std: u.stiffness,
+            normal_force_std: u.normal_force,
+        }
+    }
+}
+
+impl From<Oscillator> for OscillatorSpec {
+    /// Properties known exactly.
+    fn from(oscillator: Oscillator) -> Self {
+        Self {
+            oscillator,
+            uncertainty: PropertyUncertainty::default(),
+        }
+    }
+}
+
+impl OscillatorSpec {
+    /// Checks the properties and their standard deviations.
+    pub fn validate(&self) -> Result<(), SpecError> {
+        self.oscillator
+            .validate()
+            .and_then(|()| self.uncertainty.validate())
+            .map_err(|e| SpecError::Oscillator(e.to_string()))
+    }
+}
+
 /// Everything but the records: oscillator, model, fit, simulation and energy settings.
 #[derive(Debug, Clone, Serialize)]
 pub struct Spec {
     /// The oscillator.
     pub oscillator: Oscillator,
+    /// One standard deviation of each oscillator property (the uncertainty budget).
+    pub uncertainty: PropertyUncertainty,
     /// The friction model, if given.
     pub model: Option<ModelSpec>,
     /// Fit settings (defaults when absent).
@@ -173,17 +268,20 @@ fn parameter_names(model: &dyn FrictionModel) -> Vec<String> {
 impl Spec {
     /// A spec with `oscillator`, `model` and the other settings, checked against each other.
     pub fn new(
-        oscillator: Oscillator,
+        oscillator: impl Into<OscillatorSpec>,
         model: Option<ModelSpec>,
         fit: FitSpec,
         simulation: Option<SimulationSpec>,
         energy: EnergySpec,
     ) -> Result<Self, SpecError> {
+        let oscillator: OscillatorSpec = oscillator.into();
+        oscillator.validate()?;
         if let Some(m) = &model {
             fit.check_against(m.model.as_ref())?;
         }
         Ok(Self {
-            oscillator,
+            oscillator: oscillator.oscillator,
+            uncertainty: oscillator.uncertainty,
             model,
             fit,
             simulation,
@@ -227,6 +325,7 @@ impl Spec {
             velocity_offset: extras.velocity_offset,
             time_shift: extras.time_shift,
             x0: extras.x0,
+            uncertainty: self.uncertainty,
             multistart: extras.multistart,
             max_iterations: self.fit.max_iterations.unwrap_or(defaults.max_iterations),
             tolerance: self.fit.tolerance.or(defaults.tolerance),

@@ -3,7 +3,9 @@
 The functions take the configuration's tables as dicts (``oscillator``, ``model``, ``fit``,
 ``energy``) and records as dicts of arrays, call the same engine as the ``frictionid``
 command line, and return the same structure as its report.json, with numpy arrays for the
-series. Units are SI (m, s, kg, N).
+series. Units are SI (m, s, kg, N). The ``oscillator`` dict may give one standard deviation
+of each property (``mass_std``, ``damping_std``, ``stiffness_std``, ``normal_force_std``):
+every fitted parameter then reports ``std_error_components`` and a total ``std_error``.
 
 - ``models()``: every registered model (``frictionid models --json``).
 - ``simulate(oscillator, model, x0, t, v0=0.0, options=None)``: one free vibration.

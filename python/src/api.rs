@@ -133,7 +133,7 @@ pub fn simulate<'py>(
     v0: f64,
     options: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let osc = inputs::oscillator(oscillator)?;
+    let osc = inputs::oscillator(oscillator)?.oscillator;
     let model = inputs::model(model)?.model;
     let times = TimeBase::new(to_f64_vec(t, "t")?).map_err(|e| value_error(format!("t: {e}")))?;
     let (integrator, z0) = simulate_options(options)?;

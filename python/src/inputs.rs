@@ -4,8 +4,8 @@
 use crate::convert::{to_f64_vec, to_json};
 use crate::errors::value_error;
 use frictionid_engine::record::{Channel, NormalForce, TimeBase};
-use frictionid_engine::spec::{EnergySpec, FitSpec, ModelSpec};
-use frictionid_engine::{Oscillator, Record, Spec};
+use frictionid_engine::spec::{EnergySpec, FitSpec, ModelSpec, OscillatorSpec};
+use frictionid_engine::{Record, Spec};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use serde::de::DeserializeOwned;
@@ -21,10 +21,19 @@ fn table<T: DeserializeOwned + Default>(obj: Option<&Bound<'_, PyAny>>, name: &s
     }
 }
 
-/// `[oscillator]`: mass, damping, stiffness, normal_force.
-pub fn oscillator(obj: &Bound<'_, PyAny>) -> PyResult<Oscillator> {
+/// `[oscillator]`: mass, damping, stiffness, normal_force and, optionally, their standard
+/// deviations `mass_std`, `damping_std`, `stiffness_std`, `normal_force_std`.
+pub fn oscillator(obj: &Bound<'_, PyAny>) -> PyResult<OscillatorSpec> {
     let json = to_json(obj, "oscillator")?;
-    serde_json::from_value(json).map_err(|e| value_error(format!("[oscillator]: {e}")))
+    serde_json::from_value(json).map_err(|e| {
+        let msg = e.to_string();
+        // Range errors already name the table; serde's own (unknown or missing keys) do not.
+        value_error(if msg.starts_with("[oscillator]") {
+            msg
+        } else {
+            format!("[oscillator]: {msg}")
+        })
+    })
 }
 
 /// A model: a `[model]` table (`{"type": "lugre", "sigma0": 2e5}`) or just its name.
@@ -48,7 +57,7 @@ pub fn energy_spec(obj: Option<&Bound<'_, PyAny>>) -> PyResult<EnergySpec> {
 
 /// The checked spec (the `[fit]` names are checked against the model).
 pub fn spec(
-    oscillator: Oscillator,
+    oscillator: OscillatorSpec,
     model: Option<ModelSpec>,
     fit: FitSpec,
     energy: EnergySpec,

@@ -54,7 +54,7 @@ impl PropertyUncertainty {
             .iter()
             .find(|(_, s)| !(s.is_finite() && *s >= 0.0))
         {
-            Some((p, s)) => Err(EngineError::InvalidInput(format!(
+            Some((p, s)) => Err(EngineError::InvalidOscillator(format!(
                 "`{}_std` must be finite and >= 0, got {s}",
                 p.name()
             ))),

@@ -249,8 +249,9 @@ impl VelocityResponse {
     }
 
     /// The simulated velocity of `record` at its time stamps, released from the nuisance
-    /// values' x0 `shift` seconds after its first time stamp (samples before the release see
-    /// the release velocity); no offset.
+    /// values' x0 `shift` seconds after its release instant (the one found or given when the
+    /// record was cut at its release, which may lie between samples; else its first time
+    /// stamp). Samples before the release see the release velocity; no offset.
     pub fn simulate(
         &self,
         at: &Evaluation<'_>,
@@ -258,7 +259,7 @@ impl VelocityResponse {
         nuisance: &NuisanceValues,
     ) -> Result<Vec<f64>, EngineError> {
         let t0 = record.time().first().copied().unwrap_or(0.0);
-        let release = t0 + nuisance.shift;
+        let release = record.release_time.unwrap_or(t0) + nuisance.shift;
         // Sample times on the simulation clock; samples before the release see the initial state.
         let first = record.time().partition_point(|&t| t < release);
         let times: Vec<f64> = record.time()[first..]

@@ -8,7 +8,8 @@ use serde::ser::SerializeMap;
 use serde::{Serialize, Serializer};
 
 /// A model comparison. report.json holds `ranking` (each fit as in the fit report),
-/// `failed`, `wall_time_s`, `command`, `config` and `files`.
+/// `verdict` (see [`crate::identify::ComparisonVerdict`]), `failed`, `wall_time_s`, `command`,
+/// `config` and `files`.
 #[derive(Debug, Clone)]
 pub struct CompareReport {
     /// The configuration the run came from, as the front end names it.

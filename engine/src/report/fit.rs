@@ -5,7 +5,7 @@ use super::format::{
     serialized_name,
 };
 use super::{render_files, Render, Role, Sink, Status, Table, Verdict};
-use crate::identify::FitResult;
+use crate::identify::{FitResult, FittedParam};
 use serde::{Serialize, Serializer};
 
 /// A fit and where it came from. report.json is the identifier's result (the fitted model's
@@ -46,41 +46,106 @@ impl Serialize for FitReport {
     }
 }
 
-/// The parameter table of a fit.
+/// The parameter table of a fit; with an uncertainty budget, a last column names the source
+/// that dominates each parameter's standard error.
 pub fn parameter_table(fit: &FitResult) -> Table {
+    let budget = has_budget(fit);
     let rows = fit
         .parameters
         .iter()
         .map(|p| {
-            vec![
+            let mut row = vec![
                 p.name.clone(),
                 fmt_estimate(p.value, p.std_error),
                 fmt_std_error(p.std_error),
-                p.ci95
-                    .map(|[a, b]| {
-                        format!(
-                            "[{}, {}]",
-                            fmt_to_error(a, p.std_error),
-                            fmt_to_error(b, p.std_error)
-                        )
-                    })
-                    .unwrap_or_else(|| "-".into()),
+                fmt_interval(p),
                 p.unit.clone(),
                 if p.free { "fitted" } else { "fixed" }.into(),
+            ];
+            if budget {
+                row.push(dominant_source(p));
+            }
+            row
+        })
+        .collect();
+    let mut headers = vec![
+        "parameter",
+        "value",
+        "std error",
+        "95 % CI",
+        "unit",
+        "status",
+    ];
+    if budget {
+        headers.push("dominant source");
+    }
+    Table::new(&headers, rows)
+}
+
+/// `[lo, hi]` to the decimal the standard error supports, or `-`.
+fn fmt_interval(p: &FittedParam) -> String {
+    p.ci95
+        .map(|[a, b]| {
+            format!(
+                "[{}, {}]",
+                fmt_to_error(a, p.std_error),
+                fmt_to_error(b, p.std_error)
+            )
+        })
+        .unwrap_or_else(|| "-".into())
+}
+
+/// Whether any parameter carries the parts of its standard error.
+fn has_budget(fit: &FitResult) -> bool {
+    fit.parameters
+        .iter()
+        .any(|p| p.std_error_components.is_some())
+}
+
+/// The source with the largest part of `p`'s standard error, or `-`.
+fn dominant_source(p: &FittedParam) -> String {
+    p.std_error_components
+        .map(|c| c.dominant().to_string())
+        .unwrap_or_else(|| "-".into())
+}
+
+/// The uncertainty budget: per fitted parameter the part of its standard error from the data
+/// and from each oscillator property, and their total; `None` without a budget.
+pub fn budget_table(fit: &FitResult) -> Option<Table> {
+    if !has_budget(fit) {
+        return None;
+    }
+    let rows = fit
+        .parameters
+        .iter()
+        .filter_map(|p| p.std_error_components.map(|c| (p, c)))
+        .map(|(p, c)| {
+            let part = |x: f64| fmt_std_error(Some(x).filter(|x| *x > 0.0));
+            vec![
+                p.name.clone(),
+                fmt_std_error(c.data),
+                part(c.mass),
+                part(c.damping),
+                part(c.stiffness),
+                part(c.normal_force),
+                fmt_std_error(p.std_error),
+                c.dominant().to_string(),
             ]
         })
         .collect();
-    Table::new(
+    Some(Table::new(
         &[
             "parameter",
-            "value",
-            "std error",
-            "95 % CI",
-            "unit",
-            "status",
+            "data",
+            "mass",
+            "damping",
+            "stiffness",
+            "normal_force",
+            "total",
+            "dominant",
         ],
         rows,
-    )
+    ))
 }
 
 /// A fit's verdict as one sentence, and its status (the worst of convergence and the
@@ -270,6 +335,17 @@ impl Render for FitReport {
         sink.table(&diagnostics_table(f), Role::Detail);
         sink.heading(2, "Parameters", Role::Detail);
         sink.table(&parameter_table(f), Role::Summary);
+        if let Some(budget) = budget_table(f) {
+            sink.heading(2, "Uncertainty budget", Role::Detail);
+            sink.paragraph(
+                "Standard error of each fitted parameter from the data and from the stated \
+                 standard deviation of each oscillator property (refits at +-1 sigma); the \
+                 total is their root sum of squares and gives the 95 % interval (`-`: a \
+                 property known exactly).",
+                Role::Detail,
+            );
+            sink.table(&budget, Role::Detail);
+        }
         sink.heading(2, "Oscillator", Role::Detail);
         sink.table(&oscillator_table(f), Role::Detail);
         sink.heading(2, "Records", Role::Detail);
