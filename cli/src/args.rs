@@ -9,7 +9,10 @@ use std::path::{Path, PathBuf};
     name = "frictionid",
     version,
     about,
-    after_help = "Example:\n  frictionid compare fixtures/fmm-compare.toml --out results/"
+    after_help = "Example:\n  frictionid compare fixtures/fmm-compare.toml --out results/\n\n\
+                  Exit codes: 0 success (warnings allowed), 1 error (one line on stderr, no report),\n\
+                  2 a fit (or compare's best model) did not converge, 3 a fit converged but one of\n\
+                  its diagnostics failed; with 2 and 3 the report is written and says why."
 )]
 pub struct Cli {
     /// The subcommand.
@@ -20,7 +23,7 @@ pub struct Cli {
 /// Output options shared by the commands that write a report.
 #[derive(Debug, Clone, Args)]
 pub struct OutputArgs {
-    /// Output directory for report.json, report.md, plots and data files
+    /// Output directory for report.json, report.md, report.html, plots and data files
     /// [default: frictionid-out/<config file stem>/<command>/].
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -68,7 +71,7 @@ pub enum Command {
     },
     /// Simulate a free vibration from the config's oscillator, model and simulation tables.
     #[command(
-        after_help = "Example:\n  frictionid simulate fixtures/paper-140mm.toml --out sim-140mm/\n\nWrites trajectory.csv, report.json, report.md and SVG plots; with `noise` in\n[simulation] also record.csv, a noisy velocity record usable in [[records]]."
+        after_help = "Example:\n  frictionid simulate fixtures/paper-140mm.toml --out sim-140mm/\n\nWrites trajectory.csv, report.json, report.md, report.html and SVG plots; with `noise` in\n[simulation] also record.csv, a noisy velocity record usable in [[records]]."
     )]
     Simulate {
         /// The TOML configuration file.
@@ -77,7 +80,11 @@ pub enum Command {
         output: OutputArgs,
     },
     /// Fit the config's model to its records.
-    #[command(after_help = "Example:\n  frictionid fit fixtures/fmm-fit.toml --out fit/")]
+    #[command(
+        after_help = "Example:\n  frictionid fit fixtures/fmm-fit.toml --out fit/\n\n\
+                      Exit codes: 0 converged (warnings allowed), 1 error, 2 not converged,\n\
+                      3 a diagnostic failed (the report says which)."
+    )]
     Fit {
         /// The TOML configuration file.
         config: PathBuf,
