@@ -121,6 +121,28 @@ impl StribeckLevels {
     }
 }
 
+/// Writes `set_levels(&mut self, &StribeckLevels)` for a model with the Stribeck-curve fields
+/// `mu_c`, `mu_s`, `v_s`, `delta` and `viscous`: it takes the levels mu_c, mu_s, v_s and
+/// delta (when given) and viscous.
+macro_rules! stribeck_levels_setter {
+    ($model:ty) => {
+        impl $model {
+            fn set_levels(&mut self, levels: &$crate::start::StribeckLevels) {
+                let Self {
+                    mu_c,
+                    mu_s,
+                    v_s,
+                    delta,
+                    viscous,
+                    ..
+                } = self;
+                levels.write_into([mu_c, mu_s, v_s, delta, viscous]);
+            }
+        }
+    };
+}
+pub(crate) use stribeck_levels_setter;
+
 #[cfg(test)]
 mod tests {
     use super::*;

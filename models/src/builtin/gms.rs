@@ -184,6 +184,8 @@ fn default_stiffness(i: usize) -> f64 {
     FIRST_STIFFNESS / 3f64.powi(i32::try_from(i).unwrap_or(i32::MAX))
 }
 
+crate::start::stribeck_levels_setter!(Gms);
+
 impl Gms {
     /// The default model with `n` elements (default stiffness, equal weights, no damping).
     pub fn with_elements(n: usize) -> Self {
@@ -208,19 +210,6 @@ impl Gms {
     /// The metadata of the six shared parameters (the last six of `param_info`).
     pub fn shared_param_info() -> Vec<ParamInfo> {
         crate::params::infos(&SHARED_PARAMS)
-    }
-
-    /// Takes the levels mu_c, mu_s, v_s and delta (when given) and viscous.
-    fn set_levels(&mut self, levels: &StribeckLevels) {
-        let Self {
-            mu_c,
-            mu_s,
-            v_s,
-            delta,
-            viscous,
-            ..
-        } = self;
-        levels.write_into([mu_c, mu_s, v_s, delta, viscous]);
     }
 
     /// Scales the element stiffnesses, keeping their ratios, to the total `target` [N/m].

@@ -31,20 +31,9 @@ crate::declare_params! {
     }
 }
 
-impl Stribeck {
-    /// Takes the levels mu_c, mu_s, v_s and delta (when given) and viscous.
-    fn set_levels(&mut self, levels: &StribeckLevels) {
-        let Self {
-            mu_c,
-            mu_s,
-            v_s,
-            delta,
-            viscous,
-            ..
-        } = self;
-        levels.write_into([mu_c, mu_s, v_s, delta, viscous]);
-    }
+crate::start::stribeck_levels_setter!(Stribeck);
 
+impl Stribeck {
     /// The velocity-dependent coefficient mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta).
     pub fn coefficient(&self, v: f64) -> f64 {
         self.mu_c + (self.mu_s - self.mu_c) * (-(v / self.v_s).abs().powf(self.delta)).exp()
