@@ -65,26 +65,13 @@ impl Sink for TerminalWriter {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    struct Two;
-    impl Render for Two {
-        fn render(&self, sink: &mut dyn Sink) {
-            sink.title("hidden title");
-            sink.paragraph("detail only", Role::Detail);
-            sink.table(
-                &Table::new(&["name", "value"], vec![vec!["mu".into(), "0.2".into()]]),
-                Role::Summary,
-            );
-            sink.paragraph("best: coulomb", Role::Brief);
-            sink.files(&["report.json".into()]);
-        }
-    }
+    use frictionid_engine::report::SampleReport;
 
     #[test]
     fn terminal_shows_summary_blocks_only() {
         assert_eq!(
-            TerminalWriter::render(&Two),
-            "name  value\n----  -----\nmu    0.2\n\nbest: coulomb\n"
+            TerminalWriter::render(&SampleReport),
+            "best: coulomb\ncheck           a|b\n--------------  ----\nenergy_balance  warn\n\n"
         );
     }
 }

@@ -249,36 +249,19 @@ footer { margin-top: 3rem; color: var(--muted); font-size: .85rem; }
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    struct Tiny;
-    impl Render for Tiny {
-        fn render(&self, sink: &mut dyn Sink) {
-            sink.title("frictionid tiny");
-            sink.paragraph("Config: `a<b>.toml` & more.", Role::Detail);
-            sink.verdict(Status::Fail, "the fit did not converge");
-            sink.paragraph("terminal only", Role::Brief);
-            sink.table(
-                &Table::new(
-                    &["check", "status"],
-                    vec![vec!["energy_balance".into(), "warn".into()]],
-                ),
-                Role::Summary,
-            );
-            sink.files(&["p.svg".into(), "missing.svg".into(), "report.json".into()]);
-        }
-    }
+    use crate::report::SampleReport;
 
     fn page_of(config: Option<(&str, &str)>, f: impl Fn(&str) -> Option<String>) -> String {
         let page = Page { plot: &f, config };
-        HtmlWriter::render(&Tiny, &page)
+        HtmlWriter::render(&SampleReport, &page)
     }
 
     #[test]
     fn escapes_text_and_keeps_inline_code() {
         let html = page_of(None, |_| None);
         assert!(html.contains("<p>Config: <code>a&lt;b&gt;.toml</code> &amp; more.</p>"));
-        assert!(!html.contains("terminal only"));
-        assert!(html.contains("<title>frictionid tiny</title>"));
+        assert!(!html.contains("best: coulomb"));
+        assert!(html.contains("<title>frictionid sample</title>"));
     }
 
     #[test]

@@ -88,26 +88,16 @@ impl Sink for MarkdownWriter {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    struct Tiny;
-    impl Render for Tiny {
-        fn render(&self, sink: &mut dyn Sink) {
-            sink.title("frictionid tiny");
-            sink.paragraph("Config: `c.toml`.", Role::Summary);
-            sink.paragraph("terminal only", Role::Brief);
-            sink.table(
-                &Table::new(&["name", "a|b"], vec![vec!["mu".into(), "0.2".into()]]),
-                Role::Summary,
-            );
-            sink.files(&["report.json".into()]);
-        }
-    }
+    use crate::report::SampleReport;
 
     #[test]
-    fn markdown_has_title_tables_and_files() {
+    fn markdown_has_title_verdict_tables_and_files() {
         assert_eq!(
-            MarkdownWriter::render(&Tiny),
-            "# frictionid tiny\n\nConfig: `c.toml`.\n\n| name | a\\|b |\n|---|---|\n| mu | 0.2 |\n\n## Files\n\n- `report.json`\n"
+            MarkdownWriter::render(&SampleReport),
+            "# frictionid sample\n\nConfig: `a<b>.toml` & more.\n\n\
+             Verdict: the fit did not converge\n\n\
+             | check | a\\|b |\n|---|---|\n| energy_balance | warn |\n\n\
+             ## Files\n\n- `p.svg`\n- `missing.svg`\n- `report.json`\n"
         );
     }
 }

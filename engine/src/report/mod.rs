@@ -92,6 +92,30 @@ pub use crate::identify::outcome::Status;
 /// without a fit is `Ok`); decides the exit code of a front end.
 pub use crate::identify::Verdict;
 
+/// A report with one block of each kind, for the tests of writers (this crate's, the CLI's
+/// terminal writer, a plugin's own): a title, a detail paragraph with inline code and
+/// characters markup languages escape, a failed verdict, a terminal-only line, a summary
+/// table whose second cell is a check status, and three files (two plots, one data file).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SampleReport;
+
+impl Render for SampleReport {
+    fn render(&self, sink: &mut dyn Sink) {
+        sink.title("frictionid sample");
+        sink.paragraph("Config: `a<b>.toml` & more.", Role::Detail);
+        sink.verdict(Status::Fail, "the fit did not converge");
+        sink.paragraph("best: coulomb", Role::Brief);
+        sink.table(
+            &Table::new(
+                &["check", "a|b"],
+                vec![vec!["energy_balance".into(), "warn".into()]],
+            ),
+            Role::Summary,
+        );
+        sink.files(&["p.svg".into(), "missing.svg".into(), "report.json".into()]);
+    }
+}
+
 /// Renders a "## Files" section (shared by the report values).
 fn render_files(sink: &mut dyn Sink, files: &[String]) {
     if !files.is_empty() {
