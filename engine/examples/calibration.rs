@@ -3,7 +3,8 @@
 //! the truth, and how does the spread of the estimates compare with the reported standard
 //! errors?
 //!
-//! Each realisation draws the rig's true mass, stiffness and normal force from their stated
+//! First with the properties known exactly (only the noise varies), then with the budget:
+//! each realisation draws the rig's true mass, stiffness and normal force from their stated
 //! uncertainties (the paper's 0.0049 kg and 1.3 N/m; 1 % of N), simulates the three releases
 //! with those drawn values and fresh velocity noise, and fits mu with the *nominal* values and
 //! the standard deviations stated (`FitOptions::uncertainty`), as a user of the rig would.
@@ -87,13 +88,22 @@ fn mean_sd(x: &[f64]) -> (f64, f64) {
     (mean, sd)
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let n: usize = match std::env::args().nth(1) {
-        Some(s) => s.parse()?,
-        None => 200,
-    };
+/// What one calibration run found.
+struct Calibration {
+    coverage: f64,
+    mean: f64,
+    spread: f64,
+    mean_std_error: f64,
+}
+
+/// `n` realisations with the rig's properties drawn with standard deviations `sigma` (all 0:
+/// the nominal rig, only the noise varies), each fitted with the nominal values and `sigma`
+/// stated.
+fn calibrate(
+    n: usize,
+    sigma: PropertyUncertainty,
+) -> Result<Calibration, Box<dyn std::error::Error>> {
     let nominal = Oscillator::fmm();
-    let sigma = stated(&nominal);
     let opts = FitOptions {
         uncertainty: sigma,
         ..FitOptions::default()
@@ -117,20 +127,47 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         estimates.push(p.value);
         errors.push(p.std_error.ok_or("no standard error")?);
     }
-    let (mean, sd) = mean_sd(&estimates);
-    let mean_se = errors.iter().sum::<f64>() / n as f64;
-    println!("realisations:                     {n}");
+    let (mean, spread) = mean_sd(&estimates);
+    Ok(Calibration {
+        coverage: 100.0 * covered as f64 / n as f64,
+        mean,
+        spread,
+        mean_std_error: errors.iter().sum::<f64>() / n as f64,
+    })
+}
+
+fn print(title: &str, c: &Calibration) {
+    println!("{title}");
+    println!("  total 95 % interval coverage:   {:.1} %", c.coverage);
     println!(
-        "stated std: mass {} kg, stiffness {} N/m, normal force {} N",
-        sigma.mass, sigma.stiffness, sigma.normal_force
+        "  mean estimate of mu:            {:.6} (truth {MU})",
+        c.mean
     );
+    println!("  spread (sd) of estimates:       {:.3e}", c.spread);
+    println!("  mean reported total std error:  {:.3e}", c.mean_std_error);
     println!(
-        "total 95 % interval coverage:     {:.1} %",
-        100.0 * covered as f64 / n as f64
+        "  spread / mean std error:        {:.3}",
+        c.spread / c.mean_std_error
     );
-    println!("mean estimate of mu:              {mean:.6} (truth {MU})");
-    println!("spread (sd) of estimates:         {sd:.3e}");
-    println!("mean reported total std error:    {mean_se:.3e}");
-    println!("spread / mean std error:          {:.3}", sd / mean_se);
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let n: usize = match std::env::args().nth(1) {
+        Some(s) => s.parse()?,
+        None => 200,
+    };
+    let sigma = stated(&Oscillator::fmm());
+    println!("realisations: {n}, velocity noise {NOISE} m/s");
+    print(
+        "properties known exactly (noise only):",
+        &calibrate(n, PropertyUncertainty::default())?,
+    );
+    print(
+        &format!(
+            "m, k, N drawn per realisation (std {} kg, {} N/m, {} N) and stated:",
+            sigma.mass, sigma.stiffness, sigma.normal_force
+        ),
+        &calibrate(n, sigma)?,
+    );
     Ok(())
 }
