@@ -12,6 +12,7 @@
 
 use crate::data::MAX_SAMPLES;
 use crate::energy::{Differentiator, EnergyOptions};
+use crate::identify::setup::non_model_bound_keys;
 use crate::identify::{FitOptions, OscillatorParam, ProgressFn, PropertyUncertainty};
 use crate::oscillator::Oscillator;
 use crate::simulate::{Integrator, SimOptions};
@@ -413,8 +414,9 @@ pub struct FitExtras {
 }
 
 impl FitSpec {
-    /// Checks that `free` and `bounds` name parameters of `model` and that each bound is an
-    /// ordered pair. The error names the key and suggests the nearest name.
+    /// Checks that `free` names parameters of `model`, `bounds` parameters of `model` or the
+    /// oscillator and nuisance keys (`mass`, `shift`, `x0`, `offset`, ...), and that each
+    /// bound is an ordered pair. The error names the key and suggests the nearest name.
     pub fn check_against(&self, model: &dyn FrictionModel) -> Result<(), SpecError> {
         let known = parameter_names(model);
         let check = |name: &str, key: &str| -> Result<(), SpecError> {
@@ -432,8 +434,11 @@ impl FitSpec {
         for name in self.free.iter().flatten() {
             check(name, "free")?;
         }
+        let other = non_model_bound_keys();
         for (name, [lower, upper]) in &self.bounds {
-            check(name, "bounds")?;
+            if !other.contains(&name.as_str()) {
+                check(name, "bounds")?;
+            }
             if lower.is_nan() || upper.is_nan() || lower >= upper {
                 return Err(SpecError::BadBounds {
                     name: name.clone(),
@@ -814,6 +819,26 @@ mod tests {
         };
         let e = fit.check_against(&coulomb).unwrap_err().to_string();
         assert!(e.contains("not an interval"), "{e}");
+        // Bounds of the nuisance parameters and the oscillator are not model parameters.
+        let fit = FitSpec {
+            bounds: [
+                ("shift".to_string(), [-0.5, 0.5]),
+                ("x0".to_string(), [0.009, 0.011]),
+                ("offset".to_string(), [-1e-3, 1e-3]),
+            ]
+            .into(),
+            ..FitSpec::default()
+        };
+        fit.check_against(&coulomb).unwrap();
+        let fit = FitSpec {
+            bounds: [("x0".to_string(), [0.011, 0.009])].into(),
+            ..FitSpec::default()
+        };
+        let e = fit.check_against(&coulomb).unwrap_err().to_string();
+        assert!(
+            e.contains("`x0` = [0.011, 0.009] is not an interval"),
+            "{e}"
+        );
     }
 
     #[test]

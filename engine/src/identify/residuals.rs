@@ -29,7 +29,8 @@ pub const STEPS_PER_SAMPLE: u64 = 20;
 pub enum NuisanceKind {
     /// A constant added to the predicted velocity (an instrument's DC offset) [m/s].
     VelocityOffset,
-    /// The release instant relative to the record's first time stamp [s].
+    /// The release instant relative to the record's release time (its first time stamp unless
+    /// it was cut at a release found or given between samples) [s].
     ReleaseShift,
     /// The displacement at release [m], when the record's x0 is known only approximately.
     StartDisplacement,
