@@ -298,44 +298,40 @@ fn parse_layout(ds: &Dataset) -> Result<DatasetHeader, DataError> {
 
 /// Record 8: the abscissa must be time (17) or unknown (0).
 fn check_abscissa(ds: &Dataset) -> Result<(), DataError> {
-    let (l8, r8) = ds.record(8)?;
-    let abscissa = leading_int(r8, 10).ok_or_else(|| {
-        ds.err(
-            l8,
-            "record 8: the abscissa data type is not an integer".into(),
-        )
-    })?;
-    if !(abscissa == 0 || abscissa == 17) {
-        return Err(ds.err(
-            l8,
-            format!(
-                "the abscissa is {} (specific data type {abscissa}), not time (17)",
-                spec_type_name(abscissa)
-            ),
-        ));
-    }
-    Ok(())
+    check_data_type(ds, 8, "abscissa", (17, "time"))
 }
 
 /// Record 9: the channel of the ordinate; velocity (11) or unknown (0, read as velocity).
 fn ordinate_channel(ds: &Dataset) -> Result<Channel, DataError> {
-    let (l9, r9) = ds.record(9)?;
-    let ordinate = leading_int(r9, 10).ok_or_else(|| {
+    check_data_type(ds, 9, "ordinate", (11, "velocity"))?;
+    Ok(Channel::Velocity)
+}
+
+/// The specific data type in the first field of `record` (8 or 9) must be `expected`'s code
+/// or 0 (unknown); otherwise an error naming the `axis` and both types.
+fn check_data_type(
+    ds: &Dataset,
+    record: usize,
+    axis: &str,
+    (code, name): (i64, &str),
+) -> Result<(), DataError> {
+    let (line, text) = ds.record(record)?;
+    let found = leading_int(text, 10).ok_or_else(|| {
         ds.err(
-            l9,
-            "record 9: the ordinate data type is not an integer".into(),
+            line,
+            format!("record {record}: the {axis} data type is not an integer"),
         )
     })?;
-    if !(ordinate == 0 || ordinate == 11) {
-        return Err(ds.err(
-            l9,
-            format!(
-                "the ordinate is {} (specific data type {ordinate}), not velocity (11)",
-                spec_type_name(ordinate)
-            ),
-        ));
+    if found == 0 || found == code {
+        return Ok(());
     }
-    Ok(Channel::Velocity)
+    Err(ds.err(
+        line,
+        format!(
+            "the {axis} is {} (specific data type {found}), not {name} ({code})",
+            spec_type_name(found)
+        ),
+    ))
 }
 
 /// Record 12: every value to the closing delimiter, with its line; checks the declared count.
