@@ -38,9 +38,10 @@
 //! syntax errors name the line and column.
 
 use crate::error::CliError;
+use frictionid_engine::oscillator::OscillatorInput;
 use frictionid_engine::record::RecordSource;
 use frictionid_engine::spec::{EnergySpec, FitSpec, ModelSpec, SimulationSpec, Spec, SpecError};
-use frictionid_engine::{Oscillator, Record};
+use frictionid_engine::Record;
 use frictionid_models::build_toml;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -73,7 +74,7 @@ pub use frictionid_engine::record::source::ResolvedSource as RecordConfig;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawConfig {
-    oscillator: Option<Oscillator>,
+    oscillator: Option<OscillatorInput>,
     model: Option<toml::Table>,
     fit: Option<FitSpec>,
     simulation: Option<SimulationSpec>,
@@ -242,9 +243,14 @@ impl Config {
             .parent()
             .map(Path::to_path_buf)
             .unwrap_or_else(|| PathBuf::from("."));
-        let oscillator = raw.oscillator.ok_or_else(|| {
-            cfg_err("missing table [oscillator] (mass, damping, stiffness, normal_force)".into())
-        })?;
+        let (oscillator, unknown) = raw
+            .oscillator
+            .ok_or_else(|| {
+                cfg_err(
+                    "missing table [oscillator] (mass, damping, stiffness, normal_force)".into(),
+                )
+            })?
+            .resolve();
         oscillator
             .validate()
             .map_err(|e| cfg_err(format!("[oscillator]: {e}")))?;
@@ -256,7 +262,8 @@ impl Config {
             raw.simulation,
             raw.energy.unwrap_or_default(),
         )
-        .map_err(|e| cfg_err(e.to_string()))?;
+        .map_err(|e| cfg_err(e.to_string()))?
+        .with_unknown_oscillator(unknown);
         if raw.records.len() > MAX_RECORDS {
             return Err(cfg_err(format!(
                 "{} [[records]] entries; at most {MAX_RECORDS} are accepted",
@@ -309,8 +316,13 @@ impl Config {
         self.records
             .iter()
             .map(|r| {
-                r.load_checked(&self.spec.oscillator)
-                    .map_err(CliError::from)
+                // Units are checked against k/m only when the oscillator is known.
+                if self.spec.unknown_oscillator.is_empty() {
+                    r.load_checked(&self.spec.oscillator)
+                } else {
+                    r.load()
+                }
+                .map_err(CliError::from)
             })
             .collect()
     }
@@ -319,6 +331,7 @@ impl Config {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use frictionid_engine::Oscillator;
 
     const OSC: &str =
         "[oscillator]\nmass = 10.391\ndamping = 0.275\nstiffness = 1982.0\nnormal_force = 14.5\n";

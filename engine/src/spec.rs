@@ -12,7 +12,7 @@
 
 use crate::data::MAX_SAMPLES;
 use crate::energy::{Differentiator, EnergyOptions};
-use crate::identify::{FitOptions, OscillatorParam, ProgressFn};
+use crate::identify::{FitDomain, FitOptions, ForceTarget, OscillatorParam, ProgressFn};
 use crate::oscillator::Oscillator;
 use crate::simulate::{Integrator, SimOptions};
 use frictionid_models::suggest::did_you_mean;
@@ -123,6 +123,9 @@ pub struct Spec {
     pub simulation: Option<SimulationSpec>,
     /// Energy-analysis settings (defaults when absent).
     pub energy: EnergySpec,
+    /// `[oscillator]` keys not given (their values in `oscillator` are placeholders): a
+    /// force-domain fit on a measured force needs only the normal force.
+    pub unknown_oscillator: Vec<String>,
 }
 
 /// The friction model of a spec and which of its parameters were given explicitly.
@@ -188,7 +191,14 @@ impl Spec {
             fit,
             simulation,
             energy,
+            unknown_oscillator: Vec::new(),
         })
+    }
+
+    /// The spec with `keys` of `[oscillator]` marked as not given.
+    pub fn with_unknown_oscillator(mut self, keys: Vec<String>) -> Self {
+        self.unknown_oscillator = keys;
+        self
     }
 
     /// The model, or an error naming the command that needs it.
@@ -227,6 +237,11 @@ impl Spec {
             velocity_offset: extras.velocity_offset,
             time_shift: extras.time_shift,
             x0: extras.x0,
+            domain: extras.domain,
+            force_target: extras.force_target,
+            force_offset: extras.force_offset,
+            prefit: extras.prefit.unwrap_or(defaults.prefit),
+            unknown_oscillator: self.unknown_oscillator.clone(),
             multistart: extras.multistart,
             max_iterations: self.fit.max_iterations.unwrap_or(defaults.max_iterations),
             tolerance: self.fit.tolerance.or(defaults.tolerance),
@@ -311,6 +326,14 @@ pub struct FitExtras {
     pub guess: Option<bool>,
     /// Models compared by `compare` when none are requested.
     pub models: Option<Vec<String>>,
+    /// What the fit compares: "velocity" (default) or "force".
+    pub domain: FitDomain,
+    /// Force domain: "auto" (default: the force channel, else Eq. 7), "measured" or "energy".
+    pub force_target: ForceTarget,
+    /// Force domain: fit a constant force offset per record (a load cell's zero).
+    pub force_offset: bool,
+    /// Velocity fits of dynamic models start also from a force-domain prefit (default true).
+    pub prefit: Option<bool>,
 }
 
 impl FitSpec {

@@ -68,6 +68,8 @@ impl CompareReport {
                 ]
             })
             .collect();
+        let unit = self.best().map_or("m/s", |b| b.residual_unit.as_str());
+        let rms = format!("rms residual [{unit}]");
         Table::new(
             &[
                 "rank",
@@ -75,7 +77,7 @@ impl CompareReport {
                 "AIC",
                 "dAIC",
                 "BIC",
-                "rms residual [m/s]",
+                &rms,
                 "free",
                 "converged",
             ],
