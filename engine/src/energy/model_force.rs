@@ -63,6 +63,19 @@ pub fn model_force_with_normal(
     v: &[f64],
     normal: &NormalForce,
 ) -> Result<Vec<f64>, EngineError> {
+    model_force_budgeted(model, time, v, normal, MAX_SUBSTEPS)
+}
+
+/// [`model_force_with_normal`] with at most `max_substeps` sub-steps (accepted and rejected)
+/// for the whole motion: a fit rejects trial parameters whose states are so stiff, or so
+/// little smooth, that they would need more (see [`crate::identify::residuals::STEPS_PER_SAMPLE`]).
+pub fn model_force_budgeted(
+    model: &dyn FrictionModel,
+    time: &[f64],
+    v: &[f64],
+    normal: &NormalForce,
+    max_substeps: u64,
+) -> Result<Vec<f64>, EngineError> {
     check_motion(time, v, normal)?;
     let ns = model.n_states();
     if ns == 0 {
@@ -84,7 +97,7 @@ pub fn model_force_with_normal(
                 v1: v[i],
                 span: time[i] - time[i - 1],
             };
-            integrate_interval(&mut stepper, &along, &mut z).map_err(|failure| {
+            integrate_interval(&mut stepper, &along, &mut z, max_substeps).map_err(|failure| {
                 EngineError::StateIntegration {
                     model: model.name().to_string(),
                     failure,
@@ -209,13 +222,14 @@ fn integrate_interval(
     stepper: &mut BogackiShampine,
     along: &AlongMotion<'_>,
     z: &mut [f64],
+    max_substeps: u64,
 ) -> Result<(), IntegrationFailure> {
     stepper.reset(along, along.t0, z, along.t0 + along.span)?;
     while !stepper.reached_end() {
-        if stepper.counts().attempts() >= MAX_SUBSTEPS {
+        if stepper.counts().attempts() >= max_substeps {
             return Err(IntegrationFailure::StepBudgetExceeded {
                 time: stepper.time(),
-                max_steps: MAX_SUBSTEPS,
+                max_steps: max_substeps,
             });
         }
         // No events along a measured motion: the event function stays positive.

@@ -20,8 +20,9 @@
 
 use super::fit::{fit_with, FitResult};
 use super::options::{FitDomain, FitOptions, ForceTarget};
+use super::residuals::STEPS_PER_SAMPLE;
 use super::residuals::{Evaluation, NuisanceKind, NuisanceValues, Residuals, SampleAxes};
-use crate::energy::model_force_with_normal;
+use crate::energy::model_force_budgeted;
 use crate::energy::{analyze_record, central_difference, cumulative_trapezoid};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
@@ -88,24 +89,22 @@ impl ForceAlongMotion {
         osc: &Oscillator,
         opts: &FitOptions,
     ) -> Result<Self, EngineError> {
-        let tracks = records
-            .iter()
-            .map(|r| ForceTrack::new(r, osc, opts))
-            .collect::<Result<Vec<_>, _>>()?;
-        if opts.force_offset {
-            if let Some((t, r)) = tracks
-                .iter()
-                .zip(records)
-                .find(|(t, _)| t.source != TargetSource::Measured)
-            {
-                debug_assert_eq!(t.source, TargetSource::EnergyBased);
+        let mut tracks = Vec::with_capacity(records.len());
+        for record in records {
+            let source =
+                target_source(record, opts.force_target).map_err(|reason| EngineError::Record {
+                    record: record.name.clone(),
+                    reason,
+                })?;
+            if opts.force_offset && source != TargetSource::Measured {
                 return Err(EngineError::Record {
-                    record: r.name.clone(),
+                    record: record.name.clone(),
                     reason: "[fit.options] force_offset = true needs a measured force channel \
                              (this record is fitted to the energy-based force)"
                         .into(),
                 });
             }
+            tracks.push(ForceTrack::new(record, source, osc, opts)?);
         }
         let nuisance = if opts.force_offset {
             vec![NuisanceKind::ForceOffset]
@@ -135,8 +134,13 @@ impl ForceAlongMotion {
 }
 
 impl ForceTrack {
-    /// Prepares `record`: its motion, its normal force and its target.
-    fn new(record: &Record, osc: &Oscillator, opts: &FitOptions) -> Result<Self, EngineError> {
+    /// Prepares `record`: its motion, its normal force and its target from `source`.
+    fn new(
+        record: &Record,
+        source: TargetSource,
+        osc: &Oscillator,
+        opts: &FitOptions,
+    ) -> Result<Self, EngineError> {
         let err = |reason: String| EngineError::Record {
             record: record.name.clone(),
             reason,
@@ -150,7 +154,6 @@ impl ForceTrack {
             ))
         })?;
         let normal = normal_force(record, osc, &opts.unknown_oscillator).map_err(err)?;
-        let source = target_source(record, opts.force_target).map_err(err)?;
         let (used, target) = match source {
             TargetSource::Measured => {
                 let f = record.channel(Channel::Force).unwrap_or_default().to_vec();
@@ -309,11 +312,18 @@ impl Residuals for ForceAlongMotion {
     ) -> Result<Vec<f64>, EngineError> {
         let track = self.track_of(index, record)?;
         at.count_simulation();
-        let force = model_force_with_normal(at.model, &track.time, &track.velocity, &track.normal)
-            .map_err(|e| EngineError::Record {
-                record: record.name.clone(),
-                reason: e.to_string(),
-            })?;
+        let budget = STEPS_PER_SAMPLE * (track.time.len() as u64).max(100);
+        let force = model_force_budgeted(
+            at.model,
+            &track.time,
+            &track.velocity,
+            &track.normal,
+            budget,
+        )
+        .map_err(|e| EngineError::Record {
+            record: record.name.clone(),
+            reason: e.to_string(),
+        })?;
         Ok(track
             .used
             .iter()
@@ -472,7 +482,10 @@ mod tests {
             domain: FitDomain::Force,
             ..FitOptions::default()
         };
-        let t = ForceTrack::new(&with_force, &osc, &opts).unwrap();
+        let t = ForceAlongMotion::new(std::slice::from_ref(&with_force), &osc, &opts)
+            .unwrap()
+            .tracks
+            .remove(0);
         assert_eq!(t.source, TargetSource::Measured);
         // The velocity is the central difference of the displacement.
         let v = central_difference(with_force.time(), &x);
@@ -482,7 +495,7 @@ mod tests {
             force_target: ForceTarget::Measured,
             ..opts.clone()
         };
-        let e = ForceTrack::new(&bare, &osc, &measured).unwrap_err();
+        let e = ForceAlongMotion::new(std::slice::from_ref(&bare), &osc, &measured).unwrap_err();
         assert_eq!(
             e.to_string(),
             "record `r`: [fit.options] force_target = \"measured\" but the record has no force \
@@ -492,7 +505,7 @@ mod tests {
             unknown_oscillator: vec!["mass".into(), "stiffness".into()],
             ..opts.clone()
         };
-        let e = ForceTrack::new(&bare, &osc, &no_mechanics)
+        let e = ForceAlongMotion::new(std::slice::from_ref(&bare), &osc, &no_mechanics)
             .unwrap_err()
             .to_string();
         assert!(
@@ -500,7 +513,7 @@ mod tests {
             "{e}"
         );
         let no_motion = record(&[(Channel::Force, vec![1.0; 50])]);
-        let e = ForceTrack::new(&no_motion, &osc, &opts)
+        let e = ForceAlongMotion::new(&[no_motion], &osc, &opts)
             .unwrap_err()
             .to_string();
         assert!(
