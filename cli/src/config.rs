@@ -310,8 +310,13 @@ impl Config {
         self.records
             .iter()
             .map(|r| {
-                r.load_checked(&self.spec.oscillator)
-                    .map_err(CliError::from)
+                // Units are checked against k/m only when the oscillator is known.
+                if self.spec.unknown_oscillator.is_empty() {
+                    r.load_checked(&self.spec.oscillator)
+                } else {
+                    r.load()
+                }
+                .map_err(CliError::from)
             })
             .collect()
     }

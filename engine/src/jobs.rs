@@ -9,7 +9,9 @@ use crate::energy::{
     EnergyOptions,
 };
 use crate::error::EngineError;
-use crate::identify::{compare, fit, FitOptions, FitResult, PropertyUncertainty};
+use crate::identify::{
+    compare, fit, require_mechanics, FitOptions, FitResult, PropertyUncertainty,
+};
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use crate::report::{CompareReport, EnergyRecord, EnergyReport, FitReport, SimulateReport};
@@ -107,6 +109,7 @@ pub fn simulate_report(
 /// velocity record when the spec asks for noise.
 pub fn simulate_job(spec: &Spec) -> Result<SimulateReport, JobError> {
     let model = &spec.require_model("simulate")?.model;
+    require_mechanics(&spec.unknown_oscillator, "simulate").map_err(JobError::Fit)?;
     let sim: &SimulationSpec = spec.require_simulation("simulate")?;
     let times = uniform_times(sim.duration, sim.sample_rate);
     let init = Initial {
@@ -258,6 +261,7 @@ pub fn energy_job(
     records: &[Record],
     hooks: &Hooks,
 ) -> Result<EnergyReport, JobError> {
+    require_mechanics(&spec.unknown_oscillator, "the energy analysis").map_err(JobError::Fit)?;
     let opts = spec.energy.options();
     let model = reference_model(spec, records, hooks)?;
     let analysed = records

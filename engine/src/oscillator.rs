@@ -17,6 +17,43 @@ pub struct Oscillator {
     pub normal_force: f64,
 }
 
+/// `[oscillator]` as written: every key optional. A force-domain fit on a measured force
+/// needs none of m, c and k, and no normal force when its records carry one; the fits and
+/// analyses that need them say so ([`crate::identify::require_mechanics`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OscillatorInput {
+    /// Mass m [kg].
+    pub mass: Option<f64>,
+    /// Viscous damping c [N s/m].
+    pub damping: Option<f64>,
+    /// Stiffness k [N/m].
+    pub stiffness: Option<f64>,
+    /// Normal force N [N].
+    pub normal_force: Option<f64>,
+}
+
+impl OscillatorInput {
+    /// The oscillator, with placeholders for the keys not given (m = k = 1, c = N = 0; no
+    /// result depends on them), and the names of those keys.
+    pub fn resolve(&self) -> (Oscillator, Vec<String>) {
+        let mut missing = Vec::new();
+        let mut take = |name: &str, value: Option<f64>, placeholder: f64| {
+            value.unwrap_or_else(|| {
+                missing.push(name.to_string());
+                placeholder
+            })
+        };
+        let osc = Oscillator {
+            mass: take("mass", self.mass, 1.0),
+            damping: take("damping", self.damping, 0.0),
+            stiffness: take("stiffness", self.stiffness, 1.0),
+            normal_force: take("normal_force", self.normal_force, 0.0),
+        };
+        (osc, missing)
+    }
+}
+
 impl Oscillator {
     /// Builds and validates an oscillator.
     pub fn new(

@@ -13,7 +13,9 @@
 use crate::data::MAX_SAMPLES;
 use crate::energy::{Differentiator, EnergyOptions};
 use crate::identify::setup::non_model_bound_keys;
-use crate::identify::{FitOptions, OscillatorParam, ProgressFn, PropertyUncertainty};
+use crate::identify::{
+    FitDomain, FitOptions, ForceTarget, OscillatorParam, ProgressFn, PropertyUncertainty,
+};
 use crate::oscillator::Oscillator;
 use crate::simulate::{Integrator, SimOptions};
 use frictionid_models::suggest::did_you_mean;
@@ -118,23 +120,31 @@ impl std::fmt::Debug for Hooks {
 /// each (`mass_std`, `damping_std`, `stiffness_std`, `normal_force_std`; SI units, 0 when
 /// absent: known exactly), which the uncertainty budget propagates into every fitted
 /// parameter. Deserialized through [`OscillatorInput`], which checks every value.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "OscillatorInput", into = "OscillatorInput")]
 pub struct OscillatorSpec {
-    /// The nominal properties.
+    /// The nominal properties (placeholders for the keys in `unknown`).
     pub oscillator: Oscillator,
     /// Their standard deviations.
     pub uncertainty: PropertyUncertainty,
+    /// The property keys not given: a force-domain fit on a measured force needs only the
+    /// normal force; the analyses that need the others name them
+    /// ([`crate::identify::require_mechanics`]).
+    pub unknown: Vec<String>,
 }
 
 /// `[oscillator]` as written; [`OscillatorSpec`] is built from it.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OscillatorInput {
-    mass: f64,
-    damping: f64,
-    stiffness: f64,
-    normal_force: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    mass: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    damping: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    stiffness: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    normal_force: Option<f64>,
     #[serde(default)]
     mass_std: f64,
     #[serde(default)]
@@ -149,19 +159,22 @@ impl TryFrom<OscillatorInput> for OscillatorSpec {
     type Error = SpecError;
 
     fn try_from(o: OscillatorInput) -> Result<Self, SpecError> {
+        let (oscillator, unknown) = crate::oscillator::OscillatorInput {
+            mass: o.mass,
+            damping: o.damping,
+            stiffness: o.stiffness,
+            normal_force: o.normal_force,
+        }
+        .resolve();
         let spec = Self {
-            oscillator: Oscillator {
-                mass: o.mass,
-                damping: o.damping,
-                stiffness: o.stiffness,
-                normal_force: o.normal_force,
-            },
+            oscillator,
             uncertainty: PropertyUncertainty {
                 mass: o.mass_std,
                 damping: o.damping_std,
                 stiffness: o.stiffness_std,
                 normal_force: o.normal_force_std,
             },
+            unknown,
         };
         spec.validate()?;
         Ok(spec)
@@ -171,11 +184,13 @@ impl TryFrom<OscillatorInput> for OscillatorSpec {
 impl From<OscillatorSpec> for OscillatorInput {
     fn from(o: OscillatorSpec) -> Self {
         let (p, u) = (o.oscillator, o.uncertainty);
+        let given =
+            |name: &str, value: f64| (!o.unknown.iter().any(|k| k == name)).then_some(value);
         Self {
-            mass: p.mass,
-            damping: p.damping,
-            stiffness: p.stiffness,
-            normal_force: p.normal_force,
+            mass: given("mass", p.mass),
+            damping: given("damping", p.damping),
+            stiffness: given("stiffness", p.stiffness),
+            normal_force: given("normal_force", p.normal_force),
             mass_std: u.mass,
             damping_std: u.damping,
             stiffness_std: u.stiffness,
@@ -190,6 +205,7 @@ impl From<Oscillator> for OscillatorSpec {
         Self {
             oscillator,
             uncertainty: PropertyUncertainty::default(),
+            unknown: Vec::new(),
         }
     }
 }
@@ -219,6 +235,9 @@ pub struct Spec {
     pub simulation: Option<SimulationSpec>,
     /// Energy-analysis settings (defaults when absent).
     pub energy: EnergySpec,
+    /// `[oscillator]` keys not given (their values in `oscillator` are placeholders): a
+    /// force-domain fit on a measured force needs only the normal force.
+    pub unknown_oscillator: Vec<String>,
 }
 
 /// The friction model of a spec and which of its parameters were given explicitly.
@@ -287,6 +306,7 @@ impl Spec {
             fit,
             simulation,
             energy,
+            unknown_oscillator: oscillator.unknown,
         })
     }
 
@@ -327,6 +347,11 @@ impl Spec {
             time_shift: extras.time_shift,
             x0: extras.x0,
             uncertainty: self.uncertainty,
+            domain: extras.domain,
+            force_target: extras.force_target,
+            force_offset: extras.force_offset,
+            prefit: extras.prefit.unwrap_or(defaults.prefit),
+            unknown_oscillator: self.unknown_oscillator.clone(),
             multistart: extras.multistart,
             max_iterations: self.fit.max_iterations.unwrap_or(defaults.max_iterations),
             tolerance: self.fit.tolerance.or(defaults.tolerance),
@@ -411,6 +436,14 @@ pub struct FitExtras {
     pub guess: Option<bool>,
     /// Models compared by `compare` when none are requested.
     pub models: Option<Vec<String>>,
+    /// What the fit compares: "velocity" (default) or "force".
+    pub domain: FitDomain,
+    /// Force domain: "auto" (default: the force channel, else Eq. 7), "measured" or "energy".
+    pub force_target: ForceTarget,
+    /// Force domain: fit a constant force offset per record (a load cell's zero).
+    pub force_offset: bool,
+    /// Velocity fits of dynamic models start also from a force-domain prefit (default true).
+    pub prefit: Option<bool>,
 }
 
 impl FitSpec {

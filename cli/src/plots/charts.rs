@@ -120,6 +120,46 @@ pub fn friction_force(
     draw(path, &Figure::over_time(title, vec![panel]))
 }
 
+/// The motion axis of a force-against-motion chart: quantity, unit and the factor from SI.
+#[derive(Debug, Clone, Copy)]
+pub struct MotionAxis {
+    /// Quantity, e.g. "displacement".
+    pub quantity: &'static str,
+    /// Unit shown, e.g. "mm".
+    pub unit: &'static str,
+    /// Factor from the SI value to the unit shown.
+    pub factor: f64,
+}
+
+/// Measured and fitted friction force against a motion quantity of one record (force-domain
+/// fits): against the displacement these are the hysteresis loops, against the velocity the
+/// friction curve. Lines break where samples are missing (masked samples of Eq. 7).
+pub fn force_against_motion(
+    path: &Path,
+    title: &str,
+    axis: MotionAxis,
+    motion: &[f64],
+    measured: (&str, &[f64]),
+    fitted: &[f64],
+    model: &str,
+) -> Result<(), CliError> {
+    let x: Vec<f64> = motion.iter().map(|m| m * axis.factor).collect();
+    let panel = Panel::new("friction force", "N")
+        .with(Series::solid(measured.0, &x, measured.1).color(super::MEASURED))
+        .with(
+            Series::dashed(format!("fitted ({model})"), &x, fitted)
+                .color(super::model_color(model)),
+        );
+    let fig = Figure {
+        title: title.into(),
+        x_label: axis.quantity.into(),
+        x_unit: axis.unit.into(),
+        x_ticks: XTicks::Linear,
+        panels: vec![panel],
+    };
+    draw(path, &fig)
+}
+
 /// Half-width of the linear region of the steady-state chart's velocity axis \[m/s\]: below
 /// the smallest Stribeck velocities (1e-3 m/s) and above a vibrometer's noise.
 pub const STEADY_STATE_LINEAR_WIDTH: f64 = 1e-4;

@@ -10,8 +10,8 @@ mod panel;
 pub mod sets;
 
 pub use charts::{
-    displacement_acceleration, displacement_velocity, energy_rate, friction_force,
-    steady_state_curves, velocity_fit,
+    displacement_acceleration, displacement_velocity, energy_rate, force_against_motion,
+    friction_force, steady_state_curves, velocity_fit, MotionAxis,
 };
 
 use crate::error::CliError;

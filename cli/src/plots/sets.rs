@@ -148,6 +148,10 @@ pub fn fit_record_plots(
     let mut files = Vec::new();
     let names: Vec<&str> = fit.records.iter().map(|r| r.file.as_str()).collect();
     for (r, stem) in fit.records.iter().zip(unique_stems(&names)) {
+        if !r.displacement.is_empty() {
+            files.extend(force_record_plots(out, fit, r, &format!("{prefix}{stem}"))?);
+            continue;
+        }
         let vf = format!("{prefix}{stem}_velocity_fit.svg");
         super::velocity_fit(
             &out.path(&vf),
@@ -167,11 +171,90 @@ pub fn fit_record_plots(
     Ok(files)
 }
 
-/// The largest measured speed of the records (for steady-state plots).
+/// A gap (NaN) in `values` wherever the time step exceeds 1.5 times the smallest one, so a
+/// line is not drawn across masked samples. Unchanged when the lengths differ.
+pub fn break_at_gaps(time: &[f64], values: &[f64]) -> Vec<f64> {
+    let mut out = values.to_vec();
+    if time.len() != values.len() {
+        return out;
+    }
+    let step = time
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .fold(f64::INFINITY, f64::min);
+    for i in 1..time.len() {
+        if time[i] - time[i - 1] > 1.5 * step {
+            out[i] = f64::NAN;
+        }
+    }
+    out
+}
+
+/// A force-domain fit of one record: measured (or energy-based) and fitted friction force
+/// against displacement (hysteresis loops) and against velocity; `stem` starts the names.
+fn force_record_plots(
+    out: &OutputDir,
+    fit: &FitResult,
+    r: &RecordFit,
+    stem: &str,
+) -> Result<Vec<String>, CliError> {
+    let measured = break_at_gaps(&r.time, &r.measured);
+    let fitted = break_at_gaps(&r.time, &r.fitted);
+    let label = if r.channel == "energy_based_force" {
+        "energy-based (Eq. 7)"
+    } else {
+        "measured"
+    };
+    let mut files = Vec::new();
+    for (name, what, motion, axis) in [
+        (
+            "force_displacement",
+            "hysteresis loops",
+            &r.displacement,
+            super::MotionAxis {
+                quantity: "displacement",
+                unit: "mm",
+                factor: 1e3,
+            },
+        ),
+        (
+            "force_velocity",
+            "friction force against velocity",
+            &r.velocity,
+            super::MotionAxis {
+                quantity: "velocity",
+                unit: "mm/s",
+                factor: 1e3,
+            },
+        ),
+    ] {
+        let file = format!("{stem}_{name}.svg");
+        super::force_against_motion(
+            &out.path(&file),
+            &format!("{}: {what}", r.file),
+            axis,
+            motion,
+            (label, &measured),
+            &fitted,
+            &fit.model,
+        )?;
+        files.push(file);
+    }
+    Ok(files)
+}
+
+/// The largest speed of the records' motion (for steady-state plots): the velocity of a
+/// force-domain fit, else the measured velocity.
 pub fn peak_speed(fit: &FitResult) -> f64 {
     fit.records
         .iter()
-        .flat_map(|r| r.measured.iter())
+        .flat_map(|r| {
+            if r.velocity.is_empty() {
+                r.measured.iter()
+            } else {
+                r.velocity.iter()
+            }
+        })
         .fold(0.0f64, |m, v| m.max(v.abs()))
 }
 

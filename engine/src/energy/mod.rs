@@ -70,7 +70,10 @@ pub use differentiate::{
     savitzky_golay_derivative, Differentiator, PAPER_SPAN,
 };
 pub use halfcycle::{HalfCycle, MIN_RUN};
-pub use model_force::{force_residuals, model_force_along, ForceResiduals};
+pub use model_force::{
+    force_residuals, model_force_along, model_force_budgeted, model_force_with_normal,
+    ForceResiduals,
+};
 
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;

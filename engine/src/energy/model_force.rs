@@ -17,6 +17,7 @@
 use super::EnergyAnalysis;
 use crate::error::{EngineError, IntegrationFailure};
 use crate::oscillator::Oscillator;
+use crate::record::NormalForce;
 use crate::simulate::{BogackiShampine, OdeSystem, StepOutcome, Stepper};
 use frictionid_models::FrictionModel;
 use serde::Serialize;
@@ -40,9 +41,7 @@ pub struct ForceResiduals {
 }
 
 /// The friction force of `model` along the measured motion (`time`, `v`), with the oscillator's
-/// normal force. Static models are evaluated sample by sample, `model.force(v, &[], N)`;
-/// dynamic models have their states integrated along v (linear between samples) from zero
-/// (relaxed bristles at release), see the module docs.
+/// normal force: [`model_force_with_normal`] with a constant N.
 pub fn model_force_along(
     model: &dyn FrictionModel,
     osc: &Oscillator,
@@ -50,6 +49,68 @@ pub fn model_force_along(
     v: &[f64],
 ) -> Result<Vec<f64>, EngineError> {
     osc.validate()?;
+    model_force_with_normal(model, time, v, &NormalForce::Constant(osc.normal_force))
+}
+
+/// The friction force of `model` along the measured motion (`time`, `v`) under the normal
+/// force `normal` (constant, or one value per sample, taken linear between samples). Static
+/// models are evaluated sample by sample, `model.force(v, &[], N)`; dynamic models have their
+/// states integrated along v (linear between samples) from zero (relaxed bristles at the
+/// first sample), see the module docs.
+pub fn model_force_with_normal(
+    model: &dyn FrictionModel,
+    time: &[f64],
+    v: &[f64],
+    normal: &NormalForce,
+) -> Result<Vec<f64>, EngineError> {
+    model_force_budgeted(model, time, v, normal, MAX_SUBSTEPS)
+}
+
+/// [`model_force_with_normal`] with at most `max_substeps` sub-steps (accepted and rejected)
+/// for the whole motion: a fit rejects trial parameters whose states are so stiff, or so
+/// little smooth, that they would need more (see [`crate::identify::residuals::STEPS_PER_SAMPLE`]).
+pub fn model_force_budgeted(
+    model: &dyn FrictionModel,
+    time: &[f64],
+    v: &[f64],
+    normal: &NormalForce,
+    max_substeps: u64,
+) -> Result<Vec<f64>, EngineError> {
+    check_motion(time, v, normal)?;
+    let ns = model.n_states();
+    if ns == 0 {
+        return Ok((0..v.len())
+            .map(|i| model.force(v[i], &[], normal.at(i)))
+            .collect());
+    }
+    let mut z = vec![0.0; ns];
+    let mut out = Vec::with_capacity(v.len());
+    let mut stepper = BogackiShampine::new(ns, RTOL, ATOL);
+    for i in 0..time.len() {
+        if i > 0 {
+            let along = AlongMotion {
+                model,
+                n0: normal.at(i - 1),
+                n1: normal.at(i),
+                t0: time[i - 1],
+                v0: v[i - 1],
+                v1: v[i],
+                span: time[i] - time[i - 1],
+            };
+            integrate_interval(&mut stepper, &along, &mut z, max_substeps).map_err(|failure| {
+                EngineError::StateIntegration {
+                    model: model.name().to_string(),
+                    failure,
+                }
+            })?;
+        }
+        out.push(model.force(v[i], &z, normal.at(i)));
+    }
+    Ok(out)
+}
+
+/// Equal lengths, finite samples, strictly increasing time, a finite non-negative normal force.
+fn check_motion(time: &[f64], v: &[f64], normal: &NormalForce) -> Result<(), EngineError> {
     if time.len() != v.len() {
         return Err(EngineError::InvalidInput(format!(
             "{} time stamps but {} velocities",
@@ -70,34 +131,23 @@ pub fn model_force_along(
             "time is not strictly increasing at sample {index}"
         )));
     }
-    let normal = osc.normal_force;
-    let ns = model.n_states();
-    if ns == 0 {
-        return Ok(v.iter().map(|&vi| model.force(vi, &[], normal)).collect());
-    }
-    let mut z = vec![0.0; ns];
-    let mut out = Vec::with_capacity(v.len());
-    let mut stepper = BogackiShampine::new(ns, RTOL, ATOL);
-    for i in 0..time.len() {
-        if i > 0 {
-            let along = AlongMotion {
-                model,
-                normal,
-                t0: time[i - 1],
-                v0: v[i - 1],
-                v1: v[i],
-                span: time[i] - time[i - 1],
-            };
-            integrate_interval(&mut stepper, &along, &mut z).map_err(|failure| {
-                EngineError::StateIntegration {
-                    model: model.name().to_string(),
-                    failure,
-                }
-            })?;
+    let values: &[f64] = match normal {
+        NormalForce::Constant(n) => std::slice::from_ref(n),
+        NormalForce::Sampled(values) if values.len() != time.len() => {
+            return Err(EngineError::InvalidInput(format!(
+                "{} time stamps but {} normal-force samples",
+                time.len(),
+                values.len()
+            )))
         }
-        out.push(model.force(v[i], &z, normal));
+        NormalForce::Sampled(values) => values,
+    };
+    if let Some(n) = values.iter().find(|n| !(n.is_finite() && **n >= 0.0)) {
+        return Err(EngineError::InvalidInput(format!(
+            "the normal force must be finite and >= 0, got {n}"
+        )));
     }
-    Ok(out)
+    Ok(())
 }
 
 /// The model's force along the analysed motion against the energy-based force, on the samples
@@ -145,11 +195,12 @@ pub fn force_residuals(
     })
 }
 
-/// The states' equation along one sample interval: z' = f(v(t), z) with v linear from
-/// (t0, v0) to (t0 + span, v1).
+/// The states' equation along one sample interval: z' = f(v(t), z, N(t)) with v linear from
+/// (t0, v0) to (t0 + span, v1) and N linear from n0 to n1.
 struct AlongMotion<'a> {
     model: &'a dyn FrictionModel,
-    normal: f64,
+    n0: f64,
+    n1: f64,
     t0: f64,
     v0: f64,
     v1: f64,
@@ -158,8 +209,10 @@ struct AlongMotion<'a> {
 
 impl OdeSystem for AlongMotion<'_> {
     fn rhs(&self, t: f64, z: &[f64], dz: &mut [f64]) {
-        let v = self.v0 + (self.v1 - self.v0) * (t - self.t0) / self.span;
-        self.model.state_derivative(v, z, self.normal, dz);
+        let s = (t - self.t0) / self.span;
+        let v = self.v0 + (self.v1 - self.v0) * s;
+        let normal = self.n0 + (self.n1 - self.n0) * s;
+        self.model.state_derivative(v, z, normal, dz);
     }
 }
 
@@ -169,13 +222,14 @@ fn integrate_interval(
     stepper: &mut BogackiShampine,
     along: &AlongMotion<'_>,
     z: &mut [f64],
+    max_substeps: u64,
 ) -> Result<(), IntegrationFailure> {
     stepper.reset(along, along.t0, z, along.t0 + along.span)?;
     while !stepper.reached_end() {
-        if stepper.counts().attempts() >= MAX_SUBSTEPS {
+        if stepper.counts().attempts() >= max_substeps {
             return Err(IntegrationFailure::StepBudgetExceeded {
                 time: stepper.time(),
-                max_steps: MAX_SUBSTEPS,
+                max_steps: max_substeps,
             });
         }
         // No events along a measured motion: the event function stays positive.

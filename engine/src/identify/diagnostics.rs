@@ -447,6 +447,8 @@ mod tests {
             rms_residual: 0.0,
             energy_force: None,
             time,
+            displacement: Vec::new(),
+            velocity: Vec::new(),
             measured,
             fitted,
             energy_based_force: Vec::new(),

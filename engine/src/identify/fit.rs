@@ -5,9 +5,12 @@
 use super::budget::{apply_budget, Refit};
 use super::diagnostics;
 use super::energy_check::{energy_force_check, EnergyForce, ForceReference};
+use super::force::{fit_force, require_mechanics};
 use super::layout::{FreeParam, ParamKind};
+use super::options::FitDomain;
 use super::options::{FitOptions, OscillatorParam};
 use super::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
+use super::prefit::{prefit, prefit_finding, Prefit};
 use super::problem::{FitProblem, ProblemParts, Realised};
 use super::residuals::{NuisanceValues, Residuals, VelocityResponse};
 use super::setup::{build_layout, Layout};
@@ -32,14 +35,33 @@ pub const CORRELATION_WARNING: f64 = 0.95;
 /// Fits `model` (its free parameters, and the oscillator properties and nuisance parameters
 /// named in `opts`) to `records`: one parameter set shared by all records, minimising the
 /// weighted sum of squared velocity residuals with the bounded Levenberg-Marquardt solver.
+///
+/// With `opts.domain` = force, the model's force along the measured motion is fitted instead
+/// ([`super::force::fit_force`]). A velocity fit of a model with internal states starts also
+/// from the optimum of the force-domain prefit ([`super::prefit`]).
 pub fn fit(
     osc: &Oscillator,
     model: &(dyn FrictionModel + 'static),
     records: &[Record],
     opts: &FitOptions,
 ) -> Result<FitResult, EngineError> {
-    let residuals = VelocityResponse::new(opts.velocity_offset, opts.time_shift, opts.x0);
-    fit_with(Arc::new(residuals), osc, model, records, opts)
+    if opts.domain == FitDomain::Force {
+        return fit_force(osc, model, records, opts);
+    }
+    require_mechanics(&opts.unknown_oscillator, "a velocity-domain fit")?;
+    let clock = Instant::now();
+    let residuals = Arc::new(VelocityResponse::new(
+        opts.velocity_offset,
+        opts.time_shift,
+        opts.x0,
+    ));
+    let seed = prefit(osc, model, records, opts);
+    let mut result = fit_seeded(residuals, osc, model, records, opts, seed.as_ref())?;
+    if let Some(seed) = &seed {
+        result.diagnostics.push(prefit_finding(seed, &result));
+        result.wall_time_s = clock.elapsed().as_secs_f64();
+    }
+    Ok(result)
 }
 
 /// Fits `model` with the residuals of `residuals` (see [`fit`]; the nuisance parameters are
@@ -51,10 +73,23 @@ pub fn fit_with<R: Residuals + 'static>(
     records: &[Record],
     opts: &FitOptions,
 ) -> Result<FitResult, EngineError> {
+    fit_seeded(residuals, osc, model, records, opts, None)
+}
+
+/// [`fit_with`], with one more start at the prefit's optimum when `seed` holds one.
+fn fit_seeded<R: Residuals + 'static>(
+    residuals: Arc<R>,
+    osc: &Oscillator,
+    model: &(dyn FrictionModel + 'static),
+    records: &[Record],
+    opts: &FitOptions,
+    seed: Option<&Result<Prefit, EngineError>>,
+) -> Result<FitResult, EngineError> {
     let clock = Instant::now();
-    check_inputs(osc, model, records)?;
+    check_inputs(osc, model, records, residuals.as_ref())?;
     let layout = build_layout(osc, model, records, residuals.as_ref(), opts)?;
-    let n_starts = start_count(opts, layout.n_model_free())?;
+    let seed_model = seed.and_then(|s| s.as_ref().ok()).map(|p| &p.model);
+    let n_starts = start_count(opts, layout.n_model_free())? + usize::from(seed_model.is_some());
     let shared: Arc<[Record]> = records.into();
     let make_problem = || {
         FitProblem::new(
@@ -73,7 +108,11 @@ pub fn fit_with<R: Residuals + 'static>(
     let runs = if layout.params.is_empty() {
         evaluate_as_is(&reference)?
     } else {
-        let points = fit_starting_points(&layout.params, &layout.start, model, opts, n_starts);
+        let mut points = fit_starting_points(&layout.params, &layout.start, model, opts, n_starts);
+        if let Some(seeded) = seed_model {
+            points.truncate(n_starts - 1);
+            points.push(seeded_point(&layout, seeded.as_ref()));
+        }
         run_starts(make_problem, &reference, &points, opts)?
     };
     let context = FinishContext {
@@ -101,11 +140,28 @@ pub fn fit_with<R: Residuals + 'static>(
     Ok(result)
 }
 
-/// The model, the oscillator and every record are valid, and there is a record.
-fn check_inputs(
+/// The layout's starting point with the free model parameters at `seeded`'s values (clipped
+/// to their bounds).
+fn seeded_point(layout: &Layout, seeded: &dyn FrictionModel) -> Vec<f64> {
+    let values = seeded.params();
+    layout
+        .params
+        .iter()
+        .zip(&layout.start)
+        .map(|(f, &x)| match f.kind {
+            ParamKind::Model(i) => values.get(i).copied().unwrap_or(x).clamp(f.lower, f.upper),
+            _ => x,
+        })
+        .collect()
+}
+
+/// The model, the oscillator and every record are valid (as `residuals` needs them), and
+/// there is a record.
+fn check_inputs<R: Residuals + ?Sized>(
     osc: &Oscillator,
     model: &dyn FrictionModel,
     records: &[Record],
+    residuals: &R,
 ) -> Result<(), EngineError> {
     osc.validate()?;
     model.validate()?;
@@ -114,7 +170,9 @@ fn check_inputs(
             "a fit needs at least one record".into(),
         ));
     }
-    records.iter().try_for_each(|rec| rec.validate(3))
+    records
+        .iter()
+        .try_for_each(|rec| residuals.check_record(rec))
 }
 
 /// Nothing to vary: the model evaluated as it is, as a converged run.
@@ -131,6 +189,7 @@ fn evaluate_as_is<R: Residuals>(reference: &FitProblem<R>) -> Result<MultiStart,
         iterations: 0,
         simulations: 0,
         starts_at_best: 1,
+        best_start: 0,
         outcomes: Vec::new(),
     })
 }
@@ -269,6 +328,8 @@ fn finish<R: Residuals>(
         derived: derived_ratios(&stats.world.oscillator, params, &stats.cov.matrix, ctx.opts),
         records: fits.records,
         rms_residual: (fits.sum_sq / fits.n_total.max(1) as f64).sqrt(),
+        compared: ctx.reference.residuals.channel().to_string(),
+        residual_unit: ctx.reference.residuals.unit().to_string(),
         cost: 0.5 * stats.ssr,
         aic: aic(samples, stats.ssr, n_free),
         bic: bic(samples, stats.ssr, n_free),
@@ -280,6 +341,7 @@ fn finish<R: Residuals>(
         simulations,
         starts: ctx.n_starts,
         starts_at_best: runs.starts_at_best,
+        best_start: runs.best_start,
         start_outcomes: runs.outcomes,
         diagnostics: findings,
         warnings,
@@ -315,11 +377,13 @@ fn diagnose<R: Residuals>(
     ));
     findings.extend(diagnostics::parameters_at_bounds(params, &stats.p_best));
     findings.extend(fits.findings.iter().cloned());
-    findings.push(diagnostics::residual_structure(
-        &fits.records,
-        &stats.world.oscillator,
-        ctx.opts.energy.velocity_threshold,
-    ));
+    if ctx.reference.residuals.simulates_response() {
+        findings.push(diagnostics::residual_structure(
+            &fits.records,
+            &stats.world.oscillator,
+            ctx.opts.energy.velocity_threshold,
+        ));
+    }
     findings
 }
 
@@ -450,12 +514,18 @@ fn record_fits<R: Residuals>(
         out.sum_sq += ss;
         out.n_total += measured.len();
         let nuisance = &world.nuisance[ri];
-        let (energy_force, ebf, mf) = match energy_check(rec, nuisance, world, opts) {
+        let checked = if problem.residuals.simulates_response() {
+            energy_check(rec, nuisance, world, opts)
+        } else {
+            Err(EngineError::InvalidInput(String::new()))
+        };
+        let (energy_force, ebf, mf) = match checked {
             Ok((ef, ebf, mf)) => {
                 out.findings
                     .push(diagnostics::energy_balance(&rec.name, &ef));
                 (Some(ef), ebf, mf)
             }
+            Err(_) if !problem.residuals.simulates_response() => (None, Vec::new(), Vec::new()),
             Err(e) => {
                 out.findings.push(Finding::warn(
                     Check::EnergyBalance,
@@ -465,15 +535,18 @@ fn record_fits<R: Residuals>(
                 (None, Vec::new(), Vec::new())
             }
         };
+        let axes = problem.residuals.sample_axes(ri, rec);
         out.records.push(RecordFit {
             file: rec.name.clone(),
             x0: nuisance.x0_of(rec),
             release_time: rec.release_time,
             samples: rec.len(),
-            channel: problem.residuals.channel().to_string(),
+            channel: problem.residuals.record_channel(ri).to_string(),
             rms_residual: (ss / measured.len() as f64).sqrt(),
             energy_force,
-            time: rec.time().to_vec(),
+            time: axes.time,
+            displacement: axes.displacement,
+            velocity: axes.velocity,
             measured: measured.to_vec(),
             fitted,
             energy_based_force: ebf,

@@ -6,6 +6,8 @@
 //! - [`residuals::Residuals`]: what a fit compares. [`residuals::VelocityResponse`] simulates
 //!   the free vibration and compares the velocity; each producer declares the per-record
 //!   nuisance parameters ([`residuals::NuisanceKind`]) it adds.
+//!   [`force::ForceAlongMotion`] replays the measured motion and compares the model's force
+//!   with a measured or the energy-based force (fits in the force domain).
 //! - [`problem::FitProblem`]: generic over the producer; implements argmin's `Operator` and
 //!   `Jacobian`, so the solver, our bounded Levenberg-Marquardt ([`lm::LevenbergMarquardt`],
 //!   an argmin `Solver`), knows nothing of friction.
@@ -20,10 +22,12 @@ pub mod compare;
 pub mod diagnostics;
 pub mod energy_check;
 pub mod fit;
+pub mod force;
 pub mod layout;
 pub mod lm;
 pub mod options;
 pub mod outcome;
+pub mod prefit;
 pub mod problem;
 pub mod residuals;
 pub mod result;
@@ -35,8 +39,9 @@ pub use budget::{PropertyUncertainty, StdErrorComponents};
 pub use compare::{compare, Comparison, ComparisonVerdict, FailedFit};
 pub use energy_check::{energy_force_check, EnergyForce, ForceReference};
 pub use fit::{fit, fit_with, guess_hint, Derived, FitResult, FittedParam, RecordFit};
+pub use force::{fit_force, require_mechanics, ForceAlongMotion};
 pub use lm::LevenbergMarquardt;
-pub use options::{FitOptions, OscillatorParam, Progress, ProgressFn};
+pub use options::{FitDomain, FitOptions, ForceTarget, OscillatorParam, Progress, ProgressFn};
 pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
 pub use residuals::{Evaluation, NuisanceKind, NuisanceValues, Residuals, VelocityResponse};
 pub use result::{Rank, Verdict};

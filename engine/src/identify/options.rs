@@ -47,6 +47,31 @@ impl OscillatorParam {
     }
 }
 
+/// What a fit compares (`[fit.options] domain`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FitDomain {
+    /// The simulated free vibration against the measured velocity.
+    #[default]
+    Velocity,
+    /// The model's force along the measured motion against a target force
+    /// ([`super::force::ForceAlongMotion`]).
+    Force,
+}
+
+/// The target force of a force-domain fit (`[fit.options] force_target`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ForceTarget {
+    /// The measured force channel where a record has one, else the energy-based force.
+    #[default]
+    Auto,
+    /// The measured force channel (an error for a record without one).
+    Measured,
+    /// The energy-based force of Eq. 7 (needs m, c and k).
+    Energy,
+}
+
 /// Progress of a running fit, reported after every solver iteration.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Progress {
@@ -97,6 +122,18 @@ pub struct FitOptions {
     /// One standard deviation of the oscillator's properties, propagated into every fitted
     /// parameter's standard error (see [`super::budget`]).
     pub uncertainty: PropertyUncertainty,
+    /// What the fit compares.
+    pub domain: FitDomain,
+    /// The target force of a force-domain fit.
+    pub force_target: ForceTarget,
+    /// Fit a constant force offset per record (force domain, measured force).
+    pub force_offset: bool,
+    /// Velocity fits of models with internal states start also from the optimum of a
+    /// force-domain fit to the energy-based force (the prefit).
+    pub prefit: bool,
+    /// `[oscillator]` keys that were not given (their values are placeholders): fits that need
+    /// them fail with a message naming them.
+    pub unknown_oscillator: Vec<String>,
     /// Number of starts; `None`: 1 when at most two model parameters are free, else
     /// [`super::starts::DEFAULT_STARTS`].
     pub multistart: Option<usize>,
@@ -126,6 +163,11 @@ impl Default for FitOptions {
             time_shift: false,
             x0: false,
             uncertainty: PropertyUncertainty::default(),
+            domain: FitDomain::Velocity,
+            force_target: ForceTarget::Auto,
+            force_offset: false,
+            prefit: true,
+            unknown_oscillator: Vec::new(),
             multistart: None,
             max_iterations: 200,
             tolerance: None,
@@ -152,6 +194,11 @@ impl std::fmt::Debug for FitOptions {
             .field("time_shift", &self.time_shift)
             .field("x0", &self.x0)
             .field("uncertainty", &self.uncertainty)
+            .field("domain", &self.domain)
+            .field("force_target", &self.force_target)
+            .field("force_offset", &self.force_offset)
+            .field("prefit", &self.prefit)
+            .field("unknown_oscillator", &self.unknown_oscillator)
             .field("multistart", &self.multistart)
             .field("max_iterations", &self.max_iterations)
             .field("parallel", &self.parallel)

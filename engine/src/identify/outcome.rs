@@ -169,6 +169,8 @@ pub enum Check {
     Convergence,
     /// Autocorrelated residuals and the widening of the standard errors it calls for.
     NoiseCorrelation,
+    /// The force-domain prefit that gave a velocity fit one of its starts.
+    Prefit,
 }
 
 /// One diagnostic of a fit: a check, its status, the value it judged and a plain message.

@@ -8,11 +8,12 @@
 //! knows nothing else of them, so a producer in the force domain (replay the measured motion,
 //! compare a force) plugs in beside this one.
 
+use super::options::FitOptions;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use crate::simulate::{simulate_velocity, Initial, SimOptions};
-use frictionid_models::FrictionModel;
+use frictionid_models::{FrictionModel, GuessHint};
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -34,6 +35,8 @@ pub enum NuisanceKind {
     ReleaseShift,
     /// The displacement at release [m], when the record's x0 is known only approximately.
     StartDisplacement,
+    /// A constant added to the predicted force (a load cell's zero) \[N\].
+    ForceOffset,
 }
 
 impl NuisanceKind {
@@ -44,6 +47,7 @@ impl NuisanceKind {
             Self::VelocityOffset => "offset",
             Self::ReleaseShift => "shift",
             Self::StartDisplacement => "x0",
+            Self::ForceOffset => "force_offset",
         }
     }
 
@@ -53,6 +57,7 @@ impl NuisanceKind {
             Self::VelocityOffset => "m/s",
             Self::ReleaseShift => "s",
             Self::StartDisplacement => "m",
+            Self::ForceOffset => "N",
         }
     }
 
@@ -62,6 +67,7 @@ impl NuisanceKind {
             Self::VelocityOffset => 1e-4,
             Self::ReleaseShift => 1e-3,
             Self::StartDisplacement => 1e-3,
+            Self::ForceOffset => 1e-2,
         }
     }
 
@@ -70,7 +76,7 @@ impl NuisanceKind {
     /// business); x0 within 20 % of the record's value.
     pub fn default_bounds(self, record: &Record, osc: &Oscillator) -> (f64, f64) {
         match self {
-            Self::VelocityOffset => (f64::NEG_INFINITY, f64::INFINITY),
+            Self::VelocityOffset | Self::ForceOffset => (f64::NEG_INFINITY, f64::INFINITY),
             Self::ReleaseShift => {
                 let quarter = 0.5 * std::f64::consts::PI / osc.omega_n();
                 (-quarter, quarter)
@@ -85,16 +91,17 @@ impl NuisanceKind {
     /// The value a fit starts from (before clipping to the bounds): 0, or the record's x0.
     pub fn start(self, record: &Record) -> f64 {
         match self {
-            Self::VelocityOffset | Self::ReleaseShift => 0.0,
+            Self::VelocityOffset | Self::ReleaseShift | Self::ForceOffset => 0.0,
             Self::StartDisplacement => record.x0,
         }
     }
 
     /// Every kind, in the order a record's nuisance parameters are laid out.
-    pub const ALL: [NuisanceKind; 3] = [
+    pub const ALL: [NuisanceKind; 4] = [
         Self::VelocityOffset,
         Self::ReleaseShift,
         Self::StartDisplacement,
+        Self::ForceOffset,
     ];
 }
 
@@ -110,6 +117,8 @@ pub struct NuisanceValues {
     pub shift: f64,
     /// Fitted displacement at release [m] (`None`: the record's x0).
     pub x0: Option<f64>,
+    /// Force offset \[N\].
+    pub force_offset: f64,
 }
 
 impl NuisanceValues {
@@ -119,6 +128,7 @@ impl NuisanceValues {
             NuisanceKind::VelocityOffset => Some(self.offset),
             NuisanceKind::ReleaseShift => Some(self.shift),
             NuisanceKind::StartDisplacement => self.x0,
+            NuisanceKind::ForceOffset => Some(self.force_offset),
         }
     }
 
@@ -128,6 +138,7 @@ impl NuisanceValues {
             NuisanceKind::VelocityOffset => self.offset = value,
             NuisanceKind::ReleaseShift => self.shift = value,
             NuisanceKind::StartDisplacement => self.x0 = Some(value),
+            NuisanceKind::ForceOffset => self.force_offset = value,
         }
     }
 
@@ -171,11 +182,27 @@ impl<'a> Evaluation<'a> {
     }
 }
 
+/// The abscissae of a record's compared samples (one value per sample).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SampleAxes {
+    /// Time stamps \[s\].
+    pub time: Vec<f64>,
+    /// Displacement of the motion \[m\] (empty when not known).
+    pub displacement: Vec<f64>,
+    /// Velocity of the motion [m/s] (empty when not known).
+    pub velocity: Vec<f64>,
+}
+
 /// What produces a fit's residuals: a measured series per record and the model's prediction
 /// of it. Residuals are `sqrt(weight) (predicted - measured)`, sample by sample.
 pub trait Residuals: Send + Sync {
     /// The quantity compared, for reports (`velocity`, `force`).
     fn channel(&self) -> &'static str;
+
+    /// The quantity compared in record `index` (default: [`Residuals::channel`]).
+    fn record_channel(&self, _index: usize) -> &'static str {
+        self.channel()
+    }
 
     /// Its SI unit.
     fn unit(&self) -> &'static str;
@@ -195,6 +222,32 @@ pub trait Residuals: Send + Sync {
         record: &Record,
         nuisance: &NuisanceValues,
     ) -> Result<Vec<f64>, EngineError>;
+
+    /// Checks a record before a fit (default: a velocity record of at least 3 samples).
+    fn check_record(&self, record: &Record) -> Result<(), EngineError> {
+        record.validate(3)
+    }
+
+    /// Data-driven hints for the starting values (default: from the energy analysis of the
+    /// velocity, [`super::setup::guess_hint`]).
+    fn hint(&self, osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
+        super::setup::guess_hint(osc, records, opts)
+    }
+
+    /// Whether the prediction is the oscillator's simulated response: then the energy-balance
+    /// check and the residual-structure diagnostic apply to the fit.
+    fn simulates_response(&self) -> bool {
+        true
+    }
+
+    /// Where the compared samples of record `index` lie: their times, and the displacement
+    /// and velocity of the motion there when the producer knows them.
+    fn sample_axes(&self, _index: usize, record: &Record) -> SampleAxes {
+        SampleAxes {
+            time: record.time().to_vec(),
+            ..SampleAxes::default()
+        }
+    }
 
     /// Number of residuals record `index` contributes.
     fn residual_count(&self, index: usize, record: &Record) -> usize {
@@ -244,6 +297,7 @@ impl VelocityResponse {
                 NuisanceKind::VelocityOffset => velocity_offset,
                 NuisanceKind::ReleaseShift => time_shift,
                 NuisanceKind::StartDisplacement => x0,
+                NuisanceKind::ForceOffset => false,
             })
             .collect();
         Self { nuisance }

@@ -40,15 +40,21 @@ pub struct RecordFit {
     pub release_time: Option<f64>,
     /// Samples.
     pub samples: usize,
-    /// The quantity compared (`velocity`).
+    /// The quantity compared (`velocity`, `force`, `energy_based_force`).
     pub channel: String,
     /// RMS of fitted - measured, in the unit of the compared quantity (m/s for velocity).
     pub rms_residual: f64,
     /// Energy-based force check (absent when the record cannot be analysed).
     pub energy_force: Option<EnergyForce>,
-    /// Time stamps (for plots).
+    /// Time stamps of the compared samples (for plots).
     #[serde(skip)]
     pub time: Vec<f64>,
+    /// Displacement of the motion at the compared samples (force-domain fits; else empty).
+    #[serde(skip)]
+    pub displacement: Vec<f64>,
+    /// Velocity of the motion at the compared samples (force-domain fits; else empty).
+    #[serde(skip)]
+    pub velocity: Vec<f64>,
     /// The measured series compared.
     #[serde(skip)]
     pub measured: Vec<f64>,
@@ -95,8 +101,12 @@ pub struct FitResult {
     pub derived: Vec<Derived>,
     /// Per record.
     pub records: Vec<RecordFit>,
-    /// RMS residual over all records [m/s].
+    /// RMS residual over all records, in `residual_unit`.
     pub rms_residual: f64,
+    /// The quantity compared: `velocity`, or `force` (force-domain fits).
+    pub compared: String,
+    /// Unit of the residuals (`m/s`, `N`).
+    pub residual_unit: String,
     /// Half the weighted sum of squared residuals.
     pub cost: f64,
     /// Akaike information criterion.
@@ -120,6 +130,8 @@ pub struct FitResult {
     pub starts: usize,
     /// Starts that reached the best cost (within 1e-6 relative).
     pub starts_at_best: usize,
+    /// The start that reached the best cost (0-based, in start order).
+    pub best_start: usize,
     /// What became of each start, in start order.
     pub start_outcomes: Vec<StartOutcome>,
     /// The checks of this fit, each pass, warn or fail.

@@ -106,7 +106,7 @@ pub fn build_layout<R: Residuals + ?Sized>(
         return Err(unknown_name("initial value", k, &names));
     }
     let mut layout = Layout {
-        start_model: starting_model(osc, model, records, opts, &free)?,
+        start_model: starting_model(model, opts, &free, || residuals.hint(osc, records, opts))?,
         params: Vec::new(),
         start: Vec::new(),
     };
@@ -170,19 +170,18 @@ fn free_model_indices(
     Ok(idx)
 }
 
-/// The model at its starting values: the data-driven guess for the free parameters (unless
-/// kept), the given values for the others.
+/// The model at its starting values: the data-driven guess (from `hint`) for the free
+/// parameters (unless kept), the given values for the others.
 fn starting_model(
-    osc: &Oscillator,
     model: &(dyn FrictionModel + 'static),
-    records: &[Record],
     opts: &FitOptions,
     free: &[usize],
+    hint: impl FnOnce() -> GuessHint,
 ) -> Result<Box<dyn FrictionModel>, EngineError> {
     let mut start_model = frictionid_models::clone_model(model);
     if opts.guess && !free.is_empty() {
         let given = model.params();
-        start_model.apply_guess(&guess_hint(osc, records, opts));
+        start_model.apply_guess(&hint());
         let mut values = start_model.params();
         for (i, p) in model.param_info().iter().enumerate() {
             if !free.contains(&i) || opts.keep_initial.contains(&p.name) {

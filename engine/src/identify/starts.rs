@@ -248,6 +248,8 @@ pub struct MultiStart {
     pub simulations: u64,
     /// Starts that reached the best cost (within 1e-6 relative).
     pub starts_at_best: usize,
+    /// The start of the best run.
+    pub best_start: usize,
     /// One outcome per start, in start order.
     pub outcomes: Vec<StartOutcome>,
 }
@@ -416,6 +418,7 @@ fn pick_best(screened: Screened) -> Option<MultiStart> {
         .filter(|(_, o)| o.cost <= best_cost * (1.0 + 1e-6) + 1e-300)
         .count();
     let mut best = None;
+    let mut best_start = 0;
     for (start, run) in ok {
         if !outcomes.iter().any(|(s, _)| *s == start) {
             outcomes.push((
@@ -433,6 +436,7 @@ fn pick_best(screened: Screened) -> Option<MultiStart> {
             .is_none_or(|b: &StartRun| run.cost.total_cmp(&b.cost).is_lt());
         if better {
             best = Some(run);
+            best_start = start;
         }
     }
     outcomes.sort_by_key(|(s, _)| *s);
@@ -441,6 +445,7 @@ fn pick_best(screened: Screened) -> Option<MultiStart> {
         iterations,
         simulations,
         starts_at_best,
+        best_start,
         outcomes: outcomes.into_iter().map(|(_, o)| o).collect(),
     })
 }

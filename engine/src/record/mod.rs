@@ -198,6 +198,16 @@ impl Record {
                 channel_list(&self.channels())
             )));
         }
+        self.validate_channels(min_samples)
+    }
+
+    /// [`Record::validate`] without requiring a velocity channel (records of a force-domain
+    /// fit may hold displacement and force only).
+    pub fn validate_channels(&self, min_samples: usize) -> Result<(), EngineError> {
+        let err = |reason: String| EngineError::Record {
+            record: self.name.clone(),
+            reason,
+        };
         self.check_lengths().map_err(err)?;
         self.check_finite().map_err(err)?;
         self.time
@@ -231,11 +241,12 @@ impl Record {
     fn check_finite(&self) -> Result<(), String> {
         let time = self.time();
         let v = self.velocity();
-        if let Some(i) = (0..time.len()).find(|&i| !(time[i].is_finite() && v[i].is_finite())) {
-            return Err(format!(
-                "sample {i} is not finite (t = {}, v = {})",
-                time[i], v[i]
-            ));
+        let finite = |i: usize| time[i].is_finite() && v.get(i).is_none_or(|x| x.is_finite());
+        if let Some(i) = (0..time.len()).find(|&i| !finite(i)) {
+            return Err(match v.get(i) {
+                Some(vi) => format!("sample {i} is not finite (t = {}, v = {vi})", time[i]),
+                None => format!("time stamp {i} is not finite (t = {})", time[i]),
+            });
         }
         for channel in self.channels() {
             let values = self.channel(channel).unwrap_or_default();

@@ -86,6 +86,8 @@ impl CompareReport {
                 ]
             })
             .collect();
+        let unit = self.best().map_or("m/s", |b| b.residual_unit.as_str());
+        let rms = format!("rms residual [{unit}]");
         Table::new(
             &[
                 "rank",
@@ -94,7 +96,7 @@ impl CompareReport {
                 "dAIC",
                 "Akaike weight",
                 "BIC",
-                "rms residual [m/s]",
+                &rms,
                 "free",
                 "converged",
             ],

@@ -226,11 +226,12 @@ pub fn record_table(fit: &FitResult) -> Table {
             ]
         })
         .collect();
+    let rms = format!("rms residual [{}]", fit.residual_unit);
     Table::new(
         &[
             "record",
             "x0 [m]",
-            "rms residual [m/s]",
+            &rms,
             "mean |F| Eq. 7 [N]",
             "model mean |F| [N]",
             "difference [%]",
@@ -289,8 +290,10 @@ impl FitReport {
     fn statistics_text(&self) -> String {
         let f = &self.fit;
         format!(
-            "RMS residual {} m/s; AIC {}; BIC {}; {} iterations, {} simulations, {} s.",
+            "RMS {} residual {} {}; AIC {}; BIC {}; {} iterations, {} simulations, {} s.",
+            f.compared,
             fmt_num(f.rms_residual),
+            f.residual_unit,
             fmt_criterion(f.aic),
             fmt_criterion(f.bic),
             f.iterations,
@@ -302,10 +305,12 @@ impl FitReport {
     fn terminal_text(&self) -> String {
         let f = &self.fit;
         format!(
-            "{} ({}), rms residual {} m/s, AIC {}",
+            "{} ({}), rms {} residual {} {}, AIC {}",
             f.model,
             f.termination,
+            f.compared,
             fmt_num(f.rms_residual),
+            f.residual_unit,
             fmt_criterion(f.aic)
         )
     }

@@ -1,0 +1,526 @@
+//! Fits in the force domain: the model's friction force along the measured motion against a
+//! target force ([`ForceAlongMotion`]).
+//!
+//! The measured motion is replayed, not simulated: the velocity channel (or the differentiated
+//! displacement when only a displacement is measured) drives the model's internal states,
+//! integrated along it by [`crate::energy::model_force_with_normal`] under the record's normal
+//! force (its channel where there is one). The target is, per record,
+//!
+//! - the measured `force` channel (a tribometer, a driven rig), optionally with a constant
+//!   offset per record (a load cell's zero, [`NuisanceKind::ForceOffset`]); or
+//! - the energy-based force of Eq. 7 ([`crate::energy::analyze_record`]), masked near v = 0
+//!   and after the final stop: the paper's own route, with no force sensor. It needs m, c
+//!   and k; a measured force needs none of them.
+//!
+//! Residuals are `sqrt(weight) (model + offset - target) / sigma`, with sigma the record's
+//! noise level estimated from the target ([`noise_level`]), so records of different noise
+//! weigh as they should in a joint fit. Nothing is simulated, so a force-domain fit costs a
+//! few milliseconds per evaluation and has no phase errors to trap the optimiser: it is also
+//! the prefit of velocity fits of dynamic models (see [`super::fit::fit`]).
+
+use super::fit::{fit_with, FitResult};
+use super::options::{FitDomain, FitOptions, ForceTarget};
+use super::residuals::STEPS_PER_SAMPLE;
+use super::residuals::{Evaluation, NuisanceKind, NuisanceValues, Residuals, SampleAxes};
+use crate::energy::model_force_budgeted;
+use crate::energy::{analyze_record, central_difference, cumulative_trapezoid};
+use crate::error::EngineError;
+use crate::oscillator::Oscillator;
+use crate::record::{channel_list, Channel, NormalForce, Record};
+use frictionid_models::{FrictionModel, GuessHint};
+use std::sync::Arc;
+
+/// Where a record's target force comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TargetSource {
+    /// The measured `force` channel.
+    Measured,
+    /// The energy-based force of Eq. 7.
+    EnergyBased,
+}
+
+/// One record's motion, normal force and target, prepared once per fit.
+#[derive(Debug, Clone)]
+pub struct ForceTrack {
+    /// Where the target comes from.
+    pub source: TargetSource,
+    time: Vec<f64>,
+    velocity: Vec<f64>,
+    displacement: Vec<f64>,
+    normal: NormalForce,
+    /// Indices of the compared samples (all, or those where Eq. 7 is defined).
+    used: Vec<usize>,
+    /// The target force at the compared samples \[N\].
+    target: Vec<f64>,
+    /// Noise level of the target \[N\].
+    pub noise: f64,
+}
+
+/// The force-domain residual producer.
+#[derive(Debug, Clone)]
+pub struct ForceAlongMotion {
+    tracks: Vec<ForceTrack>,
+    nuisance: Vec<NuisanceKind>,
+}
+
+/// The oscillator properties a force-domain fit on the energy-based force, a velocity fit or
+/// an energy analysis needs, and the message when `missing` (as `[oscillator]` keys) holds
+/// any of them. The one place of this rule.
+pub fn require_mechanics(missing: &[String], purpose: &str) -> Result<(), EngineError> {
+    let absent: Vec<&str> = ["mass", "damping", "stiffness"]
+        .into_iter()
+        .filter(|k| missing.iter().any(|m| m == k))
+        .collect();
+    if absent.is_empty() {
+        return Ok(());
+    }
+    Err(EngineError::InvalidInput(format!(
+        "[oscillator]: {purpose} needs mass, damping and stiffness; `{}` not given (only a \
+         force-domain fit on a measured force channel does without them)",
+        absent.join("`, `")
+    )))
+}
+
+impl ForceAlongMotion {
+    /// The producer for `records` under `opts` (`force_target`, `force_offset`, the energy
+    /// options for Eq. 7, the oscillator keys not given).
+    pub fn new(
+        records: &[Record],
+        osc: &Oscillator,
+        opts: &FitOptions,
+    ) -> Result<Self, EngineError> {
+        let mut tracks = Vec::with_capacity(records.len());
+        for record in records {
+            let source =
+                target_source(record, opts.force_target).map_err(|reason| EngineError::Record {
+                    record: record.name.clone(),
+                    reason,
+                })?;
+            if opts.force_offset && source != TargetSource::Measured {
+                return Err(EngineError::Record {
+                    record: record.name.clone(),
+                    reason: "[fit.options] force_offset = true needs a measured force channel \
+                             (this record is fitted to the energy-based force)"
+                        .into(),
+                });
+            }
+            tracks.push(ForceTrack::new(record, source, osc, opts)?);
+        }
+        let nuisance = if opts.force_offset {
+            vec![NuisanceKind::ForceOffset]
+        } else {
+            Vec::new()
+        };
+        Ok(Self { tracks, nuisance })
+    }
+
+    /// The prepared record `index`.
+    pub fn track(&self, index: usize) -> Option<&ForceTrack> {
+        self.tracks.get(index)
+    }
+
+    /// The mean normal force over every record \[N\].
+    pub fn mean_normal_force(&self) -> f64 {
+        let sum: f64 = self.tracks.iter().map(|t| t.normal.mean()).sum();
+        sum / self.tracks.len().max(1) as f64
+    }
+
+    fn track_of(&self, index: usize, record: &Record) -> Result<&ForceTrack, EngineError> {
+        self.tracks.get(index).ok_or_else(|| EngineError::Record {
+            record: record.name.clone(),
+            reason: format!("no prepared force track {index}"),
+        })
+    }
+}
+
+impl ForceTrack {
+    /// Prepares `record`: its motion, its normal force and its target from `source`.
+    fn new(
+        record: &Record,
+        source: TargetSource,
+        osc: &Oscillator,
+        opts: &FitOptions,
+    ) -> Result<Self, EngineError> {
+        let err = |reason: String| EngineError::Record {
+            record: record.name.clone(),
+            reason,
+        };
+        record.validate_channels(3)?;
+        let (velocity, displacement) = motion(record).ok_or_else(|| {
+            err(format!(
+                "a force-domain fit needs the motion: a velocity or displacement channel (the \
+                 record has: {})",
+                channel_list(&record.channels())
+            ))
+        })?;
+        let normal = normal_force(record, osc, &opts.unknown_oscillator).map_err(err)?;
+        let (used, target) = match source {
+            TargetSource::Measured => {
+                let f = record.channel(Channel::Force).unwrap_or_default().to_vec();
+                ((0..f.len()).collect(), f)
+            }
+            TargetSource::EnergyBased => {
+                require_mechanics(&opts.unknown_oscillator, "the energy-based force (Eq. 7)")?;
+                energy_target(record, &velocity, osc, opts)?
+            }
+        };
+        if target.len() < 2 {
+            return Err(err(format!(
+                "{} samples to compare the model force with (Eq. 7 is masked where |v| <= \
+                 [energy] velocity_threshold = {} m/s)",
+                target.len(),
+                opts.energy.velocity_threshold
+            )));
+        }
+        Ok(Self {
+            source,
+            time: record.time().to_vec(),
+            velocity,
+            displacement,
+            normal,
+            noise: noise_level(&target),
+            used,
+            target,
+        })
+    }
+}
+
+/// The velocity (measured, or the central difference of the displacement) and the
+/// displacement (measured, or the velocity integrated from x0) of a record; `None` without
+/// either channel.
+fn motion(record: &Record) -> Option<(Vec<f64>, Vec<f64>)> {
+    let time = record.time();
+    let measured_x = record.channel(Channel::Displacement);
+    let v = match record.channel(Channel::Velocity) {
+        Some(v) => v.to_vec(),
+        None => central_difference(time, measured_x?),
+    };
+    let x = match measured_x {
+        Some(x) => x.to_vec(),
+        None => cumulative_trapezoid(time, &v, record.x0),
+    };
+    Some((v, x))
+}
+
+/// The record's normal force, or its absence explained.
+fn normal_force(
+    record: &Record,
+    osc: &Oscillator,
+    unknown: &[String],
+) -> Result<NormalForce, String> {
+    match record.normal_force() {
+        Some(n) => Ok(n.clone()),
+        None if unknown.iter().any(|k| k == "normal_force") => Err(
+            "no normal force: give [oscillator] normal_force, the record's `normal_force` or a \
+             normal_force channel"
+                .into(),
+        ),
+        None => Ok(NormalForce::Constant(osc.normal_force)),
+    }
+}
+
+/// The target of a record under `force_target`.
+fn target_source(record: &Record, wanted: ForceTarget) -> Result<TargetSource, String> {
+    let has_force = record.channel(Channel::Force).is_some();
+    match (wanted, has_force) {
+        (ForceTarget::Measured, false) => Err(format!(
+            "[fit.options] force_target = \"measured\" but the record has no force channel \
+             (it has: {}; name its column with `force_column`)",
+            channel_list(&record.channels())
+        )),
+        (ForceTarget::Measured, true) | (ForceTarget::Auto, true) => Ok(TargetSource::Measured),
+        (ForceTarget::Energy, _) | (ForceTarget::Auto, false) => Ok(TargetSource::EnergyBased),
+    }
+}
+
+/// The energy-based force of Eq. 7 along `record` (its velocity, or `velocity` derived from
+/// its displacement), at the samples where it is defined.
+fn energy_target(
+    record: &Record,
+    velocity: &[f64],
+    osc: &Oscillator,
+    opts: &FitOptions,
+) -> Result<(Vec<usize>, Vec<f64>), EngineError> {
+    let analysed = if record.channel(Channel::Velocity).is_some() {
+        analyze_record(record, osc, &opts.energy)?
+    } else {
+        let with_v = record
+            .clone()
+            .with_channel(Channel::Velocity, velocity.to_vec());
+        analyze_record(&with_v, osc, &opts.energy)?
+    };
+    Ok(analysed
+        .friction
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| f.is_finite())
+        .map(|(i, &f)| (i, f))
+        .unzip())
+}
+
+/// Noise level of a sampled force: the median absolute deviation of its first differences,
+/// scaled to a standard deviation (1.4826 / sqrt 2), robust to the jumps at reversals and
+/// masks. Never below 1e-6 of the force's RMS (noise-free records), nor zero.
+pub fn noise_level(force: &[f64]) -> f64 {
+    let mut d: Vec<f64> = force.windows(2).map(|w| w[1] - w[0]).collect();
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(0.0)
+    };
+    let centre = median(&mut d);
+    let mut dev: Vec<f64> = d.iter().map(|x| (x - centre).abs()).collect();
+    let sigma = 1.4826 * median(&mut dev) / std::f64::consts::SQRT_2;
+    let rms = (force.iter().map(|f| f * f).sum::<f64>() / force.len().max(1) as f64).sqrt();
+    let floor = if rms > 0.0 { 1e-6 * rms } else { 1.0 };
+    sigma.max(floor)
+}
+
+impl Residuals for ForceAlongMotion {
+    fn channel(&self) -> &'static str {
+        "force"
+    }
+
+    /// `force` for a measured force, `energy_based_force` for Eq. 7.
+    fn record_channel(&self, index: usize) -> &'static str {
+        match self.tracks.get(index).map(|t| t.source) {
+            Some(TargetSource::EnergyBased) => "energy_based_force",
+            _ => "force",
+        }
+    }
+
+    fn unit(&self) -> &'static str {
+        "N"
+    }
+
+    fn nuisance(&self) -> &[NuisanceKind] {
+        &self.nuisance
+    }
+
+    fn measured<'a>(&'a self, index: usize, _record: &'a Record) -> &'a [f64] {
+        self.tracks
+            .get(index)
+            .map(|t| t.target.as_slice())
+            .unwrap_or_default()
+    }
+
+    fn predict(
+        &self,
+        at: &Evaluation<'_>,
+        index: usize,
+        record: &Record,
+        nuisance: &NuisanceValues,
+    ) -> Result<Vec<f64>, EngineError> {
+        let track = self.track_of(index, record)?;
+        at.count_simulation();
+        let budget = STEPS_PER_SAMPLE * (track.time.len() as u64).max(100);
+        let force = model_force_budgeted(
+            at.model,
+            &track.time,
+            &track.velocity,
+            &track.normal,
+            budget,
+        )
+        .map_err(|e| EngineError::Record {
+            record: record.name.clone(),
+            reason: e.to_string(),
+        })?;
+        Ok(track
+            .used
+            .iter()
+            .map(|&i| force[i] + nuisance.force_offset)
+            .collect())
+    }
+
+    fn residuals(
+        &self,
+        at: &Evaluation<'_>,
+        index: usize,
+        record: &Record,
+        nuisance: &NuisanceValues,
+    ) -> Result<Vec<f64>, EngineError> {
+        let track = self.track_of(index, record)?;
+        let mut out = self.predict(at, index, record, nuisance)?;
+        let w = record.weight.sqrt() / track.noise;
+        for (p, m) in out.iter_mut().zip(&track.target) {
+            *p = w * (*p - m);
+        }
+        Ok(out)
+    }
+
+    fn check_record(&self, record: &Record) -> Result<(), EngineError> {
+        record.validate_channels(3)
+    }
+
+    /// The friction level from the target (mean |F| over the compared samples over the mean
+    /// normal force), the typical speed from the motion.
+    fn hint(&self, osc: &Oscillator, _records: &[Record], _opts: &FitOptions) -> GuessHint {
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+        let levels: Vec<f64> = self
+            .tracks
+            .iter()
+            .map(|t| mean(&t.target.iter().map(|f| f.abs()).collect::<Vec<_>>()))
+            .collect();
+        let speeds: Vec<f64> = self
+            .tracks
+            .iter()
+            .map(|t| 0.5 * t.velocity.iter().fold(0.0f64, |m, v| m.max(v.abs())))
+            .collect();
+        let n = self.mean_normal_force();
+        let mu = mean(&levels) / n;
+        GuessHint {
+            mu: if mu.is_finite() && mu > 0.0 {
+                mu.clamp(1e-4, 5.0)
+            } else {
+                0.2
+            },
+            typical_velocity: Some(mean(&speeds)).filter(|s| *s > 0.0).unwrap_or(0.05),
+            normal_force: n,
+            stiffness: osc.stiffness,
+            mass: osc.mass,
+        }
+    }
+
+    fn simulates_response(&self) -> bool {
+        false
+    }
+
+    fn sample_axes(&self, index: usize, record: &Record) -> SampleAxes {
+        let Some(t) = self.tracks.get(index) else {
+            return SampleAxes {
+                time: record.time().to_vec(),
+                ..SampleAxes::default()
+            };
+        };
+        let pick = |v: &[f64]| t.used.iter().map(|&i| v[i]).collect();
+        SampleAxes {
+            time: pick(&t.time),
+            displacement: pick(&t.displacement),
+            velocity: pick(&t.velocity),
+        }
+    }
+}
+
+/// Options that only a velocity fit has, as the `[fit.options]` keys they are.
+fn velocity_only_options(opts: &FitOptions) -> Vec<&'static str> {
+    let mut keys = Vec::new();
+    for (on, key) in [
+        (opts.velocity_offset, "velocity_offset"),
+        (opts.time_shift, "time_shift"),
+        (opts.x0, "x0"),
+        (!opts.oscillator.is_empty(), "oscillator"),
+    ] {
+        if on {
+            keys.push(key);
+        }
+    }
+    keys
+}
+
+/// Fits `model`'s force along the measured motion of `records` to their target forces (see
+/// the module docs). The result's residuals are in N.
+pub fn fit_force(
+    osc: &Oscillator,
+    model: &(dyn FrictionModel + 'static),
+    records: &[Record],
+    opts: &FitOptions,
+) -> Result<FitResult, EngineError> {
+    let velocity_keys = velocity_only_options(opts);
+    if !velocity_keys.is_empty() {
+        return Err(EngineError::InvalidInput(format!(
+            "[fit.options] {} apply to velocity fits only, not with domain = \"force\"",
+            velocity_keys.join(", ")
+        )));
+    }
+    if opts.domain != FitDomain::Force {
+        return Err(EngineError::InvalidInput(
+            "fit_force needs [fit.options] domain = \"force\"".into(),
+        ));
+    }
+    let producer = ForceAlongMotion::new(records, osc, opts)?;
+    let mean_normal = producer.mean_normal_force();
+    let mut result = fit_with(Arc::new(producer), osc, model, records, opts)?;
+    if opts.unknown_oscillator.iter().any(|k| k == "normal_force") {
+        // The records carry the normal force; the result's oscillator shows their mean.
+        result.oscillator.normal_force = mean_normal;
+    }
+    Ok(result)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::record::TimeBase;
+
+    #[test]
+    fn the_noise_level_of_white_noise_on_a_ramp_is_its_sigma() {
+        let sigma = 0.01;
+        let mut f: Vec<f64> = (0..20_000).map(|i| 1.0 + 1e-5 * i as f64).collect();
+        crate::synthetic::add_gaussian_noise(&mut f, sigma, 3);
+        let est = noise_level(&f);
+        assert!((est / sigma - 1.0).abs() < 0.03, "{est}");
+        assert_eq!(noise_level(&[2.0, 2.0, 2.0]), 2e-6);
+    }
+
+    fn record(channels: &[(Channel, Vec<f64>)]) -> Record {
+        let time = TimeBase::new((0..50).map(|i| i as f64 * 1e-2).collect()).unwrap();
+        channels
+            .iter()
+            .fold(Record::from_time_base("r", time), |r, (c, v)| {
+                r.with_channel(*c, v.clone())
+            })
+    }
+
+    #[test]
+    fn targets_follow_the_channels_and_the_request() {
+        let x: Vec<f64> = (0..50).map(|i| 1e-3 * (i as f64 * 0.1).sin()).collect();
+        let with_force = record(&[
+            (Channel::Displacement, x.clone()),
+            (Channel::Force, vec![1.0; 50]),
+        ]);
+        let osc = Oscillator::fmm();
+        let opts = FitOptions {
+            domain: FitDomain::Force,
+            ..FitOptions::default()
+        };
+        let t = ForceAlongMotion::new(std::slice::from_ref(&with_force), &osc, &opts)
+            .unwrap()
+            .tracks
+            .remove(0);
+        assert_eq!(t.source, TargetSource::Measured);
+        // The velocity is the central difference of the displacement.
+        let v = central_difference(with_force.time(), &x);
+        assert_eq!(t.velocity, v);
+        let bare = record(&[(Channel::Displacement, x)]);
+        let measured = FitOptions {
+            force_target: ForceTarget::Measured,
+            ..opts.clone()
+        };
+        let e = ForceAlongMotion::new(std::slice::from_ref(&bare), &osc, &measured).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "record `r`: [fit.options] force_target = \"measured\" but the record has no force \
+             channel (it has: displacement; name its column with `force_column`)"
+        );
+        let no_mechanics = FitOptions {
+            unknown_oscillator: vec!["mass".into(), "stiffness".into()],
+            ..opts.clone()
+        };
+        let e = ForceAlongMotion::new(std::slice::from_ref(&bare), &osc, &no_mechanics)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("[oscillator]: the energy-based force (Eq. 7) needs mass, damping and stiffness; `mass`, `stiffness` not given"),
+            "{e}"
+        );
+        let no_motion = record(&[(Channel::Force, vec![1.0; 50])]);
+        let e = ForceAlongMotion::new(&[no_motion], &osc, &opts)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(
+                "needs the motion: a velocity or displacement channel (the record has: force)"
+            ),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,95 @@
+//! The force-domain prefit of velocity fits of dynamic models (the paper's own route).
+//!
+//! Eq. 7 gives the friction force along the measured motion without any fit. Fitting a
+//! model's force along that motion to it ([`super::force::fit_force`] with the energy-based
+//! target) needs no simulation of the mechanics and has no phase errors to trap the
+//! optimiser, so its optimum is a good start for the velocity fit of a model with internal
+//! states, whose default starts often end in a poor local minimum. The velocity fit runs its
+//! usual starts plus this one; the report says which start won. Static laws (no internal
+//! states) are not prefitted: their fit stays one start, one run.
+
+use super::force::fit_force;
+use super::options::{FitDomain, FitOptions, ForceTarget};
+use super::outcome::{Check, Finding, Status};
+use super::result::FitResult;
+use crate::error::EngineError;
+use crate::oscillator::Oscillator;
+use crate::record::Record;
+use frictionid_models::FrictionModel;
+
+/// The prefit's optimum and what it cost.
+pub struct Prefit {
+    /// The fitted model.
+    pub model: Box<dyn FrictionModel>,
+    /// RMS of the model force against the energy-based force \[N\].
+    pub rms_force: f64,
+    /// Wall time of the prefit \[s\].
+    pub wall_time_s: f64,
+}
+
+/// The prefit of `model` on `records`, when `opts` asks for it and the model has internal
+/// states (`None` otherwise); an error when the prefit itself failed.
+pub fn prefit(
+    osc: &Oscillator,
+    model: &(dyn FrictionModel + 'static),
+    records: &[Record],
+    opts: &FitOptions,
+) -> Option<Result<Prefit, EngineError>> {
+    if !opts.prefit || model.n_states() == 0 {
+        return None;
+    }
+    let force_opts = FitOptions {
+        domain: FitDomain::Force,
+        force_target: ForceTarget::Energy,
+        force_offset: false,
+        velocity_offset: false,
+        time_shift: false,
+        x0: false,
+        oscillator: Vec::new(),
+        uncertainty: Default::default(),
+        progress: None,
+        ..opts.clone()
+    };
+    Some(
+        fit_force(osc, model, records, &force_opts).map(|r: FitResult| Prefit {
+            model: r.fitted_model,
+            rms_force: r.rms_residual,
+            wall_time_s: r.wall_time_s,
+        }),
+    )
+}
+
+/// What the prefit gave the velocity fit `result`: its start (the last) and whether it won.
+pub fn prefit_finding(seed: &Result<Prefit, EngineError>, result: &FitResult) -> Finding {
+    let p = match seed {
+        Ok(p) => p,
+        Err(e) => {
+            return Finding::warn(
+                Check::Prefit,
+                None,
+                format!("the force-domain prefit failed ({e}); the velocity fit ran without it"),
+            )
+        }
+    };
+    let prefit_start = result.starts.saturating_sub(1);
+    let who = if result.best_start == prefit_start {
+        "the prefit start reached the best cost".to_string()
+    } else {
+        format!(
+            "start {} of the default starts reached the best cost",
+            result.best_start + 1
+        )
+    };
+    Finding::new(
+        Check::Prefit,
+        Status::Pass,
+        Some(p.rms_force),
+        format!(
+            "force-domain prefit on the energy-based force (RMS {:.4} N, {:.3} s) gave start {} of {}; {who}",
+            p.rms_force,
+            p.wall_time_s,
+            prefit_start + 1,
+            result.starts
+        ),
+    )
+}

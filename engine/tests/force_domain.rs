@@ -1,0 +1,250 @@
+//! Fits in the force domain against independent truths: a LuGre force along a prescribed
+//! sinusoidal motion under a varying normal force, integrated in this file by a fixed-step
+//! classical Runge-Kutta scheme (not the engine's stepper); and the energy-based route
+//! (Eq. 7, no force sensor) on the exact Coulomb free vibration and on Stribeck records.
+
+mod common;
+
+use common::{records, NOISE};
+use frictionid_engine::exact::coulomb_free_vibration;
+use frictionid_engine::identify::{fit, FitDomain, FitOptions, ForceTarget};
+use frictionid_engine::record::{Channel, TimeBase};
+use frictionid_engine::synthetic::add_gaussian_noise;
+use frictionid_engine::{Oscillator, Record};
+use frictionid_models::{Coulomb, FrictionModel, LuGre, Stribeck};
+use std::f64::consts::PI;
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+/// The prescribed motion: x = A sin(w t), 5 mm at 2 Hz.
+const AMPLITUDE: f64 = 5e-3;
+const OMEGA: f64 = 2.0 * PI * 2.0;
+
+fn x_of(t: f64) -> f64 {
+    AMPLITUDE * (OMEGA * t).sin()
+}
+
+fn v_of(t: f64) -> f64 {
+    AMPLITUDE * OMEGA * (OMEGA * t).cos()
+}
+
+/// The normal force: 10 N with a 2 N swing at 0.3 Hz.
+fn n_of(t: f64) -> f64 {
+    10.0 + 2.0 * (2.0 * PI * 0.3 * t).sin()
+}
+
+fn lugre_truth() -> LuGre {
+    LuGre {
+        sigma0: 1e5,
+        sigma1: 300.0,
+        sigma2: 5.0,
+        mu_c: 0.2,
+        mu_s: 0.3,
+        v_s: 0.01,
+    }
+}
+
+/// LuGre written out here: dz/dt = v - sigma0 |v| z / g(v), F = sigma0 z + sigma1 z' + sigma2 v.
+fn lugre_rates(p: &LuGre, t: f64, z: f64) -> (f64, f64) {
+    let v = v_of(t);
+    let g = n_of(t) * (p.mu_c + (p.mu_s - p.mu_c) * (-(v / p.v_s).powi(2)).exp());
+    let dz = v - p.sigma0 * v.abs() * z / g;
+    (dz, p.sigma0 * z + p.sigma1 * dz + p.sigma2 * v)
+}
+
+/// The truth force at `samples` sample instants 1 ms apart, from z(0) = 0, by classical RK4
+/// with 100 fixed steps per sample (h = 1e-5 s; the bristle rate sigma0 |v| / g is at most
+/// 3e3 1/s, so h * rate <= 0.03).
+fn lugre_force_record(p: &LuGre, samples: usize) -> (Vec<f64>, Vec<f64>) {
+    let dt = 1e-3;
+    let sub = 100;
+    let h = dt / sub as f64;
+    let (mut t, mut z) = (0.0, 0.0);
+    let mut time = Vec::with_capacity(samples);
+    let mut force = Vec::with_capacity(samples);
+    for i in 0..samples {
+        if i > 0 {
+            for _ in 0..sub {
+                let k1 = lugre_rates(p, t, z).0;
+                let k2 = lugre_rates(p, t + h / 2.0, z + h / 2.0 * k1).0;
+                let k3 = lugre_rates(p, t + h / 2.0, z + h / 2.0 * k2).0;
+                let k4 = lugre_rates(p, t + h, z + h * k3).0;
+                z += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+                t += h;
+            }
+        }
+        t = i as f64 * dt;
+        time.push(t);
+        force.push(lugre_rates(p, t, z).1);
+    }
+    (time, force)
+}
+
+fn force_record(time: Vec<f64>, force: Vec<f64>) -> Record {
+    let x = time.iter().map(|&t| x_of(t)).collect();
+    let v = time.iter().map(|&t| v_of(t)).collect();
+    let n = time.iter().map(|&t| n_of(t)).collect();
+    Record::from_time_base("lugre-rig", TimeBase::new(time).expect("time base"))
+        .with_channel(Channel::Displacement, x)
+        .with_channel(Channel::Velocity, v)
+        .with_channel(Channel::NormalForce, n)
+        .with_channel(Channel::Force, force)
+}
+
+fn force_options() -> FitOptions {
+    FitOptions {
+        domain: FitDomain::Force,
+        // m, c, k play no part: a measured force needs only the normal force.
+        unknown_oscillator: vec!["mass".into(), "damping".into(), "stiffness".into()],
+        ..FitOptions::default()
+    }
+}
+
+fn lugre_errors(fitted: &dyn FrictionModel) -> Vec<(String, f64)> {
+    let truth = lugre_truth().params();
+    fitted
+        .param_info()
+        .into_iter()
+        .zip(fitted.params().into_iter().zip(truth))
+        .map(|(p, (got, want))| (p.name, rel(got, want)))
+        .collect()
+}
+
+#[test]
+fn lugre_is_recovered_from_its_force_along_a_sinusoid_under_a_varying_normal_force() {
+    let (time, force) = lugre_force_record(&lugre_truth(), 3001);
+    let record = force_record(time, force);
+    let osc = Oscillator::fmm();
+    let r = fit(&osc, &LuGre::default(), &[record], &force_options()).unwrap();
+    assert!(r.converged, "{}", r.termination);
+    assert_eq!(
+        (r.compared.as_str(), r.residual_unit.as_str()),
+        ("force", "N")
+    );
+    for (name, e) in lugre_errors(r.fitted_model.as_ref()) {
+        assert!(e < 1e-3, "noise-free {name}: relative error {e:e}");
+    }
+}
+
+#[test]
+fn lugre_is_recovered_within_two_percent_from_a_noisy_force_with_a_load_cell_offset() {
+    let (time, mut force) = lugre_force_record(&lugre_truth(), 3001);
+    let sigma = 0.02;
+    add_gaussian_noise(&mut force, sigma, 7);
+    for f in &mut force {
+        *f += 0.15;
+    }
+    let record = force_record(time, force);
+    let opts = FitOptions {
+        force_offset: true,
+        ..force_options()
+    };
+    let r = fit(&Oscillator::fmm(), &LuGre::default(), &[record], &opts).unwrap();
+    assert!(r.converged, "{}", r.termination);
+    for (name, e) in lugre_errors(r.fitted_model.as_ref()) {
+        assert!(e < 0.02, "noisy {name}: relative error {e}");
+    }
+    let offset = r.value("force_offset[lugre-rig]").unwrap();
+    assert!(
+        (offset - 0.15).abs() < 3.0 * sigma / 10.0,
+        "offset {offset}"
+    );
+    // The residuals are the noise, in N.
+    assert!(rel(r.rms_residual, sigma) < 0.05, "rms {}", r.rms_residual);
+}
+
+/// The exact Coulomb free vibration from 10, 14 and 22 mm (2 s at 1 kHz).
+fn coulomb_records(osc: &Oscillator, mu: f64, noise: f64) -> Vec<Record> {
+    let time: Vec<f64> = (0..2001).map(|i| i as f64 * 1e-3).collect();
+    [0.010, 0.014, 0.022]
+        .iter()
+        .enumerate()
+        .map(|(i, &x0)| {
+            let mut v = coulomb_free_vibration(osc, mu * osc.normal_force, x0, &time)
+                .expect("exact solution")
+                .v;
+            if noise > 0.0 {
+                add_gaussian_noise(&mut v, noise, 40 + i as u64);
+            }
+            Record::new(format!("x{i}"), time.clone(), v, x0)
+        })
+        .collect()
+}
+
+fn energy_options() -> FitOptions {
+    FitOptions {
+        domain: FitDomain::Force,
+        force_target: ForceTarget::Energy,
+        ..FitOptions::default()
+    }
+}
+
+#[test]
+fn the_energy_based_route_gives_coulomb_mu() {
+    let osc = Oscillator::fmm();
+    let clean = fit(
+        &osc,
+        &Coulomb::default(),
+        &coulomb_records(&osc, 0.24, 0.0),
+        &energy_options(),
+    )
+    .unwrap();
+    let mu = clean.value("mu").unwrap();
+    assert!(rel(mu, 0.24) < 5e-3, "noise-free mu = {mu}");
+    assert!(clean.param("mu").unwrap().std_error.is_some());
+    let noisy = fit(
+        &osc,
+        &Coulomb::default(),
+        &coulomb_records(&osc, 0.24, NOISE),
+        &energy_options(),
+    )
+    .unwrap();
+    let mu = noisy.value("mu").unwrap();
+    assert!(rel(mu, 0.24) < 1e-2, "noisy mu = {mu}");
+}
+
+fn stribeck_truth() -> Stribeck {
+    Stribeck {
+        mu_c: 0.20,
+        mu_s: 0.28,
+        v_s: 0.02,
+        delta: 2.0,
+        viscous: 3.0,
+    }
+}
+
+#[test]
+fn the_energy_based_route_gives_the_stribeck_curve() {
+    let osc = Oscillator::fmm();
+    let truth = stribeck_truth();
+    let clean = fit(
+        &osc,
+        &Stribeck::default(),
+        &records(&osc, &truth, 0.0, 1),
+        &energy_options(),
+    )
+    .unwrap();
+    for (name, want) in [
+        ("mu_c", truth.mu_c),
+        ("mu_s", truth.mu_s),
+        ("v_s", truth.v_s),
+        ("viscous", truth.viscous),
+    ] {
+        let got = clean.value(name).unwrap();
+        assert!(
+            rel(got, want) < 5e-3,
+            "noise-free {name} = {got}, truth {want}"
+        );
+    }
+    let noisy = fit(
+        &osc,
+        &Stribeck::default(),
+        &records(&osc, &truth, NOISE, 51),
+        &energy_options(),
+    )
+    .unwrap();
+    let mu_c = noisy.value("mu_c").unwrap();
+    assert!(rel(mu_c, truth.mu_c) < 1e-2, "noisy mu_c = {mu_c}");
+}
