@@ -12,7 +12,7 @@
 
 use crate::data::MAX_SAMPLES;
 use crate::energy::{Differentiator, EnergyOptions};
-use crate::identify::{FitOptions, OscillatorParam, ProgressFn, PropertyUncertainty};
+use crate::identify::{FitOptions, OscillatorParam, ProgressFn, PropertyUncertainty, Search};
 use crate::oscillator::Oscillator;
 use crate::simulate::{Integrator, SimOptions};
 use frictionid_models::suggest::did_you_mean;
@@ -327,6 +327,7 @@ impl Spec {
             x0: extras.x0,
             uncertainty: self.uncertainty,
             multistart: extras.multistart,
+            search: extras.search,
             max_iterations: self.fit.max_iterations.unwrap_or(defaults.max_iterations),
             tolerance: self.fit.tolerance.or(defaults.tolerance),
             energy: self.energy.options(),
@@ -406,6 +407,9 @@ pub struct FitExtras {
     pub x0: bool,
     /// Number of starts (default: 1, or 4 when more than two model parameters are free).
     pub multistart: Option<usize>,
+    /// Search strategy: "local", "staged" or "global" (default: staged for models with
+    /// internal states or more than two free parameters, local otherwise).
+    pub search: Option<Search>,
     /// Data-driven initial values for parameters the model table does not give (default true).
     pub guess: Option<bool>,
     /// Models compared by `compare` when none are requested.

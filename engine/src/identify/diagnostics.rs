@@ -296,6 +296,11 @@ pub fn standard_errors(parameters: &[FittedParam], singular: bool) -> Finding {
     let missing: Vec<&str> = parameters
         .iter()
         .filter(|p| p.free && p.std_error.is_none())
+        // A one-sided or unidentifiable parameter has its own finding.
+        .filter(|p| {
+            p.identifiability
+                .is_none_or(|i| i == super::identifiability::Identifiability::Determined)
+        })
         .map(|p| p.name.as_str())
         .collect();
     if singular {
@@ -544,6 +549,8 @@ mod tests {
             ci95: None,
             unit: "1".into(),
             free: true,
+            identifiability: None,
+            bound: None,
             std_error_components: None,
         };
         let ok = standard_errors(&[p("mu", Some(0.01))], false);

@@ -5,14 +5,16 @@
 use super::budget::{apply_budget, Refit};
 use super::diagnostics;
 use super::energy_check::{energy_force_check, EnergyForce, ForceReference};
+use super::identifiability::{self, covariance_of_determined, Standing};
 use super::layout::{FreeParam, ParamKind};
 use super::options::{FitOptions, OscillatorParam};
 use super::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
 use super::problem::{FitProblem, ProblemParts, Realised};
 use super::residuals::{NuisanceValues, Residuals, VelocityResponse};
 use super::setup::{build_layout, Layout};
-use super::starts::{fit_starting_points, run_starts, start_count, MultiStart, StartRun};
-use super::stats::{self, aic, bic, covariance, t_quantile_975, Covariance};
+use super::starts::{run_starts, start_count, MultiStart, StartRun};
+use super::stats::{self, aic, bic, t_quantile_975, Covariance};
+use super::strategy::{self, plan_starts, Search, Seeded, StartPlan};
 use crate::energy::{analyze_record, model_force_along};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
@@ -70,21 +72,32 @@ pub fn fit_with<R: Residuals + 'static>(
         )
     };
     let reference = make_problem();
-    let runs = if layout.params.is_empty() {
-        evaluate_as_is(&reference)?
+    let search = Search::resolve(opts.search, model, layout.n_model_free());
+    let (runs, origins) = if layout.params.is_empty() {
+        (evaluate_as_is(&reference)?, vec!["as given".to_string()])
     } else {
-        let points = fit_starting_points(&layout.params, &layout.start, model, opts, n_starts);
-        run_starts(make_problem, &reference, &points, opts)?
+        let plan = StartPlan {
+            residuals: &residuals,
+            osc,
+            model,
+            records,
+            layout: &layout,
+            opts,
+        };
+        let seeded = plan_starts(&plan, search, n_starts);
+        let points: Vec<Vec<f64>> = seeded.iter().map(|s| s.point.clone()).collect();
+        let runs = run_starts(make_problem, &reference, &points, opts, search.promoted())?;
+        (runs, seeded.into_iter().map(|s: Seeded| s.origin).collect())
     };
+    let (runs, standings) = identifiability::settle(&reference, runs, opts)?;
     let context = FinishContext {
         opts,
         layout: &layout,
         reference: &reference,
-        n_starts: if layout.params.is_empty() {
-            1
-        } else {
-            n_starts
-        },
+        n_starts: origins.len(),
+        search,
+        origins: &origins,
+        standings: &standings,
     };
     let mut result = finish(&context, runs, clock)?;
     if opts.uncertainty.any() {
@@ -131,6 +144,7 @@ fn evaluate_as_is<R: Residuals>(reference: &FitProblem<R>) -> Result<MultiStart,
         iterations: 0,
         simulations: 0,
         starts_at_best: 1,
+        best_start: 0,
         outcomes: Vec::new(),
     })
 }
@@ -141,6 +155,11 @@ struct FinishContext<'a, R: Residuals> {
     layout: &'a Layout,
     reference: &'a FitProblem<R>,
     n_starts: usize,
+    search: Search,
+    /// Where each start came from.
+    origins: &'a [String],
+    /// What the records say about each free parameter.
+    standings: &'a [Standing],
 }
 
 /// The statistics at the best parameters.
@@ -157,12 +176,13 @@ struct Statistics {
 fn statistics<R: Residuals>(
     reference: &FitProblem<R>,
     best: &StartRun,
+    standings: &[Standing],
 ) -> Result<Statistics, EngineError> {
-    // Statistics in physical coordinates at the optimum.
+    // Statistics in physical coordinates at the optimum, of the determined parameters.
     let p_best = reference.physical(&best.u);
     let (jac, r) = reference.jacobian_physical(&p_best)?;
     let ssr = r.norm_squared();
-    let mut cov = covariance(&jac, ssr);
+    let mut cov = covariance_of_determined(&jac, ssr, standings);
     let segments: Vec<usize> = reference
         .records
         .iter()
@@ -245,11 +265,11 @@ fn finish<R: Residuals>(
     clock: Instant,
 ) -> Result<FitResult, EngineError> {
     let params = &ctx.layout.params;
-    let stats = statistics(ctx.reference, &runs.best)?;
+    let stats = statistics(ctx.reference, &runs.best, ctx.standings)?;
     let mut simulations = runs.simulations + ctx.reference.simulations();
     let fits = record_fits(ctx.reference, &stats.world, ctx.opts)?;
     simulations += ctx.reference.records.len() as u64;
-    let parameters = parameter_entries(&stats, params);
+    let parameters = parameter_entries(&stats, params, ctx.standings);
     let findings = diagnose(ctx, &runs, &stats, &parameters, &fits);
     let n_free = params.len();
     let samples = ctx.reference.n_residuals();
@@ -279,7 +299,18 @@ fn finish<R: Residuals>(
         iterations: runs.iterations,
         simulations,
         starts: ctx.n_starts,
-        starts_at_best: runs.starts_at_best,
+        starts_at_best: strategy::starts_at_best(
+            &runs.outcomes,
+            runs.best.cost,
+            stats.cov.residual_variance,
+        ),
+        search: ctx.search,
+        best_start: runs.best_start,
+        best_start_origin: ctx
+            .origins
+            .get(runs.best_start)
+            .cloned()
+            .unwrap_or_default(),
         start_outcomes: runs.outcomes,
         diagnostics: findings,
         warnings,
@@ -313,6 +344,14 @@ fn diagnose<R: Residuals>(
         ctx.opts,
         ctx.layout.n_model_free(),
     ));
+    let names: Vec<(String, String)> = params
+        .iter()
+        .map(|f| (f.name.clone(), f.unit.clone()))
+        .collect();
+    findings.extend(identifiability::findings(&names, ctx.standings));
+    findings.extend(identifiability::consistency_findings(
+        stats.world.model.as_ref(),
+    ));
     findings.extend(diagnostics::parameters_at_bounds(params, &stats.p_best));
     findings.extend(fits.findings.iter().cloned());
     findings.push(diagnostics::residual_structure(
@@ -335,9 +374,20 @@ fn start_findings(outcomes: &[StartOutcome]) -> Vec<Finding> {
 }
 
 /// Every model parameter (fitted or fixed), then the free oscillator and nuisance parameters.
-fn parameter_entries(stats: &Statistics, params: &[FreeParam]) -> Vec<FittedParam> {
+fn parameter_entries(
+    stats: &Statistics,
+    params: &[FreeParam],
+    standings: &[Standing],
+) -> Vec<FittedParam> {
     let se = &stats.cov.std_errors;
     let tq = stats.t_quantile;
+    let stand = |mut p: FittedParam, slot: Option<usize>| {
+        if let Some(s) = slot.and_then(|s| standings.get(s)) {
+            p.identifiability = Some(s.class);
+            p.bound = s.bound;
+        }
+        p
+    };
     let model = &stats.world.model;
     let mut out: Vec<FittedParam> = model
         .param_info()
@@ -346,13 +396,14 @@ fn parameter_entries(stats: &Statistics, params: &[FreeParam]) -> Vec<FittedPara
         .enumerate()
         .map(|(i, (p, v))| {
             let slot = params.iter().position(|f| f.kind == ParamKind::Model(i));
-            param_entry(&p.name, &p.unit, v, slot, se, tq)
+            stand(param_entry(&p.name, &p.unit, v, slot, se, tq), slot)
         })
         .collect();
     for (slot, f) in params.iter().enumerate() {
         if !matches!(f.kind, ParamKind::Model(_)) {
             let value = stats.p_best[slot];
-            out.push(param_entry(&f.name, &f.unit, value, Some(slot), se, tq));
+            let entry = param_entry(&f.name, &f.unit, value, Some(slot), se, tq);
+            out.push(stand(entry, Some(slot)));
         }
     }
     out
@@ -376,6 +427,8 @@ fn param_entry(
         ci95: std_error.map(|s| [value - tq * s, value + tq * s]),
         unit: unit.to_string(),
         free: slot.is_some(),
+        identifiability: None,
+        bound: None,
         std_error_components: None,
     }
 }
