@@ -131,13 +131,11 @@ fn presliding_is_a_lower_bound_on_coulomb_records(model: &(dyn FrictionModel + '
 }
 
 #[test]
-#[ignore = "open: the upward profile of sigma0 cannot be simulated by the explicit integrator past ~5e6 N/m; classification needs the stiff integrator (issue 13) or the halving retry, see the branch notes"]
 fn lugre_on_coulomb_records_bounds_sigma0_from_below() {
     presliding_is_a_lower_bound_on_coulomb_records(&LuGre::default());
 }
 
 #[test]
-#[ignore = "open: the upward profile of sigma0 cannot be simulated by the explicit integrator past ~5e6 N/m; classification needs the stiff integrator (issue 13) or the halving retry, see the branch notes"]
 fn dahl_on_coulomb_records_bounds_sigma0_from_below() {
     presliding_is_a_lower_bound_on_coulomb_records(&Dahl::default());
 }
