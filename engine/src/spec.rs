@@ -14,7 +14,7 @@ use crate::data::MAX_SAMPLES;
 use crate::energy::{Differentiator, EnergyOptions};
 use crate::identify::setup::non_model_bound_keys;
 use crate::identify::{
-    FitDomain, FitOptions, ForceTarget, OscillatorParam, ProgressFn, PropertyUncertainty,
+    FitDomain, FitOptions, ForceTarget, OscillatorParam, ProgressFn, PropertyUncertainty, Search,
 };
 use crate::oscillator::Oscillator;
 use crate::simulate::{Integrator, SimOptions};
@@ -353,6 +353,7 @@ impl Spec {
             prefit: extras.prefit.unwrap_or(defaults.prefit),
             unknown_oscillator: self.unknown_oscillator.clone(),
             multistart: extras.multistart,
+            search: extras.search,
             max_iterations: self.fit.max_iterations.unwrap_or(defaults.max_iterations),
             tolerance: self.fit.tolerance.or(defaults.tolerance),
             energy: self.energy.options(),
@@ -432,6 +433,9 @@ pub struct FitExtras {
     pub x0: bool,
     /// Number of starts (default: 1, or 4 when more than two model parameters are free).
     pub multistart: Option<usize>,
+    /// Search strategy: "local", "staged" or "global" (default: staged for models with
+    /// internal states or more than two free parameters, local otherwise).
+    pub search: Option<Search>,
     /// Data-driven initial values for parameters the model table does not give (default true).
     pub guess: Option<bool>,
     /// Models compared by `compare` when none are requested.

@@ -317,7 +317,7 @@ pub fn standard_errors(parameters: &[FittedParam], singular: bool) -> Finding {
         Check::StandardErrors,
         Some(missing.len() as f64),
         format!(
-            "no standard error for {}: the data do not constrain them at the optimum",
+            "no standard error for {}: the data do not constrain them at the optimum (the identifiability findings say on which side they are bounded)",
             missing
                 .iter()
                 .map(|n| format!("`{n}`"))
@@ -546,6 +546,8 @@ mod tests {
             ci95: None,
             unit: "1".into(),
             free: true,
+            identifiability: None,
+            bound: None,
             std_error_components: None,
         };
         let ok = standard_errors(&[p("mu", Some(0.01))], false);

@@ -6,16 +6,18 @@ use super::budget::{apply_budget, Refit};
 use super::diagnostics;
 use super::energy_check::{energy_force_check, EnergyForce, ForceReference};
 use super::force::{fit_force, require_mechanics};
+use super::identifiability::{self, covariance_of_determined, Standing};
 use super::layout::{FreeParam, ParamKind};
 use super::options::FitDomain;
 use super::options::{FitOptions, OscillatorParam};
 use super::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
-use super::prefit::{prefit, prefit_finding, Prefit};
+use super::prefit::{prefit, prefit_finding, Prefit, PREFIT_ORIGIN};
 use super::problem::{FitProblem, ProblemParts, Realised};
 use super::residuals::{NuisanceValues, Residuals, VelocityResponse};
 use super::setup::{build_layout, Layout};
-use super::starts::{fit_starting_points, run_starts, start_count, MultiStart, StartRun};
-use super::stats::{self, aic, bic, covariance, t_quantile_975, Covariance};
+use super::starts::{run_starts, start_count, MultiStart, StartRun};
+use super::stats::{self, aic, bic, t_quantile_975, Covariance};
+use super::strategy::{self, plan_starts, Search, Seeded, StartPlan};
 use crate::energy::{analyze_record, model_force_along};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
@@ -89,7 +91,7 @@ fn fit_seeded<R: Residuals + 'static>(
     check_inputs(osc, model, records, residuals.as_ref())?;
     let layout = build_layout(osc, model, records, residuals.as_ref(), opts)?;
     let seed_model = seed.and_then(|s| s.as_ref().ok()).map(|p| &p.model);
-    let n_starts = start_count(opts, layout.n_model_free())? + usize::from(seed_model.is_some());
+    let n_starts = start_count(opts, layout.n_model_free())?;
     let shared: Arc<[Record]> = records.into();
     let make_problem = || {
         FitProblem::new(
@@ -105,25 +107,39 @@ fn fit_seeded<R: Residuals + 'static>(
         )
     };
     let reference = make_problem();
-    let runs = if layout.params.is_empty() {
-        evaluate_as_is(&reference)?
+    let search = Search::resolve(opts.search, model, layout.n_model_free());
+    let (runs, origins) = if layout.params.is_empty() {
+        (evaluate_as_is(&reference)?, vec!["as given".to_string()])
     } else {
-        let mut points = fit_starting_points(&layout.params, &layout.start, model, opts, n_starts);
-        if let Some(seeded) = seed_model {
-            points.truncate(n_starts - 1);
-            points.push(seeded_point(&layout, seeded.as_ref()));
+        let plan = StartPlan {
+            residuals: &residuals,
+            osc,
+            model,
+            records,
+            layout: &layout,
+            opts,
+        };
+        let mut seeded = plan_starts(&plan, search, n_starts);
+        if let Some(prefit) = seed_model {
+            // Last, where the prefit finding looks for it.
+            seeded.push(Seeded {
+                point: seeded_point(&layout, prefit.as_ref()),
+                origin: PREFIT_ORIGIN.into(),
+            });
         }
-        run_starts(make_problem, &reference, &points, opts)?
+        let points: Vec<Vec<f64>> = seeded.iter().map(|s| s.point.clone()).collect();
+        let runs = run_starts(make_problem, &reference, &points, opts, search.promoted())?;
+        (runs, seeded.into_iter().map(|s: Seeded| s.origin).collect())
     };
+    let (runs, standings) = identifiability::settle(&reference, runs, opts)?;
     let context = FinishContext {
         opts,
         layout: &layout,
         reference: &reference,
-        n_starts: if layout.params.is_empty() {
-            1
-        } else {
-            n_starts
-        },
+        n_starts: origins.len(),
+        search,
+        origins: &origins,
+        standings: &standings,
     };
     let mut result = finish(&context, runs, clock)?;
     if opts.uncertainty.any() {
@@ -200,6 +216,11 @@ struct FinishContext<'a, R: Residuals> {
     layout: &'a Layout,
     reference: &'a FitProblem<R>,
     n_starts: usize,
+    search: Search,
+    /// Where each start came from.
+    origins: &'a [String],
+    /// What the records say about each free parameter.
+    standings: &'a [Standing],
 }
 
 /// The statistics at the best parameters.
@@ -216,12 +237,13 @@ struct Statistics {
 fn statistics<R: Residuals>(
     reference: &FitProblem<R>,
     best: &StartRun,
+    standings: &[Standing],
 ) -> Result<Statistics, EngineError> {
-    // Statistics in physical coordinates at the optimum.
+    // Statistics in physical coordinates at the optimum, of the determined parameters.
     let p_best = reference.physical(&best.u);
     let (jac, r) = reference.jacobian_physical(&p_best)?;
     let ssr = r.norm_squared();
-    let mut cov = covariance(&jac, ssr);
+    let mut cov = covariance_of_determined(&jac, ssr, standings);
     let segments: Vec<usize> = reference
         .records
         .iter()
@@ -304,11 +326,11 @@ fn finish<R: Residuals>(
     clock: Instant,
 ) -> Result<FitResult, EngineError> {
     let params = &ctx.layout.params;
-    let stats = statistics(ctx.reference, &runs.best)?;
+    let stats = statistics(ctx.reference, &runs.best, ctx.standings)?;
     let mut simulations = runs.simulations + ctx.reference.simulations();
     let fits = record_fits(ctx.reference, &stats.world, ctx.opts)?;
     simulations += ctx.reference.records.len() as u64;
-    let parameters = parameter_entries(&stats, params);
+    let parameters = parameter_entries(&stats, params, ctx.standings);
     let findings = diagnose(ctx, &runs, &stats, &parameters, &fits);
     let n_free = params.len();
     let samples = ctx.reference.n_residuals();
@@ -340,8 +362,18 @@ fn finish<R: Residuals>(
         iterations: runs.iterations,
         simulations,
         starts: ctx.n_starts,
-        starts_at_best: runs.starts_at_best,
+        starts_at_best: strategy::starts_at_best(
+            &runs.outcomes,
+            runs.best.cost,
+            stats.cov.residual_variance,
+        ),
+        search: ctx.search,
         best_start: runs.best_start,
+        best_start_origin: ctx
+            .origins
+            .get(runs.best_start)
+            .cloned()
+            .unwrap_or_default(),
         start_outcomes: runs.outcomes,
         diagnostics: findings,
         warnings,
@@ -375,6 +407,14 @@ fn diagnose<R: Residuals>(
         ctx.opts,
         ctx.layout.n_model_free(),
     ));
+    let names: Vec<(String, String)> = params
+        .iter()
+        .map(|f| (f.name.clone(), f.unit.clone()))
+        .collect();
+    findings.extend(identifiability::findings(&names, ctx.standings));
+    findings.extend(identifiability::consistency_findings(
+        stats.world.model.as_ref(),
+    ));
     findings.extend(diagnostics::parameters_at_bounds(params, &stats.p_best));
     findings.extend(fits.findings.iter().cloned());
     if ctx.reference.residuals.simulates_response() {
@@ -399,9 +439,20 @@ fn start_findings(outcomes: &[StartOutcome]) -> Vec<Finding> {
 }
 
 /// Every model parameter (fitted or fixed), then the free oscillator and nuisance parameters.
-fn parameter_entries(stats: &Statistics, params: &[FreeParam]) -> Vec<FittedParam> {
+fn parameter_entries(
+    stats: &Statistics,
+    params: &[FreeParam],
+    standings: &[Standing],
+) -> Vec<FittedParam> {
     let se = &stats.cov.std_errors;
     let tq = stats.t_quantile;
+    let stand = |mut p: FittedParam, slot: Option<usize>| {
+        if let Some(s) = slot.and_then(|s| standings.get(s)) {
+            p.identifiability = Some(s.class);
+            p.bound = s.bound;
+        }
+        p
+    };
     let model = &stats.world.model;
     let mut out: Vec<FittedParam> = model
         .param_info()
@@ -410,13 +461,14 @@ fn parameter_entries(stats: &Statistics, params: &[FreeParam]) -> Vec<FittedPara
         .enumerate()
         .map(|(i, (p, v))| {
             let slot = params.iter().position(|f| f.kind == ParamKind::Model(i));
-            param_entry(&p.name, &p.unit, v, slot, se, tq)
+            stand(param_entry(&p.name, &p.unit, v, slot, se, tq), slot)
         })
         .collect();
     for (slot, f) in params.iter().enumerate() {
         if !matches!(f.kind, ParamKind::Model(_)) {
             let value = stats.p_best[slot];
-            out.push(param_entry(&f.name, &f.unit, value, Some(slot), se, tq));
+            let entry = param_entry(&f.name, &f.unit, value, Some(slot), se, tq);
+            out.push(stand(entry, Some(slot)));
         }
     }
     out
@@ -440,6 +492,8 @@ fn param_entry(
         ci95: std_error.map(|s| [value - tq * s, value + tq * s]),
         unit: unit.to_string(),
         free: slot.is_some(),
+        identifiability: None,
+        bound: None,
         std_error_components: None,
     }
 }

@@ -101,6 +101,16 @@ impl FreeParam {
         }
     }
 
+    /// A physical value clipped into the bounds (strictly positive for log coordinates).
+    pub fn clip(&self, p: f64) -> f64 {
+        let lo = if self.log {
+            self.lower.max(f64::MIN_POSITIVE)
+        } else {
+            self.lower
+        };
+        p.clamp(lo, self.upper)
+    }
+
     /// The bounds in internal coordinates.
     pub fn internal_bounds(&self) -> (f64, f64) {
         if self.log {

@@ -11,7 +11,9 @@
 //! - [`problem::FitProblem`]: generic over the producer; implements argmin's `Operator` and
 //!   `Jacobian`, so the solver, our bounded Levenberg-Marquardt ([`lm::LevenbergMarquardt`],
 //!   an argmin `Solver`), knows nothing of friction.
-//! - [`starts`]: the multi-start strategy; [`setup`]: options to free parameters.
+//! - [`starts`]: the multi-start runs; [`strategy`]: where the starts come from (`local`,
+//!   `staged`, `global`); [`identifiability`]: which parameters the records determine;
+//!   [`setup`]: options to free parameters.
 //! - [`outcome`]: typed outcomes ([`outcome::TerminationReason`], [`outcome::StartOutcome`])
 //!   and the findings ([`outcome::Finding`]) every [`FitResult`] carries.
 //! - [`energy_check::energy_force_check`]: the energy-balance check, shared with the
@@ -23,6 +25,7 @@ pub mod diagnostics;
 pub mod energy_check;
 pub mod fit;
 pub mod force;
+pub mod identifiability;
 pub mod layout;
 pub mod lm;
 pub mod options;
@@ -34,14 +37,17 @@ pub mod result;
 pub mod setup;
 pub mod starts;
 pub mod stats;
+pub mod strategy;
 
 pub use budget::{PropertyUncertainty, StdErrorComponents};
 pub use compare::{compare, Comparison, ComparisonVerdict, FailedFit};
 pub use energy_check::{energy_force_check, EnergyForce, ForceReference};
 pub use fit::{fit, fit_with, guess_hint, Derived, FitResult, FittedParam, RecordFit};
 pub use force::{fit_force, require_mechanics, ForceAlongMotion};
+pub use identifiability::Identifiability;
 pub use lm::LevenbergMarquardt;
 pub use options::{FitDomain, FitOptions, ForceTarget, OscillatorParam, Progress, ProgressFn};
 pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
 pub use residuals::{Evaluation, NuisanceKind, NuisanceValues, Residuals, VelocityResponse};
 pub use result::{Rank, Verdict};
+pub use strategy::Search;

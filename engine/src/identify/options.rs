@@ -1,6 +1,7 @@
 //! What a fit varies and how.
 
 use super::budget::PropertyUncertainty;
+use super::strategy::Search;
 use crate::energy::EnergyOptions;
 use crate::simulate::SimOptions;
 use serde::{Deserialize, Serialize};
@@ -137,6 +138,9 @@ pub struct FitOptions {
     /// Number of starts; `None`: 1 when at most two model parameters are free, else
     /// [`super::starts::DEFAULT_STARTS`].
     pub multistart: Option<usize>,
+    /// Search strategy; `None`: `staged` for models with internal states or more than two
+    /// free parameters, `local` otherwise (see [`super::strategy`]).
+    pub search: Option<Search>,
     /// Iteration limit of each start.
     pub max_iterations: u64,
     /// Convergence tolerance on the relative cost reduction of a step (solver default 1e-9).
@@ -169,6 +173,7 @@ impl Default for FitOptions {
             prefit: true,
             unknown_oscillator: Vec::new(),
             multistart: None,
+            search: None,
             max_iterations: 200,
             tolerance: None,
             sim: SimOptions {
@@ -200,6 +205,7 @@ impl std::fmt::Debug for FitOptions {
             .field("prefit", &self.prefit)
             .field("unknown_oscillator", &self.unknown_oscillator)
             .field("multistart", &self.multistart)
+            .field("search", &self.search)
             .field("max_iterations", &self.max_iterations)
             .field("parallel", &self.parallel)
             .finish_non_exhaustive()

@@ -34,6 +34,12 @@ pub enum TerminationReason {
         /// The limit.
         limit: u64,
     },
+    /// The iteration limit was reached only because the named parameters kept running
+    /// towards a value the records do not bound; with them held, the others converged.
+    ConvergedExceptUnbounded {
+        /// The unbounded parameters.
+        parameters: Vec<String>,
+    },
     /// Any other stop reported by the solver framework (e.g. an interrupt).
     Other {
         /// The framework's text.
@@ -65,6 +71,11 @@ impl fmt::Display for TerminationReason {
                 f.write_str("converged: no further decrease possible (damping limit)")
             }
             Self::IterationLimit { limit } => write!(f, "iteration limit ({limit}) reached"),
+            Self::ConvergedExceptUnbounded { parameters } => write!(
+                f,
+                "converged for the other parameters: `{}` kept running to a value the records do not bound",
+                parameters.join("`, `")
+            ),
             Self::Other { text } => f.write_str(text),
         }
     }
@@ -171,6 +182,8 @@ pub enum Check {
     NoiseCorrelation,
     /// The force-domain prefit that gave a velocity fit one of its starts.
     Prefit,
+    /// The fitted model is physically doubtful (e.g. mu_s < mu_c).
+    PhysicalConsistency,
 }
 
 /// One diagnostic of a fit: a check, its status, the value it judged and a plain message.

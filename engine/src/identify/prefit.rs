@@ -59,6 +59,9 @@ pub fn prefit(
     )
 }
 
+/// The origin a fit reports for the start the prefit gave.
+pub const PREFIT_ORIGIN: &str = "force-domain prefit";
+
 /// What the prefit gave the velocity fit `result`: its start (the last) and whether it won.
 pub fn prefit_finding(seed: &Result<Prefit, EngineError>, result: &FitResult) -> Finding {
     let p = match seed {
@@ -72,7 +75,7 @@ pub fn prefit_finding(seed: &Result<Prefit, EngineError>, result: &FitResult) ->
         }
     };
     let prefit_start = result.starts.saturating_sub(1);
-    let who = if result.best_start == prefit_start {
+    let who = if result.best_start_origin == PREFIT_ORIGIN {
         "the prefit start reached the best cost".to_string()
     } else {
         format!(

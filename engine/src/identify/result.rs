@@ -2,7 +2,9 @@
 
 use super::budget::StdErrorComponents;
 use super::energy_check::EnergyForce;
+use super::identifiability::Identifiability;
 use super::outcome::{as_display, worst_status, Finding, StartOutcome, Status, TerminationReason};
+use super::strategy::Search;
 use crate::oscillator::Oscillator;
 use frictionid_models::FrictionModel;
 use serde::Serialize;
@@ -22,6 +24,14 @@ pub struct FittedParam {
     pub unit: String,
     /// Whether it was fitted.
     pub free: bool,
+    /// What the records say about it (fitted parameters only): `determined`, or a one-sided
+    /// `lower_bound` / `upper_bound` (then `bound` holds the 95 % bound and there is no
+    /// standard error), or `not_identifiable`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub identifiability: Option<Identifiability>,
+    /// The 95 % bound of a one-sided parameter.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bound: Option<f64>,
     /// The parts of `std_error` when the oscillator's properties are uncertain (then
     /// `std_error` is their total).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -128,10 +138,15 @@ pub struct FitResult {
     pub simulations: u64,
     /// Number of starts.
     pub starts: usize,
-    /// Starts that reached the best cost (within 1e-6 relative).
+    /// Starts that reached the best cost within its statistical tolerance (a cost difference
+    /// of at most chi²(1 dof, 95 %) / 2 residual variances).
     pub starts_at_best: usize,
-    /// The start that reached the best cost (0-based, in start order).
+    /// The search strategy.
+    pub search: Search,
+    /// The start that won (index into `start_outcomes`).
     pub best_start: usize,
+    /// Where the winning start came from (`staged from stribeck`, `data-driven guess`, ...).
+    pub best_start_origin: String,
     /// What became of each start, in start order.
     pub start_outcomes: Vec<StartOutcome>,
     /// The checks of this fit, each pass, warn or fail.

@@ -23,7 +23,8 @@ pub const MAX_STARTS: usize = 1000;
 /// Iterations every start of a multi-start fit runs before the most promising is continued.
 pub const SCREEN_ITERATIONS: u64 = 15;
 
-/// Starts continued to convergence after the screening phase (the best one).
+/// Starts continued to convergence after the screening phase by a local search (the best
+/// one; see `Search::promoted`).
 pub const PROMOTED_STARTS: usize = 1;
 
 /// One start's run: where it ended and how.
@@ -93,12 +94,7 @@ pub fn starting_points(layout: &[FreeParam], start: &[f64], n: usize) -> Vec<Vec
                 } else {
                     f.scale * (q + 1.0)
                 };
-                let lo = if f.log {
-                    f.lower.max(f64::MIN_POSITIVE)
-                } else {
-                    f.lower
-                };
-                x.clamp(lo, f.upper)
+                f.clip(x)
             })
             .collect();
         out.push(p);
@@ -242,14 +238,14 @@ pub fn run_start<R: Residuals + 'static>(
 pub struct MultiStart {
     /// The run with the lowest cost.
     pub best: StartRun,
+    /// Its start's index.
+    pub best_start: usize,
     /// Solver iterations over all starts.
     pub iterations: u64,
     /// Simulations over all starts.
     pub simulations: u64,
     /// Starts that reached the best cost (within 1e-6 relative).
     pub starts_at_best: usize,
-    /// The start of the best run.
-    pub best_start: usize,
     /// One outcome per start, in start order.
     pub outcomes: Vec<StartOutcome>,
 }
@@ -285,13 +281,14 @@ fn classify(runs: Vec<Result<StartRun, EngineError>>) -> Screened {
 }
 
 /// Runs every start from `points` (phase 1: each for a few iterations when there are several;
-/// phase 2: the most promising to the iteration limit) and picks the best.
+/// phase 2: the `promote` most promising to the iteration limit) and picks the best.
 /// `make_problem` builds a fresh problem per run; `reference` explains a total failure.
 pub fn run_starts<R, F>(
     make_problem: F,
     reference: &FitProblem<R>,
     points: &[Vec<f64>],
     opts: &FitOptions,
+    promote: usize,
 ) -> Result<MultiStart, EngineError>
 where
     R: Residuals + 'static,
@@ -320,25 +317,38 @@ where
     };
     let mut screened = classify(runs);
     if n_starts > 1 && screen < opts.max_iterations {
-        continue_best(&make_problem, &mut screened, opts, screen, n_starts);
+        let phase = Phase {
+            screen,
+            n_starts,
+            promote,
+        };
+        continue_best(&make_problem, &mut screened, opts, phase);
     }
     let first_error = screened.first_error.take();
     pick_best(screened).ok_or_else(|| total_failure(first_error, reference, points))
 }
 
-/// Phase 2: continues the best screened start (unless it converged) to the iteration limit.
-fn continue_best<R, F>(
-    make_problem: &F,
-    screened: &mut Screened,
-    opts: &FitOptions,
+/// The screening's iterations, the number of starts and how many are continued.
+#[derive(Clone, Copy)]
+struct Phase {
     screen: u64,
     n_starts: usize,
-) where
+    promote: usize,
+}
+
+/// Phase 2: continues the best screened starts (unless converged) to the iteration limit.
+fn continue_best<R, F>(make_problem: &F, screened: &mut Screened, opts: &FitOptions, phase: Phase)
+where
     R: Residuals + 'static,
     F: Fn() -> FitProblem<R> + Sync,
 {
     screened.ok.sort_by(|a, b| a.1.cost.total_cmp(&b.1.cost));
-    let keep = PROMOTED_STARTS.min(screened.ok.len());
+    let Phase {
+        screen,
+        n_starts,
+        promote,
+    } = phase;
+    let keep = promote.max(1).min(screened.ok.len());
     let promoted: Vec<(usize, DVector<f64>)> = screened.ok[..keep]
         .iter()
         .filter(|(_, o)| !o.converged())
@@ -417,8 +427,7 @@ fn pick_best(screened: Screened) -> Option<MultiStart> {
         .iter()
         .filter(|(_, o)| o.cost <= best_cost * (1.0 + 1e-6) + 1e-300)
         .count();
-    let mut best = None;
-    let mut best_start = 0;
+    let mut best: Option<(usize, StartRun)> = None;
     for (start, run) in ok {
         if !outcomes.iter().any(|(s, _)| *s == start) {
             outcomes.push((
@@ -433,19 +442,19 @@ fn pick_best(screened: Screened) -> Option<MultiStart> {
         }
         let better = best
             .as_ref()
-            .is_none_or(|b: &StartRun| run.cost.total_cmp(&b.cost).is_lt());
+            .is_none_or(|(_, b)| run.cost.total_cmp(&b.cost).is_lt());
         if better {
-            best = Some(run);
-            best_start = start;
+            best = Some((start, run));
         }
     }
     outcomes.sort_by_key(|(s, _)| *s);
+    let (best_start, best) = best?;
     Some(MultiStart {
-        best: best?,
+        best,
+        best_start,
         iterations,
         simulations,
         starts_at_best,
-        best_start,
         outcomes: outcomes.into_iter().map(|(_, o)| o).collect(),
     })
 }

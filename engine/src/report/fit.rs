@@ -46,6 +46,19 @@ impl Serialize for FitReport {
     }
 }
 
+/// `fixed`, `fitted`, or what bounds a parameter the records do not determine
+/// (`fitted, > 3.1e6` for a lower bound at 95 %).
+fn fit_status(p: &FittedParam) -> String {
+    use crate::identify::Identifiability as I;
+    match (p.free, p.identifiability, p.bound) {
+        (false, _, _) => "fixed".into(),
+        (true, Some(I::LowerBound), Some(b)) => format!("fitted, > {} at 95 %", fmt_num(b)),
+        (true, Some(I::UpperBound), Some(b)) => format!("fitted, < {} at 95 %", fmt_num(b)),
+        (true, Some(I::NotIdentifiable), _) => "fitted, not identifiable".into(),
+        (true, _, _) => "fitted".into(),
+    }
+}
+
 /// The parameter table of a fit; with an uncertainty budget, a last column names the source
 /// that dominates each parameter's standard error.
 pub fn parameter_table(fit: &FitResult) -> Table {
@@ -60,7 +73,7 @@ pub fn parameter_table(fit: &FitResult) -> Table {
                 fmt_std_error(p.std_error),
                 fmt_interval(p),
                 p.unit.clone(),
-                if p.free { "fitted" } else { "fixed" }.into(),
+                fit_status(p),
             ];
             if budget {
                 row.push(dominant_source(p));
@@ -290,7 +303,7 @@ impl FitReport {
     fn statistics_text(&self) -> String {
         let f = &self.fit;
         format!(
-            "RMS {} residual {} {}; AIC {}; BIC {}; {} iterations, {} simulations, {} s.",
+            "RMS {} residual {} {}; AIC {}; BIC {}; {} iterations, {} simulations, {} s. Search `{}`: {} of {} starts reached the best cost within its statistical tolerance; start {} ({}) won.",
             f.compared,
             fmt_num(f.rms_residual),
             f.residual_unit,
@@ -298,7 +311,12 @@ impl FitReport {
             fmt_criterion(f.bic),
             f.iterations,
             f.simulations,
-            fmt_num(f.wall_time_s)
+            fmt_num(f.wall_time_s),
+            f.search.name(),
+            f.starts_at_best,
+            f.starts,
+            f.best_start,
+            f.best_start_origin
         )
     }
 

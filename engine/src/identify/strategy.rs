@@ -1,0 +1,449 @@
+//! Search strategies of a fit (`[fit.options] search`): where the starts of the multi-start
+//! Levenberg-Marquardt come from.
+//!
+//! - `local`: the data-driven guess and points spread around it ([`super::starts`]).
+//! - `staged`: first the static laws along the model hierarchy (coulomb, then stribeck when
+//!   the target has Stribeck levels), each one start, one run; their optima are mapped onto
+//!   the target through `FrictionModel::start_from` (presliding stiffness from the typical
+//!   presliding displacement and a tenth of it) and start the target alongside the local
+//!   starts.
+//! - `global`: the staged starts, plus a seeded Latin hypercube over the physical box in the
+//!   solver's (log) coordinates; all are screened and the best few refined.
+
+use super::identifiability::PROFILE_DELTA;
+use super::layout::{FreeParam, ParamKind};
+use super::options::FitOptions;
+use super::outcome::StartOutcome;
+use super::problem::{FitProblem, ProblemParts};
+use super::residuals::Residuals;
+use super::setup::{build_layout, non_model_bound_keys, Layout};
+use super::starts::{fit_starting_points, run_starts, PROMOTED_STARTS};
+use crate::oscillator::Oscillator;
+use crate::record::Record;
+use frictionid_models::start::TYPICAL_PRESLIDING_DISPLACEMENT;
+use frictionid_models::{clone_model, Coulomb, FrictionModel, StartContext, Stribeck};
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+/// How a fit searches for its optimum.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Search {
+    /// Starts around the data-driven guess.
+    Local,
+    /// Static laws first; their optima start the target (the default for models with
+    /// internal states or more than two free parameters).
+    Staged,
+    /// Staged starts plus a Latin hypercube over the physical box.
+    Global,
+}
+
+/// Latin-hypercube starts a `global` search adds.
+pub const GLOBAL_STARTS: usize = 12;
+
+/// Half-width of the global box around the start, as a factor (log coordinates).
+pub const GLOBAL_SPAN: f64 = 100.0;
+
+/// Seed of the global search's Latin hypercube (runs are reproducible).
+pub const GLOBAL_SEED: u64 = 0x5eed_0014;
+
+/// Presliding displacements (multiples of the typical one) that map the last stage onto
+/// the target: the typical one and a stiffer contact.
+pub const STAGED_PRESLIDING: [f64; 2] = [1.0, 0.1];
+
+impl Search {
+    /// Config name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Local => "local",
+            Self::Staged => "staged",
+            Self::Global => "global",
+        }
+    }
+
+    /// The strategy asked for, else `staged` for a model with internal states or more than
+    /// two free parameters and `local` otherwise (a Coulomb fit stays one start, one run).
+    pub fn resolve(asked: Option<Self>, model: &dyn FrictionModel, n_model_free: usize) -> Self {
+        asked.unwrap_or(if model.n_states() > 0 || n_model_free > 2 {
+            Self::Staged
+        } else {
+            Self::Local
+        })
+    }
+
+    /// Screened starts continued to convergence.
+    pub fn promoted(self) -> usize {
+        match self {
+            Self::Local => PROMOTED_STARTS,
+            Self::Staged => 2,
+            Self::Global => 3,
+        }
+    }
+}
+
+/// A starting point and where it came from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Seeded {
+    /// Physical values of the free parameters.
+    pub point: Vec<f64>,
+    /// `data-driven guess`, `spread around the guess`, `staged from coulomb`, ...
+    pub origin: String,
+}
+
+/// What the starts of a fit need to know.
+pub struct StartPlan<'a, R: Residuals> {
+    /// The residuals of the fit (the stages use them too).
+    pub residuals: &'a Arc<R>,
+    /// The oscillator.
+    pub osc: &'a Oscillator,
+    /// The model as configured.
+    pub model: &'a (dyn FrictionModel + 'static),
+    /// The records.
+    pub records: &'a [Record],
+    /// The target's layout.
+    pub layout: &'a Layout,
+    /// The fit's options.
+    pub opts: &'a FitOptions,
+}
+
+/// Every starting point of `search`: staged ones first, then the local ones, then (global)
+/// the Latin hypercube; duplicates dropped.
+pub fn plan_starts<R: Residuals + 'static>(
+    plan: &StartPlan<'_, R>,
+    search: Search,
+    n_local: usize,
+) -> Vec<Seeded> {
+    let mut out = Vec::new();
+    if search != Search::Local {
+        out.extend(staged_points(plan));
+    }
+    let local = fit_starting_points(
+        &plan.layout.params,
+        &plan.layout.start,
+        plan.model,
+        plan.opts,
+        n_local,
+    );
+    for (i, point) in local.into_iter().enumerate() {
+        let origin = if i == 0 {
+            "data-driven guess"
+        } else {
+            "spread around the guess"
+        };
+        out.push(Seeded {
+            point,
+            origin: origin.into(),
+        });
+    }
+    if search == Search::Global {
+        out.extend(global_points(plan.layout, GLOBAL_STARTS, GLOBAL_SEED));
+    }
+    let mut unique: Vec<Seeded> = Vec::with_capacity(out.len());
+    for s in out {
+        if !unique.iter().any(|u| u.point == s.point) {
+            unique.push(s);
+        }
+    }
+    unique
+}
+
+/// Whether a model has Stribeck levels (a static and a Coulomb level and a Stribeck
+/// velocity), so that a Stribeck fit can start it.
+fn has_stribeck_levels(model: &dyn FrictionModel) -> bool {
+    let names: Vec<String> = model.param_info().into_iter().map(|p| p.name).collect();
+    ["mu_s", "v_s"].iter().all(|n| names.iter().any(|m| m == n))
+}
+
+/// The stages below the target: coulomb, then stribeck (each only when it is not the target
+/// itself), each fitted from its data-driven guess; most refined last.
+fn stages<R: Residuals + 'static>(plan: &StartPlan<'_, R>) -> Vec<Box<dyn FrictionModel>> {
+    let target = plan.layout.start_model.name();
+    let mut out = Vec::new();
+    if target != "coulomb" {
+        out.extend(stage_fit(plan, &Coulomb::default()));
+    }
+    if target != "stribeck" && has_stribeck_levels(plan.layout.start_model.as_ref()) {
+        out.extend(stage_fit(plan, &Stribeck::default()));
+    }
+    out
+}
+
+/// The options of a stage: one start, one local run, the model's own parameters and
+/// bounds, the oscillator fixed, no uncertainty budget, no progress.
+fn stage_options(opts: &FitOptions) -> FitOptions {
+    let keys = non_model_bound_keys();
+    FitOptions {
+        free: None,
+        bounds: opts
+            .bounds
+            .iter()
+            .filter(|(k, _)| keys.contains(&k.as_str()))
+            .map(|(k, b)| (k.clone(), *b))
+            .collect(),
+        guess: true,
+        keep_initial: Vec::new(),
+        oscillator: Vec::new(),
+        uncertainty: Default::default(),
+        multistart: Some(1),
+        search: Some(Search::Local),
+        progress: None,
+        ..opts.clone()
+    }
+}
+
+/// Fits `stage` (one start, one run) and returns the fitted model; `None` when it fails
+/// (the target then starts from its other starts).
+fn stage_fit<R: Residuals + 'static>(
+    plan: &StartPlan<'_, R>,
+    stage: &(dyn FrictionModel + 'static),
+) -> Option<Box<dyn FrictionModel>> {
+    let opts = stage_options(plan.opts);
+    let residuals = plan.residuals.as_ref();
+    let layout = build_layout(plan.osc, stage, plan.records, residuals, &opts).ok()?;
+    if layout.params.is_empty() {
+        return None;
+    }
+    let shared: Arc<[Record]> = plan.records.into();
+    let make = || {
+        FitProblem::new(
+            plan.residuals.clone(),
+            ProblemParts {
+                oscillator: *plan.osc,
+                model: layout.start_model.clone(),
+                records: shared.clone(),
+                layout: layout.params.clone(),
+                sim: opts.sim,
+                parallel: opts.parallel,
+            },
+        )
+    };
+    let reference = make();
+    let runs = run_starts(
+        make,
+        &reference,
+        std::slice::from_ref(&layout.start),
+        &opts,
+        1,
+    )
+    .ok()?;
+    let p = reference.physical(&runs.best.u);
+    reference.realise(&p).ok().map(|w| w.model)
+}
+
+/// The staged starting points: each stage mapped onto the target (the last, most refined
+/// stage at every presliding scale of [`STAGED_PRESLIDING`]).
+fn staged_points<R: Residuals + 'static>(plan: &StartPlan<'_, R>) -> Vec<Seeded> {
+    let fitted = stages(plan);
+    let base = StartContext::new(plan.osc.normal_force, plan.osc.mass);
+    let mut out = Vec::new();
+    for (k, stage) in fitted.iter().enumerate().rev() {
+        let scales: &[f64] = if k + 1 == fitted.len() {
+            &STAGED_PRESLIDING
+        } else {
+            &STAGED_PRESLIDING[..1]
+        };
+        for &s in scales {
+            let ctx = StartContext {
+                presliding_displacement: s * TYPICAL_PRESLIDING_DISPLACEMENT,
+                ..base
+            };
+            if let Some(point) = mapped_point(plan.layout, stage.as_ref(), &ctx, plan.opts) {
+                out.push(Seeded {
+                    point,
+                    origin: format!("staged from {}", stage.name()),
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The target started from a fitted simpler model (`start_from`), as a point of the layout:
+/// free model parameters take the mapped values (except those kept at their initial value),
+/// everything else its start. `None` when the target cannot start from it.
+fn mapped_point(
+    layout: &Layout,
+    fitted: &dyn FrictionModel,
+    ctx: &StartContext,
+    opts: &FitOptions,
+) -> Option<Vec<f64>> {
+    let mut started = clone_model(layout.start_model.as_ref());
+    if !started.start_from(fitted, ctx) {
+        return None;
+    }
+    let values = started.params();
+    let point = layout
+        .params
+        .iter()
+        .zip(&layout.start)
+        .map(|(f, &x)| match f.kind {
+            ParamKind::Model(i) if !opts.keep_initial.contains(&f.name) => values
+                .get(i)
+                .copied()
+                .filter(|v| v.is_finite())
+                .map_or(x, |v| f.clip(v)),
+            _ => x,
+        })
+        .collect();
+    Some(point)
+}
+
+/// A small seeded generator (SplitMix64) for the Latin hypercube.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// `n` points of a Latin hypercube in [0, 1)^d: each coordinate has exactly one point in
+/// each of its `n` strata.
+pub fn latin_hypercube(n: usize, d: usize, seed: u64) -> Vec<Vec<f64>> {
+    let mut rng = SplitMix64(seed);
+    let columns: Vec<Vec<f64>> = (0..d)
+        .map(|_| {
+            let mut strata: Vec<usize> = (0..n).collect();
+            for i in (1..n).rev() {
+                let j = (rng.next_u64() % (i as u64 + 1)) as usize;
+                strata.swap(i, j);
+            }
+            strata
+                .iter()
+                .map(|&k| (k as f64 + rng.unit()) / n as f64)
+                .collect()
+        })
+        .collect();
+    (0..n)
+        .map(|i| columns.iter().map(|c| c[i]).collect())
+        .collect()
+}
+
+/// The value at fraction `q` of a free parameter's global box: a factor [`GLOBAL_SPAN`]
+/// either side of its start in log coordinates (a positive parameter), else three scales
+/// either side; within its bounds.
+fn in_box(f: &FreeParam, x0: f64, q: f64) -> f64 {
+    if x0 > 0.0 && f.lower >= 0.0 {
+        let c = x0.ln();
+        let w = GLOBAL_SPAN.ln();
+        let lo = if f.lower > 0.0 { f.lower.ln() } else { c - w };
+        let hi = if f.upper.is_finite() {
+            f.upper.ln()
+        } else {
+            c + w
+        };
+        let (a, b) = ((c - w).max(lo), (c + w).min(hi));
+        f.clip((a + q * (b - a)).exp())
+    } else {
+        let u0 = f.to_internal(x0);
+        let (lo, hi) = f.internal_bounds();
+        let (a, b) = ((u0 - 3.0).max(lo), (u0 + 3.0).min(hi));
+        f.clip(f.to_physical(a + q * (b - a)))
+    }
+}
+
+/// `n` Latin-hypercube starts over the free model parameters' global box (the others at
+/// their start).
+fn global_points(layout: &Layout, n: usize, seed: u64) -> Vec<Seeded> {
+    let slots: Vec<usize> = (0..layout.params.len())
+        .filter(|&s| matches!(layout.params[s].kind, ParamKind::Model(_)))
+        .collect();
+    latin_hypercube(n, slots.len(), seed)
+        .into_iter()
+        .map(|q| {
+            let mut point = layout.start.clone();
+            for (&s, &qs) in slots.iter().zip(&q) {
+                point[s] = in_box(&layout.params[s], layout.start[s], qs);
+            }
+            Seeded {
+                point,
+                origin: "latin hypercube".into(),
+            }
+        })
+        .collect()
+}
+
+/// Starts whose cost is within the statistical tolerance of the best: a cost difference of
+/// at most chi²(1 dof, 95 %) / 2 residual variances (at least 1: the best itself).
+pub fn starts_at_best(outcomes: &[StartOutcome], best_cost: f64, residual_variance: f64) -> usize {
+    let tolerance = if residual_variance.is_finite() && residual_variance > 0.0 {
+        PROFILE_DELTA * residual_variance
+    } else {
+        1e-6 * best_cost.abs()
+    };
+    outcomes
+        .iter()
+        .filter(
+            |o| matches!(o, StartOutcome::Finished { cost, .. } if *cost - best_cost <= tolerance),
+        )
+        .count()
+        .max(1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use frictionid_models::LuGre;
+
+    #[test]
+    fn a_latin_hypercube_fills_every_stratum_once() {
+        let n = 9;
+        let cube = latin_hypercube(n, 4, 7);
+        assert_eq!(cube.len(), n);
+        for d in 0..4 {
+            let mut strata: Vec<usize> = cube.iter().map(|p| (p[d] * n as f64) as usize).collect();
+            strata.sort_unstable();
+            assert_eq!(strata, (0..n).collect::<Vec<_>>());
+        }
+        assert_eq!(cube, latin_hypercube(n, 4, 7));
+        assert_ne!(cube, latin_hypercube(n, 4, 8));
+    }
+
+    #[test]
+    fn dynamic_or_wide_models_search_staged_and_coulomb_locally() {
+        let lugre = LuGre::default();
+        assert_eq!(Search::resolve(None, &lugre, 6), Search::Staged);
+        assert_eq!(Search::resolve(None, &Coulomb::default(), 1), Search::Local);
+        assert_eq!(
+            Search::resolve(None, &Stribeck::default(), 4),
+            Search::Staged
+        );
+        let asked = Some(Search::Global);
+        assert_eq!(
+            Search::resolve(asked, &Coulomb::default(), 1),
+            Search::Global
+        );
+    }
+
+    #[test]
+    fn the_global_box_spans_two_decades_either_side_within_the_bounds() {
+        let f = FreeParam {
+            log: true,
+            ..FreeParam::linear("s".into(), "N/m", ParamKind::Model(0), (0.0, 1e6), 1e5, 1.0)
+        };
+        assert!((in_box(&f, 1e5, 0.0) / 1e3 - 1.0).abs() < 1e-12);
+        assert!((in_box(&f, 1e5, 1.0) / 1e6 - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn starts_count_at_the_best_within_chi_square_over_two_variances() {
+        let done = |start, cost| StartOutcome::Finished {
+            start,
+            cost,
+            iterations: 1,
+            termination: super::super::outcome::TerminationReason::GradientBelowTolerance,
+        };
+        // variance 1e-8: tolerance 1.92e-8.
+        let outcomes = [done(0, 1.0), done(1, 1.0 + 1.9e-8), done(2, 1.0 + 2.0e-8)];
+        assert_eq!(starts_at_best(&outcomes, 1.0, 1e-8), 2);
+    }
+}

@@ -1,0 +1,206 @@
+//! Dynamic friction models identified from their own synthetic FMM records (issue 14): the
+//! default configuration names only the model; the truths are independent of the fit.
+
+mod common;
+
+use common::{records, NOISE};
+use frictionid_engine::identify::{fit, FitOptions, FitResult, Identifiability, Search};
+use frictionid_engine::Oscillator;
+use frictionid_models::{Coulomb, Dahl, FrictionModel, Gms, LuGre};
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+/// Every free parameter of `truth` is within 3 standard errors of its true value, or the
+/// fit flags it as not determined; returns (and prints) the table of errors.
+fn assert_recovered(r: &FitResult, truth: &dyn FrictionModel) -> String {
+    let mut all = String::new();
+    for (info, t) in truth.param_info().iter().zip(truth.params()) {
+        if let Some(p) = r.param(&info.name).filter(|p| p.free) {
+            all += &format!(
+                "{} = {:e} (truth {t:e}, se {:?}); ",
+                p.name, p.value, p.std_error
+            );
+        }
+    }
+    eprintln!("{}: rms/noise {:.4}; {all}", r.model, noise_ratio(r));
+    let mut table = String::new();
+    for (info, t) in truth.param_info().iter().zip(truth.params()) {
+        let p = r.param(&info.name).expect("every parameter is reported");
+        if !p.free {
+            continue;
+        }
+        let class = p
+            .identifiability
+            .expect("a fitted parameter has a standing");
+        table += &format!(
+            "{} = {:e} (truth {t:e}, se {:?}, {:?}); ",
+            p.name, p.value, p.std_error, class
+        );
+        if class == Identifiability::Determined {
+            let se = p
+                .std_error
+                .expect("a determined parameter has a standard error");
+            assert!(se > 0.0);
+            assert!(
+                (p.value - t).abs() <= 3.0 * se,
+                "{} = {} is {:.1} standard errors from the truth {t}",
+                p.name,
+                p.value,
+                (p.value - t).abs() / se
+            );
+        } else {
+            assert!(p.std_error.is_none(), "{}: no standard error", p.name);
+        }
+    }
+    table
+}
+
+fn noise_ratio(r: &FitResult) -> f64 {
+    r.rms_residual / NOISE
+}
+
+#[test]
+fn lugre_is_recovered_from_the_default_configuration() {
+    let osc = Oscillator::fmm();
+    let truth = LuGre {
+        sigma0: 1e5,
+        sigma1: 500.0,
+        sigma2: 1.0,
+        mu_c: 0.22,
+        mu_s: 0.30,
+        v_s: 0.01,
+    };
+    let recs = records(&osc, &truth, NOISE, 41);
+    let r = fit(&osc, &LuGre::default(), &recs, &FitOptions::default()).unwrap();
+    let table = assert_recovered(&r, &truth);
+    eprintln!(
+        "lugre: rms/noise {:.4}, {} starts, {} at best, won by {} ({}); {table}",
+        noise_ratio(&r),
+        r.starts,
+        r.starts_at_best,
+        r.best_start,
+        r.best_start_origin
+    );
+    assert_eq!(r.search, Search::Staged);
+    assert!(r.converged, "{}", r.termination);
+    assert!(
+        (noise_ratio(&r) - 1.0).abs() < 0.02,
+        "rms {} vs noise {NOISE}",
+        r.rms_residual
+    );
+    assert!(r.starts_at_best >= 1 && r.starts_at_best <= r.starts);
+}
+
+/// LuGre or Dahl on Coulomb records: converged, the Coulomb level within 0.5 %, and sigma0 a
+/// lower bound without a standard error.
+fn presliding_is_a_lower_bound_on_coulomb_records(model: &(dyn FrictionModel + 'static)) {
+    let osc = Oscillator::fmm();
+    let mu = 0.24;
+    let recs = records(&osc, &Coulomb { mu }, NOISE, 51);
+    let r = fit(&osc, model, &recs, &FitOptions::default()).unwrap();
+    let sigma0 = r.param("sigma0").unwrap();
+    eprintln!(
+        "{} on coulomb: {}, mu_c {}, sigma0 {:e} {:?} bound {:?}, rms/noise {:.4}",
+        r.model,
+        r.termination,
+        r.value("mu_c").unwrap(),
+        sigma0.value,
+        sigma0.identifiability,
+        sigma0.bound,
+        noise_ratio(&r)
+    );
+    assert!(r.converged, "{}", r.termination);
+    assert!(rel(r.value("mu_c").unwrap(), mu) < 0.005);
+    assert_eq!(sigma0.identifiability, Some(Identifiability::LowerBound));
+    let bound = sigma0.bound.expect("a lower bound states its value");
+    assert!(bound > 0.0 && bound <= sigma0.value);
+    assert!(sigma0.std_error.is_none() && sigma0.ci95.is_none());
+    for p in r.parameters.iter().filter(|p| p.free) {
+        assert!(
+            p.std_error.is_none_or(|s| s > 0.0),
+            "{}: zero error",
+            p.name
+        );
+    }
+    assert!(r
+        .diagnostics
+        .iter()
+        .any(|f| f.message.starts_with("sigma0 >") && f.message.contains("at 95 %")));
+}
+
+#[test]
+fn lugre_on_coulomb_records_bounds_sigma0_from_below() {
+    presliding_is_a_lower_bound_on_coulomb_records(&LuGre::default());
+}
+
+#[test]
+fn dahl_on_coulomb_records_bounds_sigma0_from_below() {
+    presliding_is_a_lower_bound_on_coulomb_records(&Dahl::default());
+}
+
+#[test]
+fn dahl_is_recovered_from_its_own_records() {
+    let osc = Oscillator::fmm();
+    let truth = Dahl {
+        sigma0: 2e4,
+        mu_c: 0.21,
+        alpha: 1.0,
+    };
+    let recs = records(&osc, &truth, NOISE, 61);
+    let r = fit(&osc, &Dahl::default(), &recs, &FitOptions::default()).unwrap();
+    let table = assert_recovered(&r, &truth);
+    eprintln!("dahl: rms/noise {:.4}; {table}", noise_ratio(&r));
+    assert!(r.converged, "{}", r.termination);
+    assert!((noise_ratio(&r) - 1.0).abs() < 0.02);
+    let sigma0 = r.param("sigma0").unwrap();
+    assert_eq!(sigma0.identifiability, Some(Identifiability::Determined));
+}
+
+#[test]
+#[ignore = "fails today: with delta and sharpness free the two-element GMS lands at an equivalent fit (rms/noise 1.006) with k_1 18 standard errors from the truth; the curvature errors understate the trade-off"]
+fn gms_with_two_elements_is_recovered_from_its_own_records() {
+    let osc = Oscillator::fmm();
+    let mut truth = Gms::with_elements(2);
+    truth.elements[0].stiffness = 1.5e5;
+    truth.elements[0].weight = 0.6;
+    truth.elements[1].stiffness = 2e4;
+    truth.elements[1].weight = 0.4;
+    truth.mu_c = 0.2;
+    truth.mu_s = 0.27;
+    truth.v_s = 0.01;
+    truth.viscous = 1.0;
+    let recs = records(&osc, &truth, NOISE, 71);
+    let r = fit(&osc, &Gms::with_elements(2), &recs, &FitOptions::default()).unwrap();
+    let table = assert_recovered(&r, &truth);
+    eprintln!("gms: rms/noise {:.4}; {table}", noise_ratio(&r));
+    assert!(r.converged, "{}", r.termination);
+    assert!((noise_ratio(&r) - 1.0).abs() < 0.02);
+}
+
+#[test]
+#[ignore = "needs the stiff integrator (issue 13)"]
+fn stiff_lugre_is_recovered_or_bounded() {
+    let osc = Oscillator::fmm();
+    let truth = LuGre {
+        sigma0: 1e7,
+        sigma1: 4000.0,
+        sigma2: 2.0,
+        mu_c: 0.18,
+        mu_s: 0.26,
+        v_s: 0.005,
+    };
+    let recs = records(&osc, &truth, NOISE, 81);
+    let r = fit(&osc, &LuGre::default(), &recs, &FitOptions::default()).unwrap();
+    assert!((noise_ratio(&r) - 1.0).abs() < 0.05);
+    let sigma0 = r.param("sigma0").unwrap();
+    match (sigma0.identifiability, sigma0.bound) {
+        (Some(Identifiability::Determined), _) => {
+            assert!(sigma0.value > 5e6 && sigma0.value < 2e7)
+        }
+        (Some(Identifiability::LowerBound), Some(b)) => assert!(b < 1e7),
+        (Some(Identifiability::UpperBound), Some(b)) => assert!(b > 1e7),
+        other => panic!("sigma0 {other:?}"),
+    }
+}
