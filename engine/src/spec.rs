@@ -374,6 +374,8 @@ pub enum IntegratorMethod {
     Auto,
     /// The exact closed-form propagator (coulomb, viscous_coulomb, none).
     Exact,
+    /// The stiff Rosenbrock method Rodas4 (bristle and element models with stiff contacts).
+    Rodas,
 }
 
 /// `[simulation.integrator]`: integrator choice and tolerances (engine defaults when absent).
@@ -406,6 +408,7 @@ impl IntegratorSpec {
             IntegratorMethod::Dopri5 => Integrator::Dopri5,
             IntegratorMethod::Auto => Integrator::Auto,
             IntegratorMethod::Exact => Integrator::Exact,
+            IntegratorMethod::Rodas => Integrator::Rodas,
             IntegratorMethod::Euler => Integrator::Euler {
                 steps_per_period: match (self.steps_per_period, &defaults.integrator) {
                     (Some(n), _) => n,

@@ -41,6 +41,8 @@ mod closed_form;
 mod dopri;
 mod driver;
 mod euler;
+mod jacobian;
+mod rodas;
 mod root;
 mod stepper;
 
@@ -48,6 +50,7 @@ pub use bogacki::BogackiShampine;
 pub use closed_form::ClosedForm;
 pub use dopri::Dopri5;
 pub use euler::Euler;
+pub use rodas::Rodas4;
 pub use stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper};
 
 use driver::Driver;
@@ -64,6 +67,17 @@ pub const REST_SWING_ATOLS: f64 = 10.0;
 /// Largest Dormand-Prince step, as a fraction of the undamped period (keeps one velocity zero
 /// per step).
 const H_MAX_PERIODS: f64 = 1.0 / 8.0;
+
+/// Rodas4's relative tolerance as a multiple of the options' `rtol`. Its embedded error
+/// estimate is of third order and overestimates the error of its fourth-order solution: at the
+/// same nominal tolerance it is about 100 times more accurate than Dopri5 on the FMM cases
+/// (LuGre, sigma0 = 1e7: 3e-11 m at rtol 2e-9, 2e-9 m at 2e-7). The scaling gives both
+/// methods about the same accuracy for the same options.
+pub const RODAS_TOL_SCALE: f64 = 100.0;
+
+/// Rodas4's absolute tolerance as a multiple of the options' `atol` (see
+/// [`RODAS_TOL_SCALE`]); the rest threshold of the driver keeps the options' `atol`.
+pub const RODAS_ATOL_SCALE: f64 = 100.0;
 
 /// The time integrator.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
@@ -83,6 +97,9 @@ pub enum Integrator {
     Exact,
     /// The exact propagator where it applies, Dopri5 otherwise.
     Auto,
+    /// The stiff Rosenbrock method Rodas4 ([`Rodas4`]) with the model's Jacobian, for
+    /// bristle and element models with stiff contacts (sigma0 of 1e6..1e9 N/m).
+    Rodas,
 }
 
 /// Options of [`simulate`].
@@ -189,6 +206,9 @@ pub struct SimStats {
     pub rejected_steps: u64,
     /// Number of events.
     pub events: usize,
+    /// Jacobian evaluations of the stiff stepper (not counted in `rhs_evaluations`).
+    #[serde(default)]
+    pub jacobian_evaluations: u64,
 }
 
 /// A simulated trajectory sampled at the requested times.
@@ -542,6 +562,12 @@ pub(crate) fn run<R: Recorder>(
         Integrator::Exact => driver.run(&mut ClosedForm::new(), &y0, t_end)?,
         Integrator::Euler { steps_per_period } => {
             let mut stepper = Euler::new(y0.len(), period / steps_per_period);
+            driver.run(&mut stepper, &y0, t_end)?;
+        }
+        Integrator::Rodas => {
+            let h_max = period * H_MAX_PERIODS;
+            let (rtol, atol) = (RODAS_TOL_SCALE * opts.rtol, RODAS_ATOL_SCALE * opts.atol);
+            let mut stepper = Rodas4::new(y0.len(), rtol, atol, h_max);
             driver.run(&mut stepper, &y0, t_end)?;
         }
         Integrator::Dopri5 | Integrator::Auto => {
