@@ -233,6 +233,12 @@ impl Spec {
             energy: self.energy.options(),
             parallel: hooks.parallel,
             progress: hooks.progress.clone(),
+            sim: SimOptions {
+                integrator: extras
+                    .integrator
+                    .map_or(defaults.sim.integrator, IntegratorMethod::engine_integrator),
+                ..defaults.sim
+            },
             ..defaults
         }
     }
@@ -311,6 +317,9 @@ pub struct FitExtras {
     pub guess: Option<bool>,
     /// Models compared by `compare` when none are requested.
     pub models: Option<Vec<String>>,
+    /// The integrator of the fit's simulations (default `auto`: exact, rodas or dopri5 by
+    /// the law and its stiffness).
+    pub integrator: Option<IntegratorMethod>,
 }
 
 impl FitSpec {
@@ -400,15 +409,26 @@ pub struct IntegratorSpec {
 /// default options name a number.
 pub const EULER_STEPS_PER_PERIOD: f64 = 10_000.0;
 
+impl IntegratorMethod {
+    /// The engine's integrator (Euler with [`EULER_STEPS_PER_PERIOD`]).
+    pub fn engine_integrator(self) -> Integrator {
+        match self {
+            IntegratorMethod::Dopri5 => Integrator::Dopri5,
+            IntegratorMethod::Auto => Integrator::Auto,
+            IntegratorMethod::Exact => Integrator::Exact,
+            IntegratorMethod::Rodas => Integrator::Rodas,
+            IntegratorMethod::Euler => Integrator::Euler {
+                steps_per_period: EULER_STEPS_PER_PERIOD,
+            },
+        }
+    }
+}
+
 impl IntegratorSpec {
     /// The engine's simulation options (engine defaults where not given).
     pub fn sim_options(&self) -> SimOptions {
         let defaults = SimOptions::default();
         let integrator = match self.method {
-            IntegratorMethod::Dopri5 => Integrator::Dopri5,
-            IntegratorMethod::Auto => Integrator::Auto,
-            IntegratorMethod::Exact => Integrator::Exact,
-            IntegratorMethod::Rodas => Integrator::Rodas,
             IntegratorMethod::Euler => Integrator::Euler {
                 steps_per_period: match (self.steps_per_period, &defaults.integrator) {
                     (Some(n), _) => n,
@@ -416,6 +436,7 @@ impl IntegratorSpec {
                     (None, _) => EULER_STEPS_PER_PERIOD,
                 },
             },
+            method => method.engine_integrator(),
         };
         SimOptions {
             integrator,

@@ -36,6 +36,7 @@
 //! about 1.5e4 RHS evaluations at sigma0 = 1e5 N/m but about 1e6 at sigma0 = 1e7 N/m; a stiff
 //! method would remove that bound. There is no stiffness abort: such runs finish.
 
+mod auto;
 mod bogacki;
 mod closed_form;
 mod dopri;
@@ -53,6 +54,7 @@ pub use euler::Euler;
 pub use rodas::Rodas4;
 pub use stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper};
 
+use auto::resolve_method;
 use driver::Driver;
 
 use crate::error::EngineError;
@@ -95,7 +97,9 @@ pub enum Integrator {
     /// The exact propagator ([`ClosedForm`]) for laws affine in v within each sliding mode
     /// (coulomb, viscous_coulomb, none) on an underdamped oscillator; an error otherwise.
     Exact,
-    /// The exact propagator where it applies, Dopri5 otherwise.
+    /// The exact propagator where it applies; Rodas4 where a stiffness estimate (spectral
+    /// radius of the Jacobian times Dopri5's accuracy step) says an explicit method would be
+    /// stability-limited; Dopri5 otherwise (see `auto.rs`).
     Auto,
     /// The stiff Rosenbrock method Rodas4 ([`Rodas4`]) with the model's Jacobian, for
     /// bristle and element models with stiff contacts (sigma0 of 1e6..1e9 N/m).
@@ -558,7 +562,7 @@ pub(crate) fn run<R: Recorder>(
         rest_swing: REST_SWING_ATOLS * opts.atol,
     };
     let period = osc.natural_period();
-    match resolve_method(opts.integrator, &dynamics)? {
+    match resolve_method(opts.integrator, &dynamics, &y0, period)? {
         Integrator::Exact => driver.run(&mut ClosedForm::new(), &y0, t_end)?,
         Integrator::Euler { steps_per_period } => {
             let mut stepper = Euler::new(y0.len(), period / steps_per_period);
@@ -581,27 +585,6 @@ pub(crate) fn run<R: Recorder>(
         rest: driver.rest,
         stats: driver.stats,
     })
-}
-
-/// The concrete method for `requested`: `Auto` picks the exact propagator where it applies,
-/// Dopri5 otherwise; `Exact` where it does not apply is an input error.
-fn resolve_method(
-    requested: Integrator,
-    dynamics: &Dynamics<'_>,
-) -> Result<Integrator, EngineError> {
-    match requested {
-        Integrator::Auto if dynamics.closed_form_applies() => Ok(Integrator::Exact),
-        Integrator::Auto => Ok(Integrator::Dopri5),
-        Integrator::Exact if !dynamics.closed_form_applies() => {
-            Err(EngineError::InvalidInput(format!(
-                "integrator `exact` needs a law affine in v within each sliding mode \
-                 (coulomb, viscous_coulomb, none) and an underdamped oscillator; model `{}` \
-                 does not qualify here",
-                dynamics.model.name()
-            )))
-        }
-        other => Ok(other),
-    }
 }
 
 /// How the engine treats `model`'s law: dynamic, switched (with its static limit) or smooth.
