@@ -273,6 +273,7 @@ pub fn simulate(
     let n_states = model.n_states();
     let mut rec = FullRecorder::new(osc, model, sample_times.len(), n_states);
     let out = run(osc, model, init, t_end, sample_times, opts, &mut rec)?;
+    rec.finish_energies();
     let FullRecorder {
         time,
         x,
@@ -375,8 +376,6 @@ impl<'a> FullRecorder<'a> {
 
 impl Recorder for FullRecorder<'_> {
     fn sample(&mut self, t: f64, x: f64, v: f64, z: &[f64], a: f64, friction: f64) {
-        let ke = 0.5 * self.mass * v * v;
-        let pe = 0.5 * self.stiffness * x * x;
         self.time.push(t);
         self.x.push(x);
         self.v.push(v);
@@ -385,16 +384,30 @@ impl Recorder for FullRecorder<'_> {
             col.push(zj);
         }
         self.friction.push(friction);
-        self.kinetic.push(ke);
-        self.potential.push(pe);
-        self.energy.push(ke + pe);
-        // Static laws store nothing: skip the call.
-        let stored = if z.is_empty() {
-            0.0
-        } else {
-            self.model.stored_energy(z, self.normal)
-        };
-        self.stored.push(stored);
+        // Static laws store nothing: the column is filled once at the end.
+        if !z.is_empty() {
+            self.stored.push(self.model.stored_energy(z, self.normal));
+        }
+    }
+}
+
+impl FullRecorder<'_> {
+    /// The energy columns from the recorded states, in one pass each after the run (the
+    /// per-sample work stays with the samples themselves).
+    fn finish_energies(&mut self) {
+        let (m, k) = (self.mass, self.stiffness);
+        self.kinetic.extend(self.v.iter().map(|&v| 0.5 * m * v * v));
+        self.potential
+            .extend(self.x.iter().map(|&x| 0.5 * k * x * x));
+        self.energy.extend(
+            self.kinetic
+                .iter()
+                .zip(&self.potential)
+                .map(|(ke, pe)| ke + pe),
+        );
+        if self.stored.len() < self.time.len() {
+            self.stored.resize(self.time.len(), 0.0);
+        }
     }
 }
 
