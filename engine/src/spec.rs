@@ -317,8 +317,9 @@ pub struct FitExtras {
     pub guess: Option<bool>,
     /// Models compared by `compare` when none are requested.
     pub models: Option<Vec<String>>,
-    /// The integrator of the fit's simulations (default `auto`: exact, rodas or dopri5 by
-    /// the law and its stiffness).
+    /// The integrator of the fit's simulations (default dopri5; `auto` picks exact, rodas or
+    /// dopri5 by the law and its stiffness and is what stiff bristle records, sigma0 >= 1e6
+    /// N/m, need).
     pub integrator: Option<IntegratorMethod>,
 }
 

@@ -5,7 +5,7 @@ mod common;
 
 use common::{records, NOISE};
 use frictionid_engine::identify::{compare, fit, FitOptions, OscillatorParam};
-use frictionid_engine::Oscillator;
+use frictionid_engine::{Integrator, Oscillator, SimOptions};
 use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre, NoFriction, Stribeck};
 
 fn rel(a: f64, b: f64) -> f64 {
@@ -116,7 +116,7 @@ fn lugre_fit_reaches_the_noise_level() {
 #[test]
 fn a_fit_started_at_the_truth_of_stiff_bristles_runs_and_stays_there() {
     // Issue 13: sigma0 = 1e7 N/m records; with Dopri5 under a step budget the start point
-    // itself was rejected. The fit's default integrator (auto) picks Rodas4 here.
+    // itself was rejected. With `integrator = "auto"` the fit integrates them with Rodas4.
     let osc = Oscillator::fmm();
     let truth = LuGre {
         sigma0: 1e7,
@@ -127,9 +127,14 @@ fn a_fit_started_at_the_truth_of_stiff_bristles_runs_and_stays_there() {
         v_s: 0.01,
     };
     let recs = records(&osc, &truth, NOISE, 43);
+    let defaults = FitOptions::default();
     let opts = FitOptions {
         guess: false,
-        ..FitOptions::default()
+        sim: SimOptions {
+            integrator: Integrator::Auto,
+            ..defaults.sim
+        },
+        ..defaults
     };
     let r = fit(&osc, &truth, &recs, &opts).unwrap();
     assert!(

@@ -2,7 +2,7 @@
 
 use super::budget::PropertyUncertainty;
 use crate::energy::EnergyOptions;
-use crate::simulate::{Integrator, SimOptions};
+use crate::simulate::SimOptions;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -130,7 +130,6 @@ impl Default for FitOptions {
             max_iterations: 200,
             tolerance: None,
             sim: SimOptions {
-                integrator: Integrator::Auto,
                 max_steps: FIT_MAX_STEPS,
                 ..SimOptions::default()
             },

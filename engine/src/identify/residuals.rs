@@ -17,8 +17,8 @@ use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Step budget of a simulation per sample of its record: a bound on cost, not on stiffness.
-/// The fit simulates with `Integrator::Auto`, which integrates stiff bristle and element
-/// models with Rodas4, whose steps follow the motion's accuracy whatever the stiffness (about
+/// With `Integrator::Auto` (`[fit.options] integrator = "auto"`) the fit integrates stiff
+/// bristle and element models with Rodas4, whose steps follow the motion's accuracy whatever the stiffness (about
 /// 1 000 steps for a 2 s LuGre record at sigma0 = 1e7..1e9 N/m, against 40 000 allowed): a
 /// physically valid stiff start point runs. Trial points whose dynamics need more than this
 /// many steps per sample interval (chattering, a runaway law) are still rejected as

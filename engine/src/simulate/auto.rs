@@ -7,9 +7,9 @@
 //! internal states), times the step Dopri5 takes for accuracy on a free vibration at the
 //! default tolerances (about T_n / 100). Dopri5's stability region reaches about 3.3 along
 //! the negative real axis: beyond `STIFF_RATIO` its steps are set by stability, not accuracy,
-//! and Rodas4 (a few times the cost per step, no stability bound) is cheaper. On the FMM rig
-//! LuGre with the default sigma0 = 1e5 N/m gives about 40 and uses Rodas4 (8 000 RHS against
-//! 15 000); the bristle models at 1e7 give thousands.
+//! and Rodas4 (a few times the cost per step, no stability bound) becomes the cheaper method
+//! once the ratio reaches a few hundred ([`STIFF_RATIO`]). On the FMM rig LuGre and Dahl at
+//! the default sigma0 = 1e5 N/m give about 48 (Dopri5), at 1e7 about 4 800 (Rodas4).
 
 use super::{Dynamics, Integrator, Law};
 use crate::error::EngineError;
@@ -18,8 +18,12 @@ use nalgebra::DMatrix;
 /// Dopri5's accuracy-limited step on a free vibration, as a fraction of T_n.
 const ACCURACY_STEP_PERIODS: f64 = 1.0 / 100.0;
 
-/// rho(J) h above which the stiff method is chosen (Dopri5's real stability limit is 3.3).
-pub(crate) const STIFF_RATIO: f64 = 10.0;
+/// rho(J) h above which the stiff method is chosen. Dopri5's real stability limit is 3.3,
+/// but up to a few hundred its stability-limited steps stay cheap (LuGre at the default
+/// sigma0 = 1e5 N/m, ratio 48: 15 000 RHS, 1.1 ms), and inside a fit, where trial points
+/// wander, the explicit method measured faster: `compare` of the five classical models took
+/// 5.4 s with Dopri5 everywhere against 19 s with Rodas4 from a ratio of 10 (loaded machine).
+pub(crate) const STIFF_RATIO: f64 = 500.0;
 
 /// The concrete method for `requested`: `Auto` picks the exact propagator where it applies,
 /// Rodas4 where the motion is stiff, Dopri5 otherwise; `Exact` where it does not apply is an
@@ -109,8 +113,11 @@ mod tests {
             let r = |s: f64| ratio(model(serde_json::json!({"type": name, "sigma0": s})).as_ref());
             let (soft, mid, stiff) = (r(1e3), r(1e5), r(1e7));
             eprintln!("{name}: {soft:.3e} {mid:.3e} {stiff:.3e}");
-            assert!(soft < STIFF_RATIO, "{name} {soft}");
-            assert!(stiff > 100.0 * STIFF_RATIO, "{name} {stiff}");
+            assert!(
+                soft < STIFF_RATIO && mid < STIFF_RATIO,
+                "{name} {soft} {mid}"
+            );
+            assert!(stiff > 5.0 * STIFF_RATIO, "{name} {stiff}");
             assert!(soft < mid && mid < stiff);
         }
         // Static laws are never stiff.
