@@ -55,25 +55,45 @@ fn fmm_models(c: &mut Criterion) {
     group.finish();
 }
 
-/// The stiff end of the bristle models (sigma0 = 1e7 N/m) with the explicit integrator.
+/// The stiff end of the bristle models (issue 13: sigma0 = 1e7 N/m, LuGre with sigma1 =
+/// 5000 N s/m) with the explicit integrator and with Rodas4, and Rodas4 at 1e8 and 1e9.
 fn fmm_stiff(c: &mut Criterion) {
     let osc = Oscillator::fmm();
     let times = uniform_times(2.0, 1000.0);
-    let opts = SimOptions::default();
-    let mut group = c.benchmark_group("fmm_22mm_2s_1kHz_sigma0_1e7");
+    let mut group = c.benchmark_group("fmm_22mm_2s_1kHz_stiff");
     group.sample_size(10);
     group.measurement_time(Duration::from_secs(3));
+    let cases = [
+        ("dopri5", 1e7),
+        ("rodas", 1e7),
+        ("rodas", 1e8),
+        ("rodas", 1e9),
+    ];
     for name in ["lugre", "dahl"] {
-        let json = serde_json::json!({ "type": name, "sigma0": 1e7 });
-        let Ok(built) = frictionid_models::build_json(&json) else {
-            continue;
-        };
-        let model = built.model;
-        let rhs = run(&osc, model.as_ref(), 0.022, 2.0, &times, &opts);
-        eprintln!("fmm_22mm_2s_1kHz_sigma0_1e7/{name}: {rhs} RHS evaluations");
-        group.bench_function(name, |b| {
-            b.iter(|| run(&osc, model.as_ref(), black_box(0.022), 2.0, &times, &opts))
-        });
+        for (method, sigma0) in cases {
+            let mut json = serde_json::json!({ "type": name, "sigma0": sigma0 });
+            if name == "lugre" {
+                json["sigma1"] = serde_json::json!(5000.0);
+            }
+            let Ok(built) = frictionid_models::build_json(&json) else {
+                continue;
+            };
+            let opts = SimOptions {
+                integrator: if method == "rodas" {
+                    Integrator::Rodas
+                } else {
+                    Integrator::Dopri5
+                },
+                ..SimOptions::default()
+            };
+            let model = built.model;
+            let label = format!("{name}_{sigma0:e}_{method}");
+            let rhs = run(&osc, model.as_ref(), 0.022, 2.0, &times, &opts);
+            eprintln!("fmm_22mm_2s_1kHz_stiff/{label}: {rhs} RHS evaluations");
+            group.bench_function(label, |b| {
+                b.iter(|| run(&osc, model.as_ref(), black_box(0.022), 2.0, &times, &opts))
+            });
+        }
     }
     group.finish();
 }

@@ -359,7 +359,12 @@ impl Spec {
             energy: self.energy.options(),
             parallel: hooks.parallel,
             progress: hooks.progress.clone(),
-            ..defaults
+            sim: SimOptions {
+                integrator: extras
+                    .integrator
+                    .map_or(defaults.sim.integrator, IntegratorMethod::engine_integrator),
+                ..defaults.sim
+            },
         }
     }
 
@@ -448,6 +453,10 @@ pub struct FitExtras {
     pub force_offset: bool,
     /// Velocity fits of dynamic models start also from a force-domain prefit (default true).
     pub prefit: Option<bool>,
+    /// The integrator of the fit's simulations (default dopri5; `auto` picks exact, rodas or
+    /// dopri5 by the law and its stiffness and is what stiff bristle records, sigma0 >= 1e6
+    /// N/m, need).
+    pub integrator: Option<IntegratorMethod>,
 }
 
 impl FitSpec {
@@ -515,6 +524,8 @@ pub enum IntegratorMethod {
     Auto,
     /// The exact closed-form propagator (coulomb, viscous_coulomb, none).
     Exact,
+    /// The stiff Rosenbrock method Rodas4 (bristle and element models with stiff contacts).
+    Rodas,
 }
 
 /// `[simulation.integrator]`: integrator choice and tolerances (engine defaults when absent).
@@ -539,14 +550,26 @@ pub struct IntegratorSpec {
 /// default options name a number.
 pub const EULER_STEPS_PER_PERIOD: f64 = 10_000.0;
 
+impl IntegratorMethod {
+    /// The engine's integrator (Euler with [`EULER_STEPS_PER_PERIOD`]).
+    pub fn engine_integrator(self) -> Integrator {
+        match self {
+            IntegratorMethod::Dopri5 => Integrator::Dopri5,
+            IntegratorMethod::Auto => Integrator::Auto,
+            IntegratorMethod::Exact => Integrator::Exact,
+            IntegratorMethod::Rodas => Integrator::Rodas,
+            IntegratorMethod::Euler => Integrator::Euler {
+                steps_per_period: EULER_STEPS_PER_PERIOD,
+            },
+        }
+    }
+}
+
 impl IntegratorSpec {
     /// The engine's simulation options (engine defaults where not given).
     pub fn sim_options(&self) -> SimOptions {
         let defaults = SimOptions::default();
         let integrator = match self.method {
-            IntegratorMethod::Dopri5 => Integrator::Dopri5,
-            IntegratorMethod::Auto => Integrator::Auto,
-            IntegratorMethod::Exact => Integrator::Exact,
             IntegratorMethod::Euler => Integrator::Euler {
                 steps_per_period: match (self.steps_per_period, &defaults.integrator) {
                     (Some(n), _) => n,
@@ -554,6 +577,7 @@ impl IntegratorSpec {
                     (None, _) => EULER_STEPS_PER_PERIOD,
                 },
             },
+            method => method.engine_integrator(),
         };
         SimOptions {
             integrator,

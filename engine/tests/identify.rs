@@ -5,7 +5,7 @@ mod common;
 
 use common::{records, NOISE};
 use frictionid_engine::identify::{compare, fit, FitOptions, OscillatorParam};
-use frictionid_engine::Oscillator;
+use frictionid_engine::{Integrator, Oscillator, SimOptions};
 use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre, NoFriction, Stribeck};
 
 fn rel(a: f64, b: f64) -> f64 {
@@ -111,6 +111,44 @@ fn lugre_fit_reaches_the_noise_level() {
         "rms {} vs noise {NOISE}",
         r.rms_residual
     );
+}
+
+#[test]
+fn a_fit_started_at_the_truth_of_stiff_bristles_runs_and_stays_there() {
+    // Issue 13: sigma0 = 1e7 N/m records; with Dopri5 under a step budget the start point
+    // itself was rejected. With `integrator = "auto"` the fit integrates them with Rodas4.
+    let osc = Oscillator::fmm();
+    let truth = LuGre {
+        sigma0: 1e7,
+        sigma1: 5000.0,
+        sigma2: 1.0,
+        mu_c: 0.22,
+        mu_s: 0.30,
+        v_s: 0.01,
+    };
+    let recs = records(&osc, &truth, NOISE, 43);
+    let defaults = FitOptions::default();
+    let opts = FitOptions {
+        guess: false,
+        sim: SimOptions {
+            integrator: Integrator::Auto,
+            ..defaults.sim
+        },
+        ..defaults
+    };
+    let r = fit(&osc, &truth, &recs, &opts).unwrap();
+    assert!(
+        r.rms_residual <= 1.1 * NOISE,
+        "rms {} vs noise {NOISE}",
+        r.rms_residual
+    );
+    let mu_c = r
+        .parameters
+        .iter()
+        .find(|p| p.name == "mu_c")
+        .unwrap()
+        .value;
+    assert!(rel(mu_c, 0.22) < 1e-2, "mu_c {mu_c}");
 }
 
 #[test]

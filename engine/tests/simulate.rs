@@ -99,16 +99,33 @@ fn coulomb_110mm_matches_the_exact_solution() {
 
 /// FMM case: the paper's stage with the PTFE pin (N = 14.5 N).
 fn fmm_run(model: &dyn FrictionModel, x0: f64, t_end: f64) -> Trajectory {
+    fmm_run_with(model, x0, t_end, Integrator::Dopri5)
+}
+
+/// The integrators with error control that every model supports.
+const ADAPTIVE: [Integrator; 2] = [Integrator::Dopri5, Integrator::Rodas];
+
+/// [`fmm_run`] with the given integrator.
+fn fmm_run_with(
+    model: &dyn FrictionModel,
+    x0: f64,
+    t_end: f64,
+    integrator: Integrator,
+) -> Trajectory {
     let times = uniform_times(t_end, 1000.0);
+    let opts = SimOptions {
+        integrator,
+        ..SimOptions::default()
+    };
     simulate(
         &Oscillator::fmm(),
         model,
         &Initial::at_rest(x0),
         t_end,
         &times,
-        &SimOptions::default(),
+        &opts,
     )
-    .unwrap_or_else(|e| panic!("model {} from {x0}: {e}", model.name()))
+    .unwrap_or_else(|e| panic!("model {} ({integrator:?}) from {x0}: {e}", model.name()))
 }
 
 #[test]
@@ -223,12 +240,45 @@ fn adaptive_uses_far_fewer_rhs_evaluations_than_the_papers_euler() {
     assert!(ratio >= 1000.0, "only {ratio:.0}x fewer RHS evaluations");
 }
 
+/// The FMM case over 2 s with `integrator` at the step tolerances of the default options
+/// (Rodas scales the options' tolerances by `RODAS_TOL_SCALE`; this undoes it, so that the
+/// energy identity is checked at the same per-step accuracy for every method).
+fn same_tolerance_run(model: &dyn FrictionModel, x0: f64, integrator: Integrator) -> Trajectory {
+    let defaults = SimOptions::default();
+    let (rtol, atol) = match integrator {
+        Integrator::Rodas => (
+            defaults.rtol / frictionid_engine::simulate::RODAS_TOL_SCALE,
+            defaults.atol / frictionid_engine::simulate::RODAS_ATOL_SCALE,
+        ),
+        _ => (defaults.rtol, defaults.atol),
+    };
+    let opts = SimOptions {
+        integrator,
+        rtol,
+        atol,
+        ..defaults
+    };
+    let times = uniform_times(2.0, 1000.0);
+    simulate(
+        &Oscillator::fmm(),
+        model,
+        &Initial::at_rest(x0),
+        2.0,
+        &times,
+        &opts,
+    )
+    .unwrap_or_else(|e| panic!("model {} ({integrator:?}) from {x0}: {e}", model.name()))
+}
+
 #[test]
 fn energy_never_increases_for_any_built_in_model() {
-    for name in names() {
+    for (name, integrator) in names()
+        .into_iter()
+        .flat_map(|n| ADAPTIVE.map(|i| (n.clone(), i)))
+    {
         let model = default_model(&name).unwrap();
         for x0 in [0.022, 0.014, -0.010, 0.003] {
-            let sim = fmm_run(model.as_ref(), x0, 2.0);
+            let sim = same_tolerance_run(model.as_ref(), x0, integrator);
             let total: Vec<f64> = sim
                 .energy
                 .iter()
@@ -239,7 +289,7 @@ fn energy_never_increases_for_any_built_in_model() {
             for i in 1..total.len() {
                 assert!(
                     total[i] - total[i - 1] <= 1e-9 * scale,
-                    "{name} from {x0}: energy rises by {:e} J ({:e} relative) at t = {}",
+                    "{name} ({integrator:?}) from {x0}: energy rises by {:e} J ({:e} relative) at t = {}",
                     total[i] - total[i - 1],
                     (total[i] - total[i - 1]) / scale,
                     sim.time[i]
@@ -256,14 +306,17 @@ fn energy_never_increases_for_any_built_in_model() {
 
 #[test]
 fn mirror_symmetry_for_every_built_in_model() {
-    for name in names() {
+    for (name, integrator) in names()
+        .into_iter()
+        .flat_map(|n| ADAPTIVE.map(|i| (n.clone(), i)))
+    {
         let model = default_model(&name).unwrap();
-        let a = fmm_run(model.as_ref(), 0.022, 2.0);
-        let b = fmm_run(model.as_ref(), -0.022, 2.0);
+        let a = fmm_run_with(model.as_ref(), 0.022, 2.0, integrator);
+        let b = fmm_run_with(model.as_ref(), -0.022, 2.0, integrator);
         for i in 0..a.x.len() {
             assert!(
                 (a.x[i] + b.x[i]).abs() < 1e-12 && (a.v[i] + b.v[i]).abs() < 1e-12,
-                "{name}: x(t) = {} but the mirrored run gives {} at t = {}",
+                "{name} ({integrator:?}): x(t) = {} but the mirrored run gives {} at t = {}",
                 a.x[i],
                 b.x[i],
                 a.time[i]
@@ -663,4 +716,105 @@ fn auto_uses_the_exact_propagator_only_where_it_applies() {
     assert!(dynamic.stats.rhs_evaluations > 0);
     let forced = simulate(&osc, lugre.as_ref(), &at, 1.0, &times, &exact_opts()).unwrap_err();
     assert!(matches!(forced, EngineError::InvalidInput(_)), "{forced}");
+}
+
+/// The largest |a - b| over two sampled displacement histories.
+fn max_gap(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| (p - q).abs())
+        .fold(0.0, f64::max)
+}
+
+/// A bristle model of the issue's stiff case: sigma0 as given (LuGre with sigma1 = 5000).
+fn stiff(name: &str, sigma0: f64) -> Box<dyn FrictionModel> {
+    let mut json = serde_json::json!({ "type": name, "sigma0": sigma0 });
+    if name == "lugre" {
+        json["sigma1"] = serde_json::json!(5000.0);
+    }
+    frictionid_models::build_json(&json).unwrap().model
+}
+
+/// A tight-tolerance run of the FMM case (same rest threshold as the default options).
+fn tight_run(model: &dyn FrictionModel, integrator: Integrator) -> Trajectory {
+    let times = uniform_times(2.0, 1000.0);
+    let opts = SimOptions {
+        integrator,
+        rtol: 1e-14,
+        ..SimOptions::default()
+    };
+    simulate(
+        &Oscillator::fmm(),
+        model,
+        &Initial::at_rest(0.022),
+        2.0,
+        &times,
+        &opts,
+    )
+    .unwrap()
+}
+
+#[test]
+fn rodas_agrees_with_a_tight_dopri5_reference_on_stiff_bristles() {
+    // Issue 13's case: FMM rig from 22 mm, 2 s at 1 kHz, sigma0 = 1e7 N/m. The reference is
+    // the explicit method at rtol 1e-14 (about a million RHS evaluations).
+    for name in ["lugre", "dahl"] {
+        let model = stiff(name, 1e7);
+        let reference = tight_run(model.as_ref(), Integrator::Dopri5);
+        let sim = fmm_run_with(model.as_ref(), 0.022, 2.0, Integrator::Rodas);
+        let gap = max_gap(&sim.x, &reference.x);
+        eprintln!("{name} 1e7: rodas {:?}, gap {gap:.2e} m", sim.stats);
+        assert!(gap <= 1e-8, "{name}: {gap} m");
+        assert_eq!(sim.stats.jacobian_evaluations, sim.stats.steps);
+        assert!(
+            sim.stats.rhs_evaluations < reference.stats.rhs_evaluations / 50,
+            "{name}: {:?}",
+            sim.stats
+        );
+    }
+    let lugre = fmm_run_with(stiff("lugre", 1e7).as_ref(), 0.022, 2.0, Integrator::Rodas);
+    assert!(lugre.stats.rhs_evaluations <= 10_000, "{:?}", lugre.stats);
+}
+
+#[test]
+fn rodas_completes_at_the_stiffest_bristles() {
+    // sigma0 = 1e8 and 1e9 N/m: out of the explicit method's reach; compared with Rodas
+    // itself at rtol 1e-14 (its own error control, 1e4 times tighter).
+    for name in ["lugre", "dahl"] {
+        for sigma0 in [1e8, 1e9] {
+            let model = stiff(name, sigma0);
+            let reference = tight_run(model.as_ref(), Integrator::Rodas);
+            let sim = fmm_run_with(model.as_ref(), 0.022, 2.0, Integrator::Rodas);
+            let gap = max_gap(&sim.x, &reference.x);
+            eprintln!("{name} {sigma0:e}: {:?}, gap {gap:.2e} m", sim.stats);
+            assert!(gap <= 1e-7, "{name} {sigma0}: {gap} m");
+            assert!(sim.stats.rhs_evaluations <= 30_000, "{:?}", sim.stats);
+        }
+    }
+}
+
+#[test]
+fn every_model_gives_the_same_trajectory_with_each_integrator() {
+    // Default parameters (bristle models at sigma0 = 1e5 N/m: moderately stiff). Each pair
+    // of integrators agrees to a few times their tolerance-level error (about 1e-9 m each).
+    for name in names() {
+        let model = default_model(&name).unwrap();
+        let dopri = fmm_run_with(model.as_ref(), 0.022, 2.0, Integrator::Dopri5);
+        let rodas = fmm_run_with(model.as_ref(), 0.022, 2.0, Integrator::Rodas);
+        let gap = max_gap(&dopri.x, &rodas.x);
+        eprintln!("{name}: |x_dopri5 - x_rodas| <= {gap:.2e} m");
+        assert!(gap <= 2e-8, "{name}: {gap} m");
+        if let Ok(exact) = simulate(
+            &Oscillator::fmm(),
+            model.as_ref(),
+            &Initial::at_rest(0.022),
+            2.0,
+            &uniform_times(2.0, 1000.0),
+            &exact_opts(),
+        ) {
+            let gap = max_gap(&exact.x, &rodas.x);
+            assert!(gap <= 2e-8, "{name}: exact vs rodas {gap} m");
+        }
+    }
 }

@@ -169,6 +169,28 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
         finite_difference_jacobian(self, v, z, normal, jac);
     }
 
+    /// The partial derivatives of [`force`](FrictionModel::force) at (v, z): returns dF/dv and
+    /// writes dF/dz_j into `dfdz` (n_states entries). With `state_jacobian` and
+    /// `state_velocity_derivative` it completes the Jacobian a stiff integrator needs. The
+    /// default differentiates numerically (see [`finite_difference_force_gradient`]).
+    fn force_gradient(&self, v: f64, z: &[f64], normal: f64, dfdz: &mut [f64]) -> f64 {
+        finite_difference_force_gradient(self, v, z, normal, dfdz)
+    }
+
+    /// The derivative of `state_derivative` with respect to the velocity, d(dz_i)/dv, into
+    /// `out` (n_states entries). The default differentiates numerically, never across v = 0
+    /// (see [`velocity_step`]).
+    fn state_velocity_derivative(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) {
+        let (step, v_plus, v_minus) = velocity_step(v);
+        let n = out.len();
+        let mut plus = vec![0.0; n];
+        self.state_derivative(v_plus, z, normal, &mut plus);
+        self.state_derivative(v_minus, z, normal, out);
+        for (o, p) in out.iter_mut().zip(&plus) {
+            *o = (p - *o) / step;
+        }
+    }
+
     /// For static laws that are affine in the velocity within a sliding mode: `(a, b)` such
     /// that `slip_force(v, direction, N) = a + b v` for every v in that mode (e.g. coulomb:
     /// (direction mu N, 0); viscous_coulomb: (direction mu N, c_v)). The engine may then solve
@@ -239,6 +261,47 @@ pub fn finite_difference_jacobian<M: FrictionModel + ?Sized>(
             }
         }
     }
+}
+
+/// Smallest velocity magnitude the finite-difference step in v scales with [m/s].
+const FD_VELOCITY_FLOOR: f64 = 1e-6;
+
+/// A finite-difference step in the velocity that never crosses v = 0 (where |v| and sgn(v)
+/// kink): `(width, upper, lower)` with width = upper - lower. Central around v where the step
+/// fits on v's side of zero, one-sided away from zero otherwise (towards +v at v = 0).
+pub fn velocity_step(v: f64) -> (f64, f64, f64) {
+    let step = f64::EPSILON.cbrt() * v.abs().max(FD_VELOCITY_FLOOR);
+    if step < v.abs() {
+        (2.0 * step, v + step, v - step)
+    } else if v < 0.0 {
+        (step, v, v - step)
+    } else {
+        (step, v + step, v)
+    }
+}
+
+/// The finite-difference gradient of `model.force` (the default of
+/// [`FrictionModel::force_gradient`]): returns dF/dv (step of [`velocity_step`]), writes the
+/// central-difference dF/dz_j into `dfdz` (step as in [`finite_difference_jacobian`]).
+pub fn finite_difference_force_gradient<M: FrictionModel + ?Sized>(
+    model: &M,
+    v: f64,
+    z: &[f64],
+    normal: f64,
+    dfdz: &mut [f64],
+) -> f64 {
+    let mut probe = z.to_vec();
+    for (j, d) in dfdz.iter_mut().enumerate().take(z.len()) {
+        let step = f64::EPSILON.cbrt() * z[j].abs().max(FD_STATE_FLOOR);
+        probe[j] = z[j] + step;
+        let plus = model.force(v, &probe, normal);
+        probe[j] = z[j] - step;
+        let minus = model.force(v, &probe, normal);
+        probe[j] = z[j];
+        *d = (plus - minus) / (2.0 * step);
+    }
+    let (width, v_plus, v_minus) = velocity_step(v);
+    (model.force(v_plus, z, normal) - model.force(v_minus, z, normal)) / width
 }
 
 /// Checks `values` against the bounds in `info`; the error names the model and parameter.

@@ -22,6 +22,10 @@ impl OdeSystem for Segment<'_> {
         self.dynamics.rhs(y, dy, self.dir);
     }
 
+    fn jacobian(&self, _t: f64, y: &[f64], jac: &mut [f64]) {
+        self.dynamics.jacobian(y, self.dir, jac);
+    }
+
     fn affine_motion(&self) -> Option<AffineMotion> {
         self.dynamics.affine_motion(self.dir)
     }
@@ -65,6 +69,7 @@ impl<R: Recorder> Driver<'_, R> {
         self.stats.rhs_evaluations = counts.rhs_evaluations;
         self.stats.steps = counts.accepted;
         self.stats.rejected_steps = counts.rejected;
+        self.stats.jacobian_evaluations = counts.jacobian_evaluations;
         result
     }
 

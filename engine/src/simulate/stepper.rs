@@ -15,6 +15,28 @@ pub trait OdeSystem {
     /// Writes f(t, y) into `dy` (same length as `y`).
     fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]);
 
+    /// Writes the Jacobian df/dy at (t, y), row-major, into `jac` (len(y)^2 entries). The
+    /// default takes forward differences of [`rhs`](OdeSystem::rhs) (allocating); systems
+    /// with a closed form supply it (the stiff stepper calls this once per step).
+    fn jacobian(&self, t: f64, y: &[f64], jac: &mut [f64]) {
+        let n = y.len();
+        let mut f0 = vec![0.0; n];
+        let mut f1 = vec![0.0; n];
+        let mut probe = y.to_vec();
+        self.rhs(t, y, &mut f0);
+        for j in 0..n {
+            let step = f64::EPSILON.sqrt() * y[j].abs().max(1e-8);
+            probe[j] = y[j] + step;
+            self.rhs(t, &probe, &mut f1);
+            probe[j] = y[j];
+            for i in 0..n {
+                if let Some(entry) = jac.get_mut(i * n + j) {
+                    *entry = (f1[i] - f0[i]) / step;
+                }
+            }
+        }
+    }
+
     /// When y = [x, v] obeys a linear oscillator equation (see [`AffineMotion`]): its
     /// coefficients, for closed-form propagation. `None` (the default) otherwise.
     fn affine_motion(&self) -> Option<AffineMotion> {
@@ -94,6 +116,8 @@ pub struct StepCounts {
     pub accepted: u64,
     /// Rejected steps.
     pub rejected: u64,
+    /// Jacobian evaluations (stiff steppers; not included in `rhs_evaluations`).
+    pub jacobian_evaluations: u64,
 }
 
 impl StepCounts {

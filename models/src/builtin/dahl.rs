@@ -76,6 +76,27 @@ impl FrictionModel for Dahl {
         };
         *j = -self.sigma0 * v.abs() * slope / fc;
     }
+    /// The force is the state: dF/dz = 1, dF/dv = 0.
+    fn force_gradient(&self, _v: f64, _z: &[f64], _normal: f64, dfdz: &mut [f64]) -> f64 {
+        if let Some(d) = dfdz.first_mut() {
+            *d = 1.0;
+        }
+        0.0
+    }
+    /// d(dF/dt)/dv = sigma0 |r|^alpha sgn(r) within a sliding direction (r depends on v only
+    /// through sgn(v)); 0 without normal load.
+    fn state_velocity_derivative(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) {
+        let (Some(&f), Some(o)) = (z.first(), out.first_mut()) else {
+            return;
+        };
+        let fc = self.mu_c * normal;
+        *o = if fc > 0.0 {
+            let r = 1.0 - f * sgn(v) / fc;
+            self.sigma0 * r.abs().powf(self.alpha) * sgn(r)
+        } else {
+            0.0
+        };
+    }
     fn force(&self, _v: f64, z: &[f64], _normal: f64) -> f64 {
         z.first().copied().unwrap_or(0.0)
     }

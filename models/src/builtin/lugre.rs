@@ -41,6 +41,18 @@ impl LuGre {
         normal * (self.mu_c + (self.mu_s - self.mu_c) * (-r * r).exp())
     }
 
+    /// The partial derivatives (d/dz, d/dv) of dz/dt; (0, 0) without normal load.
+    fn z_dot_partials(&self, v: f64, z: f64, normal: f64) -> (f64, f64) {
+        let g = self.g(v, normal);
+        if g <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let r = v / self.v_s;
+        let dg = normal * (self.mu_s - self.mu_c) * (-r * r).exp() * (-2.0 * r / self.v_s);
+        let d_ratio = (sgn(v) * g - v.abs() * dg) / (g * g);
+        (-self.sigma0 * v.abs() / g, 1.0 - self.sigma0 * z * d_ratio)
+    }
+
     fn z_dot(&self, v: f64, z: f64, normal: f64) -> f64 {
         let g = self.g(v, normal);
         if g > 0.0 {
@@ -76,6 +88,21 @@ impl FrictionModel for LuGre {
             } else {
                 0.0
             };
+        }
+    }
+    /// dF/dz = sigma0 + sigma1 d(dz/dt)/dz, dF/dv = sigma1 d(dz/dt)/dv + sigma2.
+    fn force_gradient(&self, v: f64, z: &[f64], normal: f64, dfdz: &mut [f64]) -> f64 {
+        let z0 = z.first().copied().unwrap_or(0.0);
+        let (dz_dz, dz_dv) = self.z_dot_partials(v, z0, normal);
+        if let Some(d) = dfdz.first_mut() {
+            *d = self.sigma0 + self.sigma1 * dz_dz;
+        }
+        self.sigma1 * dz_dv + self.sigma2
+    }
+    /// d(dz/dt)/dv = 1 - sigma0 z (sgn(v) g - |v| g') / g^2 (0 without normal load).
+    fn state_velocity_derivative(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) {
+        if let (Some(&z0), Some(o)) = (z.first(), out.first_mut()) {
+            *o = self.z_dot_partials(v, z0, normal).1;
         }
     }
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {

@@ -1,0 +1,150 @@
+//! The Jacobian of the equation of motion y = [x, v, z...] for the stiff stepper.
+//!
+//! With F(v, z) the friction force and dz/dt = h(v, z) the state law,
+//!
+//! ```text
+//!       | 0        1                 0            |
+//! J  =  | -k/m    -(c + dF/dv)/m    -(dF/dz)/m    |
+//!       | 0        dh/dv             dh/dz        |
+//! ```
+//!
+//! dh/dz is the model's `state_jacobian`, dF/dv and dF/dz its `force_gradient` and dh/dv its
+//! `state_velocity_derivative` (analytic for the built-in dynamic models, finite differences
+//! by default). For static laws only the 2 x 2 mechanics remain, with d(slip_force)/dv taken
+//! by finite differences.
+
+use super::{Dynamics, Law};
+use frictionid_models::model::velocity_step;
+
+impl Dynamics<'_> {
+    /// Writes the Jacobian of [`Dynamics::rhs`] at `y` in slip direction `dir`, row-major,
+    /// into `jac` (len(y)^2 entries). Allocates nothing beyond what the model's derivative
+    /// methods do.
+    pub fn jacobian(&self, y: &[f64], dir: f64, jac: &mut [f64]) {
+        let n = y.len();
+        let ([_, v, z @ ..], true) = (y, jac.len() == n * n) else {
+            return;
+        };
+        // At a segment's start v = 0 exactly: differentiate on the side of the slip direction
+        // (where |v| and sgn(v) have their one-sided derivatives), mirror-symmetrically.
+        let v = if *v == 0.0 {
+            dir * f64::MIN_POSITIVE
+        } else {
+            *v
+        };
+        let df_dv = match self.law {
+            Law::Dynamic => self.state_blocks(v, z, jac),
+            _ => self.slip_slope(v, dir),
+        };
+        if let Some(row0) = jac.get_mut(..n) {
+            row0.fill(0.0);
+            row0[1] = 1.0;
+        }
+        jac[n] = -self.stiffness / self.mass;
+        jac[n + 1] = -(self.damping + df_dv) / self.mass;
+    }
+
+    /// d(slip_force)/dv of a static law in direction `dir`.
+    fn slip_slope(&self, v: f64, dir: f64) -> f64 {
+        let (width, hi, lo) = velocity_step(v);
+        let force = |u: f64| self.model.slip_force(u, dir, self.normal);
+        (force(hi) - force(lo)) / width
+    }
+
+    /// Fills rows 1 (dF/dz, scaled by -1/m) and 2.. (dh/dv, dh/dz) of a dynamic model; rows
+    /// 0 and the first two entries of row 1 are left for the caller. Returns dF/dv.
+    ///
+    /// Scratch-free: the model's dense n_z x n_z state Jacobian is written into the head of
+    /// `jac` and moved into its block from the last entry backwards (each entry moves to a
+    /// higher index, so nothing unread is overwritten); dh/dv goes through row 0's tail.
+    fn state_blocks(&self, v: f64, z: &[f64], jac: &mut [f64]) -> f64 {
+        let nz = z.len();
+        let n = nz + 2;
+        self.model
+            .state_jacobian(v, z, self.normal, &mut jac[..nz * nz]);
+        for idx in (0..nz * nz).rev() {
+            let (i, j) = (idx / nz, idx % nz);
+            jac[(2 + i) * n + 2 + j] = jac[idx];
+        }
+        self.model
+            .state_velocity_derivative(v, z, self.normal, &mut jac[2..n]);
+        for i in 0..nz {
+            jac[(2 + i) * n + 1] = jac[2 + i];
+            jac[(2 + i) * n] = 0.0;
+        }
+        let df_dv = self
+            .model
+            .force_gradient(v, z, self.normal, &mut jac[n + 2..2 * n]);
+        for d in &mut jac[n + 2..2 * n] {
+            *d /= -self.mass;
+        }
+        df_dv
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{classify_law, Dynamics};
+    use frictionid_models::{build_json, names};
+
+    /// Central differences of the whole right-hand side, column by column.
+    fn numeric_jacobian(d: &Dynamics<'_>, y: &[f64], dir: f64) -> Vec<f64> {
+        let n = y.len();
+        let mut jac = vec![0.0; n * n];
+        let (mut plus, mut minus) = (vec![0.0; n], vec![0.0; n]);
+        for j in 0..n {
+            let step = 1e-6 * y[j].abs().max(1e-3);
+            let mut probe = y.to_vec();
+            probe[j] = y[j] + step;
+            d.rhs(&probe, &mut plus, dir);
+            probe[j] = y[j] - step;
+            d.rhs(&probe, &mut minus, dir);
+            for i in 0..n {
+                jac[i * n + j] = (plus[i] - minus[i]) / (2.0 * step);
+            }
+        }
+        jac
+    }
+
+    #[test]
+    fn the_jacobian_matches_finite_differences_of_the_rhs_for_every_built_in_model() {
+        for name in names() {
+            let Ok(built) = build_json(&serde_json::json!({ "type": name })) else {
+                continue;
+            };
+            let model = built.model;
+            let Ok(law) = classify_law(model.as_ref(), 14.5) else {
+                continue;
+            };
+            let d = Dynamics {
+                mass: 10.391,
+                damping: 0.275,
+                stiffness: 1982.0,
+                normal: 14.5,
+                model: model.as_ref(),
+                law,
+            };
+            let nz = model.n_states();
+            for (v, dir) in [(0.05, 1.0), (-0.02, -1.0), (3e-3, 1.0)] {
+                let mut y = vec![0.01, v];
+                // Deflections of a fraction of the sliding limit (loading and unloading).
+                y.extend(
+                    (0..nz).map(|i| 2e-7 * (1.0 + i as f64) * if i % 2 == 0 { 1.0 } else { -1.0 }),
+                );
+                let n = y.len();
+                let mut jac = vec![f64::NAN; n * n];
+                d.jacobian(&y, dir, &mut jac);
+                let num = numeric_jacobian(&d, &y, dir);
+                for (k, (a, b)) in jac.iter().zip(&num).enumerate() {
+                    let scale = 1.0 + b.abs().max(a.abs());
+                    assert!(
+                        (a - b).abs() <= 1e-5 * scale,
+                        "{name} v {v}: entry ({}, {}) analytic {a} vs numeric {b}",
+                        k / n,
+                        k % n
+                    );
+                }
+            }
+        }
+    }
+}
