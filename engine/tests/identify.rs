@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{records, NOISE};
+use common::{lugre_truth, records, NOISE};
 use frictionid_engine::identify::{compare, fit, FitOptions, OscillatorParam};
 use frictionid_engine::{Integrator, Oscillator, SimOptions};
 use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre, NoFriction, Stribeck};
@@ -96,14 +96,7 @@ fn stribeck_parameters_are_recovered_and_the_comparison_ranks_it_first() {
 #[test]
 fn lugre_fit_reaches_the_noise_level() {
     let osc = Oscillator::fmm();
-    let truth = LuGre {
-        sigma0: 1e5,
-        sigma1: 500.0,
-        sigma2: 1.0,
-        mu_c: 0.22,
-        mu_s: 0.30,
-        v_s: 0.01,
-    };
+    let truth = lugre_truth();
     let recs = records(&osc, &truth, NOISE, 41);
     let r = fit(&osc, &LuGre::default(), &recs, &FitOptions::default()).unwrap();
     assert!(

@@ -170,7 +170,7 @@ impl Default for FitOptions {
             domain: FitDomain::Velocity,
             force_target: ForceTarget::Auto,
             force_offset: false,
-            prefit: true,
+            prefit: false,
             unknown_oscillator: Vec::new(),
             multistart: None,
             search: None,

@@ -3,7 +3,7 @@
 
 use frictionid_engine::synthetic::release_records;
 use frictionid_engine::{Oscillator, Record};
-use frictionid_models::FrictionModel;
+use frictionid_models::{FrictionModel, LuGre};
 
 /// The releases of the paper: 10, 14 and 22 mm.
 pub const RELEASES: [f64; 3] = [0.010, 0.014, 0.022];
@@ -15,4 +15,17 @@ pub const NOISE: f64 = 2e-4;
 pub fn records(osc: &Oscillator, model: &dyn FrictionModel, noise: f64, seed: u64) -> Vec<Record> {
     release_records(osc, model, &RELEASES, 2.0, 1000.0, noise, seed)
         .expect("simulation of the truth")
+}
+
+/// The LuGre law of the dynamic-identification issue's acceptance: sigma0 1e5 N/m, sigma1
+/// 500 N s/m, sigma2 1 N s/m, mu_c 0.22, mu_s 0.30, v_s 0.01 m/s.
+pub fn lugre_truth() -> LuGre {
+    LuGre {
+        sigma0: 1e5,
+        sigma1: 500.0,
+        sigma2: 1.0,
+        mu_c: 0.22,
+        mu_s: 0.30,
+        v_s: 0.01,
+    }
 }
