@@ -321,3 +321,19 @@ fn simulate_and_energy_name_what_they_need() {
         "{e}"
     );
 }
+
+/// `simulate` needs every oscillator property: a missing normal force is an error naming it,
+/// never a silent frictionless run on a placeholder N = 0.
+#[test]
+fn simulate_without_a_normal_force_names_the_missing_key() {
+    let config = "[oscillator]\nmass = 10.391\ndamping = 0.275\nstiffness = 1982.0\n\
+                  [model]\ntype = \"coulomb\"\nmu = 0.24\n\
+                  [simulation]\nx0 = 0.01\nduration = 1.0\nsample_rate = 1000.0\n";
+    let e = fails("no_normal_force", "simulate", config, &[]);
+    assert!(
+        e.contains(
+            "simulate needs mass, damping, stiffness and normal_force; `normal_force` not given"
+        ),
+        "{e}"
+    );
+}

@@ -10,7 +10,7 @@ use crate::energy::{
 };
 use crate::error::EngineError;
 use crate::identify::{
-    compare, fit, require_mechanics, FitOptions, FitResult, PropertyUncertainty,
+    compare, fit, require_mechanics, require_oscillator, FitOptions, FitResult, PropertyUncertainty,
 };
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -109,7 +109,7 @@ pub fn simulate_report(
 /// velocity record when the spec asks for noise.
 pub fn simulate_job(spec: &Spec) -> Result<SimulateReport, JobError> {
     let model = &spec.require_model("simulate")?.model;
-    require_mechanics(&spec.unknown_oscillator, "simulate").map_err(JobError::Fit)?;
+    require_oscillator(&spec.unknown_oscillator, "simulate").map_err(JobError::Fit)?;
     let sim: &SimulationSpec = spec.require_simulation("simulate")?;
     let times = uniform_times(sim.duration, sim.sample_rate);
     let init = Initial {

@@ -8,6 +8,7 @@ use crate::convert::{serialized, to_f64_vec, to_json};
 use crate::errors::{engine_error, job_error, value_error};
 use crate::inputs;
 use crate::outputs::{compare_dict, energy_dict, fit_dict, simulate_dict};
+use frictionid_engine::identify::require_oscillator;
 use frictionid_engine::jobs::{compare_job, energy_job, fit_job, simulate_report};
 use frictionid_engine::record::TimeBase;
 use frictionid_engine::report::ModelsReport;
@@ -133,7 +134,9 @@ pub fn simulate<'py>(
     v0: f64,
     options: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let osc = inputs::oscillator(oscillator)?.oscillator;
+    let stage = inputs::oscillator(oscillator)?;
+    require_oscillator(&stage.unknown, "simulate").map_err(|e| value_error(e.to_string()))?;
+    let osc = stage.oscillator;
     let model = inputs::model(model)?.model;
     let times = TimeBase::new(to_f64_vec(t, "t")?).map_err(|e| value_error(format!("t: {e}")))?;
     let (integrator, z0) = simulate_options(options)?;

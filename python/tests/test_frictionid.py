@@ -151,7 +151,7 @@ def test_compare_and_energy_return_reports():
 def test_bad_input_raises_value_error_with_the_cli_message(tmp_path):
     with pytest.raises(ValueError, match=r"did you mean `coulomb`"):
         frictionid.simulate(FMM, {"type": "colomb"}, 0.01, [0.0, 0.1])
-    with pytest.raises(ValueError, match=r"\[oscillator\]: missing field `mass`"):
+    with pytest.raises(ValueError, match=r"\[oscillator\]: simulate needs .*`mass`, `stiffness`, `normal_force` not given"):
         frictionid.simulate({"damping": 0.2}, "coulomb", 0.01, [0.0, 0.1])
     with pytest.raises(ValueError, match=r"3 time stamps but 2 velocities"):
         frictionid.fit(FMM, "coulomb", [{"t": [0.0, 0.1, 0.2], "v": [0.0, 0.1], "x0": 0.01}])

@@ -67,16 +67,46 @@ pub struct ForceAlongMotion {
 /// an energy analysis needs, and the message when `missing` (as `[oscillator]` keys) holds
 /// any of them. The one place of this rule.
 pub fn require_mechanics(missing: &[String], purpose: &str) -> Result<(), EngineError> {
-    let absent: Vec<&str> = ["mass", "damping", "stiffness"]
-        .into_iter()
+    require_properties(missing, &["mass", "damping", "stiffness"], purpose)
+}
+
+/// Every oscillator property, the normal force included, is given: what a simulation of the
+/// oscillator needs (a placeholder N = 0 would silently simulate no friction at all).
+pub fn require_oscillator(missing: &[String], purpose: &str) -> Result<(), EngineError> {
+    require_properties(
+        missing,
+        &["mass", "damping", "stiffness", "normal_force"],
+        purpose,
+    )
+}
+
+/// `a, b and c`.
+fn spoken_list(items: &[&str]) -> String {
+    match items.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => items.join(""),
+    }
+}
+
+/// The `needed` `[oscillator]` keys are not among the `missing` ones; otherwise an error
+/// naming those that are.
+fn require_properties(
+    missing: &[String],
+    needed: &[&str],
+    purpose: &str,
+) -> Result<(), EngineError> {
+    let absent: Vec<&str> = needed
+        .iter()
+        .copied()
         .filter(|k| missing.iter().any(|m| m == k))
         .collect();
     if absent.is_empty() {
         return Ok(());
     }
     Err(EngineError::InvalidInput(format!(
-        "[oscillator]: {purpose} needs mass, damping and stiffness; `{}` not given (only a \
-         force-domain fit on a measured force channel does without them)",
+        "[oscillator]: {purpose} needs {}; `{}` not given (only a force-domain fit on a \
+         measured force channel does without mass, damping and stiffness)",
+        spoken_list(needed),
         absent.join("`, `")
     )))
 }

@@ -43,7 +43,7 @@ pub use budget::{PropertyUncertainty, StdErrorComponents};
 pub use compare::{compare, Comparison, ComparisonVerdict, FailedFit};
 pub use energy_check::{energy_force_check, EnergyForce, ForceReference};
 pub use fit::{fit, fit_with, guess_hint, Derived, FitResult, FittedParam, RecordFit};
-pub use force::{fit_force, require_mechanics, ForceAlongMotion};
+pub use force::{fit_force, require_mechanics, require_oscillator, ForceAlongMotion};
 pub use identifiability::Identifiability;
 pub use lm::LevenbergMarquardt;
 pub use options::{FitDomain, FitOptions, ForceTarget, OscillatorParam, Progress, ProgressFn};

@@ -81,21 +81,14 @@ pub(crate) fn stiffness_ratio(dynamics: &Dynamics<'_>, y0: &[f64], period: f64) 
 
 #[cfg(test)]
 mod tests {
-    use super::super::{classify_law, Dynamics};
+    use super::super::Dynamics;
     use super::*;
     use crate::oscillator::Oscillator;
     use frictionid_models::{build_json, FrictionModel};
 
     fn ratio(model: &dyn FrictionModel) -> f64 {
         let osc = Oscillator::fmm();
-        let dynamics = Dynamics {
-            mass: osc.mass,
-            damping: osc.damping,
-            stiffness: osc.stiffness,
-            normal: osc.normal_force,
-            model,
-            law: classify_law(model, osc.normal_force).unwrap_or(Law::Smooth),
-        };
+        let dynamics = Dynamics::new(&osc, model).expect("a classifiable law");
         let mut y0 = vec![0.022, 0.0];
         y0.resize(2 + model.n_states(), 0.0);
         stiffness_ratio(&dynamics, &y0, osc.natural_period())

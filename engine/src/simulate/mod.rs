@@ -452,6 +452,20 @@ pub(crate) enum Start {
     Rest,
 }
 
+impl<'a> Dynamics<'a> {
+    /// The equation of motion of `osc` with `model` (its law classified at the normal force).
+    pub(crate) fn new(osc: &Oscillator, model: &'a dyn FrictionModel) -> Result<Self, EngineError> {
+        Ok(Self {
+            mass: osc.mass,
+            damping: osc.damping,
+            stiffness: osc.stiffness,
+            normal: osc.normal_force,
+            model,
+            law: classify_law(model, osc.normal_force)?,
+        })
+    }
+}
+
 impl Dynamics<'_> {
     /// The friction force in slip direction `dir` (static laws) or from the states (dynamic).
     #[inline]
@@ -553,14 +567,7 @@ pub(crate) fn run<R: Recorder>(
     let y0 = initial_state(model, init)?;
     check_times(t_end, sample_times)?;
     check_options(opts)?;
-    let dynamics = Dynamics {
-        mass: osc.mass,
-        damping: osc.damping,
-        stiffness: osc.stiffness,
-        normal: osc.normal_force,
-        model,
-        law: classify_law(model, osc.normal_force)?,
-    };
+    let dynamics = Dynamics::new(osc, model)?;
     let mut driver = Driver {
         dynamics,
         samples: sample_times,
