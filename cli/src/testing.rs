@@ -38,3 +38,50 @@ pub fn read_report(out: &Path) -> serde_json::Value {
         .and_then(|text| serde_json::from_str(&text).ok())
         .unwrap_or(serde_json::Value::Null)
 }
+
+/// Runs `<binary> <command> CONFIG --out DIR` on `config` written into a fresh scratch
+/// directory of `suite` (with the data `files` beside it) and checks the contract of bad
+/// input: exit code 1, one line on stderr starting `error: `, no panic or backtrace, no
+/// report.json. Returns that line.
+///
+/// # Panics
+/// When the contract is broken, or the scratch files cannot be written.
+pub fn fails_with_one_line(
+    binary: &Path,
+    (suite, name): (&str, &str),
+    command: &str,
+    config: &str,
+    files: &[(&str, &str)],
+) -> String {
+    let dir = scratch_dir(suite, name);
+    let write = |file: &str, text: &str| {
+        if let Err(e) = std::fs::write(dir.join(file), text) {
+            panic!("cannot write {file}: {e}");
+        }
+    };
+    write("c.toml", config);
+    for (file, text) in files {
+        write(file, text);
+    }
+    let out = dir.join("out");
+    let run = std::process::Command::new(binary)
+        .arg(command)
+        .arg(dir.join("c.toml"))
+        .arg("--out")
+        .arg(&out)
+        .output();
+    let o = match run {
+        Ok(o) => o,
+        Err(e) => panic!("cannot run {}: {e}", binary.display()),
+    };
+    let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(1), "exit code; stderr: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    for bad in ["panicked", "backtrace", "internal error", "RUST_BACKTRACE"] {
+        assert!(!stderr.contains(bad), "{stderr}");
+    }
+    assert!(!out.join("report.json").exists(), "no report.json");
+    let _ = std::fs::remove_dir_all(&dir);
+    stderr.trim_end().to_string()
+}

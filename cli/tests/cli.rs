@@ -3,7 +3,7 @@
 //! no panic and no report.json.
 
 use assert_cmd::Command;
-use frictionid_cli::testing::{fixtures_dir, scratch_dir, FMM_OSCILLATOR};
+use frictionid_cli::testing::{fails_with_one_line, fixtures_dir, scratch_dir, FMM_OSCILLATOR};
 
 fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
@@ -21,29 +21,8 @@ fn csv(n: usize) -> String {
 /// Runs `frictionid <cmd> CONFIG --out DIR` on a config written into a scratch directory
 /// (with the given data files) and checks the failure contract; returns the stderr line.
 fn fails(name: &str, cmd: &str, config: &str, files: &[(&str, &str)]) -> String {
-    let dir = scratch_dir("cli", name);
-    std::fs::write(dir.join("c.toml"), config).unwrap();
-    for (f, text) in files {
-        std::fs::write(dir.join(f), text).unwrap();
-    }
-    let out = dir.join("out");
-    let o = frictionid()
-        .arg(cmd)
-        .arg(dir.join("c.toml"))
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
-    assert_eq!(o.status.code(), Some(1), "exit code; stderr: {stderr}");
-    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
-    assert!(stderr.starts_with("error: "), "{stderr}");
-    for bad in ["panicked", "backtrace", "internal error", "RUST_BACKTRACE"] {
-        assert!(!stderr.contains(bad), "{stderr}");
-    }
-    assert!(!out.join("report.json").exists(), "no report.json");
-    let _ = std::fs::remove_dir_all(&dir);
-    stderr.trim_end().to_string()
+    let binary = std::path::Path::new(env!("CARGO_BIN_EXE_frictionid"));
+    fails_with_one_line(binary, ("cli", name), cmd, config, files)
 }
 
 fn with_record(extra: &str) -> String {

@@ -3,21 +3,11 @@
 //! of force-domain configurations.
 
 use assert_cmd::Command;
-use std::path::{Path, PathBuf};
+use frictionid_cli::testing::{fails_with_one_line, fixtures_dir, scratch_dir};
+use std::path::Path;
 
 fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
-}
-
-fn fixtures() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("frictionid-force-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 const STATIC: [&str; 3] = ["coulomb", "viscous_coulomb", "stribeck"];
@@ -29,8 +19,8 @@ const DYNAMIC: [&str; 3] = ["dahl", "lugre", "gms"];
 /// at rest, while the measured force holds about 2.3 N through every dwell.
 #[test]
 fn tribometer_compare_ranks_dynamic_models_ahead_of_static_ones() {
-    let out = scratch("tribometer");
-    let cfg = fixtures().join("tribometer.toml");
+    let out = scratch_dir("force", "tribometer");
+    let cfg = fixtures_dir().join("tribometer.toml");
     let o = frictionid()
         .args(["compare", cfg.to_str().unwrap(), "--json", "--out"])
         .arg(&out)
@@ -67,24 +57,8 @@ fn tribometer_compare_ranks_dynamic_models_ahead_of_static_ones() {
 }
 
 fn fails(name: &str, cmd: &str, config: &str, files: &[(&str, &str)]) -> String {
-    let dir = scratch(name);
-    std::fs::write(dir.join("c.toml"), config).unwrap();
-    for (f, text) in files {
-        std::fs::write(dir.join(f), text).unwrap();
-    }
-    let o = frictionid()
-        .arg(cmd)
-        .arg(dir.join("c.toml"))
-        .arg("--out")
-        .arg(dir.join("out"))
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
-    assert_eq!(o.status.code(), Some(1), "exit code; stderr: {stderr}");
-    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    let _ = std::fs::remove_dir_all(&dir);
-    stderr.trim_end().to_string()
+    let binary = Path::new(env!("CARGO_BIN_EXE_frictionid"));
+    fails_with_one_line(binary, ("force", name), cmd, config, files)
 }
 
 /// A velocity record (no force column).
