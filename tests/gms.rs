@@ -293,12 +293,7 @@ fn energy_with_stored_energy_never_increases() {
     for (model, label) in &cases {
         for x0 in [0.022, 0.003, -0.010] {
             let sim = run(&osc, model, x0, 2.0, 2000.0);
-            let total: Vec<f64> = sim
-                .energy
-                .iter()
-                .zip(&sim.stored)
-                .map(|(e, s)| e + s)
-                .collect();
+            let total = sim.total_energy();
             let scale = total[0];
             for i in 1..total.len() {
                 assert!(

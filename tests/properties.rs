@@ -137,7 +137,7 @@ proptest! {
         let model = model_from(&name, &factors, true);
         let t_end = 3.0 * osc.natural_period();
         let traj = run(&osc, model.as_ref(), x0, v0, t_end, 400, &SimOptions::default());
-        let total: Vec<f64> = traj.energy.iter().zip(&traj.stored).map(|(e, s)| e + s).collect();
+        let total = traj.total_energy();
         let e0 = total[0].max(1e-12);
         for (i, w) in total.windows(2).enumerate() {
             prop_assert!(

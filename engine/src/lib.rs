@@ -15,6 +15,7 @@ pub mod report;
 pub mod simulate;
 pub mod spec;
 pub mod synthetic;
+pub mod testing;
 
 pub use energy::{
     analyze_record, analyze_states, force_residuals, model_force_along, percent_difference,

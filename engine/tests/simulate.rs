@@ -279,12 +279,7 @@ fn energy_never_increases_for_any_built_in_model() {
         let model = default_model(&name).unwrap();
         for x0 in [0.022, 0.014, -0.010, 0.003] {
             let sim = same_tolerance_run(model.as_ref(), x0, integrator);
-            let total: Vec<f64> = sim
-                .energy
-                .iter()
-                .zip(&sim.stored)
-                .map(|(e, s)| e + s)
-                .collect();
+            let total = sim.total_energy();
             let scale = total[0];
             for i in 1..total.len() {
                 assert!(

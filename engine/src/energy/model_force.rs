@@ -233,7 +233,7 @@ fn integrate_interval(
             });
         }
         // No events along a measured motion: the event function stays positive.
-        let outcome = stepper.step(along, |_| 1.0)?;
+        let outcome = stepper.step(along)?;
         let state = stepper.state();
         if outcome != StepOutcome::Rejected && state.iter().any(|x| !x.is_finite()) {
             return Err(IntegrationFailure::NonFiniteState {

@@ -8,15 +8,14 @@
 //! Dense output: the cubic Hermite interpolant through both ends of the step.
 
 use super::stepper::{
-    current_point_accessors, OdeSystem, StepCounts, StepOutcome, StepResult, Stepper,
+    current_point_accessors, OdeSystem, StepCounts, StepOutcome, StepResult, Stepper, Tolerance,
 };
 use crate::error::IntegrationFailure;
 
 /// Bogacki-Shampine 3(2) with error control and cubic Hermite dense output.
 #[derive(Debug, Clone)]
 pub struct BogackiShampine {
-    rtol: f64,
-    atol: f64,
+    tol: Tolerance,
     /// The step size to try next.
     h: f64,
     t: f64,
@@ -38,8 +37,7 @@ impl BogackiShampine {
     pub fn new(dim: usize, rtol: f64, atol: f64) -> Self {
         let zeros = || vec![0.0; dim];
         Self {
-            rtol,
-            atol,
+            tol: Tolerance { rtol, atol },
             h: 0.0,
             t: 0.0,
             t_prev: 0.0,
@@ -77,7 +75,7 @@ impl BogackiShampine {
         for j in 0..self.y.len() {
             let low = self.y[j]
                 + h * (7.0 / 24.0 * k1[j] + 0.25 * k2[j] + 1.0 / 3.0 * k3[j] + 0.125 * k4[j]);
-            let scale = self.atol + self.rtol * self.y[j].abs().max(self.next[j].abs());
+            let scale = self.tol.scale(self.y[j], self.next[j]);
             err = err.max((self.next[j] - low).abs() / scale);
         }
         if err.is_finite() {
@@ -119,11 +117,7 @@ impl Stepper for BogackiShampine {
         Ok(())
     }
 
-    fn step<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        event: impl Fn(&[f64]) -> f64,
-    ) -> StepResult<StepOutcome> {
+    fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome> {
         let last = self.t + self.h >= self.t_end - 1e-12 * self.span;
         let h = if last { self.t_end - self.t } else { self.h };
         let err = self.attempt(system, h);
@@ -154,14 +148,10 @@ impl Stepper for BogackiShampine {
             });
         }
         Ok(if accepted {
-            StepOutcome::accepted(event(&self.y))
+            StepOutcome::Accepted
         } else {
             StepOutcome::Rejected
         })
-    }
-
-    fn reached_end(&self) -> bool {
-        self.t >= self.t_end
     }
 
     fn interpolate(&self, t: f64, out: &mut [f64]) {

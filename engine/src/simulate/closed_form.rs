@@ -183,11 +183,7 @@ impl Stepper for ClosedForm {
         Ok(())
     }
 
-    fn step<S: OdeSystem>(
-        &mut self,
-        _system: &S,
-        event: impl Fn(&[f64]) -> f64,
-    ) -> StepResult<StepOutcome> {
+    fn step<S: OdeSystem>(&mut self, _system: &S) -> StepResult<StepOutcome> {
         let candidate = self.mode.t0 + (self.next_phase + PAST_ZERO * PI) / self.mode.omega_d;
         self.next_phase += PI;
         let t_next = candidate.min(self.t_end);
@@ -197,11 +193,7 @@ impl Stepper for ClosedForm {
         self.t = t_next;
         self.y = [x, v];
         self.counts.accepted += 1;
-        Ok(StepOutcome::accepted(event(&self.y)))
-    }
-
-    fn reached_end(&self) -> bool {
-        self.t >= self.t_end
+        Ok(StepOutcome::Accepted)
     }
 
     fn interpolate(&self, t: f64, out: &mut [f64]) {

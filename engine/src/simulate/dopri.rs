@@ -15,9 +15,9 @@
 //! (rms 3.7e-4 instead of about 2e-4 m/s): that fit is sensitive at the round-off level.
 
 use super::stepper::{
-    current_point_accessors, OdeSystem, StepCounts, StepOutcome, StepResult, Stepper,
+    current_point_accessors, ensure_resolvable, last_step, OdeSystem, StepCounts, StepOutcome,
+    StepResult, Stepper, Tolerance,
 };
-use crate::error::IntegrationFailure;
 
 /// Stage times c_i.
 const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
@@ -88,8 +88,7 @@ const MIN_OLD_ERROR: f64 = 1e-4;
 /// Dormand-Prince 5(4) with error control and dense output over `Vec<f64>` states.
 #[derive(Debug, Clone)]
 pub struct Dopri5 {
-    rtol: f64,
-    atol: f64,
+    tol: Tolerance,
     h_max: f64,
     t: f64,
     t_prev: f64,
@@ -123,8 +122,7 @@ impl Dopri5 {
     pub fn new(dim: usize, rtol: f64, atol: f64, h_max: f64) -> Self {
         let zeros = || vec![0.0; dim];
         Self {
-            rtol,
-            atol,
+            tol: Tolerance { rtol, atol },
             h_max: h_max.abs(),
             t: 0.0,
             t_prev: 0.0,
@@ -150,26 +148,15 @@ impl Dopri5 {
         let (f0, rest) = self.k.split_at_mut(1);
         let (f0, f1) = (&mut f0[0], &mut rest[0]);
         system.rhs(self.t, &self.y, f0);
-        let scale = |yi: f64| self.atol + yi.abs() * self.rtol;
-        let (mut d0, mut d1) = (0.0, 0.0);
-        for (&yi, &fi) in self.y.iter().zip(f0.iter()) {
-            let sc = scale(yi);
-            d0 += (yi / sc) * (yi / sc);
-            d1 += (fi / sc) * (fi / sc);
-        }
-        let h0 = if d0 < 1e-10 || d1 < 1e-10 {
-            1e-6
-        } else {
-            0.01 * (d0 / d1).sqrt()
-        }
-        .min(self.h_max);
+        let (h0, _, d1) = self.tol.first_step_guess(&self.y, f0);
+        let h0 = h0.min(self.h_max);
         for ((yn, &yi), &fi) in self.y_next.iter_mut().zip(&self.y).zip(f0.iter()) {
             *yn = yi + fi * h0;
         }
         system.rhs(self.t + h0, &self.y_next, f1);
         let mut d2 = 0.0;
         for ((&yi, &a), &b) in self.y.iter().zip(f0.iter()).zip(f1.iter()) {
-            let sc = scale(yi);
+            let sc = self.tol.scale(yi, yi);
             d2 += ((b - a) / sc) * ((b - a) / sc);
         }
         let d2 = d2.sqrt() / h0;
@@ -213,12 +200,7 @@ impl Dopri5 {
     /// The RMS error norm of the embedded estimate.
     fn error_norm(&mut self, h: f64) -> f64 {
         Self::combine(&self.k, &E, h, &mut self.err_est);
-        let mut sum = 0.0;
-        for ((&yi, &yn), &e) in self.y.iter().zip(&self.y_next).zip(&self.err_est) {
-            let sc = self.atol + yi.abs().max(yn.abs()) * self.rtol;
-            sum += (e / sc) * (e / sc);
-        }
-        (sum / self.y.len().max(1) as f64).sqrt()
+        self.tol.rms_norm(&self.y, &self.y_next, &self.err_est)
     }
 
     /// The PI controller: the next step size, and whether the step is accepted.
@@ -296,19 +278,10 @@ impl Stepper for Dopri5 {
         Ok(())
     }
 
-    fn step<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        event: impl Fn(&[f64]) -> f64,
-    ) -> StepResult<StepOutcome> {
-        if 0.1 * self.h.abs() <= f64::EPSILON * self.t.abs() {
-            return Err(IntegrationFailure::StepSizeTooSmall {
-                time: self.t,
-                step: self.h,
-            });
-        }
-        if self.t + 1.01 * self.h - self.t_end > 0.0 {
-            self.h = self.t_end - self.t;
+    fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome> {
+        ensure_resolvable(self.t, self.h)?;
+        if let Some(rest) = last_step(self.t, self.h, self.t_end) {
+            self.h = rest;
             self.last = true;
         }
         let h = self.h;
@@ -323,7 +296,7 @@ impl Stepper for Dopri5 {
         }
         self.counts.accepted += 1;
         self.accept(h);
-        Ok(StepOutcome::accepted(event(&self.y)))
+        Ok(StepOutcome::Accepted)
     }
 
     fn reached_end(&self) -> bool {

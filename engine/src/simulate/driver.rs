@@ -128,9 +128,9 @@ impl<R: Recorder> Driver<'_, R> {
                 }
                 .into());
             }
-            let StepOutcome::Accepted { crossed } = stepper.step(segment, event)? else {
+            if stepper.step(segment)? == StepOutcome::Rejected {
                 continue;
-            };
+            }
             if stepper.state().iter().any(|v| !v.is_finite()) {
                 return Err(IntegrationFailure::NonFiniteState {
                     time: stepper.time(),
@@ -138,7 +138,9 @@ impl<R: Recorder> Driver<'_, R> {
                 }
                 .into());
             }
-            if crossed {
+            // The event function is positive inside the segment: <= 0 at the step's end means
+            // it changed sign within the step (or ended on zero).
+            if event(stepper.state()) <= 0.0 {
                 let t_e = self.locate_turn(stepper, &event, y)?;
                 self.write_samples(stepper, t_e, dir, y);
                 stepper.interpolate(t_e, y);

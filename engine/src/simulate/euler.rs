@@ -54,11 +54,7 @@ impl Stepper for Euler {
         Ok(())
     }
 
-    fn step<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        event: impl Fn(&[f64]) -> f64,
-    ) -> StepResult<StepOutcome> {
+    fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome> {
         self.steps_in_segment += 1;
         let t_next = (self.t_seg + self.steps_in_segment as f64 * self.h).min(self.t_end);
         let hs = t_next - self.t;
@@ -71,11 +67,7 @@ impl Stepper for Euler {
         self.t = t_next;
         self.counts.accepted += 1;
         self.counts.rhs_evaluations += 1;
-        Ok(StepOutcome::accepted(event(&self.y)))
-    }
-
-    fn reached_end(&self) -> bool {
-        self.t >= self.t_end
+        Ok(StepOutcome::Accepted)
     }
 
     fn interpolate(&self, t: f64, out: &mut [f64]) {

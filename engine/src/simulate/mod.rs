@@ -52,7 +52,7 @@ pub use closed_form::ClosedForm;
 pub use dopri::Dopri5;
 pub use euler::Euler;
 pub use rodas::Rodas4;
-pub use stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper};
+pub use stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper, Tolerance};
 
 use auto::resolve_method;
 use driver::Driver;
@@ -216,7 +216,7 @@ pub struct SimStats {
 }
 
 /// A simulated trajectory sampled at the requested times.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Trajectory {
     /// Sample times [s].
     pub time: Vec<f64>,
@@ -247,6 +247,16 @@ pub struct Trajectory {
 }
 
 impl Trajectory {
+    /// The total energy at each sample: mechanical (KE + PE) plus the energy stored in the
+    /// friction model's states \[J\]. A passive contact never lets it rise.
+    pub fn total_energy(&self) -> Vec<f64> {
+        self.energy
+            .iter()
+            .zip(&self.stored)
+            .map(|(e, s)| e + s)
+            .collect()
+    }
+
     /// Number of slip phases (half-cycles): the turning points, plus one if the simulation
     /// ended while still moving (no rest and a non-zero velocity at the last sample).
     pub fn half_cycles(&self) -> usize {
@@ -274,33 +284,11 @@ pub fn simulate(
     let mut rec = FullRecorder::new(osc, model, sample_times.len(), n_states);
     let out = run(osc, model, init, t_end, sample_times, opts, &mut rec)?;
     rec.finish_energies();
-    let FullRecorder {
-        time,
-        x,
-        v,
-        a,
-        states,
-        friction,
-        kinetic,
-        potential,
-        energy,
-        stored,
-        ..
-    } = rec;
     Ok(Trajectory {
-        time,
-        x,
-        v,
-        a,
-        states,
-        friction,
-        kinetic,
-        potential,
-        energy,
-        stored,
         events: out.events,
         rest: out.rest,
         stats: out.stats,
+        ..rec.series
     })
 }
 
@@ -335,21 +323,14 @@ pub(crate) trait Recorder {
     fn sample(&mut self, t: f64, x: f64, v: f64, z: &[f64], a: f64, friction: f64);
 }
 
+/// Records every output into the series of a [`Trajectory`] (events, rest and statistics are
+/// the run's, added after it).
 struct FullRecorder<'a> {
     model: &'a dyn FrictionModel,
     mass: f64,
     stiffness: f64,
     normal: f64,
-    time: Vec<f64>,
-    x: Vec<f64>,
-    v: Vec<f64>,
-    a: Vec<f64>,
-    states: Vec<Vec<f64>>,
-    friction: Vec<f64>,
-    kinetic: Vec<f64>,
-    potential: Vec<f64>,
-    energy: Vec<f64>,
-    stored: Vec<f64>,
+    series: Trajectory,
 }
 
 impl<'a> FullRecorder<'a> {
@@ -360,33 +341,37 @@ impl<'a> FullRecorder<'a> {
             mass: osc.mass,
             stiffness: osc.stiffness,
             normal: osc.normal_force,
-            time: col(),
-            x: col(),
-            v: col(),
-            a: col(),
-            states: (0..n_states).map(|_| col()).collect(),
-            friction: col(),
-            kinetic: col(),
-            potential: col(),
-            energy: col(),
-            stored: col(),
+            series: Trajectory {
+                time: col(),
+                x: col(),
+                v: col(),
+                a: col(),
+                states: (0..n_states).map(|_| col()).collect(),
+                friction: col(),
+                kinetic: col(),
+                potential: col(),
+                energy: col(),
+                stored: col(),
+                ..Trajectory::default()
+            },
         }
     }
 }
 
 impl Recorder for FullRecorder<'_> {
     fn sample(&mut self, t: f64, x: f64, v: f64, z: &[f64], a: f64, friction: f64) {
-        self.time.push(t);
-        self.x.push(x);
-        self.v.push(v);
-        self.a.push(a);
-        for (col, &zj) in self.states.iter_mut().zip(z) {
+        let out = &mut self.series;
+        out.time.push(t);
+        out.x.push(x);
+        out.v.push(v);
+        out.a.push(a);
+        for (col, &zj) in out.states.iter_mut().zip(z) {
             col.push(zj);
         }
-        self.friction.push(friction);
+        out.friction.push(friction);
         // Static laws store nothing: the column is filled once at the end.
         if !z.is_empty() {
-            self.stored.push(self.model.stored_energy(z, self.normal));
+            out.stored.push(self.model.stored_energy(z, self.normal));
         }
     }
 }
@@ -396,17 +381,17 @@ impl FullRecorder<'_> {
     /// per-sample work stays with the samples themselves).
     fn finish_energies(&mut self) {
         let (m, k) = (self.mass, self.stiffness);
-        self.kinetic.extend(self.v.iter().map(|&v| 0.5 * m * v * v));
-        self.potential
-            .extend(self.x.iter().map(|&x| 0.5 * k * x * x));
-        self.energy.extend(
-            self.kinetic
+        let out = &mut self.series;
+        out.kinetic.extend(out.v.iter().map(|&v| 0.5 * m * v * v));
+        out.potential.extend(out.x.iter().map(|&x| 0.5 * k * x * x));
+        out.energy.extend(
+            out.kinetic
                 .iter()
-                .zip(&self.potential)
+                .zip(&out.potential)
                 .map(|(ke, pe)| ke + pe),
         );
-        if self.stored.len() < self.time.len() {
-            self.stored.resize(self.time.len(), 0.0);
+        if out.stored.len() < out.time.len() {
+            out.stored.resize(out.time.len(), 0.0);
         }
     }
 }

@@ -21,9 +21,9 @@
 //! steps set by the accuracy of the motion, not by 3.3 / (sigma0 |v| / g).
 
 use super::stepper::{
-    current_point_accessors, OdeSystem, StepCounts, StepOutcome, StepResult, Stepper,
+    current_point_accessors, ensure_resolvable, last_step, OdeSystem, StepCounts, StepOutcome,
+    StepResult, Stepper, Tolerance,
 };
-use crate::error::IntegrationFailure;
 use nalgebra::{DMatrix, DVectorViewMut, Dyn, LU};
 
 /// gamma, the diagonal of the method.
@@ -106,8 +106,7 @@ const MAX_SHRINK: f64 = 5.0;
 /// The Rodas4 stepper over `Vec<f64>` states (see the module docs).
 #[derive(Debug, Clone)]
 pub struct Rodas4 {
-    rtol: f64,
-    atol: f64,
+    tol: Tolerance,
     h_max: f64,
     t: f64,
     t_prev: f64,
@@ -143,8 +142,7 @@ impl Rodas4 {
     pub fn new(dim: usize, rtol: f64, atol: f64, h_max: f64) -> Self {
         let zeros = || vec![0.0; dim];
         Self {
-            rtol,
-            atol,
+            tol: Tolerance { rtol, atol },
             h_max: h_max.abs(),
             t: 0.0,
             t_prev: 0.0,
@@ -184,17 +182,7 @@ impl Rodas4 {
     /// scale 1 / ||J||_inf (a fourth-order method's first step need not resolve more).
     fn initial_step(&self) -> f64 {
         let n = self.y.len();
-        let (mut d0, mut d1) = (0.0, 0.0);
-        for (&yi, &fi) in self.y.iter().zip(&self.fx) {
-            let sc = self.atol + yi.abs() * self.rtol;
-            d0 += (yi / sc) * (yi / sc);
-            d1 += (fi / sc) * (fi / sc);
-        }
-        let h0 = if d0 < 1e-10 || d1 < 1e-10 {
-            1e-6
-        } else {
-            0.01 * (d0 / d1).sqrt()
-        };
+        let (h0, _, _) = self.tol.first_step_guess(&self.y, &self.fx);
         let norm_j = self
             .jac
             .chunks(n.max(1))
@@ -290,12 +278,7 @@ impl Rodas4 {
 
     /// The RMS norm of the error estimate k_6.
     fn error_norm(&self) -> f64 {
-        let mut sum = 0.0;
-        for ((&yi, &yn), &e) in self.y.iter().zip(&self.y_new).zip(&self.k[5]) {
-            let sc = self.atol + self.rtol * yi.abs().max(yn.abs());
-            sum += (e / sc) * (e / sc);
-        }
-        (sum / self.y.len().max(1) as f64).sqrt()
+        self.tol.rms_norm(&self.y, &self.y_new, &self.k[5])
     }
 
     /// The step-size factor h / h_new for error `err`.
@@ -387,23 +370,13 @@ impl Stepper for Rodas4 {
         Ok(())
     }
 
-    fn step<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        event: impl Fn(&[f64]) -> f64,
-    ) -> StepResult<StepOutcome> {
-        let resolvable = 0.1 * self.h.abs() > f64::EPSILON * self.t.abs();
-        if !resolvable || self.h.is_nan() {
-            return Err(IntegrationFailure::StepSizeTooSmall {
-                time: self.t,
-                step: self.h,
-            });
-        }
+    fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome> {
+        ensure_resolvable(self.t, self.h)?;
         if self.stale {
             self.refresh(system);
         }
-        if self.t + 1.01 * self.h - self.t_end > 0.0 {
-            self.h = self.t_end - self.t;
+        if let Some(rest) = last_step(self.t, self.h, self.t_end) {
+            self.h = rest;
             self.last = true;
         }
         let h = self.h;
@@ -419,7 +392,7 @@ impl Stepper for Rodas4 {
         self.after_reject = false;
         self.counts.accepted += 1;
         self.accept(h);
-        Ok(StepOutcome::accepted(event(&self.y)))
+        Ok(StepOutcome::Accepted)
     }
 
     fn reached_end(&self) -> bool {

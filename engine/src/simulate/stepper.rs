@@ -1,10 +1,10 @@
 //! The seam between the simulation driver and the time integrators.
 //!
 //! A [`Stepper`] advances an [`OdeSystem`] one step at a time and keeps the dense output of its
-//! last accepted step; it knows nothing of segments, modes, sticking or sample grids. The
-//! driver (`super::driver`) owns those: it resets the stepper at the start of each segment,
-//! asks for steps until one reports that the event function changed sign or the end time is
-//! reached, locates the event on the dense output and writes the samples. This is the split of
+//! last accepted step; it knows nothing of segments, modes, events, sticking or sample grids.
+//! The driver (`super::driver`) owns those: it resets the stepper at the start of each segment,
+//! asks for steps until the event function changes sign at an accepted step's end or the end
+//! time is reached, locates the event on the dense output and writes the samples. This is the split of
 //! diffsol's `OdeSolverMethod` (a method implements `step`, `interpolate` and statistics; the
 //! solve loop and root finding live apart), written for small dense systems.
 
@@ -58,38 +58,90 @@ pub struct AffineMotion {
     pub offset: f64,
 }
 
+/// The error tolerances of an adaptive stepper: a component y is resolved to
+/// atol + rtol |y|.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerance {
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance.
+    pub atol: f64,
+}
+
+impl Tolerance {
+    /// The error scale of a component that moves from `a` to `b` in a step.
+    pub fn scale(&self, a: f64, b: f64) -> f64 {
+        self.atol + a.abs().max(b.abs()) * self.rtol
+    }
+
+    /// The RMS over components of error / scale (Hairer's norm), for a step from `y` to
+    /// `y_new` with local error estimate `err`.
+    pub fn rms_norm(&self, y: &[f64], y_new: &[f64], err: &[f64]) -> f64 {
+        let mut sum = 0.0;
+        for ((&a, &b), &e) in y.iter().zip(y_new).zip(err) {
+            let sc = self.scale(a, b);
+            sum += (e / sc) * (e / sc);
+        }
+        (sum / y.len().max(1) as f64).sqrt()
+    }
+
+    /// The first guess of a starting step from the state `y` and its slope `f`:
+    /// 0.01 ||y|| / ||f|| in the error norm (1e-6 when either is negligible), and the two
+    /// squared norms it was made from (Hairer, Norsett & Wanner, Sec. II.4).
+    pub fn first_step_guess(&self, y: &[f64], f: &[f64]) -> (f64, f64, f64) {
+        let (mut d0, mut d1) = (0.0, 0.0);
+        for (&yi, &fi) in y.iter().zip(f) {
+            let sc = self.scale(yi, yi);
+            d0 += (yi / sc) * (yi / sc);
+            d1 += (fi / sc) * (fi / sc);
+        }
+        let h0 = if d0 < 1e-10 || d1 < 1e-10 {
+            1e-6
+        } else {
+            0.01 * (d0 / d1).sqrt()
+        };
+        (h0, d0, d1)
+    }
+}
+
 /// The outcome of one attempted step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StepOutcome {
     /// The step was rejected by the error control; the stepper retries with a smaller step.
     Rejected,
-    /// The step was accepted. `crossed`: the event function is <= 0 at the new time (it was
-    /// positive inside the segment, so it changed sign within this step or ended on zero).
-    Accepted {
-        /// Whether the event function ended the step at or below zero.
-        crossed: bool,
-    },
-}
-
-impl StepOutcome {
-    /// An accepted step whose event function ends at `event_value` (crossed when it is <= 0).
-    pub fn accepted(event_value: f64) -> Self {
-        StepOutcome::Accepted {
-            crossed: event_value <= 0.0,
-        }
-    }
+    /// The step was accepted: `time` and `state` are its end, `interpolate` covers it.
+    Accepted,
 }
 
 /// What the fallible [`Stepper`] operations return.
 pub type StepResult<T> = Result<T, IntegrationFailure>;
 
-/// Implements the [`Stepper`] accessors `time`, `previous_time`, `state` and `counts` for a
-/// stepper that keeps its current time in `t`, the previous one in `t_prev`, the state in `y`
-/// and its work counters in `counts`.
+/// Fails when a step of size `h` at time `t` is lost in round-off (or is NaN).
+pub(crate) fn ensure_resolvable(t: f64, h: f64) -> StepResult<()> {
+    if 0.1 * h.abs() > f64::EPSILON * t.abs() && !h.is_nan() {
+        Ok(())
+    } else {
+        Err(IntegrationFailure::StepSizeTooSmall { time: t, step: h })
+    }
+}
+
+/// The rest of the way from `t` to `t_end` when a step `h` would end past it or within 1 % of
+/// a step short of it (the last step of a segment), else `None`.
+pub(crate) fn last_step(t: f64, h: f64, t_end: f64) -> Option<f64> {
+    (t + 1.01 * h - t_end > 0.0).then_some(t_end - t)
+}
+
+/// Implements the [`Stepper`] accessors `time`, `previous_time`, `end_time`, `state` and
+/// `counts` for a stepper that keeps its current time in `t`, the previous one in `t_prev`, the
+/// end time in `t_end`, the state in `y` and its work counters in `counts`.
 macro_rules! current_point_accessors {
     () => {
         fn time(&self) -> f64 {
             self.t
+        }
+
+        fn end_time(&self) -> f64 {
+            self.t_end
         }
 
         fn previous_time(&self) -> f64 {
@@ -139,13 +191,8 @@ pub trait Stepper {
     /// stepper cannot integrate this system (e.g. the closed form needs an affine motion).
     fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()>;
 
-    /// Attempts one step. `event` is the event function of the state; it is positive at the
-    /// start of the segment's interior. Errors: the step size became too small.
-    fn step<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        event: impl Fn(&[f64]) -> f64,
-    ) -> StepResult<StepOutcome>;
+    /// Attempts one step. Errors: the step size became too small.
+    fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome>;
 
     /// The time of the current state.
     fn time(&self) -> f64;
@@ -156,8 +203,14 @@ pub trait Stepper {
     /// The current state.
     fn state(&self) -> &[f64];
 
-    /// Whether the current time is the end time given to `reset`.
-    fn reached_end(&self) -> bool;
+    /// The end time given to `reset`.
+    fn end_time(&self) -> f64;
+
+    /// Whether the current time is the end time given to `reset`. Steppers whose last step
+    /// may land a rounding error short of it keep a flag instead.
+    fn reached_end(&self) -> bool {
+        self.time() >= self.end_time()
+    }
 
     /// The dense output of the last accepted step at time `t` (clamped to the step) into `out`.
     fn interpolate(&self, t: f64, out: &mut [f64]);
@@ -202,7 +255,7 @@ mod tests {
         let mut out = [0.0];
         let mut worst: f64 = 0.0;
         while !stepper.reached_end() {
-            if let Ok(StepOutcome::Accepted { .. }) = stepper.step(system, |_| 1.0) {
+            if let Ok(StepOutcome::Accepted) = stepper.step(system) {
                 let mid = 0.5 * (stepper.previous_time() + stepper.time());
                 stepper.interpolate(mid, &mut out);
                 worst = worst.max((out[0] - exact(mid)).abs());
@@ -230,8 +283,8 @@ mod tests {
         assert!(s.reset(&Harmonic, 0.0, &[1.0, 0.0], 10.0).is_ok());
         // v = -sin t < 0 on (0, pi): the event function -v is positive until pi.
         loop {
-            match s.step(&Harmonic, |y| -y[1]) {
-                Ok(StepOutcome::Accepted { crossed: true }) => break,
+            match s.step(&Harmonic) {
+                Ok(StepOutcome::Accepted) if -s.state()[1] <= 0.0 => break,
                 Ok(_) => assert!(s.time() < std::f64::consts::PI),
                 Err(e) => panic!("{e}"),
             }
@@ -249,7 +302,7 @@ mod tests {
         assert!(s.reset(&Decay(1.0), 0.0, &[1.0], 1.0).is_ok());
         let mut steps = 0;
         while !s.reached_end() {
-            assert!(s.step(&Decay(1.0), |_| 1.0).is_ok());
+            assert!(s.step(&Decay(1.0)).is_ok());
             steps += 1;
         }
         assert_eq!(steps, 10);

@@ -4,55 +4,13 @@
 //! other. The checks are the shared harness `frictionid_models::testing::motion`; this file
 //! only connects it to the engine.
 
-use frictionid_engine::synthetic::uniform_times;
-use frictionid_engine::{simulate, Initial, Integrator, Oscillator, SimOptions};
+use frictionid_engine::testing::EngineSimulator;
+use frictionid_engine::Oscillator;
 use frictionid_models::testing::motion::{
-    check_energy_never_increases, check_integrators_agree, check_mirror_symmetry, Integration,
-    Motion, Simulator,
+    check_energy_never_increases, check_integrators_agree, check_mirror_symmetry,
 };
-use frictionid_models::testing::{Model, Violation};
+use frictionid_models::testing::Violation;
 use frictionid_plugin_example::StribeckPower;
-
-/// The FMM stage simulated by the engine, sampled at 1 kHz.
-struct Fmm(Oscillator);
-
-impl Simulator for Fmm {
-    fn stiffness(&self) -> f64 {
-        self.0.stiffness
-    }
-    fn normal_force(&self) -> f64 {
-        self.0.normal_force
-    }
-    fn release(
-        &self,
-        model: &Model,
-        x0: f64,
-        t_end: f64,
-        integration: Integration,
-    ) -> Result<Motion, String> {
-        let integrator = match integration {
-            Integration::Adaptive => SimOptions::default().integrator,
-            Integration::Euler { steps_per_period } => Integrator::Euler { steps_per_period },
-        };
-        let opts = SimOptions {
-            integrator,
-            ..SimOptions::default()
-        };
-        let times = uniform_times(t_end, 1000.0);
-        let sim = simulate(&self.0, model, &Initial::at_rest(x0), t_end, &times, &opts)
-            .map_err(|e| e.to_string())?;
-        let total_energy = sim.energy.iter().zip(&sim.stored).map(|(e, s)| e + s);
-        Ok(Motion {
-            total_energy: total_energy.collect(),
-            rest_displacement: sim.rest.map(|r| r.displacement),
-            events: sim.events.len(),
-            time: sim.time,
-            x: sim.x,
-            v: sim.v,
-            friction: sim.friction,
-        })
-    }
-}
 
 /// Parameter sets to test: the defaults, the fixture truth, sub- and super-linear drag.
 fn models() -> Vec<StribeckPower> {
@@ -72,8 +30,8 @@ fn models() -> Vec<StribeckPower> {
     ]
 }
 
-fn for_every_model(check: impl Fn(&Fmm, &StribeckPower) -> Result<(), Violation>) {
-    let fmm = Fmm(Oscillator::fmm());
+fn for_every_model(check: impl Fn(&EngineSimulator, &StribeckPower) -> Result<(), Violation>) {
+    let fmm = EngineSimulator(Oscillator::fmm());
     for m in models() {
         if let Err(v) = check(&fmm, &m) {
             panic!("{m:?}: {v}");
