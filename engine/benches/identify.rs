@@ -1,21 +1,21 @@
-//! Identifier benchmarks: the Coulomb mu fit on the three FMM records, and the five-model
-//! comparison.
+//! Identifier benchmarks (issues 13 and 14): the Coulomb mu fit on the three FMM records, the
+//! five-model comparison, and LuGre fits from the default start and from the truth of stiff
+//! (sigma0 = 1e7) records. Records: the acceptance set-up of the tests (releases of 10, 14
+//! and 22 mm, 2 s at 1 kHz, 0.2 mm/s noise).
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use common::{lugre_truth, records, stiff_lugre_truth, NOISE};
 use criterion::{criterion_group, criterion_main, Criterion};
-use frictionid_engine::identify::{compare, fit, FitOptions};
-use frictionid_engine::synthetic::release_records;
-use frictionid_engine::{Oscillator, Record};
-use frictionid_models::{default_model, Coulomb, FrictionModel};
+use frictionid_engine::identify::{compare, fit, FitOptions, Search};
+use frictionid_engine::Oscillator;
+use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre};
 use std::hint::black_box;
 
-fn records(osc: &Oscillator, model: &dyn FrictionModel) -> Vec<Record> {
-    release_records(osc, model, &[0.010, 0.014, 0.022], 2.0, 1000.0, 2e-4, 100)
-        .expect("truth simulation")
-}
-
-fn bench(c: &mut Criterion) {
+fn coulomb_and_compare(c: &mut Criterion) {
     let osc = Oscillator::fmm();
-    let recs = records(&osc, &Coulomb { mu: 0.24 });
+    let recs = records(&osc, &Coulomb { mu: 0.24 }, NOISE, 100);
     c.bench_function("fit coulomb mu, 3 FMM records", |b| {
         b.iter(|| {
             fit(
@@ -42,5 +42,30 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+fn lugre(c: &mut Criterion) {
+    let osc = Oscillator::fmm();
+    let mut group = c.benchmark_group("lugre");
+    group.sample_size(10);
+    let recs = records(&osc, &lugre_truth(), NOISE, 41);
+    group.bench_function("default start, 3 records of 2 s", |b| {
+        b.iter(|| {
+            let model = LuGre::default();
+            fit(&osc, black_box(&model), &recs, &FitOptions::default()).expect("fit")
+        })
+    });
+    let stiff = stiff_lugre_truth();
+    let stiff_recs = records(&osc, &stiff, NOISE, 81);
+    let at_truth = FitOptions {
+        guess: false,
+        search: Some(Search::Local),
+        multistart: Some(1),
+        ..FitOptions::default()
+    };
+    group.bench_function("from the truth, sigma0 1e7, 3 records of 2 s", |b| {
+        b.iter(|| fit(&osc, black_box(&stiff), &stiff_recs, &at_truth).expect("fit"))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, coulomb_and_compare, lugre);
 criterion_main!(benches);

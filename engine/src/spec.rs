@@ -453,9 +453,8 @@ pub struct FitExtras {
     pub force_offset: bool,
     /// Velocity fits of dynamic models start also from a force-domain prefit (default true).
     pub prefit: Option<bool>,
-    /// The integrator of the fit's simulations (default dopri5; `auto` picks exact, rodas or
-    /// dopri5 by the law and its stiffness and is what stiff bristle records, sigma0 >= 1e6
-    /// N/m, need).
+    /// The integrator of the fit's simulations (default `auto`: exact, rodas or dopri5 by the
+    /// law and its stiffness, which stiff bristle records, sigma0 >= 1e6 N/m, need).
     pub integrator: Option<IntegratorMethod>,
 }
 

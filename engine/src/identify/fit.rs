@@ -12,16 +12,16 @@ use super::options::FitDomain;
 use super::options::{FitOptions, OscillatorParam};
 use super::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
 use super::prefit::{prefit, prefit_finding, Prefit, PREFIT_ORIGIN};
-use super::problem::{FitProblem, ProblemParts, Realised};
+use super::problem::{FitProblem, ProblemParts, Realised, STEPS_PER_SAMPLE};
 use super::residuals::{NuisanceValues, Residuals, VelocityResponse};
 use super::setup::{build_layout, Layout};
 use super::starts::{run_starts, start_count, MultiStart, StartRun};
 use super::stats::{self, aic, bic, t_quantile_975, Covariance};
 use super::strategy::{self, plan_starts, Search, Seeded, StartPlan};
-use crate::energy::{analyze_record, model_force_along};
+use crate::energy::{analyze_record, model_force_budgeted};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
-use crate::record::Record;
+use crate::record::{NormalForce, Record};
 use frictionid_models::FrictionModel;
 use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
@@ -131,6 +131,9 @@ fn fit_seeded<R: Residuals + 'static>(
         let runs = run_starts(make_problem, &reference, &points, opts, search.promoted())?;
         (runs, seeded.into_iter().map(|s: Seeded| s.origin).collect())
     };
+    if let Some((jac, r)) = &runs.best.linearisation {
+        reference.adopt_linearisation(&runs.best.u, jac, r);
+    }
     let (runs, standings) = identifiability::settle(&reference, runs, opts)?;
     let context = FinishContext {
         opts,
@@ -201,6 +204,7 @@ fn evaluate_as_is<R: Residuals>(reference: &FitProblem<R>) -> Result<MultiStart,
             iterations: 0,
             simulations: reference.simulations(),
             termination: TerminationReason::NoFreeParameters,
+            linearisation: None,
         },
         iterations: 0,
         simulations: 0,
@@ -626,7 +630,16 @@ fn energy_check(
     corrected.x0 = nuisance.x0_of(rec);
     let osc = &world.oscillator;
     let analysis = analyze_record(&corrected, osc, &opts.energy)?;
-    let model_force = model_force_along(world.model.as_ref(), osc, &analysis.time, &analysis.v)?;
+    // The fit's step budget: bristles too stiff to replay cheaply (sigma0 far inside a
+    // one-sided bound) leave the check out, with a warning, instead of taking seconds.
+    let budget = STEPS_PER_SAMPLE * (analysis.time.len() as u64).max(100);
+    let model_force = model_force_budgeted(
+        world.model.as_ref(),
+        &analysis.time,
+        &analysis.v,
+        &NormalForce::Constant(osc.normal_force),
+        budget,
+    )?;
     let ef = energy_force_check(&analysis, ForceReference::ModelForce(&model_force))?;
     Ok((ef, analysis.friction, model_force))
 }

@@ -89,59 +89,190 @@ impl Standing {
     }
 }
 
+/// Times a profile that found a clearly lower cost restarts the fit from there.
+pub const PROFILE_RESTARTS: usize = 2;
+
 /// Profiles the flat parameters at the best run, settles an iteration limit caused only by
-/// unbounded ones, and returns the runs with one standing per free parameter.
+/// unbounded ones, and returns the runs with one standing per free parameter. A profile
+/// point whose cost lies a [`PROFILE_DELTA`] rise below the best (the fit stopped in a local
+/// minimum or on a plateau the profile stepped off) restarts the solver there, and the
+/// profiles are taken again at the better optimum.
 pub fn settle<R: Residuals + 'static>(
     reference: &FitProblem<R>,
     mut runs: MultiStart,
     opts: &FitOptions,
 ) -> Result<(MultiStart, Vec<Standing>), EngineError> {
-    let n = reference.layout.len();
-    let mut standings = vec![Standing::DETERMINED; n];
-    if n == 0 {
-        return Ok((runs, standings));
-    }
     let quiet = FitOptions {
         progress: None,
         ..opts.clone()
     };
-    let p = reference.physical(&runs.best.u);
+    let mut restarts = PROFILE_RESTARTS;
+    loop {
+        match profile_all(reference, &runs.best, &quiet, restarts > 0)? {
+            Profiled::Standings(standings) => {
+                return Ok(finish(reference, runs, standings, &quiet))
+            }
+            Profiled::Lower(u) => {
+                restarts = if restart_from(reference, &mut runs, u, &quiet) {
+                    restarts - 1
+                } else {
+                    0
+                };
+            }
+        }
+    }
+}
+
+fn finish<R: Residuals + 'static>(
+    reference: &FitProblem<R>,
+    mut runs: MultiStart,
+    standings: Vec<Standing>,
+    opts: &FitOptions,
+) -> (MultiStart, Vec<Standing>) {
+    settle_convergence(reference, &mut runs, &standings, opts);
+    (runs, standings)
+}
+
+/// What the profiles of a best run found.
+enum Profiled {
+    /// One standing per free parameter.
+    Standings(Vec<Standing>),
+    /// A point (internal coordinates) clearly below the best cost.
+    Lower(DVector<f64>),
+}
+
+/// The flat slots at `best` and the profile's cost rise; `None` without a residual variance.
+fn flat_and_delta<R: Residuals>(
+    reference: &FitProblem<R>,
+    best: &StartRun,
+) -> Result<Option<(Vec<usize>, f64)>, EngineError> {
+    if reference.layout.is_empty() {
+        return Ok(None);
+    }
+    let p = reference.physical(&best.u);
     let (jac, r) = reference.jacobian_physical(&p)?;
     let ssr = r.norm_squared();
     let variance = covariance(&jac, ssr).residual_variance;
     if !(variance.is_finite() && variance > 0.0) {
-        return Ok((runs, standings));
+        return Ok(None);
     }
-    for j in flat_slots(reference, &jac, ssr, &p) {
+    let slots = flat_slots(reference, &jac, ssr, &p, &r);
+    Ok(Some((slots, PROFILE_DELTA * variance)))
+}
+
+/// Profiles every flat parameter at `best`; with `restart`, stops at the first profile point
+/// a `delta` below the best cost.
+fn profile_all<R: Residuals + 'static>(
+    reference: &FitProblem<R>,
+    best: &StartRun,
+    opts: &FitOptions,
+    restart: bool,
+) -> Result<Profiled, EngineError> {
+    let mut standings = vec![Standing::DETERMINED; reference.layout.len()];
+    let Some((slots, delta)) = flat_and_delta(reference, best)? else {
+        return Ok(Profiled::Standings(standings));
+    };
+    for j in slots {
         let profile = Profile {
             reference,
-            best: &runs.best,
-            opts: &quiet,
+            best,
+            opts,
         };
-        standings[j] = profile.standing(j, PROFILE_DELTA * variance);
+        let (standing, lower) = profile.standing(j, delta);
+        if let Some(u) = lower.filter(|_| restart) {
+            return Ok(Profiled::Lower(u));
+        }
+        standings[j] = standing;
     }
-    settle_convergence(reference, &mut runs, &standings, &quiet);
-    Ok((runs, standings))
+    Ok(Profiled::Standings(standings))
+}
+
+/// Runs the solver from `u` and makes it the best run when it ends lower; whether it did.
+fn restart_from<R: Residuals + 'static>(
+    reference: &FitProblem<R>,
+    runs: &mut MultiStart,
+    u: DVector<f64>,
+    opts: &FitOptions,
+) -> bool {
+    let Some(problem) = pinned_problem(reference, &[]) else {
+        return false;
+    };
+    let slot = RunSlot {
+        start: runs.best_start,
+        starts: 1,
+        max_iterations: opts.max_iterations,
+    };
+    let Ok(run) = run_start(problem, u, opts, slot) else {
+        return false;
+    };
+    runs.iterations += run.iterations;
+    runs.simulations += run.simulations;
+    if run.cost.is_nan() || run.cost >= runs.best.cost {
+        return false;
+    }
+    let before = std::mem::replace(&mut runs.best, run);
+    runs.best.iterations += before.iterations;
+    runs.best.simulations += before.simulations;
+    if let Some((jac, r)) = &runs.best.linearisation {
+        reference.adopt_linearisation(&runs.best.u, jac, r);
+    }
+    true
 }
 
 /// Free model parameters the records may not determine: every one when the Jacobian is
 /// rank-deficient, else those whose standard error in the solver's coordinates is missing
-/// or above [`FLAT_INTERNAL_SE`].
+/// or above [`FLAT_INTERNAL_SE`], those held at a bound (where the curvature says nothing of
+/// the side beyond it), or (a model with internal states) those whose Jacobian column is
+/// integration noise ([`noise_dominated`]).
 fn flat_slots<R: Residuals>(
     reference: &FitProblem<R>,
     jac: &DMatrix<f64>,
     ssr: f64,
     p: &[f64],
+    r: &DVector<f64>,
 ) -> Vec<usize> {
     let layout = &reference.layout;
     let cov = covariance(jac, ssr);
+    let dynamic = reference.model.n_states() > 0;
     (0..layout.len())
+        .filter(|&j| matches!(layout[j].kind, ParamKind::Model(_)))
         .filter(|&j| {
             let se = cov.std_errors[j] * layout[j].internal_derivative(p[j]).abs();
             let fine = !cov.singular && se.is_finite() && se > 0.0 && se <= FLAT_INTERNAL_SE;
-            matches!(layout[j].kind, ParamKind::Model(_)) && !fine
+            let at_bound = p[j] <= layout[j].lower || p[j] >= layout[j].upper;
+            !fine || at_bound || (dynamic && noise_dominated(reference, jac, p, r, j))
         })
         .collect()
+}
+
+/// Relative disagreement of the forward and backward difference columns above which a
+/// column is taken for integration noise (a smooth column's two one-sided quotients differ
+/// by the step times its curvature: about 1e-5 relative).
+pub const NOISY_COLUMN: f64 = 0.1;
+
+/// Whether column `j` of the physical Jacobian `jac` at `p` (residuals `r`; a forward
+/// difference away from the bounds) is the adaptive integrator's noise rather than the
+/// residuals' slope: the forward and backward difference quotients disagree by more than
+/// [`NOISY_COLUMN`]. A parameter far inside a flat region (sigma0 of stiff bristles on
+/// Coulomb-like records) can then show a small, false standard error.
+fn noise_dominated<R: Residuals>(
+    reference: &FitProblem<R>,
+    jac: &DMatrix<f64>,
+    p: &[f64],
+    r: &DVector<f64>,
+    j: usize,
+) -> bool {
+    let u = reference.internal(p);
+    let h = reference.fd_step(&u, j);
+    let f = &reference.layout[j];
+    let (lo, hi) = f.internal_bounds();
+    if u[j] - h < lo || u[j] + h > hi {
+        return false;
+    }
+    let forward = jac.column(j) / f.internal_derivative(p[j]);
+    let backward = reference.difference_column(&u, r, j, -h);
+    let scale = forward.norm().max(backward.norm());
+    (forward - backward).norm() > NOISY_COLUMN * scale || !scale.is_finite()
 }
 
 /// The problem with the free parameters `pins` (slot, internal value) fixed at those values.
@@ -215,6 +346,7 @@ fn pinned_fit<R: Residuals + 'static>(
             iterations: 0,
             simulations: sub.simulations(),
             termination: TerminationReason::NoFreeParameters,
+            linearisation: None,
         }
     } else {
         let slot = RunSlot {
@@ -225,6 +357,14 @@ fn pinned_fit<R: Residuals + 'static>(
         run_start(sub, others.clone(), opts, slot).ok()?
     };
     run.cost.is_finite().then_some(run)
+}
+
+/// One profile step: the parameter's internal value, the re-optimised cost, and the whole
+/// point (internal coordinates).
+struct ProfilePoint {
+    u: f64,
+    cost: f64,
+    at: DVector<f64>,
 }
 
 /// A profile of the cost along one parameter at the best run.
@@ -238,7 +378,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
     /// Profile points (internal value, cost) on one side (`side` = ±1), stepping outward
     /// until the cost exceeds `limit`, a bound is reached or a step fails; a first step that
     /// fails is retried at half the distance (at most [`PROFILE_HALVINGS`] times).
-    fn side(&self, j: usize, side: f64, limit: f64) -> Vec<(f64, f64)> {
+    fn side(&self, j: usize, side: f64, limit: f64) -> Vec<ProfilePoint> {
         let f = &self.reference.layout[j];
         let (lo, hi) = f.internal_bounds();
         let centre = self.best.u[j];
@@ -248,10 +388,10 @@ impl<R: Residuals + 'static> Profile<'_, R> {
             centre.abs().max(1.0)
         };
         let mut others = without(&self.best.u, &[(j, centre)]);
-        let mut out: Vec<(f64, f64)> = Vec::new();
+        let mut out: Vec<ProfilePoint> = Vec::new();
         let mut halvings = 0;
         while out.len() < PROFILE_STEPS {
-            let previous = out.last().map_or(centre, |&(v, _)| v);
+            let previous = out.last().map_or(centre, |p| p.u);
             let u = (previous + side * step).clamp(lo, hi);
             if u == previous {
                 break;
@@ -270,8 +410,12 @@ impl<R: Residuals + 'static> Profile<'_, R> {
                 }
                 None => break,
                 Some(run) => {
-                    out.push((u, run.cost));
                     others = run.u;
+                    out.push(ProfilePoint {
+                        u,
+                        cost: run.cost,
+                        at: merged(&others, &pins, self.best.u.len()),
+                    });
                     if run.cost > limit {
                         break;
                     }
@@ -281,17 +425,28 @@ impl<R: Residuals + 'static> Profile<'_, R> {
         out
     }
 
-    /// The standing of slot `j` for a cost rise `delta` (absolute).
-    fn standing(&self, j: usize, delta: f64) -> Standing {
+    /// The standing of slot `j` for a cost rise `delta` (absolute), and the lowest profile
+    /// point (internal coordinates) when its cost lies more than `delta` below the best.
+    fn standing(&self, j: usize, delta: f64) -> (Standing, Option<DVector<f64>>) {
         let best = self.best.cost;
         let below = self.side(j, -1.0, best + delta);
         let above = self.side(j, 1.0, best + delta);
+        let lowest = below
+            .iter()
+            .chain(&above)
+            .min_by(|a, b| a.cost.total_cmp(&b.cost))
+            .filter(|p| p.cost < best - delta)
+            .map(|p| p.at.clone());
         // A profile that found a lower cost (a parameter still running on) measures from it.
         let floor = below
             .iter()
             .chain(&above)
-            .map(|&(_, c)| c)
+            .map(|p| p.cost)
             .fold(best, f64::min);
+        let pairs = |side: &[ProfilePoint]| -> Vec<(f64, f64)> {
+            side.iter().map(|p| (p.u, p.cost)).collect()
+        };
+        let (below, above) = (pairs(&below), pairs(&above));
         let centre = (self.best.u[j], best);
         let f = &self.reference.layout[j];
         // A side that cannot be evaluated at all (too stiff to simulate) counts as open.
@@ -303,7 +458,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
             (None, Some(b)) => (Identifiability::UpperBound, Some(b)),
             (None, None) => (Identifiability::NotIdentifiable, None),
         };
-        Standing { class, bound }
+        (Standing { class, bound }, lowest)
     }
 }
 
@@ -361,6 +516,7 @@ fn settle_convergence<R: Residuals + 'static>(
         iterations: runs.best.iterations + run.iterations,
         simulations: runs.best.simulations + run.simulations,
         termination: TerminationReason::ConvergedExceptUnbounded { parameters: names },
+        linearisation: None,
     };
 }
 

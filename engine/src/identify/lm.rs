@@ -237,6 +237,12 @@ impl NormalEquations {
 }
 
 impl LevenbergMarquardt {
+    /// The Jacobian and residuals at the current (best) point: the solver only moves to a
+    /// point of lower cost, and linearises there before it decides to stop.
+    pub fn linearisation(&self) -> (&DMatrix<f64>, &DVector<f64>) {
+        (&self.jacobian, &self.residuals)
+    }
+
     /// The typed reason of the last run's convergence (`None` while running, or when it was
     /// stopped from outside, e.g. by the iteration limit).
     pub fn termination(&self) -> Option<&TerminationReason> {

@@ -38,6 +38,7 @@ pub mod setup;
 pub mod starts;
 pub mod stats;
 pub mod strategy;
+pub mod work;
 
 pub use budget::{PropertyUncertainty, StdErrorComponents};
 pub use compare::{compare, Comparison, ComparisonVerdict, FailedFit};

@@ -3,7 +3,7 @@
 use super::budget::PropertyUncertainty;
 use super::strategy::Search;
 use crate::energy::EnergyOptions;
-use crate::simulate::SimOptions;
+use crate::simulate::{Integrator, SimOptions};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -145,7 +145,10 @@ pub struct FitOptions {
     pub max_iterations: u64,
     /// Convergence tolerance on the relative cost reduction of a step (solver default 1e-9).
     pub tolerance: Option<f64>,
-    /// Simulation options.
+    /// Simulation options. The default integrator is `Auto`: the exact propagator for laws
+    /// affine in v, Rodas4 for stiff bristles and elements, Dopri5 otherwise (with Dopri5 for
+    /// every model, `compare` of the five classical models took 19.3 s against 6.4 s, and
+    /// stiff bristle records were rejected by the step budget).
     pub sim: SimOptions,
     /// Energy-analysis options (for the energy-based force residuals).
     pub energy: EnergyOptions,
@@ -177,6 +180,7 @@ impl Default for FitOptions {
             max_iterations: 200,
             tolerance: None,
             sim: SimOptions {
+                integrator: Integrator::Auto,
                 max_steps: FIT_MAX_STEPS,
                 ..SimOptions::default()
             },

@@ -8,6 +8,7 @@
 
 use super::layout::{FreeParam, ParamKind};
 use super::residuals::{Evaluation, NuisanceValues, Residuals, VelocityResponse};
+use super::work::WorkBudget;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -44,9 +45,17 @@ pub struct FitProblem<R: Residuals = VelocityResponse> {
     pub parallel: bool,
     simulations: AtomicU64,
     last_error: Mutex<Option<String>>,
+    /// The step budget of the simulations, per record ([`WorkBudget`]).
+    work: WorkBudget,
     /// The last point `apply` evaluated, reused by `jacobian` at the same point.
     cache: Mutex<Option<(DVector<f64>, DVector<f64>)>>,
+    /// The last physical Jacobian and residuals, by point: the identifiability check and the
+    /// statistics both ask for them at the optimum.
+    physical_cache: Mutex<Option<PhysicalJacobian>>,
 }
+
+/// A physical point with the Jacobian and residuals there.
+type PhysicalJacobian = (Vec<f64>, DMatrix<f64>, DVector<f64>);
 
 /// The state of the world for one parameter vector.
 pub struct Realised {
@@ -79,6 +88,7 @@ impl<R: Residuals> FitProblem<R> {
     /// oscillator carry the fixed values.
     pub fn new(residuals: Arc<R>, parts: ProblemParts) -> Self {
         Self {
+            work: WorkBudget::new(parts.records.len()),
             oscillator: parts.oscillator,
             model: parts.model,
             records: parts.records,
@@ -89,6 +99,7 @@ impl<R: Residuals> FitProblem<R> {
             simulations: AtomicU64::new(0),
             last_error: Mutex::new(None),
             cache: Mutex::new(None),
+            physical_cache: Mutex::new(None),
         }
     }
 
@@ -168,6 +179,7 @@ impl<R: Residuals> FitProblem<R> {
             &self.sim,
             &self.simulations,
         )
+        .with_work(&self.work)
     }
 
     /// The prediction of record `r`'s measured series at `world`.
@@ -221,13 +233,8 @@ impl<R: Residuals> FitProblem<R> {
         }
         let column = |j: usize| -> DVector<f64> {
             let (_, hi) = self.layout[j].internal_bounds();
-            let mut h = FD_STEP * u[j].abs().max(1.0);
-            if u[j] + h > hi {
-                h = -h;
-            }
-            let mut up = u.clone();
-            up[j] += h;
-            (self.residuals_or_nan(&up) - r0) / h
+            let h = self.fd_step(u, j);
+            self.difference_column(u, r0, j, if u[j] + h > hi { -h } else { h })
         };
         let cols: Vec<DVector<f64>> = if self.parallel && n > 1 {
             (0..n).into_par_iter().map(column).collect()
@@ -237,19 +244,75 @@ impl<R: Residuals> FitProblem<R> {
         DMatrix::from_columns(&cols)
     }
 
-    /// The Jacobian with respect to the physical parameters (for the statistics).
+    /// The forward-difference step of parameter `j` at `u` (internal coordinates).
+    pub fn fd_step(&self, u: &DVector<f64>, j: usize) -> f64 {
+        FD_STEP * u[j].abs().max(1.0)
+    }
+
+    /// The difference quotient of the residuals along parameter `j` with step `h` (either
+    /// sign), from the residuals `r0` at `u`.
+    pub fn difference_column(
+        &self,
+        u: &DVector<f64>,
+        r0: &DVector<f64>,
+        j: usize,
+        h: f64,
+    ) -> DVector<f64> {
+        let mut moved = u.clone();
+        moved[j] += h;
+        (self.residuals_or_nan(&moved) - r0) / h
+    }
+
+    /// The Jacobian with respect to the physical parameters (for the statistics), and the
+    /// residuals at `p`; computed once per point.
     pub fn jacobian_physical(
+        &self,
+        p: &[f64],
+    ) -> Result<(DMatrix<f64>, DVector<f64>), EngineError> {
+        let cached = self.physical_cache.lock().ok().and_then(|c| {
+            c.as_ref()
+                .filter(|(at, _, _)| at.as_slice() == p)
+                .map(|(_, j, r)| (j.clone(), r.clone()))
+        });
+        if let Some(hit) = cached {
+            return Ok(hit);
+        }
+        let (j, r0) = self.compute_jacobian_physical(p)?;
+        if let Ok(mut c) = self.physical_cache.lock() {
+            *c = Some((p.to_vec(), j.clone(), r0.clone()));
+        }
+        Ok((j, r0))
+    }
+
+    /// Takes the Jacobian `jac` (internal coordinates) and residuals `r` a solver run of this
+    /// problem's twin computed at `u`, as the physical Jacobian there (saves recomputing it).
+    pub fn adopt_linearisation(&self, u: &DVector<f64>, jac: &DMatrix<f64>, r: &DVector<f64>) {
+        let p = self.physical(u);
+        if let Ok(mut c) = self.physical_cache.lock() {
+            *c = Some((
+                p.clone(),
+                self.to_physical_columns(jac.clone(), &p),
+                r.clone(),
+            ));
+        }
+    }
+
+    /// Scales the columns of an internal-coordinate Jacobian at physical `p` to physical ones.
+    fn to_physical_columns(&self, mut j: DMatrix<f64>, p: &[f64]) -> DMatrix<f64> {
+        for (c, f) in self.layout.iter().enumerate() {
+            j.column_mut(c).scale_mut(f.internal_derivative(p[c]));
+        }
+        j
+    }
+
+    fn compute_jacobian_physical(
         &self,
         p: &[f64],
     ) -> Result<(DMatrix<f64>, DVector<f64>), EngineError> {
         let r0 = self.residuals_at(p)?;
         let u = self.internal(p);
-        let mut j = self.jacobian_internal(&u, &r0);
-        for (c, f) in self.layout.iter().enumerate() {
-            let d = f.internal_derivative(p[c]);
-            j.column_mut(c).scale_mut(d);
-        }
-        Ok((j, r0))
+        let j = self.jacobian_internal(&u, &r0);
+        Ok((self.to_physical_columns(j, p), r0))
     }
 }
 

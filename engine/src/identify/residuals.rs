@@ -9,10 +9,11 @@
 //! compare a force) plugs in beside this one.
 
 use super::options::FitOptions;
+use super::work::WorkBudget;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
-use crate::simulate::{simulate_velocity, Initial, SimOptions};
+use crate::simulate::{simulate_velocity, Initial, SimOptions, SimStats};
 use frictionid_models::{FrictionModel, GuessHint};
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -160,6 +161,7 @@ pub struct Evaluation<'a> {
     /// Simulation options.
     pub sim: &'a SimOptions,
     simulations: &'a AtomicU64,
+    work: Option<&'a WorkBudget>,
 }
 
 impl<'a> Evaluation<'a> {
@@ -175,6 +177,31 @@ impl<'a> Evaluation<'a> {
             model,
             sim,
             simulations,
+            work: None,
+        }
+    }
+
+    /// The same, with simulations held to `work` ([`super::work`]).
+    pub fn with_work(self, work: &'a WorkBudget) -> Self {
+        Self {
+            work: Some(work),
+            ..self
+        }
+    }
+
+    /// `sim` with its step limit lowered to `base` and to record `index`'s work budget.
+    pub fn capped(&self, index: usize, samples: usize, base: u64) -> SimOptions {
+        let budget = self.work.and_then(|w| w.cap(index, samples));
+        SimOptions {
+            max_steps: self.sim.max_steps.min(base).min(budget.unwrap_or(u64::MAX)),
+            ..*self.sim
+        }
+    }
+
+    /// Records the work of a simulation of record `index` (the first sets its budget).
+    pub fn record_work(&self, index: usize, stats: &SimStats, samples: usize) {
+        if let Some(w) = self.work {
+            w.record(index, stats, samples);
         }
     }
 
@@ -308,10 +335,12 @@ impl VelocityResponse {
     /// The simulated velocity of `record` at its time stamps, released from the nuisance
     /// values' x0 `shift` seconds after its release instant (the one found or given when the
     /// record was cut at its release, which may lie between samples; else its first time
-    /// stamp). Samples before the release see the release velocity; no offset.
+    /// stamp). Samples before the release see the release velocity; no offset. `index` is the
+    /// record's place in the fit (for its work budget).
     pub fn simulate(
         &self,
         at: &Evaluation<'_>,
+        index: usize,
         record: &Record,
         nuisance: &NuisanceValues,
     ) -> Result<Vec<f64>, EngineError> {
@@ -332,11 +361,9 @@ impl VelocityResponse {
                 z0: None,
             };
             let mut sim = Vec::with_capacity(times.len());
-            let mut opts = *at.sim;
-            opts.max_steps = opts
-                .max_steps
-                .min(STEPS_PER_SAMPLE * (record.len() as u64).max(100));
-            simulate_velocity(
+            let base = STEPS_PER_SAMPLE * (record.len() as u64).max(100);
+            let opts = at.capped(index, times.len(), base);
+            let stats = simulate_velocity(
                 at.oscillator,
                 at.model,
                 &init,
@@ -345,6 +372,7 @@ impl VelocityResponse {
                 &opts,
                 &mut sim,
             )?;
+            at.record_work(index, &stats, times.len());
             v.extend_from_slice(&sim);
         }
         Ok(v)
@@ -371,11 +399,11 @@ impl Residuals for VelocityResponse {
     fn predict(
         &self,
         at: &Evaluation<'_>,
-        _index: usize,
+        index: usize,
         record: &Record,
         nuisance: &NuisanceValues,
     ) -> Result<Vec<f64>, EngineError> {
-        let mut v = self.simulate(at, record, nuisance)?;
+        let mut v = self.simulate(at, index, record, nuisance)?;
         for x in &mut v {
             *x += nuisance.offset;
         }
@@ -431,7 +459,7 @@ mod tests {
             ..NuisanceValues::default()
         };
         let v = VelocityResponse::new(false, true, false)
-            .simulate(&at, &record, &shifted)
+            .simulate(&at, 0, &record, &shifted)
             .unwrap();
         assert!(v[..31].iter().all(|&x| x == 0.0));
         let shifted: Vec<f64> = time[31..].iter().map(|t| t - 0.0305).collect();

@@ -11,7 +11,7 @@ use crate::error::EngineError;
 use argmin::core::observers::{Observe, ObserverMode};
 use argmin::core::{Executor, State, KV};
 use frictionid_models::FrictionModel;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 /// Starts of a multi-start fit when more than two model parameters are free.
@@ -39,6 +39,8 @@ pub struct StartRun {
     pub simulations: u64,
     /// Why it stopped.
     pub termination: TerminationReason,
+    /// The Jacobian (internal coordinates) and residuals at `u`, when the solver has them.
+    pub linearisation: Option<(DMatrix<f64>, DVector<f64>)>,
 }
 
 impl StartRun {
@@ -221,8 +223,12 @@ pub fn run_start<R: Residuals + 'static>(
         .get_best_param()
         .cloned()
         .ok_or_else(|| EngineError::Fit("the solver returned no parameters".into()))?;
+    let (jac, r) = res.solver.linearisation();
+    let linearisation =
+        (jac.ncols() == u.len() && r.len() == jac.nrows()).then(|| (jac.clone(), r.clone()));
     Ok(StartRun {
         u,
+        linearisation,
         cost: state.get_best_cost(),
         iterations: state.get_iter(),
         simulations,

@@ -29,3 +29,15 @@ pub fn lugre_truth() -> LuGre {
         v_s: 0.01,
     }
 }
+
+/// Issue 14's stiff LuGre truth: bristles of sigma0 1e7 N/m.
+pub fn stiff_lugre_truth() -> LuGre {
+    LuGre {
+        sigma0: 1e7,
+        sigma1: 4000.0,
+        sigma2: 2.0,
+        mu_c: 0.18,
+        mu_s: 0.26,
+        v_s: 0.005,
+    }
+}

@@ -1,0 +1,88 @@
+//! The work budget of a fit's simulations: a trial point may cost at most a multiple of what
+//! the start point cost, so runaway trial points (a law that chatters, bristles stiffening
+//! without bound on records that cannot tell) are cut off by cost, not by stiffness. A
+//! physically valid stiff point is integrated by the stiff stepper in about as many steps as
+//! a soft one and stays well inside the budget.
+//!
+//! Work is counted in integrator steps (accepted and rejected) per sample; the first
+//! simulation a problem runs (its start point) sets the baseline. A simulation over its cap
+//! fails, which the solver takes as a rejected trial.
+
+use crate::simulate::SimStats;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// A trial simulation may take this many times the start point's steps per sample.
+pub const WORK_FACTOR: f64 = 8.0;
+
+/// Steps per sample every simulation may take whatever the baseline (the exact propagator's
+/// baseline is a few steps per record).
+pub const MIN_STEPS_PER_SAMPLE: f64 = 1.0;
+
+/// Baseline steps per sample, in millionths (0: not measured yet).
+const SCALE: f64 = 1e6;
+
+/// The budget of one fit problem: per record, the start point's steps per sample, once
+/// measured (per record, so that the caps do not depend on which simulation ends first).
+#[derive(Debug, Default)]
+pub struct WorkBudget {
+    baseline: Vec<AtomicU64>,
+}
+
+impl WorkBudget {
+    /// A budget for `records` records whose baselines their first simulations set.
+    pub fn new(records: usize) -> Self {
+        Self {
+            baseline: (0..records).map(|_| AtomicU64::new(0)).collect(),
+        }
+    }
+
+    /// The step cap of a simulation of record `record` with `samples` samples (`None` before
+    /// its baseline).
+    pub fn cap(&self, record: usize, samples: usize) -> Option<u64> {
+        let base = self.baseline.get(record)?.load(Ordering::Relaxed);
+        (base > 0).then(|| {
+            let per_sample = (WORK_FACTOR * base as f64 / SCALE).max(MIN_STEPS_PER_SAMPLE);
+            (per_sample * samples.max(1) as f64).ceil() as u64
+        })
+    }
+
+    /// Records the work of a finished simulation of record `record` with `samples` samples:
+    /// the record's first one sets its baseline.
+    pub fn record(&self, record: usize, stats: &SimStats, samples: usize) {
+        let Some(slot) = self.baseline.get(record) else {
+            return;
+        };
+        let steps = (stats.steps + stats.rejected_steps).max(1);
+        let per_sample = (steps as f64 / samples.max(1) as f64 * SCALE).ceil() as u64;
+        let _ = slot.compare_exchange(0, per_sample.max(1), Ordering::Relaxed, Ordering::Relaxed);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_first_simulation_sets_a_cap_of_a_multiple_of_its_steps_per_sample() {
+        let budget = WorkBudget::new(2);
+        assert_eq!(budget.cap(0, 1000), None);
+        let start = SimStats {
+            steps: 3000,
+            rejected_steps: 1000,
+            ..SimStats::default()
+        };
+        budget.record(0, &start, 2000);
+        // 2 steps per sample at the start: 16 per sample allowed.
+        assert_eq!(budget.cap(0, 1000), Some(16_000));
+        assert_eq!(budget.cap(1, 1000), None);
+        let later = SimStats {
+            steps: 1,
+            ..SimStats::default()
+        };
+        budget.record(0, &later, 2000);
+        assert_eq!(budget.cap(0, 1000), Some(16_000));
+        budget.record(1, &later, 2000);
+        assert_eq!(budget.cap(1, 500), Some(500));
+        assert_eq!(budget.cap(2, 500), None);
+    }
+}
