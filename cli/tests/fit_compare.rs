@@ -2,7 +2,7 @@
 //! N = 14.5 N; see fixtures/README.md), and their failure modes.
 
 use assert_cmd::Command;
-use frictionid_cli::testing::{fixtures_dir, read_report, scratch_dir};
+use frictionid_cli::testing::{fixtures_dir, read_report, scratch_dir, FMM_OSCILLATOR};
 use std::path::Path;
 
 fn frictionid() -> Command {
@@ -292,7 +292,42 @@ fn energy_without_a_model_takes_its_reference_from_a_coulomb_fit() {
         );
         let half = rec["half_cycle_mean"].as_f64().unwrap();
         assert!((half / MU_N - 1.0).abs() < 0.01, "half-cycle mean {half}");
+        assert_eq!(rec["sources"]["displacement"], "integrated");
+        assert_eq!(rec["sources"]["acceleration"], "differentiated");
     }
+}
+
+/// A record with interferometer and accelerometer columns beside the velocity (the exact
+/// Coulomb motion): `energy` uses the measured x and a, says so, and its Eq. 7 mean is mu N
+/// to round-off.
+#[test]
+fn energy_uses_measured_displacement_and_acceleration_columns() {
+    let dir = scratch_dir("fc", "energy-3ch");
+    let osc = frictionid_engine::Oscillator::fmm();
+    let times = frictionid_engine::synthetic::uniform_times(2.0, 1000.0);
+    let ex = frictionid_engine::exact::coulomb_free_vibration(&osc, MU_N, 0.014, &times).unwrap();
+    let mut csv = String::from("time,velocity,displacement,acceleration\n");
+    for i in 0..ex.time.len() {
+        csv += &format!(
+            "{:e},{:e},{:e},{:e}\n",
+            ex.time[i], ex.v[i], ex.x[i], ex.a[i]
+        );
+    }
+    std::fs::write(dir.join("r.csv"), csv).unwrap();
+    let cfg = format!(
+        "{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\nmu = {TRUTH_MU}\n[[records]]\nfile = \"r.csv\"\nx0 = 0.014\n"
+    );
+    std::fs::write(dir.join("energy.toml"), cfg).unwrap();
+    let out = dir.join("out");
+    let (o, r) = run_json(&["energy", dir.join("energy.toml").to_str().unwrap()], &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rec = &r["records"][0];
+    assert_eq!(rec["sources"]["displacement"], "measured");
+    assert_eq!(rec["sources"]["acceleration"], "measured");
+    let mean = rec["mean_abs_force"].as_f64().unwrap();
+    assert!((mean / MU_N - 1.0).abs() < 1e-6, "mean |F| {mean}");
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("measured / measured"), "{md}");
 }
 
 #[test]

@@ -249,6 +249,7 @@ fn energy_record(
         half_cycles: analysis.half_cycles.clone(),
         masked: analysis.masked,
         samples: analysis.time.len(),
+        sources: analysis.sources,
         analysis,
         model_force,
     })

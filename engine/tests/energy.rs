@@ -3,9 +3,10 @@
 
 use frictionid_engine::energy::{
     central_difference, cumulative_trapezoid, derivative_weights, moving_average, paper_derivative,
-    savitzky_golay_derivative,
+    savitzky_golay_derivative, SeriesSource,
 };
 use frictionid_engine::exact::{coulomb_free_vibration, ExactCoulomb};
+use frictionid_engine::record::Channel;
 use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
 use frictionid_engine::{
     analyze_record, analyze_states, force_residuals, model_force_along, percent_difference,
@@ -890,4 +891,58 @@ fn lugre_residuals_shrink_towards_coulomb() {
     eprintln!("LuGre residual RMS: sigma0 1e5 -> {soft:.4} N, 1e7 -> {stiff:.4} N");
     assert!(stiff < soft);
     assert!(stiff < 0.05 * mu_n(), "{stiff}");
+}
+
+// ------------------------------------------------- measured displacement and acceleration
+
+/// A record of the exact solution with measured displacement and acceleration channels
+/// beside the velocity (interferometer, vibrometer and accelerometer, noise-free).
+fn three_sensor_record(x0: f64) -> Record {
+    let ex = exact(x0);
+    Record::new(format!("fmm-{:.0}mm-3ch", x0 * 1e3), ex.time, ex.v, x0)
+        .with_channel(Channel::Displacement, ex.x)
+        .with_channel(Channel::Acceleration, ex.a)
+}
+
+/// The largest |Eq. 7 force - mu N sgn(v)| over the unmasked samples.
+fn worst_eq7_error(an: &frictionid_engine::EnergyAnalysis) -> f64 {
+    an.friction
+        .iter()
+        .zip(&an.v)
+        .filter(|(f, _)| !f.is_nan())
+        .map(|(f, v)| (f - mu_n() * v.signum()).abs())
+        .fold(0.0, f64::max)
+}
+
+/// The paper's proposal: measured x and a replace the integrated and differentiated ones.
+/// With the exact channels every unmasked Eq. 7 sample is mu N to round-off, where the
+/// velocity-only analysis of the same motion carries the differentiation error.
+#[test]
+fn measured_displacement_and_acceleration_replace_the_derived_ones() {
+    for x0 in X0S {
+        let measured = analyze_record(
+            &three_sensor_record(x0),
+            &Oscillator::fmm(),
+            &Default::default(),
+        )
+        .expect("analysis");
+        assert_eq!(measured.sources.displacement, SeriesSource::Measured);
+        assert_eq!(measured.sources.acceleration, SeriesSource::Measured);
+        let derived = analyze_record(&record(x0, 0.0, 0), &Oscillator::fmm(), &Default::default())
+            .expect("analysis");
+        assert_eq!(derived.sources.displacement, SeriesSource::Integrated);
+        assert_eq!(derived.sources.acceleration, SeriesSource::Differentiated);
+        let (with_channels, without) = (worst_eq7_error(&measured), worst_eq7_error(&derived));
+        eprintln!(
+            "x0 = {x0}: worst Eq. 7 error {with_channels:.2e} N measured, {without:.2e} N derived"
+        );
+        assert!(
+            with_channels < 1e-9 * mu_n(),
+            "x0 = {x0}: {with_channels} N"
+        );
+        assert!(with_channels < without, "x0 = {x0}");
+        assert_eq!(measured.half_cycles.len(), exact(x0).half_cycles());
+        let hc = measured.half_cycle_mean / mu_n() - 1.0;
+        assert!(hc.abs() < 1e-3, "x0 = {x0}: half-cycle mean off by {hc}");
+    }
 }

@@ -77,7 +77,7 @@ pub use model_force::{
 
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
-use crate::record::Record;
+use crate::record::{Channel, Record};
 use halfcycle::{detect_motion, half_cycles, Interp, Motion, Samples};
 use serde::{Deserialize, Serialize};
 
@@ -121,11 +121,11 @@ impl EnergyOptions {
 pub struct EnergyAnalysis {
     /// Time \[s\].
     pub time: Vec<f64>,
-    /// Displacement \[m\] (integrated for a record, exact for states).
+    /// Displacement \[m\] (measured or integrated for a record, exact for states).
     pub x: Vec<f64>,
     /// Velocity [m/s].
     pub v: Vec<f64>,
-    /// Acceleration [m/s^2] (differentiated for a record, exact for states).
+    /// Acceleration [m/s^2] (measured or differentiated for a record, exact for states).
     pub a: Vec<f64>,
     /// Kinetic energy m v^2 / 2 \[J\] (Eq. 3).
     pub kinetic: Vec<f64>,
@@ -147,6 +147,44 @@ pub struct EnergyAnalysis {
     pub half_cycle_mean: f64,
     /// Sample standard deviation of the half-cycle forces \[N\] (0 for one half-cycle).
     pub half_cycle_std: f64,
+    /// Where the displacement and acceleration series came from.
+    pub sources: SeriesSources,
+}
+
+/// How a series of the energy analysis was obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SeriesSource {
+    /// Read from the record's own channel (interferometer, accelerometer).
+    Measured,
+    /// Integrated from the velocity (cumulative trapezoid from x0).
+    Integrated,
+    /// Differentiated from the velocity (the configured differentiator).
+    Differentiated,
+    /// Given exactly (states of a simulation).
+    Exact,
+}
+
+impl SeriesSource {
+    /// The lower-case name used in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            SeriesSource::Measured => "measured",
+            SeriesSource::Integrated => "integrated",
+            SeriesSource::Differentiated => "differentiated",
+            SeriesSource::Exact => "exact",
+        }
+    }
+}
+
+/// The origin of the displacement and acceleration of an [`EnergyAnalysis`] (the velocity is
+/// always the record's).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct SeriesSources {
+    /// Displacement: measured, or integrated from the velocity.
+    pub displacement: SeriesSource,
+    /// Acceleration: measured, or differentiated from the velocity.
+    pub acceleration: SeriesSource,
 }
 
 /// The mean |F| of a model force series over the samples where the energy-based force
@@ -190,7 +228,10 @@ pub fn cumulative_trapezoid(time: &[f64], v: &[f64], x0: f64) -> Vec<f64> {
     x
 }
 
-/// The energy analysis of a measured record.
+/// The energy analysis of a measured record. A displacement channel (interferometer) replaces
+/// the displacement integrated from the velocity, and an acceleration channel (accelerometer)
+/// the differentiated acceleration, as the paper proposes; `sources` says which were used. A
+/// measured displacement must be relative to the spring's equilibrium (the x of Eq. 2).
 ///
 /// Errors: invalid options or oscillator; a record with fewer samples than the
 /// differentiator's window, non-finite values, non-increasing time (see
@@ -206,7 +247,13 @@ pub fn analyze_record(
     record.validate(opts.differentiator.min_samples().max(MIN_RUN + 1))?;
     let time = record.time();
     let v = record.velocity();
-    let x = cumulative_trapezoid(time, v, record.x0);
+    let (x, displacement) = match record.channel(Channel::Displacement) {
+        Some(measured) => (measured.to_vec(), SeriesSource::Measured),
+        None => (
+            cumulative_trapezoid(time, v, record.x0),
+            SeriesSource::Integrated,
+        ),
+    };
     let samples = Samples {
         time,
         x: &x,
@@ -215,14 +262,35 @@ pub fn analyze_record(
         interp: Interp::Linear,
     };
     let motion = detect_motion(&samples, opts.velocity_threshold, record.v0, &record.name)?;
-    let a = match opts.differentiator {
-        Differentiator::Paper => paper_derivative(time, v),
-        Differentiator::SavitzkyGolay { window, order } => {
-            savitzky_golay_derivative(time, v, window, order, &motion.break_indices(time))?
-        }
+    let (a, acceleration) = match record.channel(Channel::Acceleration) {
+        Some(measured) => (measured.to_vec(), SeriesSource::Measured),
+        None => (
+            differentiate_velocity(time, v, opts, &motion)?,
+            SeriesSource::Differentiated,
+        ),
     };
     let samples = Samples { a: &a, ..samples };
-    Ok(assemble(osc, &samples, &motion, opts))
+    let sources = SeriesSources {
+        displacement,
+        acceleration,
+    };
+    Ok(assemble(osc, &samples, &motion, opts, sources))
+}
+
+/// The acceleration from the velocity by the configured differentiator (Savitzky-Golay
+/// windows do not straddle the breaks of the motion).
+fn differentiate_velocity(
+    time: &[f64],
+    v: &[f64],
+    opts: &EnergyOptions,
+    motion: &Motion,
+) -> Result<Vec<f64>, EngineError> {
+    match opts.differentiator {
+        Differentiator::Paper => Ok(paper_derivative(time, v)),
+        Differentiator::SavitzkyGolay { window, order } => {
+            savitzky_golay_derivative(time, v, window, order, &motion.break_indices(time))
+        }
+    }
 }
 
 /// The energy analysis from exact states (e.g. a simulated trajectory): no integration, no
@@ -275,7 +343,11 @@ pub fn analyze_states(
         interp: Interp::Hermite,
     };
     let motion = detect_motion(&samples, opts.velocity_threshold, v[0], "states")?;
-    Ok(assemble(osc, &samples, &motion, opts))
+    let exact = SeriesSources {
+        displacement: SeriesSource::Exact,
+        acceleration: SeriesSource::Exact,
+    };
+    Ok(assemble(osc, &samples, &motion, opts, exact))
 }
 
 /// Energies, Eq. 7 and the half-cycles from complete samples.
@@ -284,6 +356,7 @@ fn assemble(
     s: &Samples,
     motion: &Motion,
     opts: &EnergyOptions,
+    sources: SeriesSources,
 ) -> EnergyAnalysis {
     let (m, c, k) = (osc.mass, osc.damping, osc.stiffness);
     let n = s.time.len();
@@ -326,5 +399,6 @@ fn assemble(
         half_cycles: cycles,
         half_cycle_mean,
         half_cycle_std,
+        sources,
     }
 }

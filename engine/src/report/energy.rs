@@ -3,7 +3,7 @@
 
 use super::format::{fmt_num, fmt_percent};
 use super::{render_files, Render, Role, Sink, Table};
-use crate::energy::{EnergyAnalysis, EnergyOptions, HalfCycle};
+use crate::energy::{EnergyAnalysis, EnergyOptions, HalfCycle, SeriesSources};
 use crate::oscillator::Oscillator;
 use frictionid_models::FrictionModel;
 use serde::Serialize;
@@ -56,6 +56,8 @@ pub struct EnergyRecord {
     pub masked: usize,
     /// Samples analysed.
     pub samples: usize,
+    /// Whether x and a were measured or integrated / differentiated from the velocity.
+    pub sources: SeriesSources,
     /// The analysis (for plots).
     #[serde(skip)]
     pub analysis: EnergyAnalysis,
@@ -78,6 +80,11 @@ impl EnergyReport {
                     fmt_num(r.reference),
                     fmt_percent(r.percent_difference),
                     r.half_cycles.len().to_string(),
+                    format!(
+                        "{} / {}",
+                        r.sources.displacement.name(),
+                        r.sources.acceleration.name()
+                    ),
                 ]
             })
             .collect();
@@ -89,6 +96,7 @@ impl EnergyReport {
                 "reference [N]",
                 "difference [%]",
                 "half-cycles",
+                "x / a",
             ],
             rows,
         )

@@ -109,6 +109,7 @@ impl ClosedForm {
 
     /// (P, Q) at `t`, by one rotation from the last evaluation when `t` is one sample spacing
     /// after it (uniform grids), directly otherwise.
+    #[inline]
     fn pq_at(&self, t: f64) -> (f64, f64) {
         if let Some(r) = self.cache.get() {
             let step = t - r.t;
@@ -196,6 +197,7 @@ impl Stepper for ClosedForm {
         Ok(StepOutcome::Accepted)
     }
 
+    #[inline]
     fn interpolate(&self, t: f64, out: &mut [f64]) {
         let (p, q) = self.pq_at(t.clamp(self.t_prev, self.t));
         let (x, v) = self.mode.state_at_pq(p, q);

@@ -174,21 +174,14 @@ impl<R: Recorder> Driver<'_, R> {
 
     /// Writes the samples with time <= `until` from the dense output of the last step.
     fn write_samples<S: Stepper>(&mut self, stepper: &S, until: f64, dir: f64, buf: &mut [f64]) {
-        let n = self.pending_until(until);
-        for _ in 0..n {
-            let Some(&ts) = self.samples.get(self.next) else {
+        let samples = self.samples;
+        while let Some(&ts) = samples.get(self.next) {
+            if ts > until {
                 break;
-            };
+            }
             stepper.interpolate(ts, buf);
             self.write_moving(ts, buf, dir);
         }
-    }
-
-    /// Samples not yet written whose time is <= `t`.
-    fn pending_until(&self, t: f64) -> usize {
-        self.samples
-            .get(self.next..)
-            .map_or(0, |rest| rest.iter().take_while(|&&ts| ts <= t).count())
     }
 
     /// Writes one sample of a moving state in direction `dir`.

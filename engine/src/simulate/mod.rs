@@ -645,6 +645,15 @@ fn check_times(t_end: f64, times: &[f64]) -> Result<(), EngineError> {
             "the end time must be finite and >= 0, got {t_end}"
         )));
     }
+    // One pass for the common case (NaN fails every comparison); the diagnosis below names
+    // the first bad sample.
+    let in_order = times
+        .iter()
+        .try_fold(0.0, |floor, &t| (t >= floor && t <= t_end).then_some(t))
+        .is_some();
+    if in_order {
+        return Ok(());
+    }
     for (i, &t) in times.iter().enumerate() {
         if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
             return Err(EngineError::InvalidInput(format!(
