@@ -80,47 +80,54 @@ fn config(oscillator: &str, options: &str, record: &str) -> String {
 
 const FULL: &str = "mass = 10.391\ndamping = 0.275\nstiffness = 1982.0\nnormal_force = 14.5";
 
-#[test]
-fn a_measured_force_requested_of_a_record_without_one_is_named() {
-    let e = fails(
-        "no-force",
-        "fit",
-        &config(FULL, "domain = \"force\"\nforce_target = \"measured\"", ""),
-        &[("r.csv", &velocity_csv())],
-    );
-    assert!(
-        e.contains("c.toml: record `r.csv`: [fit.options] force_target = \"measured\" but the record has no force channel (it has: velocity"),
-        "{e}"
-    );
+/// Force-domain configurations that cannot run on a velocity record: (scratch name, command,
+/// config, what the one-line error says).
+fn bad_configs() -> Vec<(&'static str, &'static str, String, &'static str)> {
+    vec![
+        (
+            "no-force",
+            "fit",
+            config(FULL, "domain = \"force\"\nforce_target = \"measured\"", ""),
+            "c.toml: record `r.csv`: [fit.options] force_target = \"measured\" but the record has no force channel (it has: velocity",
+        ),
+        (
+            "no-mck-velocity",
+            "fit",
+            config("normal_force = 14.5", "", ""),
+            "c.toml: invalid input: [oscillator]: a velocity-domain fit needs mass, damping and stiffness; `mass`, `damping`, `stiffness` not given",
+        ),
+        // Force domain without a force channel falls back to Eq. 7, which needs them too.
+        (
+            "no-mck-energy",
+            "compare",
+            config("normal_force = 14.5\nmass = 10.0", "domain = \"force\"", ""),
+            "the energy-based force (Eq. 7) needs mass, damping and stiffness; `damping`, `stiffness` not given",
+        ),
+        (
+            "bad-domain",
+            "fit",
+            config(FULL, "domain = \"forces\"", ""),
+            "unknown value `forces` in [fit.options] (did you mean `force`?)",
+        ),
+        (
+            "offset-energy",
+            "fit",
+            config(FULL, "domain = \"force\"\nforce_offset = true", ""),
+            "force_offset = true needs a measured force channel",
+        ),
+    ]
 }
 
 #[test]
-fn fits_that_need_m_c_k_name_the_missing_keys() {
-    let e = fails(
-        "no-mck-velocity",
-        "fit",
-        &config("normal_force = 14.5", "", ""),
-        &[("r.csv", &velocity_csv())],
-    );
-    assert!(
-        e.contains("c.toml: invalid input: [oscillator]: a velocity-domain fit needs mass, damping and stiffness; `mass`, `damping`, `stiffness` not given"),
-        "{e}"
-    );
-    // Force domain without a force channel falls back to Eq. 7, which needs them too.
-    let e = fails(
-        "no-mck-energy",
-        "compare",
-        &config("normal_force = 14.5\nmass = 10.0", "domain = \"force\"", ""),
-        &[("r.csv", &velocity_csv())],
-    );
-    assert!(
-        e.contains("the energy-based force (Eq. 7) needs mass, damping and stiffness; `damping`, `stiffness` not given"),
-        "{e}"
-    );
+fn bad_force_domain_configs_are_named_in_one_line() {
+    for (name, command, cfg, says) in bad_configs() {
+        let e = fails(name, command, &cfg, &[("r.csv", &velocity_csv())]);
+        assert!(e.contains(says), "{name}: {e}");
+    }
 }
 
 #[test]
-fn a_force_column_missing_from_the_header_and_a_bad_domain_are_named() {
+fn a_force_column_missing_from_the_header_is_named() {
     let e = fails(
         "no-column",
         "fit",
@@ -133,30 +140,6 @@ fn a_force_column_missing_from_the_header_and_a_bad_domain_are_named() {
     );
     assert!(
         e.ends_with("r.csv: line 1: no column `F [N]`; the header has: time, velocity"),
-        "{e}"
-    );
-    let e = fails(
-        "bad-domain",
-        "fit",
-        &config(FULL, "domain = \"forces\"", ""),
-        &[("r.csv", &velocity_csv())],
-    );
-    assert!(
-        e.contains("unknown value `forces` in [fit.options] (did you mean `force`?)"),
-        "{e}"
-    );
-}
-
-#[test]
-fn force_offset_needs_a_measured_force() {
-    let e = fails(
-        "offset-energy",
-        "fit",
-        &config(FULL, "domain = \"force\"\nforce_offset = true", ""),
-        &[("r.csv", &velocity_csv())],
-    );
-    assert!(
-        e.contains("force_offset = true needs a measured force channel"),
         "{e}"
     );
 }

@@ -555,38 +555,22 @@ fn bad_records_are_clear_errors() {
 fn bad_options_and_states_are_clear_errors() {
     let osc = Oscillator::fmm();
     let rec = record(0.014, 0.0, 0);
-    for d in [
-        Differentiator::SavitzkyGolay {
-            window: 30,
-            order: 4,
-        },
-        Differentiator::SavitzkyGolay {
-            window: 5,
-            order: 5,
-        },
-        Differentiator::SavitzkyGolay {
-            window: 31,
-            order: 0,
-        },
-    ] {
-        let opts = EnergyOptions {
-            differentiator: d,
-            ..Default::default()
-        };
-        assert!(matches!(
-            analyze_record(&rec, &osc, &opts),
-            Err(EngineError::InvalidInput(_))
-        ));
-    }
-    for thr in [-1e-3, f64::NAN] {
-        let opts = EnergyOptions {
-            velocity_threshold: thr,
-            ..Default::default()
-        };
-        assert!(matches!(
-            analyze_record(&rec, &osc, &opts),
-            Err(EngineError::InvalidInput(_))
-        ));
+    let bad_differentiators = [(30, 4), (5, 5), (31, 0)].map(|(window, order)| EnergyOptions {
+        differentiator: Differentiator::SavitzkyGolay { window, order },
+        ..Default::default()
+    });
+    let bad_thresholds = [-1e-3, f64::NAN].map(|velocity_threshold| EnergyOptions {
+        velocity_threshold,
+        ..Default::default()
+    });
+    for opts in bad_differentiators.into_iter().chain(bad_thresholds) {
+        assert!(
+            matches!(
+                analyze_record(&rec, &osc, &opts),
+                Err(EngineError::InvalidInput(_))
+            ),
+            "{opts:?}"
+        );
     }
     let mut bad_osc = osc;
     bad_osc.mass = 0.0;

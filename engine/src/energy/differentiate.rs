@@ -4,8 +4,6 @@
 use crate::error::EngineError;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
-use std::collections::hash_map::Entry;
-use std::collections::HashMap;
 
 /// The moving-average span of the paper's recipe (section 5: "a moving average filter with a
 /// span of 10 points").
@@ -140,6 +138,10 @@ pub fn paper_derivative(time: &[f64], v: &[f64]) -> Vec<f64> {
     moving_average(&central_difference(time, v), PAPER_SPAN)
 }
 
+/// Savitzky-Golay weights of one window size and degree, by the sample's place in its window
+/// (filled on first use).
+type WeightsByPlace = Vec<Option<Vec<f64>>>;
+
 /// Savitzky-Golay derivative of `v` sampled at `time`.
 ///
 /// At each sample the polynomial of degree `order` is fitted by least squares to `window`
@@ -169,7 +171,9 @@ pub fn savitzky_golay_derivative(
         return Ok(out);
     }
     let uniform_dt = uniform_spacing(&time[..n]);
-    let mut cache: HashMap<(usize, usize, usize), Vec<f64>> = HashMap::new();
+    // Uniform grid: the weights depend only on the sample's place in its window, per window
+    // size and degree.
+    let mut cache: Vec<((usize, usize), WeightsByPlace)> = Vec::new();
     let mut bounds: Vec<usize> = Vec::with_capacity(breaks.len() + 2);
     bounds.push(0);
     bounds.extend(breaks.iter().copied().filter(|&b| b > 0 && b < n));
@@ -186,24 +190,26 @@ pub fn savitzky_golay_derivative(
         } else {
             (len, order.min(len - 1))
         };
+        let slot = match cache.iter().position(|(key, _)| *key == (w, p)) {
+            Some(k) => k,
+            None => {
+                cache.push(((w, p), vec![None; w]));
+                cache.len() - 1
+            }
+        };
         for i in seg[0]..seg[1] {
             let lo = i.saturating_sub(w / 2).clamp(s, e - w);
             let hi = lo + w;
             let fresh;
             let weights: &[f64] = match uniform_dt {
                 Some(dt) => {
-                    let key = (i - lo, w, p);
-                    match cache.entry(key) {
-                        Entry::Occupied(e) => e.into_mut().as_slice(),
-                        Entry::Vacant(e) => {
-                            let offsets: Vec<f64> = (lo..hi).map(|j| j as f64 - i as f64).collect();
-                            let wts: Vec<f64> = derivative_weights(&offsets, p)?
-                                .into_iter()
-                                .map(|x| x / dt)
-                                .collect();
-                            e.insert(wts).as_slice()
-                        }
+                    let place = &mut cache[slot].1[i - lo];
+                    if place.is_none() {
+                        let offsets: Vec<f64> = (lo..hi).map(|j| j as f64 - i as f64).collect();
+                        let wts = derivative_weights(&offsets, p)?;
+                        *place = Some(wts.into_iter().map(|x| x / dt).collect());
                     }
+                    place.as_deref().unwrap_or_default()
                 }
                 None => {
                     let offsets: Vec<f64> = (lo..hi).map(|j| time[j] - time[i]).collect();

@@ -200,11 +200,12 @@ impl<R: Residuals> FitProblem<R> {
             self.residuals
                 .residuals(&at, r, &self.records[r], &world.nuisance[r])
         };
-        let parts: Vec<Result<Vec<f64>, EngineError>> = if self.parallel && self.records.len() > 1 {
-            (0..self.records.len()).into_par_iter().map(run).collect()
-        } else {
-            (0..self.records.len()).map(run).collect()
-        };
+        let parts: Vec<Result<Vec<f64>, EngineError>> =
+            if self.worth_threads() && self.records.len() > 1 {
+                (0..self.records.len()).into_par_iter().map(run).collect()
+            } else {
+                (0..self.records.len()).map(run).collect()
+            };
         let mut out = Vec::with_capacity(self.n_residuals());
         for part in parts {
             out.extend(part?);
@@ -236,12 +237,21 @@ impl<R: Residuals> FitProblem<R> {
             let h = self.fd_step(u, j);
             self.difference_column(u, r0, j, if u[j] + h > hi { -h } else { h })
         };
-        let cols: Vec<DVector<f64>> = if self.parallel && n > 1 {
+        let cols: Vec<DVector<f64>> = if self.worth_threads() && n > 1 {
             (0..n).into_par_iter().map(column).collect()
         } else {
             (0..n).map(column).collect()
         };
         DMatrix::from_columns(&cols)
+    }
+
+    /// Whether simulations should go to other threads: allowed, and the records are not so
+    /// light that the hand-over costs more than the work.
+    fn worth_threads(&self) -> bool {
+        self.parallel
+            && !self
+                .work
+                .is_light(self.records.iter().map(|r| r.time().len()))
     }
 
     /// The forward-difference step of parameter `j` at `u` (internal coordinates).

@@ -18,6 +18,12 @@ pub const WORK_FACTOR: f64 = 8.0;
 /// baseline is a few steps per record).
 pub const MIN_STEPS_PER_SAMPLE: f64 = 1.0;
 
+/// Below this many integrator steps over all records at the start point, a problem's records
+/// and Jacobian columns are simulated on one thread: handing them to other threads costs
+/// more than it saves (the exact propagator takes a few steps per record; Dopri5 on a 2 s
+/// FMM record about 400).
+pub const PARALLEL_MIN_STEPS: f64 = 2000.0;
+
 /// Baseline steps per sample, in millionths (0: not measured yet).
 const SCALE: f64 = 1e6;
 
@@ -44,6 +50,20 @@ impl WorkBudget {
             let per_sample = (WORK_FACTOR * base as f64 / SCALE).max(MIN_STEPS_PER_SAMPLE);
             (per_sample * samples.max(1) as f64).ceil() as u64
         })
+    }
+
+    /// Whether every record's baseline is known and together they take fewer than
+    /// [`PARALLEL_MIN_STEPS`] steps, for records of `samples` samples each.
+    pub fn is_light(&self, samples: impl Iterator<Item = usize>) -> bool {
+        let mut steps = 0.0;
+        for (slot, n) in self.baseline.iter().zip(samples) {
+            let base = slot.load(Ordering::Relaxed);
+            if base == 0 {
+                return false;
+            }
+            steps += base as f64 / SCALE * n as f64;
+        }
+        steps < PARALLEL_MIN_STEPS
     }
 
     /// Records the work of a finished simulation of record `record` with `samples` samples:
@@ -84,5 +104,29 @@ mod tests {
         budget.record(1, &later, 2000);
         assert_eq!(budget.cap(1, 500), Some(500));
         assert_eq!(budget.cap(2, 500), None);
+    }
+
+    #[test]
+    fn records_are_light_once_measured_below_the_parallel_threshold() {
+        let budget = WorkBudget::new(2);
+        let few = SimStats {
+            steps: 10,
+            ..SimStats::default()
+        };
+        assert!(!budget.is_light([2000, 2000].into_iter()));
+        budget.record(0, &few, 2000);
+        assert!(
+            !budget.is_light([2000, 2000].into_iter()),
+            "record 1 unmeasured"
+        );
+        budget.record(1, &few, 2000);
+        assert!(budget.is_light([2000, 2000].into_iter()));
+        let many = WorkBudget::new(1);
+        let dopri = SimStats {
+            steps: 2500,
+            ..SimStats::default()
+        };
+        many.record(0, &dopri, 2000);
+        assert!(!many.is_light([2000].into_iter()));
     }
 }
