@@ -31,6 +31,18 @@ pub fn fixtures_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
 }
 
+/// The text of the fixture config `name` (under [`fixtures_dir`]) with its record files made
+/// absolute, so that a test can write a variant of it anywhere.
+///
+/// # Panics
+/// When the fixture cannot be read.
+pub fn fixture_config(name: &str) -> String {
+    let dir = fixtures_dir();
+    std::fs::read_to_string(dir.join(name))
+        .unwrap_or_else(|e| panic!("fixture {name}: {e}"))
+        .replace("file = \"", &format!("file = \"{}/", dir.display()))
+}
+
 /// report.json in `out`, or `Null` when the run wrote none (a failed run writes none).
 pub fn read_report(out: &Path) -> serde_json::Value {
     std::fs::read_to_string(out.join("report.json"))

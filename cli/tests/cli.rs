@@ -275,30 +275,30 @@ fn fixture_configs_parse() {
 
 #[test]
 fn simulate_and_energy_name_what_they_need() {
-    let e = fails(
-        "no-sim",
-        "simulate",
-        &format!("{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\n"),
-        &[],
-    );
-    assert!(e.contains("simulate needs a [simulation] table"), "{e}");
-    let e = fails(
-        "no-model",
-        "simulate",
-        &format!("{FMM_OSCILLATOR}[simulation]\nx0 = 0.01\nduration = 1.0\n"),
-        &[],
-    );
-    assert!(e.contains("simulate needs a [model] table"), "{e}");
-    let e = fails(
-        "no-records",
-        "energy",
-        &format!("{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\n"),
-        &[],
-    );
-    assert!(
-        e.contains("energy needs at least one [[records]] entry"),
-        "{e}"
-    );
+    let cases = [
+        (
+            "no-sim",
+            "simulate",
+            "[model]\ntype = \"coulomb\"\n",
+            "simulate needs a [simulation] table",
+        ),
+        (
+            "no-model",
+            "simulate",
+            "[simulation]\nx0 = 0.01\nduration = 1.0\n",
+            "simulate needs a [model] table",
+        ),
+        (
+            "no-records",
+            "energy",
+            "[model]\ntype = \"coulomb\"\n",
+            "energy needs at least one [[records]] entry",
+        ),
+    ];
+    for (name, command, tables, says) in cases {
+        let e = fails(name, command, &format!("{FMM_OSCILLATOR}{tables}"), &[]);
+        assert!(e.contains(says), "{name}: {e}");
+    }
 }
 
 /// `simulate` needs every oscillator property: a missing normal force is an error naming it,

@@ -2,7 +2,9 @@
 //! N = 14.5 N; see fixtures/README.md), and their failure modes.
 
 use assert_cmd::Command;
-use frictionid_cli::testing::{fixtures_dir, read_report, scratch_dir, FMM_OSCILLATOR};
+use frictionid_cli::testing::{
+    fixture_config, fixtures_dir, read_report, scratch_dir, FMM_OSCILLATOR,
+};
 use std::path::Path;
 
 fn frictionid() -> Command {
@@ -212,13 +214,7 @@ fn compare_rejects_an_unknown_model_with_a_suggestion() {
 #[test]
 fn a_fit_that_does_not_converge_exits_2_with_its_report() {
     let dir = scratch_dir("fc", "noconv");
-    let text = std::fs::read_to_string(fixtures_dir().join("fmm-fit.toml"))
-        .unwrap()
-        .replace(
-            "file = \"",
-            &format!("file = \"{}/", fixtures_dir().display()),
-        )
-        .replace("[fit]\n", "[fit]\nmax_iterations = 1\n");
+    let text = fixture_config("fmm-fit.toml").replace("[fit]\n", "[fit]\nmax_iterations = 1\n");
     let cfg = dir.join("fit.toml");
     std::fs::write(&cfg, text).unwrap();
     let out = dir.join("out");
@@ -246,13 +242,7 @@ fn a_fit_that_does_not_converge_exits_2_with_its_report() {
 #[test]
 fn unknown_fit_option_is_named() {
     let dir = scratch_dir("fc", "fitopt");
-    let text = std::fs::read_to_string(fixtures_dir().join("fmm-fit.toml"))
-        .unwrap()
-        .replace(
-            "file = \"",
-            &format!("file = \"{}/", fixtures_dir().display()),
-        )
-        + "\n[fit.options]\nvelocity_ofset = true\n";
+    let text = fixture_config("fmm-fit.toml") + "\n[fit.options]\nvelocity_ofset = true\n";
     let cfg = dir.join("fit.toml");
     std::fs::write(&cfg, text).unwrap();
     let o = frictionid()
@@ -272,12 +262,7 @@ fn unknown_fit_option_is_named() {
 #[test]
 fn energy_without_a_model_takes_its_reference_from_a_coulomb_fit() {
     let dir = scratch_dir("fc", "energy-fit");
-    let text = std::fs::read_to_string(fixtures_dir().join("fmm-compare.toml"))
-        .unwrap()
-        .replace(
-            "file = \"",
-            &format!("file = \"{}/", fixtures_dir().display()),
-        );
+    let text = fixture_config("fmm-compare.toml");
     let cfg = dir.join("energy.toml");
     std::fs::write(&cfg, text).unwrap();
     let out = dir.join("out");
@@ -333,12 +318,7 @@ fn energy_uses_measured_displacement_and_acceleration_columns() {
 #[test]
 fn expression_sign_law_fits_the_same_mu_as_coulomb() {
     let dir = scratch_dir("fc", "expr");
-    let base = std::fs::read_to_string(fixtures_dir().join("fmm-fit.toml"))
-        .unwrap()
-        .replace(
-            "file = \"",
-            &format!("file = \"{}/", fixtures_dir().display()),
-        );
+    let base = fixture_config("fmm-fit.toml");
     let expr = base.replace(
         "type = \"coulomb\"\nmu = 0.2               # initial value",
         "type = \"expression\"\nforce = \"mu * N * sign(v)\"\nparams = { mu = 0.2 }",

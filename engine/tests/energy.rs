@@ -744,14 +744,7 @@ fn bristle_models_follow_the_distance_closed_form() {
         }
         expected.push(sigma0 * z);
     }
-    let lugre = LuGre {
-        sigma0,
-        sigma1: 0.0,
-        sigma2: 0.0,
-        mu_c: MU,
-        mu_s: MU,
-        v_s: 0.01,
-    };
+    let lugre = coulomb_like_lugre(sigma0);
     let dahl = Dahl {
         sigma0,
         mu_c: MU,
@@ -852,6 +845,19 @@ fn lugre_residuals_on_a_simulated_motion() {
     );
 }
 
+/// LuGre with mu_s = mu_c and no damping terms: a Coulomb law of level MU N behind bristles
+/// of stiffness `sigma0`.
+fn coulomb_like_lugre(sigma0: f64) -> LuGre {
+    LuGre {
+        sigma0,
+        sigma1: 0.0,
+        sigma2: 0.0,
+        mu_c: MU,
+        mu_s: MU,
+        v_s: 0.01,
+    }
+}
+
 /// A stiffer LuGre (mu_s = mu_c, no damping terms) is closer to Coulomb: its residual RMS
 /// against the Coulomb motion's energy-based force falls with sigma0 and is small at 1e7.
 #[test]
@@ -861,14 +867,7 @@ fn lugre_residuals_shrink_towards_coulomb() {
     let an =
         analyze_states(&osc, &ex.time, &ex.x, &ex.v, &ex.a, &Default::default()).expect("analysis");
     let rms = |sigma0: f64| {
-        let model = LuGre {
-            sigma0,
-            sigma1: 0.0,
-            sigma2: 0.0,
-            mu_c: MU,
-            mu_s: MU,
-            v_s: 0.01,
-        };
+        let model = coulomb_like_lugre(sigma0);
         force_residuals(&an, &model, &osc).expect("residuals").rms
     };
     let (soft, stiff) = (rms(1e5), rms(1e7));

@@ -206,3 +206,22 @@ def test_ctrl_c_interrupts_a_long_fit():
     out, _ = proc.communicate(timeout=60)
     assert out.strip() in ("interrupted", "finished")
     assert proc.returncode == 0
+
+
+def test_force_domain_fit_from_arrays_recovers_a_coulomb_law():
+    """A tribometer-like record from Python arrays: the imposed motion x = A sin(w t), a
+    measured friction force mu N sgn(v) plus a load-cell offset and a sampled normal force.
+    The force-domain fit needs only N (no m, c, k) and returns mu and the offset exactly."""
+    t = np.arange(0.0, 2.0, 1e-3)
+    x = 1e-3 * np.sin(2.0 * np.pi * 1.5 * t)
+    v = 1e-3 * 2.0 * np.pi * 1.5 * np.cos(2.0 * np.pi * 1.5 * t)
+    normal = 5.0 + 0.5 * np.sin(2.0 * np.pi * 0.25 * t)
+    mu, offset = 0.31, 0.02
+    force = mu * normal * np.sign(v) + offset
+    record = {"name": "tribo", "t": t, "x": x, "v": v, "force": force, "normal_force": normal, "x0": 0.0}
+    out = frictionid.fit(
+        {}, {"type": "coulomb", "mu": 0.2}, [record],
+        {"options": {"domain": "force", "force_offset": True}},
+    )
+    (param,) = [p for p in out["parameters"] if p["name"] == "mu"]
+    assert abs(param["value"] / mu - 1.0) < 1e-6
