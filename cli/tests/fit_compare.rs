@@ -335,3 +335,29 @@ fn expression_sign_law_fits_the_same_mu_as_coulomb() {
     }
     assert!((mus[0] - mus[1]).abs() < 1e-6, "{mus:?}");
 }
+
+/// An interferometer record (time and displacement only) is a valid fit input: the fit
+/// compares displacement, in metres, and finds the exact motion's mu.
+#[test]
+fn a_displacement_only_record_is_fitted_in_displacement() {
+    let dir = scratch_dir("fc", "fit-x");
+    let osc = frictionid_engine::Oscillator::fmm();
+    let times = frictionid_engine::synthetic::uniform_times(2.0, 1000.0);
+    let ex = frictionid_engine::exact::coulomb_free_vibration(&osc, MU_N, 0.014, &times).unwrap();
+    let mut csv = String::from("time,displacement\n");
+    for (t, x) in ex.time.iter().zip(&ex.x) {
+        csv += &format!("{t:e},{x:e}\n");
+    }
+    std::fs::write(dir.join("x.csv"), csv).unwrap();
+    let cfg = format!(
+        "{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\n[[records]]\nfile = \"x.csv\"\nx0 = 0.014\n"
+    );
+    std::fs::write(dir.join("fit.toml"), cfg).unwrap();
+    let out = dir.join("out");
+    let (o, r) = run_json(&["fit", dir.join("fit.toml").to_str().unwrap()], &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mu = r["parameters"][0]["value"].as_f64().unwrap();
+    assert!((mu / TRUTH_MU - 1.0).abs() < 1e-6, "mu {mu}");
+    assert_eq!(r["residual_unit"], "m", "{}", r["residual_unit"]);
+    assert!(out.join("x_displacement_fit.svg").exists());
+}

@@ -5,25 +5,27 @@ use crate::error::CliError;
 use frictionid_models::FrictionModel;
 use std::path::Path;
 
-/// Measured and fitted velocity of one record (the paper's Fig. 8), and under it their
-/// difference, where an offset or a misfit shows.
-pub fn velocity_fit(
+/// The measured and fitted response of one record over time, and their difference:
+/// `quantity` is the compared channel and its unit (velocity in m/s, or displacement in m
+/// for interferometer records).
+pub fn response_fit(
     path: &Path,
     record: &str,
+    quantity: (&str, &str),
     time: &[f64],
-    measured: &[f64],
-    fitted: &[f64],
+    series: (&[f64], &[f64]),
     model: &str,
 ) -> Result<(), CliError> {
+    let ((name, unit), (measured, fitted)) = (quantity, series);
     let residual: Vec<f64> = measured.iter().zip(fitted).map(|(m, f)| m - f).collect();
     let color = super::model_color(model);
-    let fit_panel = Panel::new("velocity", "m/s")
+    let fit_panel = Panel::new(name, unit)
         .with(Series::solid("measured", time, measured).color(super::MEASURED))
         .with(Series::dashed(format!("fitted ({model})"), time, fitted).color(color));
-    let residual_panel = Panel::new("residual measured - fitted", "m/s")
+    let residual_panel = Panel::new("residual measured - fitted", unit)
         .with(Series::solid("", time, &residual).width(1).color(color))
         .with_reference("", 0.0);
-    let title = format!("{record}: measured and fitted velocity");
+    let title = format!("{record}: measured and fitted {name}");
     draw(
         path,
         &Figure::over_time(title, vec![fit_panel, residual_panel]),

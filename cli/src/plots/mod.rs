@@ -11,7 +11,7 @@ pub mod sets;
 
 pub use charts::{
     displacement_acceleration, displacement_velocity, energy_rate, force_against_motion,
-    friction_force, steady_state_curves, velocity_fit, MotionAxis,
+    friction_force, response_fit, steady_state_curves, MotionAxis,
 };
 
 use crate::error::CliError;

@@ -138,7 +138,7 @@ fn fit_force_plot(
     )
 }
 
-/// `fit` and `compare`: the velocity fit and the friction-force check of every record;
+/// `fit` and `compare`: the response fit and the friction-force check of every record;
 /// `prefix` starts every file name.
 pub fn fit_record_plots(
     out: &OutputDir,
@@ -152,13 +152,13 @@ pub fn fit_record_plots(
             files.extend(force_record_plots(out, fit, r, &format!("{prefix}{stem}"))?);
             continue;
         }
-        let vf = format!("{prefix}{stem}_velocity_fit.svg");
-        super::velocity_fit(
+        let vf = format!("{prefix}{stem}_{}_fit.svg", r.channel);
+        super::response_fit(
             &out.path(&vf),
             &r.file,
+            (&r.channel, &fit.residual_unit),
             &r.time,
-            &r.measured,
-            &r.fitted,
+            (&r.measured, &r.fitted),
             &fit.model,
         )?;
         files.push(vf);

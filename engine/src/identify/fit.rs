@@ -21,7 +21,7 @@ use super::strategy::{self, plan_starts, Search, Seeded, StartPlan};
 use crate::energy::{analyze_record, model_force_budgeted};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
-use crate::record::{NormalForce, Record};
+use crate::record::{Channel, NormalForce, Record};
 use frictionid_models::FrictionModel;
 use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
@@ -52,11 +52,7 @@ pub fn fit(
     }
     require_mechanics(&opts.unknown_oscillator, "a velocity-domain fit")?;
     let clock = Instant::now();
-    let residuals = Arc::new(VelocityResponse::new(
-        opts.velocity_offset,
-        opts.time_shift,
-        opts.x0,
-    ));
+    let residuals = Arc::new(response_for(records, opts)?);
     let seed = prefit(osc, model, records, opts);
     let mut result = fit_seeded(residuals, osc, model, records, opts, seed.as_ref())?;
     if let Some(seed) = &seed {
@@ -64,6 +60,24 @@ pub fn fit(
         result.wall_time_s = clock.elapsed().as_secs_f64();
     }
     Ok(result)
+}
+
+/// The response a velocity-domain fit compares: the velocity when every record has one, else
+/// the displacement (interferometer records). Errors: a record with neither; a velocity offset
+/// asked of displacement records.
+fn response_for(records: &[Record], opts: &FitOptions) -> Result<VelocityResponse, EngineError> {
+    match VelocityResponse::common_channel(records) {
+        Some(Channel::Displacement) if opts.velocity_offset => Err(EngineError::InvalidInput(
+            "[fit.options] velocity_offset needs velocity records; these have displacement only"
+                .into(),
+        )),
+        Some(Channel::Displacement) => Ok(VelocityResponse::displacement(opts.time_shift, opts.x0)),
+        _ => Ok(VelocityResponse::new(
+            opts.velocity_offset,
+            opts.time_shift,
+            opts.x0,
+        )),
+    }
 }
 
 /// Fits `model` with the residuals of `residuals` (see [`fit`]; the nuisance parameters are

@@ -218,7 +218,7 @@ impl ForceTrack {
 /// The velocity (measured, or the central difference of the displacement) and the
 /// displacement (measured, or the velocity integrated from x0) of a record; `None` without
 /// either channel.
-fn motion(record: &Record) -> Option<(Vec<f64>, Vec<f64>)> {
+pub(crate) fn motion(record: &Record) -> Option<(Vec<f64>, Vec<f64>)> {
     let time = record.time();
     let measured_x = record.channel(Channel::Displacement);
     let v = match record.channel(Channel::Velocity) {

@@ -12,8 +12,8 @@ use super::options::FitOptions;
 use super::work::WorkBudget;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
-use crate::record::Record;
-use crate::simulate::{simulate_velocity, Initial, SimOptions, SimStats};
+use crate::record::{Channel, Record};
+use crate::simulate::{simulate, simulate_velocity, Initial, SimOptions, SimStats};
 use frictionid_models::{FrictionModel, GuessHint};
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -309,11 +309,14 @@ pub trait Residuals: Send + Sync {
     }
 }
 
-/// The velocity response: simulate the free vibration from the record's release state and
-/// compare the simulated velocity (plus the record's offset) with the measured one.
+/// The oscillator's response: simulate the free vibration from the record's release state and
+/// compare the simulated velocity (plus the record's offset) with the measured one, or, for
+/// records of an interferometer ([`VelocityResponse::displacement`]), the simulated
+/// displacement with the measured one.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VelocityResponse {
     nuisance: Vec<NuisanceKind>,
+    compared: Channel,
 }
 
 impl VelocityResponse {
@@ -329,7 +332,83 @@ impl VelocityResponse {
                 NuisanceKind::ForceOffset => false,
             })
             .collect();
-        Self { nuisance }
+        Self {
+            nuisance,
+            compared: Channel::Velocity,
+        }
+    }
+
+    /// The response seen by an interferometer: the simulated displacement against a measured
+    /// displacement channel (relative to the spring's equilibrium), with a per-record release
+    /// shift and/or release displacement.
+    pub fn displacement(time_shift: bool, x0: bool) -> Self {
+        Self {
+            compared: Channel::Displacement,
+            ..Self::new(false, time_shift, x0)
+        }
+    }
+
+    /// The channel every record of a response fit is compared in: velocity when each record has
+    /// one, else displacement when each has one (`None`: neither).
+    pub fn common_channel(records: &[Record]) -> Option<Channel> {
+        [Channel::Velocity, Channel::Displacement]
+            .into_iter()
+            .find(|&c| records.iter().all(|r| r.channel(c).is_some()))
+    }
+
+    /// The simulated response of `record` in the compared channel (see [`Self::simulate`]).
+    fn simulate_compared(
+        &self,
+        at: &Evaluation<'_>,
+        index: usize,
+        record: &Record,
+        nuisance: &NuisanceValues,
+    ) -> Result<Vec<f64>, EngineError> {
+        match self.compared {
+            Channel::Displacement => self.simulate_displacement(at, index, record, nuisance),
+            _ => self.simulate(at, index, record, nuisance),
+        }
+    }
+
+    /// The simulated displacement of `record` at its time stamps (as [`Self::simulate`]; the
+    /// samples before the release see the release displacement).
+    fn simulate_displacement(
+        &self,
+        at: &Evaluation<'_>,
+        index: usize,
+        record: &Record,
+        nuisance: &NuisanceValues,
+    ) -> Result<Vec<f64>, EngineError> {
+        let (first, times) = Self::simulation_clock(record, nuisance);
+        let x0 = nuisance.x0_of(record);
+        let mut x = vec![x0; first];
+        if let Some(&t_end) = times.last() {
+            at.count_simulation();
+            let init = Initial {
+                x0,
+                v0: record.v0,
+                z0: None,
+            };
+            let base = STEPS_PER_SAMPLE * (record.len() as u64).max(100);
+            let opts = at.capped(index, times.len(), base);
+            let traj = simulate(at.oscillator, at.model, &init, t_end, &times, &opts)?;
+            at.record_work(index, &traj.stats, times.len());
+            x.extend_from_slice(&traj.x);
+        }
+        Ok(x)
+    }
+
+    /// The number of samples before the release (shifted by the nuisance `shift`) and the
+    /// remaining sample times on the simulation clock (0 at the release).
+    fn simulation_clock(record: &Record, nuisance: &NuisanceValues) -> (usize, Vec<f64>) {
+        let t0 = record.time().first().copied().unwrap_or(0.0);
+        let release = record.release_time.unwrap_or(t0) + nuisance.shift;
+        let first = record.time().partition_point(|&t| t < release);
+        let times = record.time()[first..]
+            .iter()
+            .map(|&t| t - release)
+            .collect();
+        (first, times)
     }
 
     /// The simulated velocity of `record` at its time stamps, released from the nuisance
@@ -344,14 +423,8 @@ impl VelocityResponse {
         record: &Record,
         nuisance: &NuisanceValues,
     ) -> Result<Vec<f64>, EngineError> {
-        let t0 = record.time().first().copied().unwrap_or(0.0);
-        let release = record.release_time.unwrap_or(t0) + nuisance.shift;
-        // Sample times on the simulation clock; samples before the release see the initial state.
-        let first = record.time().partition_point(|&t| t < release);
-        let times: Vec<f64> = record.time()[first..]
-            .iter()
-            .map(|&t| t - release)
-            .collect();
+        // Samples before the release see the initial state.
+        let (first, times) = Self::simulation_clock(record, nuisance);
         let mut v = vec![record.v0; first];
         if let Some(&t_end) = times.last() {
             at.count_simulation();
@@ -381,11 +454,14 @@ impl VelocityResponse {
 
 impl Residuals for VelocityResponse {
     fn channel(&self) -> &'static str {
-        "velocity"
+        self.compared.name()
     }
 
     fn unit(&self) -> &'static str {
-        "m/s"
+        match self.compared {
+            Channel::Displacement => "m",
+            _ => "m/s",
+        }
     }
 
     fn nuisance(&self) -> &[NuisanceKind] {
@@ -393,7 +469,36 @@ impl Residuals for VelocityResponse {
     }
 
     fn measured<'a>(&'a self, _index: usize, record: &'a Record) -> &'a [f64] {
-        record.velocity()
+        record.channel(self.compared).unwrap_or_default()
+    }
+
+    fn check_record(&self, record: &Record) -> Result<(), EngineError> {
+        match self.compared {
+            Channel::Displacement => record.validate_channels(3),
+            _ => record.validate(3),
+        }
+    }
+
+    /// Displacement records: the hints of their motion's velocity (the differentiated
+    /// displacement, as the force domain takes it).
+    fn hint(&self, osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
+        if self.compared == Channel::Velocity {
+            return super::setup::guess_hint(osc, records, opts);
+        }
+        let with_velocity: Vec<Record> = records
+            .iter()
+            .map(|r| match super::force::motion(r) {
+                Some((v, _)) => r.clone().with_channel(Channel::Velocity, v),
+                None => r.clone(),
+            })
+            .collect();
+        super::setup::guess_hint(osc, &with_velocity, opts)
+    }
+
+    /// The energy-balance check and the residual-structure diagnostic read the velocity: they
+    /// apply to velocity records only.
+    fn simulates_response(&self) -> bool {
+        self.compared == Channel::Velocity
     }
 
     fn predict(
@@ -403,7 +508,7 @@ impl Residuals for VelocityResponse {
         record: &Record,
         nuisance: &NuisanceValues,
     ) -> Result<Vec<f64>, EngineError> {
-        let mut v = self.simulate(at, index, record, nuisance)?;
+        let mut v = self.simulate_compared(at, index, record, nuisance)?;
         for x in &mut v {
             *x += nuisance.offset;
         }
