@@ -2,11 +2,24 @@
 //! N = 14.5 N; see fixtures/README.md), and their failure modes.
 
 use assert_cmd::Command;
-use frictionid_cli::testing::{fixtures_dir, read_report, scratch_dir};
+use frictionid_cli::testing::Says::Contains;
+use frictionid_cli::testing::{
+    assert_bad_inputs, fixtures_dir, read_report, scratch_dir, BadInput,
+};
 use std::path::Path;
 
 fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
+}
+
+/// The bundled fixture config `name` with its record paths made absolute, so that a copy
+/// written elsewhere still reads the fixture records.
+fn fixture_config(name: &str) -> String {
+    let text = std::fs::read_to_string(fixtures_dir().join(name)).unwrap();
+    text.replace(
+        "file = \"",
+        &format!("file = \"{}/", fixtures_dir().display()),
+    )
 }
 
 fn run_json(args: &[&str], out: &Path) -> (std::process::Output, serde_json::Value) {
@@ -94,15 +107,10 @@ fn fit_recovers_the_fixture_truth_and_writes_every_output() {
 #[test]
 fn a_normal_force_uncertainty_in_the_config_reaches_every_fitted_parameter() {
     let out = scratch_dir("fc", "budget");
-    let mut config = std::fs::read_to_string(fixtures_dir().join("fmm-fit.toml")).unwrap();
-    config = config.replace(
+    let config = fixture_config("fmm-fit.toml").replace(
         "normal_force = 14.5",
         "normal_force = 14.5\nnormal_force_std = 0.145",
     );
-    for x in ["x10mm.csv", "x14mm.csv", "x22mm.csv"] {
-        let path = fixtures_dir().join(x).display().to_string();
-        config = config.replace(&format!("\"{x}\""), &format!("{path:?}"));
-    }
     let cfg = out.join("budget.toml");
     std::fs::write(&cfg, config).unwrap();
     let (o, r) = run_json(&["fit", cfg.to_str().unwrap()], &out.join("out"));
@@ -212,13 +220,7 @@ fn compare_rejects_an_unknown_model_with_a_suggestion() {
 #[test]
 fn a_fit_that_does_not_converge_exits_2_with_its_report() {
     let dir = scratch_dir("fc", "noconv");
-    let text = std::fs::read_to_string(fixtures_dir().join("fmm-fit.toml"))
-        .unwrap()
-        .replace(
-            "file = \"",
-            &format!("file = \"{}/", fixtures_dir().display()),
-        )
-        .replace("[fit]\n", "[fit]\nmax_iterations = 1\n");
+    let text = fixture_config("fmm-fit.toml").replace("[fit]\n", "[fit]\nmax_iterations = 1\n");
     let cfg = dir.join("fit.toml");
     std::fs::write(&cfg, text).unwrap();
     let out = dir.join("out");
@@ -245,39 +247,17 @@ fn a_fit_that_does_not_converge_exits_2_with_its_report() {
 
 #[test]
 fn unknown_fit_option_is_named() {
-    let dir = scratch_dir("fc", "fitopt");
-    let text = std::fs::read_to_string(fixtures_dir().join("fmm-fit.toml"))
-        .unwrap()
-        .replace(
-            "file = \"",
-            &format!("file = \"{}/", fixtures_dir().display()),
-        )
-        + "\n[fit.options]\nvelocity_ofset = true\n";
-    let cfg = dir.join("fit.toml");
-    std::fs::write(&cfg, text).unwrap();
-    let o = frictionid()
-        .args(["fit", cfg.to_str().unwrap(), "--out"])
-        .arg(dir.join("out"))
-        .output()
-        .unwrap();
-    assert_eq!(o.status.code(), Some(1));
-    let e = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        e.contains("`velocity_ofset`") && e.contains("did you mean `velocity_offset`"),
-        "{e}"
-    );
-    assert!(!dir.join("out").join("report.json").exists());
+    let config = fixture_config("fmm-fit.toml") + "\n[fit.options]\nvelocity_ofset = true\n";
+    let case = BadInput::new("fitopt", "fit", config)
+        .says(Contains("`velocity_ofset`"))
+        .says(Contains("did you mean `velocity_offset`"));
+    assert_bad_inputs(Path::new(env!("CARGO_BIN_EXE_frictionid")), "fc", &[case]);
 }
 
 #[test]
 fn energy_without_a_model_takes_its_reference_from_a_coulomb_fit() {
     let dir = scratch_dir("fc", "energy-fit");
-    let text = std::fs::read_to_string(fixtures_dir().join("fmm-compare.toml"))
-        .unwrap()
-        .replace(
-            "file = \"",
-            &format!("file = \"{}/", fixtures_dir().display()),
-        );
+    let text = fixture_config("fmm-compare.toml");
     let cfg = dir.join("energy.toml");
     std::fs::write(&cfg, text).unwrap();
     let out = dir.join("out");
@@ -298,12 +278,7 @@ fn energy_without_a_model_takes_its_reference_from_a_coulomb_fit() {
 #[test]
 fn expression_sign_law_fits_the_same_mu_as_coulomb() {
     let dir = scratch_dir("fc", "expr");
-    let base = std::fs::read_to_string(fixtures_dir().join("fmm-fit.toml"))
-        .unwrap()
-        .replace(
-            "file = \"",
-            &format!("file = \"{}/", fixtures_dir().display()),
-        );
+    let base = fixture_config("fmm-fit.toml");
     let expr = base.replace(
         "type = \"coulomb\"\nmu = 0.2               # initial value",
         "type = \"expression\"\nforce = \"mu * N * sign(v)\"\nparams = { mu = 0.2 }",

@@ -3,7 +3,8 @@
 //! of force-domain configurations.
 
 use assert_cmd::Command;
-use frictionid_cli::testing::{fails_with_one_line, fixtures_dir, scratch_dir};
+use frictionid_cli::testing::Says::{Contains, EndsWith};
+use frictionid_cli::testing::{assert_bad_inputs, fixtures_dir, scratch_dir, BadInput};
 use std::path::Path;
 
 fn frictionid() -> Command {
@@ -56,11 +57,6 @@ fn tribometer_compare_ranks_dynamic_models_ahead_of_static_ones() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
-fn fails(name: &str, cmd: &str, config: &str, files: &[(&str, &str)]) -> String {
-    let binary = Path::new(env!("CARGO_BIN_EXE_frictionid"));
-    fails_with_one_line(binary, ("force", name), cmd, config, files)
-}
-
 /// A velocity record (no force column).
 fn velocity_csv() -> String {
     let mut s = String::from("time,velocity\n");
@@ -80,83 +76,50 @@ fn config(oscillator: &str, options: &str, record: &str) -> String {
 
 const FULL: &str = "mass = 10.391\ndamping = 0.275\nstiffness = 1982.0\nnormal_force = 14.5";
 
+/// Force-domain configurations that cannot run are named in one line: the missing channel,
+/// column or oscillator keys, a misspelt domain and an offset without a measured force.
 #[test]
-fn a_measured_force_requested_of_a_record_without_one_is_named() {
-    let e = fails(
-        "no-force",
-        "fit",
-        &config(FULL, "domain = \"force\"\nforce_target = \"measured\"", ""),
-        &[("r.csv", &velocity_csv())],
-    );
-    assert!(
-        e.contains("c.toml: record `r.csv`: [fit.options] force_target = \"measured\" but the record has no force channel (it has: velocity"),
-        "{e}"
-    );
-}
-
-#[test]
-fn fits_that_need_m_c_k_name_the_missing_keys() {
-    let e = fails(
-        "no-mck-velocity",
-        "fit",
-        &config("normal_force = 14.5", "", ""),
-        &[("r.csv", &velocity_csv())],
-    );
-    assert!(
-        e.contains("c.toml: invalid input: [oscillator]: a velocity-domain fit needs mass, damping and stiffness; `mass`, `damping`, `stiffness` not given"),
-        "{e}"
-    );
-    // Force domain without a force channel falls back to Eq. 7, which needs them too.
-    let e = fails(
-        "no-mck-energy",
-        "compare",
-        &config("normal_force = 14.5\nmass = 10.0", "domain = \"force\"", ""),
-        &[("r.csv", &velocity_csv())],
-    );
-    assert!(
-        e.contains("the energy-based force (Eq. 7) needs mass, damping and stiffness; `damping`, `stiffness` not given"),
-        "{e}"
-    );
-}
-
-#[test]
-fn a_force_column_missing_from_the_header_and_a_bad_domain_are_named() {
-    let e = fails(
-        "no-column",
-        "fit",
-        &config(
-            "normal_force = 5.0",
-            "domain = \"force\"",
-            "force_column = \"F [N]\"\n",
-        ),
-        &[("r.csv", &velocity_csv())],
-    );
-    assert!(
-        e.ends_with("r.csv: line 1: no column `F [N]`; the header has: time, velocity"),
-        "{e}"
-    );
-    let e = fails(
-        "bad-domain",
-        "fit",
-        &config(FULL, "domain = \"forces\"", ""),
-        &[("r.csv", &velocity_csv())],
-    );
-    assert!(
-        e.contains("unknown value `forces` in [fit.options] (did you mean `force`?)"),
-        "{e}"
-    );
-}
-
-#[test]
-fn force_offset_needs_a_measured_force() {
-    let e = fails(
-        "offset-energy",
-        "fit",
-        &config(FULL, "domain = \"force\"\nforce_offset = true", ""),
-        &[("r.csv", &velocity_csv())],
-    );
-    assert!(
-        e.contains("force_offset = true needs a measured force channel"),
-        "{e}"
-    );
+fn bad_force_domain_configurations_are_named() {
+    let case = |name, command, config| {
+        BadInput::new(name, command, config).with_file("r.csv", velocity_csv())
+    };
+    let cases = [
+        case(
+            "no-force",
+            "fit",
+            config(FULL, "domain = \"force\"\nforce_target = \"measured\"", ""),
+        )
+        .says(Contains("c.toml: record `r.csv`: [fit.options] force_target = \"measured\" but the record has no force channel (it has: velocity")),
+        case("no-mck-velocity", "fit", config("normal_force = 14.5", "", ""))
+            .says(Contains("c.toml: invalid input: [oscillator]: a velocity-domain fit needs mass, damping and stiffness; `mass`, `damping`, `stiffness` not given")),
+        // Force domain without a force channel falls back to Eq. 7, which needs them too.
+        case(
+            "no-mck-energy",
+            "compare",
+            config("normal_force = 14.5\nmass = 10.0", "domain = \"force\"", ""),
+        )
+        .says(Contains("the energy-based force (Eq. 7) needs mass, damping and stiffness; `damping`, `stiffness` not given")),
+        case(
+            "no-column",
+            "fit",
+            config(
+                "normal_force = 5.0",
+                "domain = \"force\"",
+                "force_column = \"F [N]\"\n",
+            ),
+        )
+        .says(EndsWith(
+            "r.csv: line 1: no column `F [N]`; the header has: time, velocity",
+        )),
+        case("bad-domain", "fit", config(FULL, "domain = \"forces\"", "")).says(Contains(
+            "unknown value `forces` in [fit.options] (did you mean `force`?)",
+        )),
+        case(
+            "offset-energy",
+            "fit",
+            config(FULL, "domain = \"force\"\nforce_offset = true", ""),
+        )
+        .says(Contains("force_offset = true needs a measured force channel")),
+    ];
+    assert_bad_inputs(Path::new(env!("CARGO_BIN_EXE_frictionid")), "force", &cases);
 }
