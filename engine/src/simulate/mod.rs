@@ -258,6 +258,15 @@ impl Trajectory {
         let moving = self.rest.is_none() && self.v.last().is_some_and(|&v| v != 0.0);
         turning + usize::from(moving)
     }
+
+    /// KE + PE + stored energy at each sample \[J\]: what a passive law never lets rise.
+    pub fn total_energy(&self) -> Vec<f64> {
+        self.energy
+            .iter()
+            .zip(&self.stored)
+            .map(|(e, s)| e + s)
+            .collect()
+    }
 }
 
 /// Simulates the free vibration of `osc` with friction `model` from `init` up to `t_end`,

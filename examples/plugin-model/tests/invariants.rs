@@ -41,9 +41,8 @@ impl Simulator for Fmm {
         let times = uniform_times(t_end, 1000.0);
         let sim = simulate(&self.0, model, &Initial::at_rest(x0), t_end, &times, &opts)
             .map_err(|e| e.to_string())?;
-        let total_energy = sim.energy.iter().zip(&sim.stored).map(|(e, s)| e + s);
         Ok(Motion {
-            total_energy: total_energy.collect(),
+            total_energy: sim.total_energy(),
             rest_displacement: sim.rest.map(|r| r.displacement),
             events: sim.events.len(),
             time: sim.time,
