@@ -28,6 +28,22 @@ fn exact(x0: f64) -> ExactCoulomb {
     coulomb_free_vibration(&Oscillator::fmm(), mu_n(), x0, &times).expect("exact solution")
 }
 
+/// The exact Coulomb motion from `x0` and the energy analysis (default options) of its exact
+/// states.
+fn exact_analysis(x0: f64) -> (ExactCoulomb, frictionid_engine::EnergyAnalysis) {
+    let ex = exact(x0);
+    let an = analyze_states(
+        &Oscillator::fmm(),
+        &ex.time,
+        &ex.x,
+        &ex.v,
+        &ex.a,
+        &Default::default(),
+    )
+    .expect("analysis");
+    (ex, an)
+}
+
 /// The FMM release from rest at `x0` simulated by the engine (default options, 1 kHz for
 /// `duration` s) and the energy analysis of its exact states.
 fn simulated_states(
@@ -124,16 +140,7 @@ fn noise_free_half_cycles_within_a_tenth_percent() {
 #[test]
 fn exact_states_give_mu_n_to_one_part_per_million() {
     for x0 in X0S {
-        let ex = exact(x0);
-        let an = analyze_states(
-            &Oscillator::fmm(),
-            &ex.time,
-            &ex.x,
-            &ex.v,
-            &ex.a,
-            &Default::default(),
-        )
-        .expect("analysis");
+        let (ex, an) = exact_analysis(x0);
         let e7 = an.mean_abs_force / mu_n() - 1.0;
         let hc = an.half_cycle_mean / mu_n() - 1.0;
         eprintln!("x0 = {x0}: exact states, Eq. 7 {e7:+.2e}, half-cycles {hc:+.2e}");
@@ -554,38 +561,28 @@ fn bad_records_are_clear_errors() {
 fn bad_options_and_states_are_clear_errors() {
     let osc = Oscillator::fmm();
     let rec = record(0.014, 0.0, 0);
-    for d in [
-        Differentiator::SavitzkyGolay {
-            window: 30,
-            order: 4,
-        },
-        Differentiator::SavitzkyGolay {
-            window: 5,
-            order: 5,
-        },
-        Differentiator::SavitzkyGolay {
-            window: 31,
-            order: 0,
-        },
+    let sg = |window, order| EnergyOptions {
+        differentiator: Differentiator::SavitzkyGolay { window, order },
+        ..Default::default()
+    };
+    let threshold = |velocity_threshold| EnergyOptions {
+        velocity_threshold,
+        ..Default::default()
+    };
+    for opts in [
+        sg(30, 4),
+        sg(5, 5),
+        sg(31, 0),
+        threshold(-1e-3),
+        threshold(f64::NAN),
     ] {
-        let opts = EnergyOptions {
-            differentiator: d,
-            ..Default::default()
-        };
-        assert!(matches!(
-            analyze_record(&rec, &osc, &opts),
-            Err(EngineError::InvalidInput(_))
-        ));
-    }
-    for thr in [-1e-3, f64::NAN] {
-        let opts = EnergyOptions {
-            velocity_threshold: thr,
-            ..Default::default()
-        };
-        assert!(matches!(
-            analyze_record(&rec, &osc, &opts),
-            Err(EngineError::InvalidInput(_))
-        ));
+        assert!(
+            matches!(
+                analyze_record(&rec, &osc, &opts),
+                Err(EngineError::InvalidInput(_))
+            ),
+            "{opts:?}"
+        );
     }
     let mut bad_osc = osc;
     bad_osc.mass = 0.0;
@@ -759,14 +756,7 @@ fn bristle_models_follow_the_distance_closed_form() {
         }
         expected.push(sigma0 * z);
     }
-    let lugre = LuGre {
-        sigma0,
-        sigma1: 0.0,
-        sigma2: 0.0,
-        mu_c: MU,
-        mu_s: MU,
-        v_s: 0.01,
-    };
+    let lugre = undamped_lugre(sigma0);
     let dahl = Dahl {
         sigma0,
         mu_c: MU,
@@ -818,9 +808,7 @@ fn coulomb_force_along_is_exact() {
 #[test]
 fn coulomb_residuals_are_exact() {
     let osc = Oscillator::fmm();
-    let ex = exact(0.022);
-    let an =
-        analyze_states(&osc, &ex.time, &ex.x, &ex.v, &ex.a, &Default::default()).expect("analysis");
+    let (_, an) = exact_analysis(0.022);
     let true_fit = force_residuals(&an, &Coulomb { mu: MU }, &osc).expect("residuals");
     assert_eq!(true_fit.used, an.time.len() - an.masked);
     assert!(true_fit.rms < 1e-9, "{}", true_fit.rms);
@@ -867,24 +855,29 @@ fn lugre_residuals_on_a_simulated_motion() {
     );
 }
 
+/// LuGre without damping terms or Stribeck dip (mu_s = mu_c = MU): a bristle of stiffness
+/// `sigma0` that saturates at the Coulomb level.
+fn undamped_lugre(sigma0: f64) -> LuGre {
+    LuGre {
+        sigma0,
+        sigma1: 0.0,
+        sigma2: 0.0,
+        mu_c: MU,
+        mu_s: MU,
+        v_s: 0.01,
+    }
+}
+
 /// A stiffer LuGre (mu_s = mu_c, no damping terms) is closer to Coulomb: its residual RMS
 /// against the Coulomb motion's energy-based force falls with sigma0 and is small at 1e7.
 #[test]
 fn lugre_residuals_shrink_towards_coulomb() {
     let osc = Oscillator::fmm();
-    let ex = exact(0.014);
-    let an =
-        analyze_states(&osc, &ex.time, &ex.x, &ex.v, &ex.a, &Default::default()).expect("analysis");
+    let (_, an) = exact_analysis(0.014);
     let rms = |sigma0: f64| {
-        let model = LuGre {
-            sigma0,
-            sigma1: 0.0,
-            sigma2: 0.0,
-            mu_c: MU,
-            mu_s: MU,
-            v_s: 0.01,
-        };
-        force_residuals(&an, &model, &osc).expect("residuals").rms
+        force_residuals(&an, &undamped_lugre(sigma0), &osc)
+            .expect("residuals")
+            .rms
     };
     let (soft, stiff) = (rms(1e5), rms(1e7));
     eprintln!("LuGre residual RMS: sigma0 1e5 -> {soft:.4} N, 1e7 -> {stiff:.4} N");
