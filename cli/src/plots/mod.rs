@@ -10,8 +10,8 @@ mod panel;
 pub mod sets;
 
 pub use charts::{
-    displacement_acceleration, displacement_velocity, energy_rate, force_against_motion,
-    friction_force, steady_state_curves, velocity_fit, MotionAxis,
+    force_against_motion, friction_force, over_time, steady_state_curves, velocity_fit, MotionAxis,
+    Quantity,
 };
 
 use crate::error::CliError;
