@@ -10,9 +10,10 @@ use frictionid_engine::identify::{fit, FitOptions};
 use frictionid_engine::simulate::{simulate, Initial, SimOptions, Trajectory};
 use frictionid_engine::synthetic::uniform_times;
 use frictionid_engine::{Oscillator, Record};
+use frictionid_models::testing::motion::{first_energy_rise, first_unmirrored};
 use frictionid_models::{default_model, names, Coulomb, FrictionModel, ViscousCoulomb};
 use proptest::prelude::*;
-use proptest::test_runner::RngSeed;
+use proptest::test_runner::{RngSeed, TestCaseError};
 
 /// FMM-like oscillators: the paper's stage is m = 10.4 kg, c = 0.275 N s/m, k = 1982 N/m,
 /// N = 14.5 N.
@@ -139,12 +140,11 @@ proptest! {
         let traj = run(&osc, model.as_ref(), x0, v0, t_end, 400, &SimOptions::default());
         let total = traj.total_energy();
         let e0 = total[0].max(1e-12);
-        for (i, w) in total.windows(2).enumerate() {
-            prop_assert!(
-                w[1] <= w[0] + 1e-6 * e0,
+        if let Some((i, _)) = first_energy_rise(&total, 1e-6 * e0) {
+            return Err(TestCaseError::fail(format!(
                 "{name} {:?}: energy rises from {} to {} J at t = {} s",
-                model.params(), w[0], w[1], traj.time[i + 1]
-            );
+                model.params(), total[i - 1], total[i], traj.time[i]
+            )));
         }
     }
 
@@ -163,12 +163,11 @@ proptest! {
         let a = run(&osc, model.as_ref(), x0, v0, t_end, 200, &opts);
         let b = run(&osc, model.as_ref(), -x0, -v0, t_end, 200, &opts);
         let scale = x0.abs() + v0.abs() / osc.omega_n() + 1e-9;
-        for i in 0..a.x.len() {
-            prop_assert!(
-                (a.x[i] + b.x[i]).abs() <= 1e-9 * scale,
+        if let Some(i) = first_unmirrored(&a.x, &b.x, 1e-9 * scale) {
+            return Err(TestCaseError::fail(format!(
                 "{name} {:?}: x(t) = {} but mirrored {} at t = {} s",
                 model.params(), a.x[i], b.x[i], a.time[i]
-            );
+            )));
         }
     }
 

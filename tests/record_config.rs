@@ -42,6 +42,10 @@ fn lab_export(name: &str) -> PathBuf {
     dir
 }
 
+/// `[record_defaults]` naming the lab export's columns (velocity in mm/s).
+const LAB_COLUMNS: &str = "[record_defaults]\ntime_column = \"Zeit [s]\"\n\
+                           velocity_column = \"Geschwindigkeit [mm/s]\"\n";
+
 fn config(dir: &Path, text: &str) -> Result<Config, String> {
     Config::parse(&dir.join("c.toml"), &format!("{OSC}{text}")).map_err(|e| e.to_string())
 }
@@ -51,9 +55,10 @@ fn record_defaults_and_auto_release_read_a_lab_export() {
     let dir = lab_export("ok");
     let cfg = config(
         &dir,
-        "[record_defaults]\ntime_column = \"Zeit [s]\"\nvelocity_column = \"Geschwindigkeit [mm/s]\"\n\
-         velocity_scale = 1e-3\nrelease = \"auto\"\nweight = 3.0\n\
-         [[records]]\nfile = \"rest.csv\"\nx0 = 0.014\nweight = 2.0\n",
+        &format!(
+            "{LAB_COLUMNS}velocity_scale = 1e-3\nrelease = \"auto\"\nweight = 3.0\n\
+             [[records]]\nfile = \"rest.csv\"\nx0 = 0.014\nweight = 2.0\n"
+        ),
     )
     .unwrap();
     let records = cfg.load_records("fit").unwrap();
@@ -69,12 +74,8 @@ fn record_defaults_and_auto_release_read_a_lab_export() {
 #[test]
 fn an_export_in_mm_per_s_without_its_scale_is_an_error_naming_the_key() {
     let dir = lab_export("mm");
-    let cfg = config(
-        &dir,
-        "[record_defaults]\ntime_column = \"Zeit [s]\"\nvelocity_column = \"Geschwindigkeit [mm/s]\"\n\
-         [[records]]\nfile = \"rest.csv\"\nx0 = 0.014\n",
-    )
-    .unwrap();
+    let records = format!("{LAB_COLUMNS}[[records]]\nfile = \"rest.csv\"\nx0 = 0.014\n");
+    let cfg = config(&dir, &records).unwrap();
     let e = cfg.load_records("fit").unwrap_err().to_string();
     assert!(e.starts_with("rest.csv: peak speed"), "{e}");
     assert!(

@@ -335,6 +335,18 @@ mod tests {
         Config::parse(Path::new("dir/c.toml"), &format!("{OSC}{extra}"))
     }
 
+    /// The error line of the FMM oscillator followed by `extra` (as dir/c.toml).
+    fn parse_error(extra: &str) -> String {
+        parse(extra).unwrap_err().to_string()
+    }
+
+    /// The error line of `text` alone, as c.toml.
+    fn bare_parse_error(text: &str) -> String {
+        Config::parse(Path::new("c.toml"), text)
+            .unwrap_err()
+            .to_string()
+    }
+
     #[test]
     fn full_config_parses_with_relative_paths() {
         let c = parse(
@@ -366,7 +378,7 @@ mod tests {
     }
 
     #[test]
-    fn unknown_key_names_line_section_and_suggestion() {
+    fn unknown_keys_and_names_are_located_and_suggest_the_nearest() {
         let e = parse("[simulation]\nx0 = 0.01\ndurtion = 1.0\n").unwrap_err();
         let msg = e.to_string();
         assert!(
@@ -375,25 +387,35 @@ mod tests {
             ),
             "{msg}"
         );
-        let e = parse("[simulaton]\nx0 = 1\n").unwrap_err().to_string();
-        assert!(
-            e.contains("unknown key `simulaton` at the top level (did you mean `simulation`?)"),
-            "{e}"
-        );
-        let e = parse("[[records]]\nfile = \"a.csv\"\nx0 = 0.01\nvelocity_colum = \"v\"\n")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("in [[records]] (did you mean `velocity_column`?)"),
-            "{e}"
-        );
-        let e = parse("[simulation]\nx0 = 0.01\nduration = 1.0\n[simulation.integratr]\n")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("`integratr` in [simulation] (did you mean `integrator`?)"),
-            "{e}"
-        );
+        for (config, says) in [
+            (
+                "[simulaton]\nx0 = 1\n",
+                "unknown key `simulaton` at the top level (did you mean `simulation`?)",
+            ),
+            (
+                "[[records]]\nfile = \"a.csv\"\nx0 = 0.01\nvelocity_colum = \"v\"\n",
+                "in [[records]] (did you mean `velocity_column`?)",
+            ),
+            (
+                "[simulation]\nx0 = 0.01\nduration = 1.0\n[simulation.integratr]\n",
+                "`integratr` in [simulation] (did you mean `integrator`?)",
+            ),
+            (
+                "[model]\ntype = \"colomb\"\n",
+                "[model]: unknown friction model `colomb` (did you mean `coulomb`?)",
+            ),
+            (
+                "[model]\ntype = \"coulomb\"\n[fit]\nfree = [\"mu_\"]\n",
+                "no parameter `mu_` (did you mean `mu`?)",
+            ),
+            (
+                "[model]\ntype = \"coulomb\"\n[fit]\nbounds = { mu = [1.0, 0.5] }\n",
+                "not an interval",
+            ),
+        ] {
+            let e = parse_error(config);
+            assert!(e.contains(says), "{e}");
+        }
     }
 
     #[test]
@@ -426,9 +448,7 @@ mod tests {
             ("stiffness_std = inf", "stiffness_std"),
             ("normal_force_std = -1e-3", "normal_force_std"),
         ] {
-            let e = Config::parse(Path::new("c.toml"), &format!("{OSC}{line}\n"))
-                .unwrap_err()
-                .to_string();
+            let e = bare_parse_error(&format!("{OSC}{line}\n"));
             assert!(e.starts_with("c.toml:"), "{e}");
             assert!(
                 e.contains(&format!(
@@ -438,7 +458,7 @@ mod tests {
             );
             assert!(!e.contains('\n'), "{e}");
         }
-        let e = parse("mas_std = 0.1\n").unwrap_err().to_string();
+        let e = parse_error("mas_std = 0.1\n");
         assert!(
             e.starts_with(
                 "dir/c.toml:6:1: unknown key `mas_std` in [oscillator] (did you mean `mass_std`?)"
@@ -449,63 +469,31 @@ mod tests {
 
     #[test]
     fn syntax_error_has_line_and_column() {
-        let e = parse("[model]\ntype = \"coulomb\nmu = 0.2\n")
-            .unwrap_err()
-            .to_string();
+        let e = parse_error("[model]\ntype = \"coulomb\nmu = 0.2\n");
         assert!(e.starts_with("dir/c.toml:7:"), "{e}");
         assert!(!e.contains('\n'));
     }
 
     #[test]
     fn missing_pieces_are_named() {
-        let e = parse("[[records]]\nfile = \"a.csv\"\n")
-            .unwrap_err()
-            .to_string();
+        let e = parse_error("[[records]]\nfile = \"a.csv\"\n");
         assert_eq!(
             e,
             "dir/c.toml: [[records]] entry 1 (`a.csv`): missing `x0` (the release displacement, m)"
         );
-        let e = parse("[simulation]\nduration = 1.0\n")
-            .unwrap_err()
-            .to_string();
+        let e = parse_error("[simulation]\nduration = 1.0\n");
         assert!(e.contains("[simulation]: missing `x0`"), "{e}");
-        let e = Config::parse(Path::new("c.toml"), "[model]\ntype = \"coulomb\"\n")
-            .unwrap_err()
-            .to_string();
+        let e = bare_parse_error("[model]\ntype = \"coulomb\"\n");
         assert!(e.contains("missing table [oscillator]"), "{e}");
     }
 
     #[test]
-    fn model_and_fit_errors_suggest_names() {
-        let e = parse("[model]\ntype = \"colomb\"\n")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("[model]: unknown friction model `colomb` (did you mean `coulomb`?)"),
-            "{e}"
-        );
-        let e = parse("[model]\ntype = \"coulomb\"\n[fit]\nfree = [\"mu_\"]\n")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("no parameter `mu_` (did you mean `mu`?)"), "{e}");
-        let e = parse("[model]\ntype = \"coulomb\"\n[fit]\nbounds = { mu = [1.0, 0.5] }\n")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("not an interval"), "{e}");
-    }
-
-    #[test]
     fn invalid_values_are_rejected() {
-        let e = parse("[simulation]\nx0 = 0.01\nduration = -1.0\n")
-            .unwrap_err()
-            .to_string();
+        let e = parse_error("[simulation]\nx0 = 0.01\nduration = -1.0\n");
         assert!(e.contains("`duration` must be a positive number"), "{e}");
-        let e = Config::parse(
-            Path::new("c.toml"),
+        let e = bare_parse_error(
             "[oscillator]\nmass = 0.0\ndamping = 0.0\nstiffness = 1.0\nnormal_force = 1.0\n",
-        )
-        .unwrap_err()
-        .to_string();
+        );
         assert!(
             e.contains("[oscillator]: invalid oscillator: `mass` must be > 0"),
             "{e}"

@@ -51,6 +51,25 @@ pub fn read_report(out: &Path) -> serde_json::Value {
         .unwrap_or(serde_json::Value::Null)
 }
 
+/// Runs `command` and checks that it exits successfully; returns its output.
+///
+/// # Panics
+/// When it cannot run, or exits unsuccessfully (the message shows the command and its
+/// stderr).
+pub fn run_ok(command: &mut std::process::Command) -> std::process::Output {
+    let o = match command.output() {
+        Ok(o) => o,
+        Err(e) => panic!("cannot run {command:?}: {e}"),
+    };
+    assert!(
+        o.status.success(),
+        "{command:?}: exit {:?}: {}",
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
 /// Runs `<binary> <command> CONFIG --out DIR` on `config` written into a fresh scratch
 /// directory of `suite` (with the data `files` beside it) and checks the contract of bad
 /// input: exit code 1, one line on stderr starting `error: `, no panic or backtrace, no
@@ -96,4 +115,89 @@ pub fn fails_with_one_line(
     assert!(!out.join("report.json").exists(), "no report.json");
     let _ = std::fs::remove_dir_all(&dir);
     stderr.trim_end().to_string()
+}
+
+/// What the one error line of a bad input must say.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Says<'a> {
+    /// The line contains this text.
+    Contains(&'a str),
+    /// The line ends with this text.
+    EndsWith(&'a str),
+}
+
+impl Says<'_> {
+    /// Whether `line` says it.
+    pub fn holds(&self, line: &str) -> bool {
+        match self {
+            Says::Contains(text) => line.contains(text),
+            Says::EndsWith(text) => line.ends_with(text),
+        }
+    }
+}
+
+/// One bad input: `command` run on `config` (with the data `files` beside it), and what its
+/// one error line must say. `name` names its scratch directory.
+#[derive(Debug, Clone)]
+pub struct BadInput<'a> {
+    /// The case's name (its scratch directory).
+    pub name: &'a str,
+    /// The subcommand run.
+    pub command: &'a str,
+    /// The config file's text.
+    pub config: String,
+    /// Data files beside the config: (file name, text).
+    pub files: Vec<(&'a str, String)>,
+    /// What the error line says.
+    pub says: Vec<Says<'a>>,
+}
+
+impl<'a> BadInput<'a> {
+    /// `command` on `config`, with no data files and nothing yet to say.
+    pub fn new(name: &'a str, command: &'a str, config: impl Into<String>) -> Self {
+        BadInput {
+            name,
+            command,
+            config: config.into(),
+            files: Vec::new(),
+            says: Vec::new(),
+        }
+    }
+
+    /// With the data file `file` holding `text` beside the config.
+    pub fn with_file(mut self, file: &'a str, text: impl Into<String>) -> Self {
+        self.files.push((file, text.into()));
+        self
+    }
+
+    /// The error line must also say `says`.
+    pub fn says(mut self, says: Says<'a>) -> Self {
+        self.says.push(says);
+        self
+    }
+}
+
+/// Runs every case through [`fails_with_one_line`] (suite `suite`) and checks that its line
+/// says what the case expects.
+///
+/// # Panics
+/// At the first case that breaks the contract or does not say what it should.
+pub fn assert_bad_inputs(binary: &Path, suite: &str, cases: &[BadInput<'_>]) {
+    for case in cases {
+        let files: Vec<(&str, &str)> = case
+            .files
+            .iter()
+            .map(|(file, text)| (*file, text.as_str()))
+            .collect();
+        let line = fails_with_one_line(
+            binary,
+            (suite, case.name),
+            case.command,
+            &case.config,
+            &files,
+        );
+        for says in &case.says {
+            assert!(says.holds(&line), "{}: {says:?} but: {line}", case.name);
+        }
+    }
 }

@@ -3,7 +3,11 @@
 //! no panic and no report.json.
 
 use assert_cmd::Command;
-use frictionid_cli::testing::{fails_with_one_line, fixtures_dir, scratch_dir, FMM_OSCILLATOR};
+use frictionid_cli::testing::Says::{Contains, EndsWith};
+use frictionid_cli::testing::{
+    assert_bad_inputs, fixtures_dir, scratch_dir, BadInput, FMM_OSCILLATOR,
+};
+use std::path::Path;
 
 fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
@@ -18,15 +22,28 @@ fn csv(n: usize) -> String {
     s
 }
 
-/// Runs `frictionid <cmd> CONFIG --out DIR` on a config written into a scratch directory
-/// (with the given data files) and checks the failure contract; returns the stderr line.
-fn fails(name: &str, cmd: &str, config: &str, files: &[(&str, &str)]) -> String {
-    let binary = std::path::Path::new(env!("CARGO_BIN_EXE_frictionid"));
-    fails_with_one_line(binary, ("cli", name), cmd, config, files)
+/// The binary under test, for the bad-input cases.
+fn binary() -> &'static Path {
+    Path::new(env!("CARGO_BIN_EXE_frictionid"))
+}
+
+/// A one-second `[simulation]` from 10 mm.
+const SIMULATION: &str = "[simulation]\nx0 = 0.01\nduration = 1.0\n";
+
+/// The FMM rig's `[oscillator]` table followed by `tables`.
+fn fmm(tables: &str) -> String {
+    format!("{FMM_OSCILLATOR}{tables}")
+}
+
+/// The FMM rig with Coulomb friction (`[model]`), followed by `tables`.
+fn coulomb(tables: &str) -> String {
+    fmm(&format!("[model]\ntype = \"coulomb\"\n{tables}"))
 }
 
 fn with_record(extra: &str) -> String {
-    format!("{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\n[[records]]\nfile = \"r.csv\"\nx0 = 0.014\n{extra}")
+    coulomb(&format!(
+        "[[records]]\nfile = \"r.csv\"\nx0 = 0.014\n{extra}"
+    ))
 }
 
 #[test]
@@ -118,142 +135,114 @@ fn missing_config_file() {
     assert_eq!(o.status.code(), Some(1));
 }
 
+/// Errors in a record file name the file and, where there is one, the line (comment and
+/// header lines count).
 #[test]
-fn missing_record_file() {
-    let e = fails("missing-file", "fit", &with_record(""), &[]);
-    assert!(
-        e.ends_with("r.csv: cannot read the file: no such file"),
-        "{e}"
-    );
+fn record_file_errors_name_the_file_and_line() {
+    let cases = [
+        BadInput::new("missing-file", "fit", with_record(""))
+            .says(EndsWith("r.csv: cannot read the file: no such file")),
+        // Line 1 is a comment, line 2 the header, t = 0.005 s is the sixth sample: line 8.
+        BadInput::new("bad-line", "fit", with_record(""))
+            .with_file("r.csv", csv(20).replacen("0.005,", "0.005,x", 1))
+            .says(Contains("r.csv: line 8: column `velocity`: `x"))
+            .says(EndsWith("is not a number")),
+        BadInput::new("columns", "energy", with_record(""))
+            .with_file("r.csv", csv(20) + "0.02,1,2\n")
+            .says(Contains("r.csv: line 23: 3 fields, but the header has 2")),
+        BadInput::new("nan", "fit", with_record(""))
+            .with_file(
+                "r.csv",
+                csv(20)
+                    .replacen("0.003,", "0.003,NaN\n0.0035,", 1)
+                    .replacen("NaN\n0.0035,", "NaN\n#", 1),
+            )
+            .says(Contains("r.csv: line 6: column `velocity` is NaN")),
+        BadInput::new("time", "compare", with_record(""))
+            .with_file("r.csv", csv(20).replacen("0.004,", "0.002,", 1))
+            .says(Contains(
+                "r.csv: line 7: time 0.002 s does not increase (previous 0.003 s)",
+            )),
+        BadInput::new("uneven", "fit", with_record(""))
+            .with_file("r.csv", csv(20).replacen("0.004,", "0.0045,", 1))
+            .says(Contains("line 7: uneven sampling")),
+        BadInput::new("few", "fit", with_record(""))
+            .with_file("r.csv", csv(4))
+            .says(Contains("r.csv: 4 samples, at least 10 needed")),
+    ];
+    assert_bad_inputs(binary(), "cli", &cases);
 }
 
+/// Errors in the config name the file, line and column or the table and key, and suggest the
+/// nearest known name.
 #[test]
-fn bad_csv_line_names_its_line() {
-    let mut data = csv(20);
-    data = data.replacen("0.005,", "0.005,x", 1);
-    let e = fails("bad-line", "fit", &with_record(""), &[("r.csv", &data)]);
-    // Line 1 is a comment, line 2 the header, t = 0.005 s is the sixth sample: line 8.
-    assert!(e.contains("r.csv: line 8: column `velocity`: `x"), "{e}");
-    assert!(e.ends_with("is not a number"), "{e}");
+fn config_errors_name_the_key_and_suggest_the_nearest() {
+    // A string left open on line 7.
+    let unterminated = fmm("[model]\ntype = \"coulomb\nmu = 0.2\n");
+    let cases = [
+        BadInput::new("toml", "fit", unterminated).says(Contains("c.toml:7:")),
+        BadInput::new("key", "fit", with_record("velocity_colum = \"v\"\n"))
+            .with_file("r.csv", csv(20))
+            .says(Contains("c.toml:11:1: unknown key `velocity_colum` in [[records]] (did you mean `velocity_column`?)")),
+        BadInput::new("key2", "simulate", fmm("[simulaton]\nx0 = 0.1\n"))
+            .says(Contains(
+                "unknown key `simulaton` at the top level (did you mean `simulation`?)",
+            )),
+        BadInput::new("model", "fit", fmm("[model]\ntype = \"stribek\"\n"))
+            .says(Contains(
+                "[model]: unknown friction model `stribek` (did you mean `stribeck`?)",
+            )),
+        BadInput::new(
+            "param",
+            "fit",
+            fmm("[model]\ntype = \"stribeck\"\nmu_d = 0.3\n"),
+        )
+        .says(Contains("unknown parameter `mu_d`")),
+        BadInput::new(
+            "bounds",
+            "fit",
+            coulomb("mu = -0.1\n"),
+        )
+        .says(Contains("parameter `mu` of model `coulomb` is -0.1")),
+    ];
+    assert_bad_inputs(binary(), "cli", &cases);
 }
 
+/// Each command names the tables and keys it needs and does not have. `simulate` needs every
+/// oscillator property: a missing normal force is an error naming it, never a silent
+/// frictionless run on a placeholder N = 0.
 #[test]
-fn wrong_column_count_names_its_line() {
-    let data = csv(20) + "0.02,1,2\n";
-    let e = fails("columns", "energy", &with_record(""), &[("r.csv", &data)]);
-    assert!(
-        e.contains("r.csv: line 23: 3 fields, but the header has 2"),
-        "{e}"
-    );
-}
-
-#[test]
-fn nan_is_rejected() {
-    let data = csv(20).replacen("0.003,", "0.003,NaN\n0.0035,", 1);
-    let data = data.replacen("NaN\n0.0035,", "NaN\n#", 1);
-    let e = fails("nan", "fit", &with_record(""), &[("r.csv", &data)]);
-    assert!(e.contains("r.csv: line 6: column `velocity` is NaN"), "{e}");
-}
-
-#[test]
-fn non_increasing_time_is_rejected() {
-    let data = csv(20).replacen("0.004,", "0.002,", 1);
-    let e = fails("time", "compare", &with_record(""), &[("r.csv", &data)]);
-    assert!(
-        e.contains("r.csv: line 7: time 0.002 s does not increase (previous 0.003 s)"),
-        "{e}"
-    );
-}
-
-#[test]
-fn uneven_sampling_and_too_few_samples() {
-    let data = csv(20).replacen("0.004,", "0.0045,", 1);
-    let e = fails("uneven", "fit", &with_record(""), &[("r.csv", &data)]);
-    assert!(e.contains("line 7: uneven sampling"), "{e}");
-    let e = fails("few", "fit", &with_record(""), &[("r.csv", &csv(4))]);
-    assert!(e.contains("r.csv: 4 samples, at least 10 needed"), "{e}");
-}
-
-#[test]
-fn bad_toml_names_line_and_column() {
-    let cfg = format!("{FMM_OSCILLATOR}[model]\ntype = \"coulomb\nmu = 0.2\n");
-    let e = fails("toml", "fit", &cfg, &[]);
-    assert!(e.contains("c.toml:7:"), "{e}");
-}
-
-#[test]
-fn unknown_key_suggests_the_nearest() {
-    let e = fails(
-        "key",
-        "fit",
-        &with_record("velocity_colum = \"v\"\n"),
-        &[("r.csv", &csv(20))],
-    );
-    assert!(
-        e.contains("c.toml:11:1: unknown key `velocity_colum` in [[records]] (did you mean `velocity_column`?)"),
-        "{e}"
-    );
-    let e = fails(
-        "key2",
-        "simulate",
-        &format!("{FMM_OSCILLATOR}[simulaton]\nx0 = 0.1\n"),
-        &[],
-    );
-    assert!(
-        e.contains("unknown key `simulaton` at the top level (did you mean `simulation`?)"),
-        "{e}"
-    );
-}
-
-#[test]
-fn unknown_model_and_parameter_suggest_the_nearest() {
-    let e = fails(
-        "model",
-        "fit",
-        &format!("{FMM_OSCILLATOR}[model]\ntype = \"stribek\"\n"),
-        &[],
-    );
-    assert!(
-        e.contains("[model]: unknown friction model `stribek` (did you mean `stribeck`?)"),
-        "{e}"
-    );
-    let e = fails(
-        "param",
-        "fit",
-        &format!("{FMM_OSCILLATOR}[model]\ntype = \"stribeck\"\nmu_d = 0.3\n"),
-        &[],
-    );
-    assert!(e.contains("unknown parameter `mu_d`"), "{e}");
-}
-
-#[test]
-fn missing_x0_is_named() {
-    let cfg = format!("{FMM_OSCILLATOR}[[records]]\nfile = \"r.csv\"\n");
-    let e = fails("x0", "fit", &cfg, &[("r.csv", &csv(20))]);
-    assert!(
-        e.ends_with(
-            "c.toml: [[records]] entry 1 (`r.csv`): missing `x0` (the release displacement, m)"
-        ),
-        "{e}"
-    );
-    let cfg =
-        format!("{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\n[simulation]\nduration = 1.0\n");
-    let e = fails("x0-sim", "simulate", &cfg, &[]);
-    assert!(e.contains("[simulation]: missing `x0`"), "{e}");
-}
-
-#[test]
-fn out_of_bounds_parameter_is_an_error() {
-    let e = fails(
-        "bounds",
-        "fit",
-        &format!("{FMM_OSCILLATOR}[model]\ntype = \"coulomb\"\nmu = -0.1\n"),
-        &[],
-    );
-    assert!(
-        e.contains("parameter `mu` of model `coulomb` is -0.1"),
-        "{e}"
-    );
+fn commands_name_the_tables_and_keys_they_need() {
+    let cases = [
+        BadInput::new("x0", "fit", fmm("[[records]]\nfile = \"r.csv\"\n"))
+            .with_file("r.csv", csv(20))
+            .says(EndsWith(
+                "c.toml: [[records]] entry 1 (`r.csv`): missing `x0` (the release displacement, m)",
+            )),
+        BadInput::new(
+            "x0-sim",
+            "simulate",
+            coulomb("[simulation]\nduration = 1.0\n"),
+        )
+        .says(Contains("[simulation]: missing `x0`")),
+        BadInput::new("no-sim", "simulate", coulomb(""))
+            .says(Contains("simulate needs a [simulation] table")),
+        BadInput::new("no-model", "simulate", fmm(SIMULATION))
+            .says(Contains("simulate needs a [model] table")),
+        BadInput::new("no-records", "energy", coulomb(""))
+            .says(Contains("energy needs at least one [[records]] entry")),
+        BadInput::new(
+            "no_normal_force",
+            "simulate",
+            "[oscillator]\nmass = 10.391\ndamping = 0.275\nstiffness = 1982.0\n\
+             [model]\ntype = \"coulomb\"\nmu = 0.24\n\
+             [simulation]\nx0 = 0.01\nduration = 1.0\nsample_rate = 1000.0\n",
+        )
+        .says(Contains(
+            "simulate needs mass, damping, stiffness and normal_force; `normal_force` not given",
+        )),
+    ];
+    assert_bad_inputs(binary(), "cli", &cases);
 }
 
 #[test]
@@ -271,48 +260,4 @@ fn fixture_configs_parse() {
         let c = frictionid_cli::Config::load(&fixtures_dir().join(f)).unwrap();
         assert!(c.spec.oscillator.mass > 0.0, "{f}");
     }
-}
-
-#[test]
-fn simulate_and_energy_name_what_they_need() {
-    let cases = [
-        (
-            "no-sim",
-            "simulate",
-            "[model]\ntype = \"coulomb\"\n",
-            "simulate needs a [simulation] table",
-        ),
-        (
-            "no-model",
-            "simulate",
-            "[simulation]\nx0 = 0.01\nduration = 1.0\n",
-            "simulate needs a [model] table",
-        ),
-        (
-            "no-records",
-            "energy",
-            "[model]\ntype = \"coulomb\"\n",
-            "energy needs at least one [[records]] entry",
-        ),
-    ];
-    for (name, command, tables, says) in cases {
-        let e = fails(name, command, &format!("{FMM_OSCILLATOR}{tables}"), &[]);
-        assert!(e.contains(says), "{name}: {e}");
-    }
-}
-
-/// `simulate` needs every oscillator property: a missing normal force is an error naming it,
-/// never a silent frictionless run on a placeholder N = 0.
-#[test]
-fn simulate_without_a_normal_force_names_the_missing_key() {
-    let config = "[oscillator]\nmass = 10.391\ndamping = 0.275\nstiffness = 1982.0\n\
-                  [model]\ntype = \"coulomb\"\nmu = 0.24\n\
-                  [simulation]\nx0 = 0.01\nduration = 1.0\nsample_rate = 1000.0\n";
-    let e = fails("no_normal_force", "simulate", config, &[]);
-    assert!(
-        e.contains(
-            "simulate needs mass, damping, stiffness and normal_force; `normal_force` not given"
-        ),
-        "{e}"
-    );
 }

@@ -2,8 +2,10 @@
 //! N = 14.5 N; see fixtures/README.md), and their failure modes.
 
 use assert_cmd::Command;
+use frictionid_cli::testing::Says::Contains;
 use frictionid_cli::testing::{
-    fixture_config, fixtures_dir, read_report, scratch_dir, FMM_OSCILLATOR,
+    assert_bad_inputs, fixture_config, fixtures_dir, read_report, scratch_dir, BadInput,
+    FMM_OSCILLATOR,
 };
 use std::path::Path;
 
@@ -96,15 +98,10 @@ fn fit_recovers_the_fixture_truth_and_writes_every_output() {
 #[test]
 fn a_normal_force_uncertainty_in_the_config_reaches_every_fitted_parameter() {
     let out = scratch_dir("fc", "budget");
-    let mut config = std::fs::read_to_string(fixtures_dir().join("fmm-fit.toml")).unwrap();
-    config = config.replace(
+    let config = fixture_config("fmm-fit.toml").replace(
         "normal_force = 14.5",
         "normal_force = 14.5\nnormal_force_std = 0.145",
     );
-    for x in ["x10mm.csv", "x14mm.csv", "x22mm.csv"] {
-        let path = fixtures_dir().join(x).display().to_string();
-        config = config.replace(&format!("\"{x}\""), &format!("{path:?}"));
-    }
     let cfg = out.join("budget.toml");
     std::fs::write(&cfg, config).unwrap();
     let (o, r) = run_json(&["fit", cfg.to_str().unwrap()], &out.join("out"));
@@ -241,22 +238,11 @@ fn a_fit_that_does_not_converge_exits_2_with_its_report() {
 
 #[test]
 fn unknown_fit_option_is_named() {
-    let dir = scratch_dir("fc", "fitopt");
-    let text = fixture_config("fmm-fit.toml") + "\n[fit.options]\nvelocity_ofset = true\n";
-    let cfg = dir.join("fit.toml");
-    std::fs::write(&cfg, text).unwrap();
-    let o = frictionid()
-        .args(["fit", cfg.to_str().unwrap(), "--out"])
-        .arg(dir.join("out"))
-        .output()
-        .unwrap();
-    assert_eq!(o.status.code(), Some(1));
-    let e = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        e.contains("`velocity_ofset`") && e.contains("did you mean `velocity_offset`"),
-        "{e}"
-    );
-    assert!(!dir.join("out").join("report.json").exists());
+    let config = fixture_config("fmm-fit.toml") + "\n[fit.options]\nvelocity_ofset = true\n";
+    let case = BadInput::new("fitopt", "fit", config)
+        .says(Contains("`velocity_ofset`"))
+        .says(Contains("did you mean `velocity_offset`"));
+    assert_bad_inputs(Path::new(env!("CARGO_BIN_EXE_frictionid")), "fc", &[case]);
 }
 
 #[test]

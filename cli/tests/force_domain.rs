@@ -3,7 +3,8 @@
 //! of force-domain configurations.
 
 use assert_cmd::Command;
-use frictionid_cli::testing::{fails_with_one_line, fixtures_dir, scratch_dir};
+use frictionid_cli::testing::Says::{Contains, EndsWith};
+use frictionid_cli::testing::{assert_bad_inputs, fixtures_dir, scratch_dir, BadInput};
 use std::path::Path;
 
 fn frictionid() -> Command {
@@ -56,11 +57,6 @@ fn tribometer_compare_ranks_dynamic_models_ahead_of_static_ones() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
-fn fails(name: &str, cmd: &str, config: &str, files: &[(&str, &str)]) -> String {
-    let binary = Path::new(env!("CARGO_BIN_EXE_frictionid"));
-    fails_with_one_line(binary, ("force", name), cmd, config, files)
-}
-
 /// A velocity record (no force column).
 fn velocity_csv() -> String {
     let mut s = String::from("time,velocity\n");
@@ -80,66 +76,50 @@ fn config(oscillator: &str, options: &str, record: &str) -> String {
 
 const FULL: &str = "mass = 10.391\ndamping = 0.275\nstiffness = 1982.0\nnormal_force = 14.5";
 
-/// Force-domain configurations that cannot run on a velocity record: (scratch name, command,
-/// config, what the one-line error says).
-fn bad_configs() -> Vec<(&'static str, &'static str, String, &'static str)> {
-    vec![
-        (
+/// Force-domain configurations that cannot run are named in one line: the missing channel,
+/// column or oscillator keys, a misspelt domain and an offset without a measured force.
+#[test]
+fn bad_force_domain_configurations_are_named() {
+    let case = |name, command, config| {
+        BadInput::new(name, command, config).with_file("r.csv", velocity_csv())
+    };
+    let cases = [
+        case(
             "no-force",
             "fit",
             config(FULL, "domain = \"force\"\nforce_target = \"measured\"", ""),
-            "c.toml: record `r.csv`: [fit.options] force_target = \"measured\" but the record has no force channel (it has: velocity",
-        ),
-        (
-            "no-mck-velocity",
-            "fit",
-            config("normal_force = 14.5", "", ""),
-            "c.toml: invalid input: [oscillator]: a velocity-domain fit needs mass, damping and stiffness; `mass`, `damping`, `stiffness` not given",
-        ),
+        )
+        .says(Contains("c.toml: record `r.csv`: [fit.options] force_target = \"measured\" but the record has no force channel (it has: velocity")),
+        case("no-mck-velocity", "fit", config("normal_force = 14.5", "", ""))
+            .says(Contains("c.toml: invalid input: [oscillator]: a velocity-domain fit needs mass, damping and stiffness; `mass`, `damping`, `stiffness` not given")),
         // Force domain without a force channel falls back to Eq. 7, which needs them too.
-        (
+        case(
             "no-mck-energy",
             "compare",
             config("normal_force = 14.5\nmass = 10.0", "domain = \"force\"", ""),
-            "the energy-based force (Eq. 7) needs mass, damping and stiffness; `damping`, `stiffness` not given",
-        ),
-        (
-            "bad-domain",
+        )
+        .says(Contains("the energy-based force (Eq. 7) needs mass, damping and stiffness; `damping`, `stiffness` not given")),
+        case(
+            "no-column",
             "fit",
-            config(FULL, "domain = \"forces\"", ""),
+            config(
+                "normal_force = 5.0",
+                "domain = \"force\"",
+                "force_column = \"F [N]\"\n",
+            ),
+        )
+        .says(EndsWith(
+            "r.csv: line 1: no column `F [N]`; the header has: time, velocity",
+        )),
+        case("bad-domain", "fit", config(FULL, "domain = \"forces\"", "")).says(Contains(
             "unknown value `forces` in [fit.options] (did you mean `force`?)",
-        ),
-        (
+        )),
+        case(
             "offset-energy",
             "fit",
             config(FULL, "domain = \"force\"\nforce_offset = true", ""),
-            "force_offset = true needs a measured force channel",
-        ),
-    ]
-}
-
-#[test]
-fn bad_force_domain_configs_are_named_in_one_line() {
-    for (name, command, cfg, says) in bad_configs() {
-        let e = fails(name, command, &cfg, &[("r.csv", &velocity_csv())]);
-        assert!(e.contains(says), "{name}: {e}");
-    }
-}
-
-#[test]
-fn a_force_column_missing_from_the_header_is_named() {
-    let e = fails(
-        "no-column",
-        "fit",
-        &config(
-            "normal_force = 5.0",
-            "domain = \"force\"",
-            "force_column = \"F [N]\"\n",
-        ),
-        &[("r.csv", &velocity_csv())],
-    );
-    assert!(
-        e.ends_with("r.csv: line 1: no column `F [N]`; the header has: time, velocity"),
-        "{e}"
-    );
+        )
+        .says(Contains("force_offset = true needs a measured force channel")),
+    ];
+    assert_bad_inputs(Path::new(env!("CARGO_BIN_EXE_frictionid")), "force", &cases);
 }

@@ -2,26 +2,21 @@
 //! with html5gum, a WHATWG-conformant tokenizer) that shows the report's content and its
 //! plots inline and loads nothing from outside the file.
 
-use assert_cmd::Command;
-use frictionid_cli::testing::{fixtures_dir, scratch_dir};
+use frictionid_cli::testing::{fixtures_dir, run_ok, scratch_dir};
 use html5gum::{Token, Tokenizer};
+use std::process::Command;
 
 /// Runs `frictionid <command> <config> --out <fresh dir> --quiet` and returns report.html.
 fn report_html(command: &str, config: &str, extra: &[&str]) -> String {
     let out = scratch_dir("html", command);
-    let o = Command::new(env!("CARGO_BIN_EXE_frictionid"))
-        .arg(command)
-        .arg(fixtures_dir().join(config))
-        .args(extra)
-        .arg("--out")
-        .arg(&out)
-        .arg("--quiet")
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "{command}: {}",
-        String::from_utf8_lossy(&o.stderr)
+    run_ok(
+        Command::new(env!("CARGO_BIN_EXE_frictionid"))
+            .arg(command)
+            .arg(fixtures_dir().join(config))
+            .args(extra)
+            .arg("--out")
+            .arg(&out)
+            .arg("--quiet"),
     );
     std::fs::read_to_string(out.join("report.html")).unwrap()
 }

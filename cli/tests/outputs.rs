@@ -1,26 +1,16 @@
 //! Where the commands write: per config and command by default, `--out` when given, and
 //! distinct plot files when record file names collide.
 
-use assert_cmd::Command;
-use frictionid_cli::testing::{fixtures_dir, read_report, scratch_dir, FMM_OSCILLATOR};
+use frictionid_cli::testing::{fixtures_dir, read_report, run_ok, scratch_dir, FMM_OSCILLATOR};
 use std::path::Path;
+use std::process::Command;
 
 fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
 }
 
 fn run_in(dir: &Path, args: &[&str]) {
-    let o = frictionid()
-        .current_dir(dir)
-        .args(args)
-        .arg("--quiet")
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    run_ok(frictionid().current_dir(dir).args(args).arg("--quiet"));
 }
 
 fn files_in(dir: &Path) -> Vec<String> {

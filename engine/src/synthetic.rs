@@ -46,15 +46,7 @@ pub fn release_records(
         .iter()
         .enumerate()
         .map(|(i, &x0)| {
-            let traj = crate::simulate(
-                osc,
-                model,
-                &crate::Initial::at_rest(x0),
-                duration,
-                &times,
-                &crate::SimOptions::default(),
-            )?;
-            let mut v = traj.v;
+            let mut v = released_velocity(osc, model, x0, duration, &times)?;
             add_gaussian_noise(&mut v, noise, seed + i as u64);
             Ok(crate::Record::new(
                 format!("x{}mm", (x0 * 1e3).round()),
@@ -64,6 +56,20 @@ pub fn release_records(
             ))
         })
         .collect()
+}
+
+/// The velocity of the free vibration of `osc` with `model` released from rest at `x0`,
+/// simulated until `t_end` with the default options, at `times`.
+fn released_velocity(
+    osc: &crate::Oscillator,
+    model: &dyn frictionid_models::FrictionModel,
+    x0: f64,
+    t_end: f64,
+    times: &[f64],
+) -> Result<Vec<f64>, crate::EngineError> {
+    let initial = crate::Initial::at_rest(x0);
+    let opts = crate::SimOptions::default();
+    Ok(crate::simulate(osc, model, &initial, t_end, times, &opts)?.v)
 }
 
 /// Adds stationary AR(1) ("coloured") noise of standard deviation `sigma` and lag-one
@@ -117,16 +123,8 @@ pub fn defective_record(
         .map(|t| (t - defects.rest).max(0.0))
         .collect();
     let end = moving.last().copied().unwrap_or(0.0);
-    let traj = crate::simulate(
-        osc,
-        model,
-        &crate::Initial::at_rest(x0),
-        end,
-        &moving,
-        &crate::SimOptions::default(),
-    )?;
     let mut v = vec![0.0; first_moving];
-    v.extend_from_slice(&traj.v);
+    v.extend(released_velocity(osc, model, x0, end, &moving)?);
     add_coloured_noise(&mut v, defects.noise, defects.correlation, seed);
     v.iter_mut().for_each(|x| *x += defects.offset);
     Ok(crate::Record::new(

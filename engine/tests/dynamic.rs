@@ -78,6 +78,12 @@ fn lugre_is_recovered_from_the_default_configuration() {
     );
     assert_eq!(r.search, Search::Staged);
     assert!(r.converged, "{}", r.termination);
+    // The noise level (this fit was also engine/tests/identify.rs's LuGre check).
+    assert!(
+        r.rms_residual <= 1.1 * NOISE,
+        "rms {} vs noise {NOISE}",
+        r.rms_residual
+    );
     assert!(
         (noise_ratio(&r) - 1.0).abs() < 0.02,
         "rms {} vs noise {NOISE}",

@@ -29,6 +29,22 @@ fn exact(x0: f64) -> ExactCoulomb {
     coulomb_free_vibration(&Oscillator::fmm(), mu_n(), x0, &times).expect("exact solution")
 }
 
+/// The exact Coulomb motion from `x0` and the energy analysis (default options) of its exact
+/// states.
+fn exact_analysis(x0: f64) -> (ExactCoulomb, frictionid_engine::EnergyAnalysis) {
+    let ex = exact(x0);
+    let an = analyze_states(
+        &Oscillator::fmm(),
+        &ex.time,
+        &ex.x,
+        &ex.v,
+        &ex.a,
+        &Default::default(),
+    )
+    .expect("analysis");
+    (ex, an)
+}
+
 /// The FMM release from rest at `x0` simulated by the engine (default options, 1 kHz for
 /// `duration` s) and the energy analysis of its exact states.
 fn simulated_states(
@@ -125,16 +141,7 @@ fn noise_free_half_cycles_within_a_tenth_percent() {
 #[test]
 fn exact_states_give_mu_n_to_one_part_per_million() {
     for x0 in X0S {
-        let ex = exact(x0);
-        let an = analyze_states(
-            &Oscillator::fmm(),
-            &ex.time,
-            &ex.x,
-            &ex.v,
-            &ex.a,
-            &Default::default(),
-        )
-        .expect("analysis");
+        let (ex, an) = exact_analysis(x0);
         let e7 = an.mean_abs_force / mu_n() - 1.0;
         let hc = an.half_cycle_mean / mu_n() - 1.0;
         eprintln!("x0 = {x0}: exact states, Eq. 7 {e7:+.2e}, half-cycles {hc:+.2e}");
@@ -555,15 +562,21 @@ fn bad_records_are_clear_errors() {
 fn bad_options_and_states_are_clear_errors() {
     let osc = Oscillator::fmm();
     let rec = record(0.014, 0.0, 0);
-    let bad_differentiators = [(30, 4), (5, 5), (31, 0)].map(|(window, order)| EnergyOptions {
+    let sg = |window, order| EnergyOptions {
         differentiator: Differentiator::SavitzkyGolay { window, order },
         ..Default::default()
-    });
-    let bad_thresholds = [-1e-3, f64::NAN].map(|velocity_threshold| EnergyOptions {
+    };
+    let threshold = |velocity_threshold| EnergyOptions {
         velocity_threshold,
         ..Default::default()
-    });
-    for opts in bad_differentiators.into_iter().chain(bad_thresholds) {
+    };
+    for opts in [
+        sg(30, 4),
+        sg(5, 5),
+        sg(31, 0),
+        threshold(-1e-3),
+        threshold(f64::NAN),
+    ] {
         assert!(
             matches!(
                 analyze_record(&rec, &osc, &opts),
@@ -796,9 +809,7 @@ fn coulomb_force_along_is_exact() {
 #[test]
 fn coulomb_residuals_are_exact() {
     let osc = Oscillator::fmm();
-    let ex = exact(0.022);
-    let an =
-        analyze_states(&osc, &ex.time, &ex.x, &ex.v, &ex.a, &Default::default()).expect("analysis");
+    let (_, an) = exact_analysis(0.022);
     let true_fit = force_residuals(&an, &Coulomb { mu: MU }, &osc).expect("residuals");
     assert_eq!(true_fit.used, an.time.len() - an.masked);
     assert!(true_fit.rms < 1e-9, "{}", true_fit.rms);
@@ -863,9 +874,7 @@ fn coulomb_like_lugre(sigma0: f64) -> LuGre {
 #[test]
 fn lugre_residuals_shrink_towards_coulomb() {
     let osc = Oscillator::fmm();
-    let ex = exact(0.014);
-    let an =
-        analyze_states(&osc, &ex.time, &ex.x, &ex.v, &ex.a, &Default::default()).expect("analysis");
+    let (_, an) = exact_analysis(0.014);
     let rms = |sigma0: f64| {
         let model = coulomb_like_lugre(sigma0);
         force_residuals(&an, &model, &osc).expect("residuals").rms

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{records, NOISE};
+use common::{records, stribeck_truth, NOISE};
 use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::identify::{fit, FitDomain, FitOptions, ForceTarget};
 use frictionid_engine::record::{Channel, TimeBase};
@@ -203,16 +203,6 @@ fn the_energy_based_route_gives_coulomb_mu() {
     .unwrap();
     let mu = noisy.value("mu").unwrap();
     assert!(rel(mu, 0.24) < 1e-2, "noisy mu = {mu}");
-}
-
-fn stribeck_truth() -> Stribeck {
-    Stribeck {
-        mu_c: 0.20,
-        mu_s: 0.28,
-        v_s: 0.02,
-        delta: 2.0,
-        viscous: 3.0,
-    }
 }
 
 #[test]

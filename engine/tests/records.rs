@@ -161,6 +161,18 @@ fn lab_export(
     truth
 }
 
+/// The `[[records]]` entry of the lab export `file` released from 14 mm: its column names,
+/// read as they are (no unit scales).
+fn lab_entry(file: &str) -> RecordSource {
+    RecordSource {
+        file: Some(file.into()),
+        x0: Some(0.014),
+        time_column: Some("t_s".into()),
+        velocity_column: Some("v_mm_s".into()),
+        ..RecordSource::default()
+    }
+}
+
 fn defects(rest: f64) -> Defects {
     Defects {
         rest,
@@ -219,13 +231,9 @@ fn a_release_time_in_seconds_cuts_there_and_a_record_without_rest_is_kept_whole(
     let dir = scratch("given");
     lab_export(&dir, "r.csv", 0.014, 1.0, 1000.0, 0.3, 9);
     let entry = RecordSource {
-        file: Some("r.csv".into()),
-        x0: Some(0.014),
-        time_column: Some("t_s".into()),
-        velocity_column: Some("v_mm_s".into()),
         velocity_scale: Some(1e-3),
         release: Some(Release::At(0.3)),
-        ..RecordSource::default()
+        ..lab_entry("r.csv")
     };
     let r = entry.load_checked(&dir, &osc).unwrap();
     assert_eq!(
@@ -281,13 +289,7 @@ fn unit_mistakes_are_errors_naming_the_record_the_ratio_and_the_key() {
     let osc = Oscillator::fmm();
     let dir = scratch("units");
     lab_export(&dir, "x14.csv", 0.014, 2.0, 1000.0, 0.0, 5);
-    let entry = RecordSource {
-        file: Some("x14.csv".into()),
-        x0: Some(0.014),
-        time_column: Some("t_s".into()),
-        velocity_column: Some("v_mm_s".into()),
-        ..RecordSource::default()
-    };
+    let entry = lab_entry("x14.csv");
     // The mm/s export read as m/s.
     let e = entry.load_checked(&dir, &osc).unwrap_err();
     let msg = e.to_string();

@@ -23,93 +23,83 @@
 
 use crate::error::ModelError;
 use exmex::prelude::*;
-use exmex::{ops_factory, BinOp, MakeOperators, Operator};
+use exmex::{BinOp, MakeOperators, Operator};
 
-ops_factory!(
-    FormulaOps,
-    f64,
-    Operator::make_bin(
-        "^",
-        BinOp {
-            apply: |a: f64, b: f64| a.powf(b),
-            prio: 4,
-            is_commutative: false,
-        }
-    ),
-    Operator::make_bin(
-        "*",
-        BinOp {
-            apply: |a: f64, b: f64| a * b,
-            prio: 2,
-            is_commutative: true,
-        }
-    ),
-    Operator::make_bin(
-        "/",
-        BinOp {
-            apply: |a: f64, b: f64| a / b,
-            prio: 3,
-            is_commutative: false,
-        }
-    ),
-    Operator::make_bin_unary(
-        "+",
-        BinOp {
-            apply: |a: f64, b: f64| a + b,
-            prio: 0,
-            is_commutative: true,
-        },
-        |a: f64| a
-    ),
-    Operator::make_bin_unary(
-        "-",
-        BinOp {
-            apply: |a: f64, b: f64| a - b,
-            prio: 1,
-            is_commutative: false,
-        },
-        |a: f64| -a
-    ),
-    Operator::make_bin(
-        "min",
-        BinOp {
-            apply: |a: f64, b: f64| a.min(b),
-            prio: 0,
-            is_commutative: false,
-        }
-    ),
-    Operator::make_bin(
-        "max",
-        BinOp {
-            apply: |a: f64, b: f64| a.max(b),
-            prio: 0,
-            is_commutative: false,
-        }
-    ),
-    Operator::make_bin(
-        "atan2",
-        BinOp {
-            apply: |a: f64, b: f64| a.atan2(b),
-            prio: 0,
-            is_commutative: false,
-        }
-    ),
-    Operator::make_unary("sign", crate::model::sgn),
-    Operator::make_unary("abs", |a: f64| a.abs()),
-    Operator::make_unary("exp", |a: f64| a.exp()),
-    Operator::make_unary("ln", |a: f64| a.ln()),
-    Operator::make_unary("log10", |a: f64| a.log10()),
-    Operator::make_unary("sqrt", |a: f64| a.sqrt()),
-    Operator::make_unary("sin", |a: f64| a.sin()),
-    Operator::make_unary("cos", |a: f64| a.cos()),
-    Operator::make_unary("tan", |a: f64| a.tan()),
-    Operator::make_unary("asin", |a: f64| a.asin()),
-    Operator::make_unary("acos", |a: f64| a.acos()),
-    Operator::make_unary("atan", |a: f64| a.atan()),
-    Operator::make_unary("sinh", |a: f64| a.sinh()),
-    Operator::make_unary("cosh", |a: f64| a.cosh()),
-    Operator::make_unary("tanh", |a: f64| a.tanh())
-);
+/// The operators of the formula language handed to exmex: arithmetic, `min`, `max`, `atan2`,
+/// `sign` and the functions of [`UNARY`], in this order.
+#[derive(Clone, Debug)]
+pub struct FormulaOps;
+
+/// A one-argument function exmex evaluates: name and function.
+type Unary = (&'static str, fn(f64) -> f64);
+
+/// The one-argument functions other than `sign`.
+const UNARY: [Unary; 14] = [
+    ("abs", f64::abs),
+    ("exp", f64::exp),
+    ("ln", f64::ln),
+    ("log10", f64::log10),
+    ("sqrt", f64::sqrt),
+    ("sin", f64::sin),
+    ("cos", f64::cos),
+    ("tan", f64::tan),
+    ("asin", f64::asin),
+    ("acos", f64::acos),
+    ("atan", f64::atan),
+    ("sinh", f64::sinh),
+    ("cosh", f64::cosh),
+    ("tanh", f64::tanh),
+];
+
+/// A two-argument operator exmex evaluates: name, function, priority (higher binds first)
+/// and whether it commutes.
+type Binary = (&'static str, fn(f64, f64) -> f64, i64, bool);
+
+/// The arithmetic operators without a one-argument form.
+const ARITHMETIC: [Binary; 3] = [
+    ("^", f64::powf, 4, false),
+    ("*", |a, b| a * b, 2, true),
+    ("/", |a, b| a / b, 3, false),
+];
+
+/// The two-argument functions.
+const BINARY_FUNCTIONS: [Binary; 3] = [
+    ("min", f64::min, 0, false),
+    ("max", f64::max, 0, false),
+    ("atan2", f64::atan2, 0, false),
+];
+
+fn bin_op((_, apply, prio, is_commutative): Binary) -> BinOp<f64> {
+    BinOp {
+        apply,
+        prio,
+        is_commutative,
+    }
+}
+
+fn binary<'a>(op: &Binary) -> Operator<'a, f64> {
+    Operator::make_bin(op.0, bin_op(*op))
+}
+
+impl MakeOperators<f64> for FormulaOps {
+    fn make<'a>() -> Vec<Operator<'a, f64>> {
+        let mut ops: Vec<Operator<'a, f64>> = ARITHMETIC.iter().map(binary).collect();
+        ops.push(Operator::make_bin_unary(
+            "+",
+            bin_op(("+", |a, b| a + b, 0, true)),
+            |a| a,
+        ));
+        ops.push(Operator::make_bin_unary(
+            "-",
+            bin_op(("-", |a, b| a - b, 1, false)),
+            |a| -a,
+        ));
+        ops.extend(BINARY_FUNCTIONS.iter().map(binary));
+        ops.push(Operator::make_unary("sign", crate::model::sgn));
+        ops.extend(UNARY.iter().map(|&(name, f)| Operator::make_unary(name, f)));
+        ops
+    }
+}
 
 /// A function callable in a formula.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -191,10 +191,14 @@ fn every_model_round_trips_through_json_and_toml() {
     check_every_model(testing::check_serde);
 }
 
+/// A model built from the TOML table `text`.
+fn build_from(text: &str) -> Result<Built, ModelError> {
+    build_toml(&toml::from_str(text).unwrap())
+}
+
 #[test]
 fn missing_parameters_take_their_defaults() {
-    let t: toml::Value = toml::from_str("type = \"lugre\"\nsigma0 = 2.0e5\nmu_c = 0.22\n").unwrap();
-    let b = build_toml(&t).unwrap();
+    let b = build_from("type = \"lugre\"\nsigma0 = 2.0e5\nmu_c = 0.22\n").unwrap();
     let d = LuGre::default();
     assert_eq!(
         b.model.params(),
@@ -205,8 +209,7 @@ fn missing_parameters_take_their_defaults() {
 
 #[test]
 fn unknown_type_lists_the_registered_names() {
-    let t: toml::Value = toml::from_str("type = \"lugra\"").unwrap();
-    let e = build_toml(&t).unwrap_err().to_string();
+    let e = build_from("type = \"lugra\"").unwrap_err().to_string();
     assert!(e.contains("unknown friction model `lugra`"), "{e}");
     assert!(e.contains("did you mean `lugre`"), "{e}");
     for n in names() {
@@ -220,8 +223,9 @@ fn unknown_type_lists_the_registered_names() {
 
 #[test]
 fn unknown_parameter_is_named_with_the_models_parameters() {
-    let t: toml::Value = toml::from_str("type = \"stribeck\"\nmu_k = 0.2").unwrap();
-    let e = build_toml(&t).unwrap_err().to_string();
+    let e = build_from("type = \"stribeck\"\nmu_k = 0.2")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("unknown parameter `mu_k`"), "{e}");
     assert!(e.contains("stribeck"), "{e}");
     for p in ["mu_c", "mu_s", "v_s", "delta", "viscous"] {
@@ -238,8 +242,7 @@ fn out_of_bounds_values_are_errors() {
         ("type = \"stribeck\"\nv_s = 0.0", "v_s"),
         ("type = \"viscous_coulomb\"\nviscous = -1.0", "viscous"),
     ] {
-        let t: toml::Value = toml::from_str(text).unwrap();
-        let e = build_toml(&t).unwrap_err();
+        let e = build_from(text).unwrap_err();
         assert!(
             matches!(&e, ModelError::OutOfBounds { param: p, .. } if p == param),
             "{text}: {e}"
@@ -255,9 +258,7 @@ fn out_of_bounds_values_are_errors() {
 #[test]
 fn mu_s_below_mu_c_is_a_warning_not_an_error() {
     for ty in ["stribeck", "lugre"] {
-        let t: toml::Value =
-            toml::from_str(&format!("type = \"{ty}\"\nmu_c = 0.3\nmu_s = 0.2")).unwrap();
-        let b = build_toml(&t).unwrap();
+        let b = build_from(&format!("type = \"{ty}\"\nmu_c = 0.3\nmu_s = 0.2")).unwrap();
         assert_eq!(b.warnings.len(), 1, "{ty}");
         assert!(b.warnings[0].contains("mu_s"));
     }

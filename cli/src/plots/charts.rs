@@ -32,69 +32,66 @@ pub fn response_fit(
     )
 }
 
+/// A quantity against time, drawn in a panel of its own by [`over_time`].
+#[derive(Debug, Clone, Copy)]
+pub enum Quantity<'a> {
+    /// Displacement \[m\], shown in mm when it stays within +-0.1 m (records of a few mm).
+    Displacement(&'a [f64]),
+    /// Velocity [m/s].
+    Velocity(&'a [f64]),
+    /// Acceleration [m/s²].
+    Acceleration(&'a [f64]),
+    /// Mechanical energy E = KE + PE \[J\].
+    Energy(&'a [f64]),
+    /// The rate of change of the mechanical energy \[W\].
+    EnergyRate(&'a [f64]),
+}
+
+impl<'a> Quantity<'a> {
+    /// Its panel: one solid line against `time`; `scaled` holds the values when they are
+    /// shown in another unit.
+    fn panel(self, time: &'a [f64], scaled: &'a mut Vec<f64>) -> Panel<'a> {
+        let (axis, name, y) = match self {
+            Quantity::Displacement(x) => return displacement_panel(time, x, scaled),
+            Quantity::Velocity(v) => (("velocity", "m/s"), "v", v),
+            Quantity::Acceleration(a) => (("acceleration", "m/s²"), "a", a),
+            Quantity::Energy(e) => (("energy E = KE + PE", "J"), "E", e),
+            Quantity::EnergyRate(r) => (("dE/dt", "W"), "dE/dt", r),
+        };
+        Panel::new(axis.0, axis.1).with(Series::solid(name, time, y))
+    }
+}
+
 /// Displacement in mm when it stays within +-0.1 m (records of a few mm), else in m.
 fn displacement_panel<'a>(time: &'a [f64], x: &'a [f64], scaled: &'a mut Vec<f64>) -> Panel<'a> {
     let peak = x
         .iter()
         .filter(|v| v.is_finite())
         .fold(0.0f64, |m, v| m.max(v.abs()));
-    if peak < 0.1 {
+    let (unit, y) = if peak < 0.1 {
         *scaled = x.iter().map(|v| v * 1e3).collect();
-        line_panel(("displacement", "mm"), "x", time, scaled)
+        ("mm", &scaled[..])
     } else {
-        line_panel(("displacement", "m"), "x", time, x)
-    }
+        ("m", x)
+    };
+    Panel::new("displacement", unit).with(Series::solid("x", time, y))
 }
 
-/// A panel with one solid line `name` of `y` against `time`; `axis` is (quantity, unit).
-fn line_panel<'a>(axis: (&str, &str), name: &str, time: &'a [f64], y: &'a [f64]) -> Panel<'a> {
-    Panel::new(axis.0, axis.1).with(Series::solid(name, time, y))
-}
-
-/// Displacement and velocity against time (simulations).
-pub fn displacement_velocity(
+/// Quantities against time in stacked panels, in the order given: displacement and velocity
+/// (simulations), displacement and the acceleration derived from a measured velocity (the
+/// paper's Figs. 9-10), mechanical energy and its rate of change (Figs. 4-5, 11).
+pub fn over_time(
     path: &Path,
     title: &str,
     time: &[f64],
-    x: &[f64],
-    v: &[f64],
+    quantities: &[Quantity<'_>],
 ) -> Result<(), CliError> {
-    let mut mm = Vec::new();
-    let panels = vec![
-        displacement_panel(time, x, &mut mm),
-        line_panel(("velocity", "m/s"), "v", time, v),
-    ];
-    draw(path, &Figure::over_time(title, panels))
-}
-
-/// Displacement and acceleration derived from a measured velocity (the paper's Figs. 9-10).
-pub fn displacement_acceleration(
-    path: &Path,
-    title: &str,
-    time: &[f64],
-    x: &[f64],
-    a: &[f64],
-) -> Result<(), CliError> {
-    let mut mm = Vec::new();
-    let panels = vec![
-        displacement_panel(time, x, &mut mm),
-        line_panel(("acceleration", "m/s²"), "a", time, a),
-    ];
-    draw(path, &Figure::over_time(title, panels))
-}
-
-/// Mechanical energy and its rate of change (the paper's Figs. 4-5, 11).
-pub fn energy_rate(
-    path: &Path,
-    title: &str,
-    time: &[f64],
-    energy: &[f64],
-    de_dt: &[f64],
-) -> Result<(), CliError> {
-    let panels = vec![
-        line_panel(("energy E = KE + PE", "J"), "E", time, energy),
-        line_panel(("dE/dt", "W"), "dE/dt", time, de_dt),
-    ];
+    let mut scaled = vec![Vec::new(); quantities.len()];
+    let panels = quantities
+        .iter()
+        .zip(scaled.iter_mut())
+        .map(|(q, s)| q.panel(time, s))
+        .collect();
     draw(path, &Figure::over_time(title, panels))
 }
 

@@ -1,7 +1,7 @@
 //! The plots of each report: which charts a command draws from its report value, and their
 //! file names in the output directory.
 
-use super::{draw, Figure, Panel, Series};
+use super::{draw, Figure, Panel, Quantity, Series};
 use crate::error::CliError;
 use crate::report::{fmt_num, OutputDir};
 use frictionid_engine::identify::{FitResult, RecordFit};
@@ -81,12 +81,11 @@ pub fn break_at_reversals(force: &[f64], v: &[f64]) -> Vec<f64> {
 pub fn simulate_plots(out: &OutputDir, report: &SimulateReport) -> Result<Vec<String>, CliError> {
     let traj = &report.trajectory;
     let title = format!("{} from x0 = {} m", report.model.name(), fmt_num(report.x0));
-    super::displacement_velocity(
+    super::over_time(
         &out.path("displacement_velocity.svg"),
         &format!("Free vibration: {title}"),
         &traj.time,
-        &traj.x,
-        &traj.v,
+        &[Quantity::Displacement(&traj.x), Quantity::Velocity(&traj.v)],
     )?;
     let t = &traj.time;
     draw(
@@ -290,22 +289,24 @@ fn energy_record_plots(
     stem: &str,
 ) -> Result<Vec<String>, CliError> {
     let a = &r.analysis;
-    let xa = format!("{stem}_displacement_acceleration.svg");
-    super::displacement_acceleration(
-        &out.path(&xa),
-        &format!("{}: displacement and acceleration", r.file),
-        &a.time,
-        &a.x,
-        &a.a,
-    )?;
-    let en = format!("{stem}_energy.svg");
-    super::energy_rate(
-        &out.path(&en),
-        &format!("{}: energy and dissipation rate", r.file),
-        &a.time,
-        &a.energy,
-        &a.de_dt,
-    )?;
+    let mut files = Vec::new();
+    for (kind, what, quantities) in [
+        (
+            "displacement_acceleration",
+            "displacement and acceleration",
+            [Quantity::Displacement(&a.x), Quantity::Acceleration(&a.a)],
+        ),
+        (
+            "energy",
+            "energy and dissipation rate",
+            [Quantity::Energy(&a.energy), Quantity::EnergyRate(&a.de_dt)],
+        ),
+    ] {
+        let file = format!("{stem}_{kind}.svg");
+        let title = format!("{}: {what}", r.file);
+        super::over_time(&out.path(&file), &title, &a.time, &quantities)?;
+        files.push(file);
+    }
     let ff = format!("{stem}_friction_force.svg");
     let model_label = report
         .reference_model
@@ -322,7 +323,8 @@ fn energy_record_plots(
         model_label.as_deref().zip(model_shown.as_deref()),
         Some((ref_label.as_str(), r.reference)).filter(|(_, v)| v.is_finite()),
     )?;
-    Ok(vec![xa, en, ff])
+    files.push(ff);
+    Ok(files)
 }
 
 /// `energy`: the plots of every record.

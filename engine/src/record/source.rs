@@ -443,30 +443,29 @@ mod tests {
 
     #[test]
     fn errors_name_the_entry_and_key() {
-        let e = source("x0 = 1.0")
-            .unwrap()
-            .resolve(2, Path::new("."))
-            .unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "[[records]] entry 2: missing `file` (the record's data file)"
-        );
-        let e = source("file = \"a.csv\"")
-            .unwrap()
-            .resolve(1, Path::new("."))
-            .unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "[[records]] entry 1 (`a.csv`): missing `x0` (the release displacement, m)"
-        );
-        let e = source("file = \"a.csv\"\nx0 = 0.01\nweight = 0.0")
-            .unwrap()
-            .resolve(1, Path::new("."))
-            .unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "[[records]] entry 1 (`a.csv`): `weight` must be > 0, got 0"
-        );
+        for (index, toml, says) in [
+            (
+                2,
+                "x0 = 1.0",
+                "[[records]] entry 2: missing `file` (the record's data file)",
+            ),
+            (
+                1,
+                "file = \"a.csv\"",
+                "[[records]] entry 1 (`a.csv`): missing `x0` (the release displacement, m)",
+            ),
+            (
+                1,
+                "file = \"a.csv\"\nx0 = 0.01\nweight = 0.0",
+                "[[records]] entry 1 (`a.csv`): `weight` must be > 0, got 0",
+            ),
+        ] {
+            let e = source(toml)
+                .unwrap()
+                .resolve(index, Path::new("."))
+                .unwrap_err();
+            assert_eq!(e.to_string(), says);
+        }
         let nan = RecordSource {
             x0: Some(f64::NAN),
             ..source("file = \"a.csv\"").unwrap()

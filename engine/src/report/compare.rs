@@ -2,7 +2,7 @@
 
 use super::fit::{fit_json, parameter_table, verdict_line};
 use super::format::{fmt_criterion, fmt_num, fmt_opt};
-use super::{render_files, Render, Role, Sink, Status, Table};
+use super::{render_files, render_opening, Render, Role, Sink, Status, Table};
 use crate::identify::{Comparison, FitResult};
 use serde::ser::SerializeMap;
 use serde::{Serialize, Serializer};
@@ -108,16 +108,12 @@ impl CompareReport {
 impl Render for CompareReport {
     fn render(&self, sink: &mut dyn Sink) {
         let c = &self.comparison;
-        sink.title("frictionid compare");
-        sink.paragraph(
-            &format!(
-                "Config: `{}`. {} model(s) fitted to {} record(s), ranked by AIC (lower is better).",
-                self.config,
-                c.ranking.len(),
-                self.records
-            ),
-            Role::Detail,
+        let summary = format!(
+            "{} model(s) fitted to {} record(s), ranked by AIC (lower is better).",
+            c.ranking.len(),
+            self.records
         );
+        render_opening(sink, "compare", &self.config, &summary);
         if let Some((status, text)) = self.verdict_line() {
             sink.verdict(status, &text);
         }

@@ -4,7 +4,7 @@ use super::format::{
     fmt_criterion, fmt_estimate, fmt_num, fmt_opt, fmt_percent, fmt_std_error, fmt_to_error,
     serialized_name,
 };
-use super::{render_files, Render, Role, Sink, Status, Table, Verdict};
+use super::{render_files, render_opening, Render, Role, Sink, Status, Table, Verdict};
 use crate::identify::{FitResult, FittedParam};
 use serde::{Serialize, Serializer};
 
@@ -337,21 +337,17 @@ impl FitReport {
 impl Render for FitReport {
     fn render(&self, sink: &mut dyn Sink) {
         let f = &self.fit;
-        sink.title("frictionid fit");
-        sink.paragraph(
-            &format!(
-                "Config: `{}`. Model `{}` fitted to {} record(s): {}.",
-                self.config,
-                f.model,
-                f.records.len(),
-                if f.converged {
-                    "converged"
-                } else {
-                    "NOT converged"
-                }
-            ),
-            Role::Detail,
+        let outcome = if f.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        };
+        let summary = format!(
+            "Model `{}` fitted to {} record(s): {outcome}.",
+            f.model,
+            f.records.len()
         );
+        render_opening(sink, "fit", &self.config, &summary);
         let (status, verdict) = verdict_line(f);
         sink.verdict(status, &verdict);
         sink.heading(2, "Diagnostics", Role::Detail);

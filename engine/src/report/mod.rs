@@ -116,6 +116,13 @@ impl Render for SampleReport {
     }
 }
 
+/// Renders the opening of a command's report (shared by the report values): the title
+/// `frictionid <command>` and a detail paragraph naming the config, then `summary`.
+fn render_opening(sink: &mut dyn Sink, command: &str, config: &str, summary: &str) {
+    sink.title(&format!("frictionid {command}"));
+    sink.paragraph(&format!("Config: `{config}`. {summary}"), Role::Detail);
+}
+
 /// Renders a "## Files" section (shared by the report values).
 fn render_files(sink: &mut dyn Sink, files: &[String]) {
     if !files.is_empty() {

@@ -1,7 +1,7 @@
 //! The report of `simulate`: one free vibration.
 
 use super::format::{fmt_num, fmt_opt};
-use super::{render_files, Render, Role, Sink, Table};
+use super::{render_files, render_opening, Render, Role, Sink, Table};
 use crate::oscillator::Oscillator;
 use crate::simulate::{Event, SimStats, Trajectory};
 use frictionid_models::FrictionModel;
@@ -109,11 +109,8 @@ impl SimulateReport {
 
 impl Render for SimulateReport {
     fn render(&self, sink: &mut dyn Sink) {
-        sink.title("frictionid simulate");
-        sink.paragraph(
-            &format!("Config: `{}`. Model: `{}`.", self.config, self.model_json()),
-            Role::Detail,
-        );
+        let summary = format!("Model: `{}`.", self.model_json());
+        render_opening(sink, "simulate", &self.config, &summary);
         sink.table(&self.summary_table(), Role::Summary);
         sink.heading(2, "Events", Role::Detail);
         sink.table(&self.event_table(), Role::Detail);

@@ -10,9 +10,10 @@
 //!
 //! Bit-compatibility: at the start of a step (other than the first after a reset) the dense
 //! output returns the previous step's interpolant at its end, as ode_solvers' output model
-//! did. Changing this moves turning points by round-off only, yet it flips the LuGre fit of
-//! `engine/tests/identify.rs` (`lugre_fit_reaches_the_noise_level`) into another local minimum
-//! (rms 3.7e-4 instead of about 2e-4 m/s): that fit is sensitive at the round-off level.
+//! did. Changing this moves turning points by round-off only, yet it flips the default LuGre
+//! fit (`engine/tests/dynamic.rs`, `lugre_is_recovered_from_the_default_configuration`) into
+//! another local minimum (rms 3.7e-4 instead of about 2e-4 m/s): that fit is sensitive at the
+//! round-off level.
 
 use super::stepper::{
     current_point_accessors, ensure_resolvable, last_step, OdeSystem, StepCounts, StepOutcome,

@@ -3,7 +3,7 @@
 
 use frictionid_engine::synthetic::release_records;
 use frictionid_engine::{Oscillator, Record};
-use frictionid_models::{FrictionModel, LuGre};
+use frictionid_models::{FrictionModel, LuGre, Stribeck};
 
 /// The releases of the paper: 10, 14 and 22 mm.
 pub const RELEASES: [f64; 3] = [0.010, 0.014, 0.022];
@@ -39,5 +39,17 @@ pub fn stiff_lugre_truth() -> LuGre {
         mu_c: 0.18,
         mu_s: 0.26,
         v_s: 0.005,
+    }
+}
+
+/// A Stribeck law with a pronounced dip and viscous drag: mu_c 0.20, mu_s 0.28, v_s 0.02 m/s,
+/// delta 2, viscous 3 N s/m.
+pub fn stribeck_truth() -> Stribeck {
+    Stribeck {
+        mu_c: 0.20,
+        mu_s: 0.28,
+        v_s: 0.02,
+        delta: 2.0,
+        viscous: 3.0,
     }
 }

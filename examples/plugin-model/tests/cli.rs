@@ -7,11 +7,11 @@
 //! the static limit (simulate); the parameters the committed fixture was made with (fit,
 //! compare).
 
-use assert_cmd::Command;
-use frictionid_cli::testing::{read_report, scratch_dir, FMM_OSCILLATOR};
+use frictionid_cli::testing::{read_report, run_ok, scratch_dir, FMM_OSCILLATOR};
 use frictionid_models::FrictionModel;
 use frictionid_plugin_example::StribeckPower;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 fn plugin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid-plugin"))
@@ -21,16 +21,24 @@ fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures")
 }
 
-/// Runs the plugin binary and returns its stdout; fails the test on a non-zero exit.
-fn run_ok(args: &[&std::ffi::OsStr]) -> String {
-    let o = plugin().args(args).output().unwrap();
-    assert!(
-        o.status.success(),
-        "exit {:?}: {}",
-        o.status.code(),
-        String::from_utf8_lossy(&o.stderr)
+/// Runs the plugin binary with `args` and returns its stdout; fails the test on a non-zero
+/// exit.
+fn stdout_of(args: &[&str]) -> String {
+    String::from_utf8(run_ok(plugin().args(args)).stdout).unwrap()
+}
+
+/// Runs `frictionid-plugin <command> <config> <extra...> --out <out> --quiet`; fails the test
+/// on a non-zero exit.
+fn run_into(out: &Path, command: &str, config: &Path, extra: &[&str]) {
+    run_ok(
+        plugin()
+            .arg(command)
+            .arg(config)
+            .args(extra)
+            .arg("--out")
+            .arg(out)
+            .arg("--quiet"),
     );
-    String::from_utf8(o.stdout).unwrap()
 }
 
 /// The named columns of a CSV file with a header row (comment lines starting with `#` skipped).
@@ -65,19 +73,13 @@ fn simulate(name: &str, model: &str) -> PathBuf {
     )
     .unwrap();
     let out = dir.join("out");
-    run_ok(&[
-        "simulate".as_ref(),
-        config.as_os_str(),
-        "--out".as_ref(),
-        out.as_os_str(),
-        "--quiet".as_ref(),
-    ]);
+    run_into(&out, "simulate", &config, &[]);
     out
 }
 
 #[test]
 fn models_lists_the_plugin_model_and_every_builtin() {
-    let text = run_ok(&["models".as_ref()]);
+    let text = stdout_of(&["models"]);
     let plugin = StribeckPower::default();
     assert!(text.contains("stribeck_power"), "{text}");
     assert!(text.contains(&plugin.equation()), "{text}");
@@ -104,8 +106,7 @@ fn models_lists_the_plugin_model_and_every_builtin() {
 
 #[test]
 fn models_json_describes_the_plugin_model_by_its_metadata() {
-    let json: serde_json::Value =
-        serde_json::from_str(&run_ok(&["models".as_ref(), "--json".as_ref()])).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&stdout_of(&["models", "--json"])).unwrap();
     let list = json.as_array().unwrap();
     let names: Vec<&str> = list.iter().map(|m| m["name"].as_str().unwrap()).collect();
     // Every model of the registry as linked into this test (the built-ins and the plugin).
@@ -244,13 +245,7 @@ fn check_recovers_truth(fit: &serde_json::Value) {
 #[test]
 fn fit_recovers_the_parameters_the_fixture_was_made_with() {
     let out = scratch_dir("plugin", "fit").join("out");
-    run_ok(&[
-        "fit".as_ref(),
-        fixtures().join("fit.toml").as_os_str(),
-        "--out".as_ref(),
-        out.as_os_str(),
-        "--quiet".as_ref(),
-    ]);
+    run_into(&out, "fit", &fixtures().join("fit.toml"), &[]);
     let report: serde_json::Value = read_report(&out);
     assert_eq!(report["command"], "fit");
     check_recovers_truth(&report);
@@ -260,15 +255,8 @@ fn fit_recovers_the_parameters_the_fixture_was_made_with() {
 #[test]
 fn compare_ranks_the_plugin_model_above_coulomb() {
     let out = scratch_dir("plugin", "compare").join("out");
-    run_ok(&[
-        "compare".as_ref(),
-        fixtures().join("compare.toml").as_os_str(),
-        "--models".as_ref(),
-        "coulomb,stribeck_power".as_ref(),
-        "--out".as_ref(),
-        out.as_os_str(),
-        "--quiet".as_ref(),
-    ]);
+    let models = ["--models", "coulomb,stribeck_power"];
+    run_into(&out, "compare", &fixtures().join("compare.toml"), &models);
     let report: serde_json::Value = read_report(&out);
     assert_eq!(report["failed"].as_array().map(Vec::len), Some(0));
     let ranking = report["ranking"].as_array().unwrap();
