@@ -5,8 +5,8 @@
 //! them in the report's `files`, and hands the report to its writers.
 
 use crate::energy::{
-    analyze_record, mean_abs_where_defined, model_force_along, percent_difference, EnergyAnalysis,
-    EnergyOptions,
+    analyze_record, mean_abs_where_defined, model_force_along, percent_difference, series_origins,
+    EnergyAnalysis, EnergyOptions,
 };
 use crate::error::EngineError;
 use crate::identify::{
@@ -249,6 +249,7 @@ fn energy_record(
         half_cycles: analysis.half_cycles.clone(),
         masked: analysis.masked,
         samples: analysis.time.len(),
+        series: series_origins(record).into_iter().collect(),
         analysis,
         model_force,
     })

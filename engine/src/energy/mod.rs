@@ -2,8 +2,13 @@
 //!
 //! From the measured velocity v(t), the oscillator's m, c, k and the release displacement x0:
 //!
-//! - displacement x(t) by the trapezoidal rule from x(t0) = x0 ([`cumulative_trapezoid`]);
-//! - acceleration a(t) by numerical differentiation ([`Differentiator`]);
+//! - displacement x(t) by the trapezoidal rule from x(t0) = x0 ([`cumulative_trapezoid`]),
+//!   or the record's measured displacement (an interferometer);
+//! - acceleration a(t) by numerical differentiation ([`Differentiator`]), or the record's
+//!   measured acceleration (an accelerometer): the paper's proposal of separate sensors,
+//!   which removes the differentiation error and the displacement drift from Eq. 7
+//!   ([`series_origins`] says which series were measured; a displacement-only record has its
+//!   velocity by central differences);
 //! - PE = k x^2 / 2 (Eq. 2), KE = m v^2 / 2 (Eq. 3), E = KE + PE, dE/dt = v (m a + k x) (Eq. 4);
 //! - the friction force from Eq. 7 where |v| > `velocity_threshold`, NaN elsewhere;
 //! - the differentiation-free half-cycle estimate (energy lost between turning points, less
@@ -77,7 +82,7 @@ pub use model_force::{
 
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
-use crate::record::Record;
+use crate::record::{Channel, Record};
 use halfcycle::{detect_motion, half_cycles, Interp, Motion, Samples};
 use serde::{Deserialize, Serialize};
 
@@ -190,12 +195,83 @@ pub fn cumulative_trapezoid(time: &[f64], v: &[f64], x0: f64) -> Vec<f64> {
     x
 }
 
-/// The energy analysis of a measured record.
+/// Where a series of the energy analysis of a record comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SeriesOrigin {
+    /// The record's own channel.
+    Measured,
+    /// Integrated from the velocity (trapezoidal rule from x0).
+    Integrated,
+    /// Differentiated (the velocity from the displacement, the acceleration from the
+    /// velocity).
+    Differentiated,
+}
+
+impl SeriesOrigin {
+    /// `measured`, `integrated`, `differentiated`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Measured => "measured",
+            Self::Integrated => "integrated",
+            Self::Differentiated => "differentiated",
+        }
+    }
+}
+
+/// Where the displacement, velocity and acceleration of a record's analysis come from: its
+/// channels where it has them (the paper's proposal of separate sensors), else integrated or
+/// differentiated. The one place of this rule ([`record_motion`] and [`analyze_record`]
+/// follow it).
+pub fn series_origins(record: &Record) -> [(Channel, SeriesOrigin); 3] {
+    let has = |c: Channel| record.channel(c).is_some();
+    let origin = |c: Channel, otherwise: SeriesOrigin| {
+        if has(c) {
+            SeriesOrigin::Measured
+        } else {
+            otherwise
+        }
+    };
+    let velocity = origin(Channel::Velocity, SeriesOrigin::Differentiated);
+    let displacement = if has(Channel::Velocity) || has(Channel::Displacement) {
+        origin(Channel::Displacement, SeriesOrigin::Integrated)
+    } else {
+        SeriesOrigin::Integrated
+    };
+    [
+        (Channel::Displacement, displacement),
+        (Channel::Velocity, velocity),
+        (
+            Channel::Acceleration,
+            origin(Channel::Acceleration, SeriesOrigin::Differentiated),
+        ),
+    ]
+}
+
+/// The velocity (measured, or the central difference of the displacement) and the
+/// displacement (measured, or the velocity integrated from x0) of a record; `None` without
+/// either channel.
+pub fn record_motion(record: &Record) -> Option<(Vec<f64>, Vec<f64>)> {
+    let time = record.time();
+    let measured_x = record.channel(Channel::Displacement);
+    let v = match record.channel(Channel::Velocity) {
+        Some(v) => v.to_vec(),
+        None => central_difference(time, measured_x?),
+    };
+    let x = match measured_x {
+        Some(x) => x.to_vec(),
+        None => cumulative_trapezoid(time, &v, record.x0),
+    };
+    Some((v, x))
+}
+
+/// The energy analysis of a measured record, from its measured displacement, velocity and
+/// acceleration where it has them ([`series_origins`]).
 ///
-/// Errors: invalid options or oscillator; a record with fewer samples than the
-/// differentiator's window, non-finite values, non-increasing time (see
-/// [`Record::validate`]); a record without motion (|v| never clearly above the threshold and
-/// the noise).
+/// Errors: invalid options or oscillator; a record with neither velocity nor displacement,
+/// fewer samples than the differentiator's window, non-finite values, non-increasing time
+/// (see [`Record::validate_channels`]); a record without motion (|v| never clearly above the
+/// threshold and the noise).
 pub fn analyze_record(
     record: &Record,
     osc: &Oscillator,
@@ -203,23 +279,32 @@ pub fn analyze_record(
 ) -> Result<EnergyAnalysis, EngineError> {
     opts.validate()?;
     osc.validate()?;
-    record.validate(opts.differentiator.min_samples().max(MIN_RUN + 1))?;
+    record.validate_channels(opts.differentiator.min_samples().max(MIN_RUN + 1))?;
+    let Some((v, x)) = record_motion(record) else {
+        // The velocity check names what the record has instead.
+        record.validate(0)?;
+        return Err(EngineError::InvalidInput(format!(
+            "record `{}`: no motion",
+            record.name
+        )));
+    };
     let time = record.time();
-    let v = record.velocity();
-    let x = cumulative_trapezoid(time, v, record.x0);
     let samples = Samples {
         time,
         x: &x,
-        v,
+        v: &v,
         a: &[],
         interp: Interp::Linear,
     };
     let motion = detect_motion(&samples, opts.velocity_threshold, record.v0, &record.name)?;
-    let a = match opts.differentiator {
-        Differentiator::Paper => paper_derivative(time, v),
-        Differentiator::SavitzkyGolay { window, order } => {
-            savitzky_golay_derivative(time, v, window, order, &motion.break_indices(time))?
-        }
+    let a = match record.channel(Channel::Acceleration) {
+        Some(a) => a.to_vec(),
+        None => match opts.differentiator {
+            Differentiator::Paper => paper_derivative(time, &v),
+            Differentiator::SavitzkyGolay { window, order } => {
+                savitzky_golay_derivative(time, &v, window, order, &motion.break_indices(time))?
+            }
+        },
     };
     let samples = Samples { a: &a, ..samples };
     Ok(assemble(osc, &samples, &motion, opts))

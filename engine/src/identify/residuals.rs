@@ -1,5 +1,6 @@
-//! What a fit compares: the [`Residuals`] trait and its implementation for the velocity
-//! response ([`VelocityResponse`]: simulate the free vibration, compare the velocity).
+//! What a fit compares: the [`Residuals`] trait. Its producers: the oscillator's response
+//! ([`VelocityResponse`] in `response.rs`: simulate the free vibration, compare every response
+//! channel) and the force along the measured motion (`force.rs`).
 //!
 //! A residual producer says which nuisance parameters it adds to every record (a velocity
 //! offset, a release-time shift, ...), what it measures and what the model predicts for it
@@ -12,10 +13,12 @@ use super::options::FitOptions;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
-use crate::simulate::{simulate_velocity, Initial, SimOptions};
+use crate::simulate::SimOptions;
 use frictionid_models::{FrictionModel, GuessHint};
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};
+
+pub use super::response::VelocityResponse;
 
 /// Step budget of a simulation per sample of its record: a bound on cost, not on stiffness.
 /// With `Integrator::Auto` (`[fit.options] integrator = "auto"`) the fit integrates stiff
@@ -256,7 +259,20 @@ pub trait Residuals: Send + Sync {
         self.measured(index, record).len()
     }
 
-    /// Weighted residuals `sqrt(weight) (predicted - measured)` of record `index`.
+    /// The parts of record `index`'s measured series, in order: one per compared channel
+    /// (default: one part, the whole series, unscaled).
+    fn segments(&self, index: usize, record: &Record) -> Vec<Segment> {
+        vec![Segment {
+            channel: self.record_channel(index),
+            unit: self.unit(),
+            len: self.measured(index, record).len(),
+            noise: None,
+            scale: 1.0,
+        }]
+    }
+
+    /// Weighted residuals `sqrt(weight) scale (predicted - measured)` of record `index`, with
+    /// the scale of each of its [`Residuals::segments`].
     fn residuals(
         &self,
         at: &Evaluation<'_>,
@@ -275,173 +291,37 @@ pub trait Residuals: Send + Sync {
             )));
         }
         let w = record.weight.sqrt();
-        for (p, m) in out.iter_mut().zip(measured) {
-            *p = w * (*p - m);
+        let mut start = 0;
+        for segment in self.segments(index, record) {
+            let end = (start + segment.len).min(out.len());
+            for (p, m) in out[start..end].iter_mut().zip(&measured[start..end]) {
+                *p = w * segment.scale * (*p - m);
+            }
+            start = end;
         }
         Ok(out)
     }
 }
 
-/// The velocity response: simulate the free vibration from the record's release state and
-/// compare the simulated velocity (plus the record's offset) with the measured one.
-#[derive(Debug, Clone, PartialEq)]
-pub struct VelocityResponse {
-    nuisance: Vec<NuisanceKind>,
-}
-
-impl VelocityResponse {
-    /// A velocity response with a per-record velocity offset, release shift and/or release
-    /// displacement.
-    pub fn new(velocity_offset: bool, time_shift: bool, x0: bool) -> Self {
-        let nuisance = NuisanceKind::ALL
-            .into_iter()
-            .filter(|k| match k {
-                NuisanceKind::VelocityOffset => velocity_offset,
-                NuisanceKind::ReleaseShift => time_shift,
-                NuisanceKind::StartDisplacement => x0,
-                NuisanceKind::ForceOffset => false,
-            })
-            .collect();
-        Self { nuisance }
-    }
-
-    /// The simulated velocity of `record` at its time stamps, released from the nuisance
-    /// values' x0 `shift` seconds after its release instant (the one found or given when the
-    /// record was cut at its release, which may lie between samples; else its first time
-    /// stamp). Samples before the release see the release velocity; no offset.
-    pub fn simulate(
-        &self,
-        at: &Evaluation<'_>,
-        record: &Record,
-        nuisance: &NuisanceValues,
-    ) -> Result<Vec<f64>, EngineError> {
-        let t0 = record.time().first().copied().unwrap_or(0.0);
-        let release = record.release_time.unwrap_or(t0) + nuisance.shift;
-        // Sample times on the simulation clock; samples before the release see the initial state.
-        let first = record.time().partition_point(|&t| t < release);
-        let times: Vec<f64> = record.time()[first..]
-            .iter()
-            .map(|&t| t - release)
-            .collect();
-        let mut v = vec![record.v0; first];
-        if let Some(&t_end) = times.last() {
-            at.count_simulation();
-            let init = Initial {
-                x0: nuisance.x0_of(record),
-                v0: record.v0,
-                z0: None,
-            };
-            let mut sim = Vec::with_capacity(times.len());
-            let mut opts = *at.sim;
-            opts.max_steps = opts
-                .max_steps
-                .min(STEPS_PER_SAMPLE * (record.len() as u64).max(100));
-            simulate_velocity(
-                at.oscillator,
-                at.model,
-                &init,
-                t_end,
-                &times,
-                &opts,
-                &mut sim,
-            )?;
-            v.extend_from_slice(&sim);
-        }
-        Ok(v)
-    }
-}
-
-impl Residuals for VelocityResponse {
-    fn channel(&self) -> &'static str {
-        "velocity"
-    }
-
-    fn unit(&self) -> &'static str {
-        "m/s"
-    }
-
-    fn nuisance(&self) -> &[NuisanceKind] {
-        &self.nuisance
-    }
-
-    fn measured<'a>(&'a self, _index: usize, record: &'a Record) -> &'a [f64] {
-        record.velocity()
-    }
-
-    fn predict(
-        &self,
-        at: &Evaluation<'_>,
-        _index: usize,
-        record: &Record,
-        nuisance: &NuisanceValues,
-    ) -> Result<Vec<f64>, EngineError> {
-        let mut v = self.simulate(at, record, nuisance)?;
-        for x in &mut v {
-            *x += nuisance.offset;
-        }
-        Ok(v)
-    }
+/// One compared channel's part of a record's measured series.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Segment {
+    /// The quantity compared (`velocity`, `displacement`, `force`, ...).
+    pub channel: &'static str,
+    /// Its SI unit.
+    pub unit: &'static str,
+    /// Number of samples.
+    pub len: usize,
+    /// The noise level its residuals are weighted by, in `unit` (`None`: not weighted).
+    pub noise: Option<f64>,
+    /// The factor on its residuals (besides sqrt(weight)): 1 for the fit's own unit, the ratio
+    /// of noise levels for a channel stacked beside it.
+    pub scale: f64,
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::exact::coulomb_free_vibration;
-    use frictionid_models::Coulomb;
-
-    /// The velocity response of a Coulomb oscillator against the exact piecewise solution:
-    /// residuals are sqrt(w) (exact + offset - measured).
-    #[test]
-    fn velocity_residuals_match_the_exact_coulomb_solution() {
-        let osc = Oscillator::fmm();
-        let model = Coulomb { mu: 0.24 };
-        let time: Vec<f64> = (0..400).map(|i| i as f64 * 2e-3).collect();
-        let exact = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.014, &time)
-            .unwrap()
-            .v;
-        let mut record = Record::new("r", time, vec![0.0; 400], 0.014);
-        record.weight = 4.0;
-        let producer = VelocityResponse::new(true, false, false);
-        assert_eq!(producer.nuisance(), &[NuisanceKind::VelocityOffset]);
-        let counter = AtomicU64::new(0);
-        let sim = SimOptions::default();
-        let at = Evaluation::new(&osc, &model, &sim, &counter);
-        let nuisance = NuisanceValues {
-            offset: 1e-3,
-            ..NuisanceValues::default()
-        };
-        let r = producer.residuals(&at, 0, &record, &nuisance).unwrap();
-        assert_eq!(counter.load(Ordering::Relaxed), 1);
-        for (ri, e) in r.iter().zip(&exact) {
-            assert!((ri - 2.0 * (e + 1e-3)).abs() < 1e-7, "{ri} vs {e}");
-        }
-    }
-
-    #[test]
-    fn samples_before_a_shifted_release_see_the_release_velocity() {
-        let osc = Oscillator::fmm();
-        let model = Coulomb { mu: 0.24 };
-        let time: Vec<f64> = (0..100).map(|i| i as f64 * 1e-3).collect();
-        let record = Record::new("r", time.clone(), vec![0.0; 100], 0.01);
-        let counter = AtomicU64::new(0);
-        let sim = SimOptions::default();
-        let at = Evaluation::new(&osc, &model, &sim, &counter);
-        let shifted = NuisanceValues {
-            shift: 0.0305,
-            ..NuisanceValues::default()
-        };
-        let v = VelocityResponse::new(false, true, false)
-            .simulate(&at, &record, &shifted)
-            .unwrap();
-        assert!(v[..31].iter().all(|&x| x == 0.0));
-        let shifted: Vec<f64> = time[31..].iter().map(|t| t - 0.0305).collect();
-        let exact = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.01, &shifted)
-            .unwrap()
-            .v;
-        for (got, e) in v[31..].iter().zip(&exact) {
-            assert!((got - e).abs() < 1e-8, "{got} vs {e}");
-        }
-    }
 
     /// The default bounds: a quarter of the natural period 2 pi sqrt(m/k) for a shift, 20 %
     /// of the stated x0 for x0.

@@ -3,10 +3,12 @@
 
 use super::format::{fmt_num, fmt_percent};
 use super::{render_files, Render, Role, Sink, Table};
-use crate::energy::{EnergyAnalysis, EnergyOptions, HalfCycle};
+use crate::energy::{EnergyAnalysis, EnergyOptions, HalfCycle, SeriesOrigin};
 use crate::oscillator::Oscillator;
+use crate::record::Channel;
 use frictionid_models::FrictionModel;
 use serde::Serialize;
+use std::collections::BTreeMap;
 
 /// The energy analysis of every record.
 #[derive(Debug, Clone, Serialize)]
@@ -56,6 +58,9 @@ pub struct EnergyRecord {
     pub masked: usize,
     /// Samples analysed.
     pub samples: usize,
+    /// Where the displacement, velocity and acceleration came from (measured, integrated or
+    /// differentiated).
+    pub series: BTreeMap<Channel, SeriesOrigin>,
     /// The analysis (for plots).
     #[serde(skip)]
     pub analysis: EnergyAnalysis,
@@ -95,6 +100,25 @@ impl EnergyReport {
     }
 }
 
+impl EnergyReport {
+    /// Which series each record measured: `Series: `a.csv`: displacement integrated, ...`.
+    pub fn series_sentence(&self) -> String {
+        let records: Vec<String> = self
+            .records
+            .iter()
+            .map(|r| {
+                let series: Vec<String> = r
+                    .series
+                    .iter()
+                    .map(|(c, o)| format!("{c} {}", o.name()))
+                    .collect();
+                format!("`{}`: {}", r.file, series.join(", "))
+            })
+            .collect();
+        format!("Series: {}.", records.join("; "))
+    }
+}
+
 impl Render for EnergyReport {
     fn render(&self, sink: &mut dyn Sink) {
         sink.title("frictionid energy");
@@ -106,6 +130,7 @@ impl Render for EnergyReport {
             Role::Detail,
         );
         sink.table(&self.record_table(), Role::Summary);
+        sink.paragraph(&self.series_sentence(), Role::Detail);
         render_files(sink, &self.files);
     }
 }
