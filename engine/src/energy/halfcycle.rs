@@ -115,20 +115,6 @@ impl Motion {
     }
 }
 
-/// Robust white-noise level of `v`: median |second difference| / (0.6745 sqrt 6).
-pub(crate) fn noise_level(v: &[f64]) -> f64 {
-    let mut d2: Vec<f64> = v
-        .windows(3)
-        .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
-        .collect();
-    if d2.is_empty() {
-        return 0.0;
-    }
-    let mid = d2.len() / 2;
-    let (_, median, _) = d2.select_nth_unstable_by(mid, f64::total_cmp);
-    *median / (0.6745 * 6.0_f64.sqrt())
-}
-
 impl Samples<'_> {
     fn n(&self) -> usize {
         self.time.len()
@@ -266,7 +252,8 @@ pub(crate) fn detect_motion(
     record: &str,
 ) -> Result<Motion, EngineError> {
     let n = s.n();
-    let level = velocity_threshold.max(NOISE_FACTOR * noise_level(s.v));
+    let level =
+        velocity_threshold.max(NOISE_FACTOR * crate::record::noise::difference_noise(s.v, 2));
     // Excursions: (first, last, sign) runs of |v| > level, at least MIN_RUN long.
     let mut runs: Vec<(usize, usize, f64)> = Vec::new();
     let mut i = 0;

@@ -2,8 +2,13 @@
 //!
 //! From the measured velocity v(t), the oscillator's m, c, k and the release displacement x0:
 //!
-//! - displacement x(t) by the trapezoidal rule from x(t0) = x0 ([`cumulative_trapezoid`]);
-//! - acceleration a(t) by numerical differentiation ([`Differentiator`]);
+//! - displacement x(t) by the trapezoidal rule from x(t0) = x0 ([`cumulative_trapezoid`]),
+//!   or the record's measured displacement (an interferometer);
+//! - acceleration a(t) by numerical differentiation ([`Differentiator`]), or the record's
+//!   measured acceleration (an accelerometer): the paper's proposal of separate sensors,
+//!   which removes the differentiation error and the displacement drift from Eq. 7
+//!   ([`EnergyAnalysis::sources`] says which series were measured; a displacement-only record has its
+//!   velocity by central differences);
 //! - PE = k x^2 / 2 (Eq. 2), KE = m v^2 / 2 (Eq. 3), E = KE + PE, dE/dt = v (m a + k x) (Eq. 4);
 //! - the friction force from Eq. 7 where |v| > `velocity_threshold`, NaN elsewhere;
 //! - the differentiation-free half-cycle estimate (energy lost between turning points, less
@@ -147,7 +152,7 @@ pub struct EnergyAnalysis {
     pub half_cycle_mean: f64,
     /// Sample standard deviation of the half-cycle forces \[N\] (0 for one half-cycle).
     pub half_cycle_std: f64,
-    /// Where the displacement and acceleration series came from.
+    /// Where the displacement, velocity and acceleration series came from.
     pub sources: SeriesSources,
 }
 
@@ -159,7 +164,8 @@ pub enum SeriesSource {
     Measured,
     /// Integrated from the velocity (cumulative trapezoid from x0).
     Integrated,
-    /// Differentiated from the velocity (the configured differentiator).
+    /// Differentiated (the acceleration from the velocity by the configured differentiator,
+    /// the velocity from the displacement by central differences).
     Differentiated,
     /// Given exactly (states of a simulation).
     Exact,
@@ -177,12 +183,13 @@ impl SeriesSource {
     }
 }
 
-/// The origin of the displacement and acceleration of an [`EnergyAnalysis`] (the velocity is
-/// always the record's).
+/// The origin of the displacement, velocity and acceleration of an [`EnergyAnalysis`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct SeriesSources {
     /// Displacement: measured, or integrated from the velocity.
     pub displacement: SeriesSource,
+    /// Velocity: measured, or differentiated from the displacement (an interferometer).
+    pub velocity: SeriesSource,
     /// Acceleration: measured, or differentiated from the velocity.
     pub acceleration: SeriesSource,
 }
@@ -228,15 +235,56 @@ pub fn cumulative_trapezoid(time: &[f64], v: &[f64], x0: f64) -> Vec<f64> {
     x
 }
 
-/// The energy analysis of a measured record. A displacement channel (interferometer) replaces
-/// the displacement integrated from the velocity, and an acceleration channel (accelerometer)
-/// the differentiated acceleration, as the paper proposes; `sources` says which were used. A
-/// measured displacement must be relative to the spring's equilibrium (the x of Eq. 2).
+/// The velocity (measured, or the central difference of the displacement) and the
+/// displacement (measured, or the velocity integrated from x0) of a record, with their
+/// sources; `None` without either channel. The one place of this rule.
+pub fn record_motion(record: &Record) -> Option<RecordMotion> {
+    let time = record.time();
+    let measured_x = record.channel(Channel::Displacement);
+    let (v, velocity) = match record.channel(Channel::Velocity) {
+        Some(v) => (v.to_vec(), SeriesSource::Measured),
+        None => (
+            central_difference(time, measured_x?),
+            SeriesSource::Differentiated,
+        ),
+    };
+    let (x, displacement) = match measured_x {
+        Some(x) => (x.to_vec(), SeriesSource::Measured),
+        None => (
+            cumulative_trapezoid(time, &v, record.x0),
+            SeriesSource::Integrated,
+        ),
+    };
+    Some(RecordMotion {
+        v,
+        x,
+        velocity,
+        displacement,
+    })
+}
+
+/// The velocity and displacement of a record ([`record_motion`]) and where each came from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordMotion {
+    /// Velocity \[m/s\].
+    pub v: Vec<f64>,
+    /// Displacement \[m\].
+    pub x: Vec<f64>,
+    /// Measured, or differentiated from the displacement.
+    pub velocity: SeriesSource,
+    /// Measured, or integrated from the velocity.
+    pub displacement: SeriesSource,
+}
+
+/// The energy analysis of a measured record, from its measured displacement, velocity and
+/// acceleration where it has them (the paper's proposal of separate sensors); `sources` says
+/// which were used. A measured displacement must be relative to the spring's equilibrium
+/// (the x of Eq. 2).
 ///
-/// Errors: invalid options or oscillator; a record with fewer samples than the
-/// differentiator's window, non-finite values, non-increasing time (see
-/// [`Record::validate`]); a record without motion (|v| never clearly above the threshold and
-/// the noise).
+/// Errors: invalid options or oscillator; a record with neither velocity nor displacement,
+/// fewer samples than the differentiator's window, non-finite values, non-increasing time
+/// (see [`Record::validate_channels`]); a record without motion (|v| never clearly above the
+/// threshold and the noise).
 pub fn analyze_record(
     record: &Record,
     osc: &Oscillator,
@@ -244,20 +292,26 @@ pub fn analyze_record(
 ) -> Result<EnergyAnalysis, EngineError> {
     opts.validate()?;
     osc.validate()?;
-    record.validate(opts.differentiator.min_samples().max(MIN_RUN + 1))?;
-    let time = record.time();
-    let v = record.velocity();
-    let (x, displacement) = match record.channel(Channel::Displacement) {
-        Some(measured) => (measured.to_vec(), SeriesSource::Measured),
-        None => (
-            cumulative_trapezoid(time, v, record.x0),
-            SeriesSource::Integrated,
-        ),
+    record.validate_channels(opts.differentiator.min_samples().max(MIN_RUN + 1))?;
+    let Some(RecordMotion {
+        v,
+        x,
+        velocity,
+        displacement,
+    }) = record_motion(record)
+    else {
+        // The velocity check names what the record has instead.
+        record.validate(0)?;
+        return Err(EngineError::InvalidInput(format!(
+            "record `{}`: no motion",
+            record.name
+        )));
     };
+    let time = record.time();
     let samples = Samples {
         time,
         x: &x,
-        v,
+        v: &v,
         a: &[],
         interp: Interp::Linear,
     };
@@ -265,13 +319,14 @@ pub fn analyze_record(
     let (a, acceleration) = match record.channel(Channel::Acceleration) {
         Some(measured) => (measured.to_vec(), SeriesSource::Measured),
         None => (
-            differentiate_velocity(time, v, opts, &motion)?,
+            differentiate_velocity(time, &v, opts, &motion)?,
             SeriesSource::Differentiated,
         ),
     };
     let samples = Samples { a: &a, ..samples };
     let sources = SeriesSources {
         displacement,
+        velocity,
         acceleration,
     };
     Ok(assemble(osc, &samples, &motion, opts, sources))
@@ -345,6 +400,7 @@ pub fn analyze_states(
     let motion = detect_motion(&samples, opts.velocity_threshold, v[0], "states")?;
     let exact = SeriesSources {
         displacement: SeriesSource::Exact,
+        velocity: SeriesSource::Exact,
         acceleration: SeriesSource::Exact,
     };
     Ok(assemble(osc, &samples, &motion, opts, exact))

@@ -132,6 +132,10 @@ struct Moving {
 }
 
 fn moving_part(r: &RecordFit, osc: &Oscillator, threshold: f64) -> Option<Moving> {
+    if r.channel != "velocity" {
+        // The statistics read the fitted series as a velocity.
+        return None;
+    }
     let end = r.fitted.iter().rposition(|v| v.abs() > threshold)? + 1;
     if end < 3 || r.time.len() < end || r.measured.len() < end {
         return None;
@@ -445,6 +449,7 @@ mod tests {
             samples: time.len(),
             channel: "velocity".into(),
             rms_residual: 0.0,
+            channels: Vec::new(),
             energy_force: None,
             time,
             displacement: Vec::new(),

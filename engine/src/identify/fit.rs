@@ -13,7 +13,7 @@ use super::options::{FitOptions, OscillatorParam};
 use super::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
 use super::prefit::{prefit, prefit_finding, Prefit, PREFIT_ORIGIN};
 use super::problem::{FitProblem, ProblemParts, Realised, STEPS_PER_SAMPLE};
-use super::residuals::{NuisanceValues, Residuals, VelocityResponse};
+use super::residuals::{NuisanceValues, Residuals, Segment, VelocityResponse};
 use super::setup::{build_layout, Layout};
 use super::starts::{run_starts, start_count, MultiStart, StartRun};
 use super::stats::{self, aic, bic, t_quantile_975, Covariance};
@@ -21,13 +21,13 @@ use super::strategy::{self, plan_starts, Search, Seeded, StartPlan};
 use crate::energy::{analyze_record, model_force_budgeted};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
-use crate::record::{Channel, NormalForce, Record};
+use crate::record::{NormalForce, Record};
 use frictionid_models::FrictionModel;
 use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use super::result::{Derived, FitResult, FittedParam, Rank, RecordFit};
+pub use super::result::{ChannelFit, Derived, FitResult, FittedParam, Rank, RecordFit};
 pub use super::setup::guess_hint;
 pub use super::starts::{DEFAULT_STARTS, MAX_STARTS, PROMOTED_STARTS, SCREEN_ITERATIONS};
 
@@ -52,7 +52,12 @@ pub fn fit(
     }
     require_mechanics(&opts.unknown_oscillator, "a velocity-domain fit")?;
     let clock = Instant::now();
-    let residuals = Arc::new(response_for(records, opts)?);
+    let residuals = Arc::new(VelocityResponse::for_records(
+        records,
+        opts.velocity_offset,
+        opts.time_shift,
+        opts.x0,
+    )?);
     let seed = prefit(osc, model, records, opts);
     let mut result = fit_seeded(residuals, osc, model, records, opts, seed.as_ref())?;
     if let Some(seed) = &seed {
@@ -60,24 +65,6 @@ pub fn fit(
         result.wall_time_s = clock.elapsed().as_secs_f64();
     }
     Ok(result)
-}
-
-/// The response a velocity-domain fit compares: the velocity when every record has one, else
-/// the displacement (interferometer records). Errors: a record with neither; a velocity offset
-/// asked of displacement records.
-fn response_for(records: &[Record], opts: &FitOptions) -> Result<VelocityResponse, EngineError> {
-    match VelocityResponse::common_channel(records) {
-        Some(Channel::Displacement) if opts.velocity_offset => Err(EngineError::InvalidInput(
-            "[fit.options] velocity_offset needs velocity records; these have displacement only"
-                .into(),
-        )),
-        Some(Channel::Displacement) => Ok(VelocityResponse::displacement(opts.time_shift, opts.x0)),
-        _ => Ok(VelocityResponse::new(
-            opts.velocity_offset,
-            opts.time_shift,
-            opts.x0,
-        )),
-    }
 }
 
 /// Fits `model` with the residuals of `residuals` (see [`fit`]; the nuisance parameters are
@@ -576,13 +563,13 @@ fn record_fits<R: Residuals>(
         findings: Vec::new(),
     };
     for (ri, rec) in problem.records.iter().enumerate() {
-        let fitted = problem.predict_record(world, ri)?;
-        let measured = problem.residuals.measured(ri, rec);
-        let ss: f64 = fitted
-            .iter()
-            .zip(measured)
-            .map(|(f, m)| (f - m).powi(2))
-            .sum();
+        let predicted = problem.predict_record(world, ri)?;
+        let stacked = problem.residuals.measured(ri, rec);
+        let channels = channel_fits(&problem.residuals.segments(ri, rec), &predicted, stacked);
+        // The record's first channel is what its `measured` and `fitted` series hold.
+        let first = channels.first().map_or(0, |c| c.samples);
+        let (fitted, measured) = (predicted[..first].to_vec(), &stacked[..first]);
+        let ss = channels.first().map_or(0.0, |c| c.rms_residual.powi(2)) * first as f64;
         out.sum_sq += ss;
         out.n_total += measured.len();
         let nuisance = &world.nuisance[ri];
@@ -615,6 +602,7 @@ fn record_fits<R: Residuals>(
             samples: rec.len(),
             channel: problem.residuals.record_channel(ri).to_string(),
             rms_residual: (ss / measured.len() as f64).sqrt(),
+            channels,
             energy_force,
             time: axes.time,
             displacement: axes.displacement,
@@ -626,6 +614,32 @@ fn record_fits<R: Residuals>(
         });
     }
     Ok(out)
+}
+
+/// The fit of each compared channel of a record: its RMS residual and noise level, from the
+/// record's stacked `predicted` and `measured` series cut at `segments`.
+fn channel_fits(segments: &[Segment], predicted: &[f64], measured: &[f64]) -> Vec<ChannelFit> {
+    let mut start = 0;
+    segments
+        .iter()
+        .map(|s| {
+            let end = (start + s.len).min(predicted.len()).min(measured.len());
+            let ss: f64 = predicted[start..end]
+                .iter()
+                .zip(&measured[start..end])
+                .map(|(p, m)| (p - m).powi(2))
+                .sum();
+            let samples = end - start;
+            start = end;
+            ChannelFit {
+                channel: s.channel.to_string(),
+                unit: s.unit.to_string(),
+                samples,
+                rms_residual: (ss / samples.max(1) as f64).sqrt(),
+                noise: s.noise,
+            }
+        })
+        .collect()
 }
 
 /// The energy check of one record, its energy-based force and the model force along it.

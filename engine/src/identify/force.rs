@@ -13,7 +13,7 @@
 //!   and k; a measured force needs none of them.
 //!
 //! Residuals are `sqrt(weight) (model + offset - target) / sigma`, with sigma the record's
-//! noise level estimated from the target ([`noise_level`]), so records of different noise
+//! noise level estimated from the target ([`crate::record::noise::noise_floor_level`] of its first differences), so records of different noise
 //! weigh as they should in a joint fit. Nothing is simulated, so a force-domain fit costs a
 //! few milliseconds per evaluation and has no phase errors to trap the optimiser: it is also
 //! the prefit of velocity fits of dynamic models (see [`super::fit::fit`]).
@@ -21,11 +21,12 @@
 use super::fit::{fit_with, FitResult};
 use super::options::{FitDomain, FitOptions, ForceTarget};
 use super::residuals::STEPS_PER_SAMPLE;
-use super::residuals::{Evaluation, NuisanceKind, NuisanceValues, Residuals, SampleAxes};
+use super::residuals::{Evaluation, NuisanceKind, NuisanceValues, Residuals, SampleAxes, Segment};
 use crate::energy::model_force_budgeted;
-use crate::energy::{analyze_record, central_difference, cumulative_trapezoid};
+use crate::energy::{analyze_record, record_motion};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
+use crate::record::noise::noise_floor_level;
 use crate::record::{channel_list, Channel, NormalForce, Record};
 use frictionid_models::{FrictionModel, GuessHint};
 use std::sync::Arc;
@@ -176,7 +177,7 @@ impl ForceTrack {
             reason,
         };
         record.validate_channels(3)?;
-        let (velocity, displacement) = motion(record).ok_or_else(|| {
+        let motion = record_motion(record).ok_or_else(|| {
             err(format!(
                 "a force-domain fit needs the motion: a velocity or displacement channel (the \
                  record has: {})",
@@ -191,7 +192,7 @@ impl ForceTrack {
             }
             TargetSource::EnergyBased => {
                 require_mechanics(&opts.unknown_oscillator, "the energy-based force (Eq. 7)")?;
-                energy_target(record, &velocity, osc, opts)?
+                energy_target(record, osc, opts)?
             }
         };
         if target.len() < 2 {
@@ -205,31 +206,17 @@ impl ForceTrack {
         Ok(Self {
             source,
             time: record.time().to_vec(),
-            velocity,
-            displacement,
+            velocity: motion.v,
+            displacement: motion.x,
             normal,
-            noise: noise_level(&target),
+            noise: record
+                .given_noise(Channel::Force)
+                .filter(|_| source == TargetSource::Measured)
+                .unwrap_or_else(|| noise_floor_level(&target, 1)),
             used,
             target,
         })
     }
-}
-
-/// The velocity (measured, or the central difference of the displacement) and the
-/// displacement (measured, or the velocity integrated from x0) of a record; `None` without
-/// either channel.
-pub(crate) fn motion(record: &Record) -> Option<(Vec<f64>, Vec<f64>)> {
-    let time = record.time();
-    let measured_x = record.channel(Channel::Displacement);
-    let v = match record.channel(Channel::Velocity) {
-        Some(v) => v.to_vec(),
-        None => central_difference(time, measured_x?),
-    };
-    let x = match measured_x {
-        Some(x) => x.to_vec(),
-        None => cumulative_trapezoid(time, &v, record.x0),
-    };
-    Some((v, x))
 }
 
 /// The record's normal force, or its absence explained.
@@ -263,22 +250,14 @@ fn target_source(record: &Record, wanted: ForceTarget) -> Result<TargetSource, S
     }
 }
 
-/// The energy-based force of Eq. 7 along `record` (its velocity, or `velocity` derived from
-/// its displacement), at the samples where it is defined.
+/// The energy-based force of Eq. 7 along `record` (from its measured channels, see
+/// [`crate::energy::record_motion`]), at the samples where it is defined.
 fn energy_target(
     record: &Record,
-    velocity: &[f64],
     osc: &Oscillator,
     opts: &FitOptions,
 ) -> Result<(Vec<usize>, Vec<f64>), EngineError> {
-    let analysed = if record.channel(Channel::Velocity).is_some() {
-        analyze_record(record, osc, &opts.energy)?
-    } else {
-        let with_v = record
-            .clone()
-            .with_channel(Channel::Velocity, velocity.to_vec());
-        analyze_record(&with_v, osc, &opts.energy)?
-    };
+    let analysed = analyze_record(record, osc, &opts.energy)?;
     Ok(analysed
         .friction
         .iter()
@@ -286,23 +265,6 @@ fn energy_target(
         .filter(|(_, f)| f.is_finite())
         .map(|(i, &f)| (i, f))
         .unzip())
-}
-
-/// Noise level of a sampled force: the median absolute deviation of its first differences,
-/// scaled to a standard deviation (1.4826 / sqrt 2), robust to the jumps at reversals and
-/// masks. Never below 1e-6 of the force's RMS (noise-free records), nor zero.
-pub fn noise_level(force: &[f64]) -> f64 {
-    let mut d: Vec<f64> = force.windows(2).map(|w| w[1] - w[0]).collect();
-    let median = |v: &mut Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v.get(v.len() / 2).copied().unwrap_or(0.0)
-    };
-    let centre = median(&mut d);
-    let mut dev: Vec<f64> = d.iter().map(|x| (x - centre).abs()).collect();
-    let sigma = 1.4826 * median(&mut dev) / std::f64::consts::SQRT_2;
-    let rms = (force.iter().map(|f| f * f).sum::<f64>() / force.len().max(1) as f64).sqrt();
-    let floor = if rms > 0.0 { 1e-6 * rms } else { 1.0 };
-    sigma.max(floor)
 }
 
 impl Residuals for ForceAlongMotion {
@@ -361,20 +323,17 @@ impl Residuals for ForceAlongMotion {
             .collect())
     }
 
-    fn residuals(
-        &self,
-        at: &Evaluation<'_>,
-        index: usize,
-        record: &Record,
-        nuisance: &NuisanceValues,
-    ) -> Result<Vec<f64>, EngineError> {
-        let track = self.track_of(index, record)?;
-        let mut out = self.predict(at, index, record, nuisance)?;
-        let w = record.weight.sqrt() / track.noise;
-        for (p, m) in out.iter_mut().zip(&track.target) {
-            *p = w * (*p - m);
-        }
-        Ok(out)
+    /// One segment, weighted by the target's noise level: records of different noise weigh
+    /// as they should in a joint fit.
+    fn segments(&self, index: usize, record: &Record) -> Vec<Segment> {
+        let noise = self.tracks.get(index).map_or(1.0, |t| t.noise);
+        vec![Segment {
+            channel: self.record_channel(index),
+            unit: self.unit(),
+            len: self.measured(index, record).len(),
+            noise: Some(noise),
+            scale: 1.0 / noise,
+        }]
     }
 
     fn check_record(&self, record: &Record) -> Result<(), EngineError> {
@@ -481,16 +440,6 @@ mod tests {
     use super::*;
     use crate::record::TimeBase;
 
-    #[test]
-    fn the_noise_level_of_white_noise_on_a_ramp_is_its_sigma() {
-        let sigma = 0.01;
-        let mut f: Vec<f64> = (0..20_000).map(|i| 1.0 + 1e-5 * i as f64).collect();
-        crate::synthetic::add_gaussian_noise(&mut f, sigma, 3);
-        let est = noise_level(&f);
-        assert!((est / sigma - 1.0).abs() < 0.03, "{est}");
-        assert_eq!(noise_level(&[2.0, 2.0, 2.0]), 2e-6);
-    }
-
     fn record(channels: &[(Channel, Vec<f64>)]) -> Record {
         let time = TimeBase::new((0..50).map(|i| i as f64 * 1e-2).collect()).unwrap();
         channels
@@ -518,7 +467,7 @@ mod tests {
             .remove(0);
         assert_eq!(t.source, TargetSource::Measured);
         // The velocity is the central difference of the displacement.
-        let v = central_difference(with_force.time(), &x);
+        let v = crate::energy::central_difference(with_force.time(), &x);
         assert_eq!(t.velocity, v);
         let bare = record(&[(Channel::Displacement, x)]);
         let measured = FitOptions {

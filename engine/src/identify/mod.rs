@@ -4,7 +4,8 @@
 //!
 //! The seams:
 //! - [`residuals::Residuals`]: what a fit compares. [`residuals::VelocityResponse`] simulates
-//!   the free vibration and compares the velocity; each producer declares the per-record
+//!   the free vibration and compares every response channel (velocity, displacement,
+//!   acceleration, each weighted by its noise); each producer declares the per-record
 //!   nuisance parameters ([`residuals::NuisanceKind`]) it adds.
 //!   [`force::ForceAlongMotion`] replays the measured motion and compares the model's force
 //!   with a measured or the energy-based force (fits in the force domain).
@@ -33,6 +34,7 @@ pub mod outcome;
 pub mod prefit;
 pub mod problem;
 pub mod residuals;
+pub mod response;
 pub mod result;
 pub mod setup;
 pub mod starts;
@@ -49,6 +51,8 @@ pub use identifiability::Identifiability;
 pub use lm::LevenbergMarquardt;
 pub use options::{FitDomain, FitOptions, ForceTarget, OscillatorParam, Progress, ProgressFn};
 pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
-pub use residuals::{Evaluation, NuisanceKind, NuisanceValues, Residuals, VelocityResponse};
+pub use residuals::{
+    Evaluation, NuisanceKind, NuisanceValues, Residuals, Segment, VelocityResponse,
+};
 pub use result::{Rank, Verdict};
 pub use strategy::Search;

@@ -1,5 +1,6 @@
-//! What a fit compares: the [`Residuals`] trait and its implementation for the velocity
-//! response ([`VelocityResponse`]: simulate the free vibration, compare the velocity).
+//! What a fit compares: the [`Residuals`] trait. Its producers: the oscillator's response
+//! ([`VelocityResponse`] in `response.rs`: simulate the free vibration, compare every response
+//! channel) and the force along the measured motion (`force.rs`).
 //!
 //! A residual producer says which nuisance parameters it adds to every record (a velocity
 //! offset, a release-time shift, ...), what it measures and what the model predicts for it
@@ -12,11 +13,13 @@ use super::options::FitOptions;
 use super::work::WorkBudget;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
-use crate::record::{Channel, Record};
-use crate::simulate::{simulate, simulate_velocity, Initial, SimOptions, SimStats};
+use crate::record::Record;
+use crate::simulate::{SimOptions, SimStats};
 use frictionid_models::{FrictionModel, GuessHint};
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};
+
+pub use super::response::VelocityResponse;
 
 /// Step budget of a simulation per sample of its record: a bound on cost, not on stiffness.
 /// With `Integrator::Auto` (`[fit.options] integrator = "auto"`) the fit integrates stiff
@@ -283,7 +286,20 @@ pub trait Residuals: Send + Sync {
         self.measured(index, record).len()
     }
 
-    /// Weighted residuals `sqrt(weight) (predicted - measured)` of record `index`.
+    /// The parts of record `index`'s measured series, in order: one per compared channel
+    /// (default: one part, the whole series, unscaled).
+    fn segments(&self, index: usize, record: &Record) -> Vec<Segment> {
+        vec![Segment {
+            channel: self.record_channel(index),
+            unit: self.unit(),
+            len: self.measured(index, record).len(),
+            noise: None,
+            scale: 1.0,
+        }]
+    }
+
+    /// Weighted residuals `sqrt(weight) scale (predicted - measured)` of record `index`, with
+    /// the scale of each of its [`Residuals::segments`].
     fn residuals(
         &self,
         at: &Evaluation<'_>,
@@ -302,279 +318,37 @@ pub trait Residuals: Send + Sync {
             )));
         }
         let w = record.weight.sqrt();
-        for (p, m) in out.iter_mut().zip(measured) {
-            *p = w * (*p - m);
+        let mut start = 0;
+        for segment in self.segments(index, record) {
+            let end = (start + segment.len).min(out.len());
+            for (p, m) in out[start..end].iter_mut().zip(&measured[start..end]) {
+                *p = w * segment.scale * (*p - m);
+            }
+            start = end;
         }
         Ok(out)
     }
 }
 
-/// The oscillator's response: simulate the free vibration from the record's release state and
-/// compare the simulated velocity (plus the record's offset) with the measured one, or, for
-/// records of an interferometer ([`VelocityResponse::displacement`]), the simulated
-/// displacement with the measured one.
-#[derive(Debug, Clone, PartialEq)]
-pub struct VelocityResponse {
-    nuisance: Vec<NuisanceKind>,
-    compared: Channel,
-}
-
-impl VelocityResponse {
-    /// A velocity response with a per-record velocity offset, release shift and/or release
-    /// displacement.
-    pub fn new(velocity_offset: bool, time_shift: bool, x0: bool) -> Self {
-        let nuisance = NuisanceKind::ALL
-            .into_iter()
-            .filter(|k| match k {
-                NuisanceKind::VelocityOffset => velocity_offset,
-                NuisanceKind::ReleaseShift => time_shift,
-                NuisanceKind::StartDisplacement => x0,
-                NuisanceKind::ForceOffset => false,
-            })
-            .collect();
-        Self {
-            nuisance,
-            compared: Channel::Velocity,
-        }
-    }
-
-    /// The response seen by an interferometer: the simulated displacement against a measured
-    /// displacement channel (relative to the spring's equilibrium), with a per-record release
-    /// shift and/or release displacement.
-    pub fn displacement(time_shift: bool, x0: bool) -> Self {
-        Self {
-            compared: Channel::Displacement,
-            ..Self::new(false, time_shift, x0)
-        }
-    }
-
-    /// The channel every record of a response fit is compared in: velocity when each record has
-    /// one, else displacement when each has one (`None`: neither).
-    pub fn common_channel(records: &[Record]) -> Option<Channel> {
-        [Channel::Velocity, Channel::Displacement]
-            .into_iter()
-            .find(|&c| records.iter().all(|r| r.channel(c).is_some()))
-    }
-
-    /// The simulated response of `record` in the compared channel (see [`Self::simulate`]).
-    fn simulate_compared(
-        &self,
-        at: &Evaluation<'_>,
-        index: usize,
-        record: &Record,
-        nuisance: &NuisanceValues,
-    ) -> Result<Vec<f64>, EngineError> {
-        match self.compared {
-            Channel::Displacement => self.simulate_displacement(at, index, record, nuisance),
-            _ => self.simulate(at, index, record, nuisance),
-        }
-    }
-
-    /// The simulated displacement of `record` at its time stamps (as [`Self::simulate`]; the
-    /// samples before the release see the release displacement).
-    fn simulate_displacement(
-        &self,
-        at: &Evaluation<'_>,
-        index: usize,
-        record: &Record,
-        nuisance: &NuisanceValues,
-    ) -> Result<Vec<f64>, EngineError> {
-        let (first, times) = Self::simulation_clock(record, nuisance);
-        let x0 = nuisance.x0_of(record);
-        let mut x = vec![x0; first];
-        if let Some(&t_end) = times.last() {
-            at.count_simulation();
-            let init = Initial {
-                x0,
-                v0: record.v0,
-                z0: None,
-            };
-            let base = STEPS_PER_SAMPLE * (record.len() as u64).max(100);
-            let opts = at.capped(index, times.len(), base);
-            let traj = simulate(at.oscillator, at.model, &init, t_end, &times, &opts)?;
-            at.record_work(index, &traj.stats, times.len());
-            x.extend_from_slice(&traj.x);
-        }
-        Ok(x)
-    }
-
-    /// The number of samples before the release (shifted by the nuisance `shift`) and the
-    /// remaining sample times on the simulation clock (0 at the release).
-    fn simulation_clock(record: &Record, nuisance: &NuisanceValues) -> (usize, Vec<f64>) {
-        let t0 = record.time().first().copied().unwrap_or(0.0);
-        let release = record.release_time.unwrap_or(t0) + nuisance.shift;
-        let first = record.time().partition_point(|&t| t < release);
-        let times = record.time()[first..]
-            .iter()
-            .map(|&t| t - release)
-            .collect();
-        (first, times)
-    }
-
-    /// The simulated velocity of `record` at its time stamps, released from the nuisance
-    /// values' x0 `shift` seconds after its release instant (the one found or given when the
-    /// record was cut at its release, which may lie between samples; else its first time
-    /// stamp). Samples before the release see the release velocity; no offset. `index` is the
-    /// record's place in the fit (for its work budget).
-    pub fn simulate(
-        &self,
-        at: &Evaluation<'_>,
-        index: usize,
-        record: &Record,
-        nuisance: &NuisanceValues,
-    ) -> Result<Vec<f64>, EngineError> {
-        // Samples before the release see the initial state.
-        let (first, times) = Self::simulation_clock(record, nuisance);
-        let mut v = vec![record.v0; first];
-        if let Some(&t_end) = times.last() {
-            at.count_simulation();
-            let init = Initial {
-                x0: nuisance.x0_of(record),
-                v0: record.v0,
-                z0: None,
-            };
-            let mut sim = Vec::with_capacity(times.len());
-            let base = STEPS_PER_SAMPLE * (record.len() as u64).max(100);
-            let opts = at.capped(index, times.len(), base);
-            let stats = simulate_velocity(
-                at.oscillator,
-                at.model,
-                &init,
-                t_end,
-                &times,
-                &opts,
-                &mut sim,
-            )?;
-            at.record_work(index, &stats, times.len());
-            v.extend_from_slice(&sim);
-        }
-        Ok(v)
-    }
-}
-
-impl Residuals for VelocityResponse {
-    fn channel(&self) -> &'static str {
-        self.compared.name()
-    }
-
-    fn unit(&self) -> &'static str {
-        match self.compared {
-            Channel::Displacement => "m",
-            _ => "m/s",
-        }
-    }
-
-    fn nuisance(&self) -> &[NuisanceKind] {
-        &self.nuisance
-    }
-
-    fn measured<'a>(&'a self, _index: usize, record: &'a Record) -> &'a [f64] {
-        record.channel(self.compared).unwrap_or_default()
-    }
-
-    fn check_record(&self, record: &Record) -> Result<(), EngineError> {
-        match self.compared {
-            Channel::Displacement => record.validate_channels(3),
-            _ => record.validate(3),
-        }
-    }
-
-    /// Displacement records: the hints of their motion's velocity (the differentiated
-    /// displacement, as the force domain takes it).
-    fn hint(&self, osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
-        if self.compared == Channel::Velocity {
-            return super::setup::guess_hint(osc, records, opts);
-        }
-        let with_velocity: Vec<Record> = records
-            .iter()
-            .map(|r| match super::force::motion(r) {
-                Some((v, _)) => r.clone().with_channel(Channel::Velocity, v),
-                None => r.clone(),
-            })
-            .collect();
-        super::setup::guess_hint(osc, &with_velocity, opts)
-    }
-
-    /// The energy-balance check and the residual-structure diagnostic read the velocity: they
-    /// apply to velocity records only.
-    fn simulates_response(&self) -> bool {
-        self.compared == Channel::Velocity
-    }
-
-    fn predict(
-        &self,
-        at: &Evaluation<'_>,
-        index: usize,
-        record: &Record,
-        nuisance: &NuisanceValues,
-    ) -> Result<Vec<f64>, EngineError> {
-        let mut v = self.simulate_compared(at, index, record, nuisance)?;
-        for x in &mut v {
-            *x += nuisance.offset;
-        }
-        Ok(v)
-    }
+/// One compared channel's part of a record's measured series.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Segment {
+    /// The quantity compared (`velocity`, `displacement`, `force`, ...).
+    pub channel: &'static str,
+    /// Its SI unit.
+    pub unit: &'static str,
+    /// Number of samples.
+    pub len: usize,
+    /// The noise level its residuals are weighted by, in `unit` (`None`: not weighted).
+    pub noise: Option<f64>,
+    /// The factor on its residuals (besides sqrt(weight)): 1 for the fit's own unit, the ratio
+    /// of noise levels for a channel stacked beside it.
+    pub scale: f64,
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::exact::coulomb_free_vibration;
-    use frictionid_models::Coulomb;
-
-    /// The velocity response of a Coulomb oscillator against the exact piecewise solution:
-    /// residuals are sqrt(w) (exact + offset - measured).
-    #[test]
-    fn velocity_residuals_match_the_exact_coulomb_solution() {
-        let osc = Oscillator::fmm();
-        let model = Coulomb { mu: 0.24 };
-        let time: Vec<f64> = (0..400).map(|i| i as f64 * 2e-3).collect();
-        let exact = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.014, &time)
-            .unwrap()
-            .v;
-        let mut record = Record::new("r", time, vec![0.0; 400], 0.014);
-        record.weight = 4.0;
-        let producer = VelocityResponse::new(true, false, false);
-        assert_eq!(producer.nuisance(), &[NuisanceKind::VelocityOffset]);
-        let counter = AtomicU64::new(0);
-        let sim = SimOptions::default();
-        let at = Evaluation::new(&osc, &model, &sim, &counter);
-        let nuisance = NuisanceValues {
-            offset: 1e-3,
-            ..NuisanceValues::default()
-        };
-        let r = producer.residuals(&at, 0, &record, &nuisance).unwrap();
-        assert_eq!(counter.load(Ordering::Relaxed), 1);
-        for (ri, e) in r.iter().zip(&exact) {
-            assert!((ri - 2.0 * (e + 1e-3)).abs() < 1e-7, "{ri} vs {e}");
-        }
-    }
-
-    #[test]
-    fn samples_before_a_shifted_release_see_the_release_velocity() {
-        let osc = Oscillator::fmm();
-        let model = Coulomb { mu: 0.24 };
-        let time: Vec<f64> = (0..100).map(|i| i as f64 * 1e-3).collect();
-        let record = Record::new("r", time.clone(), vec![0.0; 100], 0.01);
-        let counter = AtomicU64::new(0);
-        let sim = SimOptions::default();
-        let at = Evaluation::new(&osc, &model, &sim, &counter);
-        let shifted = NuisanceValues {
-            shift: 0.0305,
-            ..NuisanceValues::default()
-        };
-        let v = VelocityResponse::new(false, true, false)
-            .simulate(&at, 0, &record, &shifted)
-            .unwrap();
-        assert!(v[..31].iter().all(|&x| x == 0.0));
-        let shifted: Vec<f64> = time[31..].iter().map(|t| t - 0.0305).collect();
-        let exact = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.01, &shifted)
-            .unwrap()
-            .v;
-        for (got, e) in v[31..].iter().zip(&exact) {
-            assert!((got - e).abs() < 1e-8, "{got} vs {e}");
-        }
-    }
 
     /// The default bounds: a quarter of the natural period 2 pi sqrt(m/k) for a shift, 20 %
     /// of the stated x0 for x0.

@@ -54,6 +54,8 @@ pub struct RecordFit {
     pub channel: String,
     /// RMS of fitted - measured, in the unit of the compared quantity (m/s for velocity).
     pub rms_residual: f64,
+    /// Every compared channel (the first is `channel`): its RMS residual and noise level.
+    pub channels: Vec<ChannelFit>,
     /// Energy-based force check (absent when the record cannot be analysed).
     pub energy_force: Option<EnergyForce>,
     /// Time stamps of the compared samples (for plots).
@@ -77,6 +79,21 @@ pub struct RecordFit {
     /// The model's force along the measured motion.
     #[serde(skip)]
     pub model_force: Vec<f64>,
+}
+
+/// The fit of one compared channel of a record.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ChannelFit {
+    /// The quantity compared (`velocity`, `displacement`, `acceleration`, `force`, ...).
+    pub channel: String,
+    /// Its SI unit.
+    pub unit: String,
+    /// Samples compared.
+    pub samples: usize,
+    /// RMS of fitted - measured \[unit\].
+    pub rms_residual: f64,
+    /// The noise level its residuals were weighted by \[unit\] (`None`: unweighted).
+    pub noise: Option<f64>,
 }
 
 /// A ratio the data fix even when its parts are not separately identifiable.

@@ -52,6 +52,26 @@ impl Channel {
         }
     }
 
+    /// Whether the channel measures the oscillator's response (velocity, displacement,
+    /// acceleration), which a simulation predicts.
+    pub fn is_response(self) -> bool {
+        matches!(
+            self,
+            Channel::Velocity | Channel::Displacement | Channel::Acceleration
+        )
+    }
+
+    /// The difference order its noise level is estimated from: the response channels are
+    /// smooth between reversals ([`super::noise::RESPONSE_ORDER`]); a force jumps at every
+    /// reversal and is judged on first differences.
+    pub fn noise_order(self) -> usize {
+        if self.is_response() {
+            super::noise::RESPONSE_ORDER
+        } else {
+            1
+        }
+    }
+
     /// The channel called `name` ([`Channel::name`]).
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|c| c.name() == name)

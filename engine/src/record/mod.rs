@@ -3,11 +3,13 @@
 //!
 //! - [`time`]: the [`TimeBase`] and the one check of time stamps used everywhere.
 //! - [`channel`]: the [`Channel`] names and the [`NormalForce`].
+//! - [`noise`]: a channel's white-noise level estimated from its samples.
 //! - [`source`]: one `[[records]]` entry of a configuration ([`RecordSource`]) and its loading.
 //! - [`release`]: the release instant, given or found in the pre-trigger rest.
 //! - [`sanity`]: units checked against the oscillator (mm/s, milliseconds, x0 in mm).
 
 pub mod channel;
+pub mod noise;
 pub mod release;
 pub mod sanity;
 pub mod source;
@@ -34,6 +36,9 @@ pub struct Record {
     channels: BTreeMap<Channel, Vec<f64>>,
     /// The contact's normal force; `None`: the oscillator's.
     normal_force: Option<NormalForce>,
+    /// Noise levels given for channels (`<channel>_noise`), in the channel's unit.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    noise: BTreeMap<Channel, f64>,
     /// Displacement at the first time stamp (release) [m].
     pub x0: f64,
     /// Velocity at release [m/s] (0 for a release from rest).
@@ -64,6 +69,7 @@ impl Record {
             time,
             channels: BTreeMap::new(),
             normal_force: None,
+            noise: BTreeMap::new(),
             x0: 0.0,
             v0: 0.0,
             weight: 1.0,
@@ -168,11 +174,34 @@ impl Record {
                 NormalForce::Sampled(v) => NormalForce::Sampled(tail(v)),
                 constant => constant.clone(),
             }),
+            noise: self.noise.clone(),
             x0: self.x0,
             v0: self.v0,
             weight: self.weight,
             release_time: self.release_time,
         }
+    }
+
+    /// The record with `sigma` as the given noise level of `channel` (in its unit).
+    pub fn with_noise(mut self, channel: Channel, sigma: f64) -> Self {
+        self.noise.insert(channel, sigma);
+        self
+    }
+
+    /// The noise level given for `channel`, if any.
+    pub fn given_noise(&self, channel: Channel) -> Option<f64> {
+        self.noise.get(&channel).copied()
+    }
+
+    /// The noise level of `channel`: the given one, else estimated from its samples
+    /// ([`noise::noise_floor_level`] of the channel's [`Channel::noise_order`] differences);
+    /// `None` when the record lacks the channel.
+    pub fn noise_level(&self, channel: Channel) -> Option<f64> {
+        let values = self.channel(channel)?;
+        Some(
+            self.given_noise(channel)
+                .unwrap_or_else(|| noise::noise_floor_level(values, channel.noise_order())),
+        )
     }
 
     /// Number of samples.
@@ -218,6 +247,13 @@ impl Record {
         }
         if !(self.weight.is_finite() && self.weight > 0.0) {
             return Err(err(format!("weight must be > 0, got {}", self.weight)));
+        }
+        if let Some((c, sigma)) = self
+            .noise
+            .iter()
+            .find(|(_, s)| !(s.is_finite() && **s > 0.0))
+        {
+            return Err(err(format!("{c}_noise must be > 0, got {sigma}")));
         }
         Ok(())
     }

@@ -17,6 +17,8 @@
 //! # displacement_, acceleration_, force_ and normal_force_ column and scale alike: a channel
 //! # is read when its column is found (default: the channel's own name); a negative scale
 //! # flips a sign convention
+//! velocity_noise = 2e-4       # m/s, the channel's noise level (default: estimated from it);
+//! # displacement_, acceleration_ and force_noise alike, in the channel's SI unit
 //! normal_force = 14.5         # N, this record's constant normal force (else the oscillator's)
 //! release = "auto"            # or a time in s: drop the pre-trigger rest (default: none)
 //! min_samples = 10
@@ -78,6 +80,14 @@ pub struct RecordSource {
     pub normal_force_scale: Option<f64>,
     /// This record's constant normal force \[N\] (default: the oscillator's, or the channel).
     pub normal_force: Option<f64>,
+    /// Noise level of the velocity channel [m/s] (default: estimated from the record).
+    pub velocity_noise: Option<f64>,
+    /// Noise level of the displacement channel \[m\] (default: estimated).
+    pub displacement_noise: Option<f64>,
+    /// Noise level of the acceleration channel [m/s^2] (default: estimated).
+    pub acceleration_noise: Option<f64>,
+    /// Noise level of the force channel \[N\] (default: estimated).
+    pub force_noise: Option<f64>,
     /// Where the free vibration starts (default: at the first sample).
     pub release: Option<Release>,
     /// Fewest samples accepted (default 10).
@@ -108,6 +118,14 @@ pub enum RecordSourceError {
     BadWeight {
         index: usize,
         file: String,
+        value: f64,
+    },
+    /// A noise level that is not a positive number.
+    #[error("[[records]] entry {index} (`{file}`): `{key}` must be > 0 (the channel's noise level in SI units), got {value}")]
+    BadNoise {
+        index: usize,
+        file: String,
+        key: String,
         value: f64,
     },
     /// A negative constant normal force.
@@ -144,6 +162,10 @@ macro_rules! record_keys {
             normal_force_column,
             normal_force_scale,
             normal_force,
+            velocity_noise,
+            displacement_noise,
+            acceleration_noise,
+            force_noise,
             release,
             min_samples,
             sampling_tolerance
@@ -166,6 +188,8 @@ pub struct ResolvedSource {
     pub weight: f64,
     /// This record's constant normal force \[N\], if given.
     pub normal_force: Option<f64>,
+    /// Noise levels given per channel, in the channel's SI unit.
+    pub noise: Vec<(Channel, f64)>,
     /// Where the free vibration starts (`None`: at the first sample).
     pub release: Option<Release>,
     /// How to read the file.
@@ -183,6 +207,9 @@ impl ResolvedSource {
         record.weight = self.weight;
         if let Some(n) = self.normal_force {
             record.set_normal_force(Some(NormalForce::Constant(n)));
+        }
+        for &(channel, sigma) in &self.noise {
+            record = record.with_noise(channel, sigma);
         }
         self.start_at_release(record)
     }
@@ -291,6 +318,7 @@ impl RecordSource {
             finite("release", t)?;
         }
         let normal_force = self.normal_force(index, &file)?;
+        let noise = self.noise(index, &file)?;
         let path = Path::new(&file);
         Ok(ResolvedSource {
             file: if path.is_absolute() {
@@ -302,6 +330,7 @@ impl RecordSource {
             v0,
             weight,
             normal_force,
+            noise,
             release: self.release,
             read: self.read_options(),
             file_as_written: file,
@@ -335,6 +364,32 @@ impl RecordSource {
             });
         }
         Ok(Some(n))
+    }
+
+    /// The given noise levels (`<channel>_noise`), each checked to be > 0.
+    fn noise(&self, index: usize, file: &str) -> Result<Vec<(Channel, f64)>, RecordSourceError> {
+        let given = [
+            (Channel::Velocity, self.velocity_noise),
+            (Channel::Displacement, self.displacement_noise),
+            (Channel::Acceleration, self.acceleration_noise),
+            (Channel::Force, self.force_noise),
+        ];
+        given
+            .into_iter()
+            .filter_map(|(c, sigma)| sigma.map(|s| (c, s)))
+            .map(|(channel, value)| {
+                if value.is_finite() && value > 0.0 {
+                    Ok((channel, value))
+                } else {
+                    Err(RecordSourceError::BadNoise {
+                        index,
+                        file: file.into(),
+                        key: format!("{channel}_noise"),
+                        value,
+                    })
+                }
+            })
+            .collect()
     }
 
     /// The column and scale keys of each channel.

@@ -56,7 +56,7 @@ pub struct EnergyRecord {
     pub masked: usize,
     /// Samples analysed.
     pub samples: usize,
-    /// Whether x and a were measured or integrated / differentiated from the velocity.
+    /// Whether x, v and a were measured, or integrated / differentiated.
     pub sources: SeriesSources,
     /// The analysis (for plots).
     #[serde(skip)]
@@ -81,8 +81,9 @@ impl EnergyReport {
                     fmt_percent(r.percent_difference),
                     r.half_cycles.len().to_string(),
                     format!(
-                        "{} / {}",
+                        "{} / {} / {}",
                         r.sources.displacement.name(),
+                        r.sources.velocity.name(),
                         r.sources.acceleration.name()
                     ),
                 ]
@@ -96,7 +97,7 @@ impl EnergyReport {
                 "reference [N]",
                 "difference [%]",
                 "half-cycles",
-                "x / a",
+                "x / v / a",
             ],
             rows,
         )

@@ -253,6 +253,43 @@ pub fn record_table(fit: &FitResult) -> Table {
     )
 }
 
+/// Every compared channel of every record: its RMS residual against the noise level its
+/// residuals were weighted by (`-`: unweighted).
+pub fn channel_table(fit: &FitResult) -> Table {
+    let rows = fit
+        .records
+        .iter()
+        .flat_map(|r| r.channels.iter().map(move |c| (r, c)))
+        .map(|(r, c)| {
+            let (noise, ratio) = match c.noise {
+                Some(n) => (fmt_num(n), fmt_num(c.rms_residual / n)),
+                None => ("-".into(), "-".into()),
+            };
+            vec![
+                r.file.clone(),
+                c.channel.clone(),
+                c.unit.clone(),
+                c.samples.to_string(),
+                fmt_num(c.rms_residual),
+                noise,
+                ratio,
+            ]
+        })
+        .collect();
+    Table::new(
+        &[
+            "record",
+            "channel",
+            "unit",
+            "samples",
+            "rms residual",
+            "noise",
+            "rms/noise",
+        ],
+        rows,
+    )
+}
+
 /// The oscillator's derived quantities: k/m, c/m, the undamped natural frequency and the
 /// damping ratio, with standard errors where the fit gives them.
 pub fn oscillator_table(fit: &FitResult) -> Table {
@@ -369,6 +406,7 @@ impl Render for FitReport {
         sink.table(&oscillator_table(f), Role::Detail);
         sink.heading(2, "Records", Role::Detail);
         sink.table(&record_table(f), Role::Summary);
+        sink.table(&channel_table(f), Role::Detail);
         sink.paragraph(&self.statistics_text(), Role::Detail);
         sink.paragraph(&self.terminal_text(), Role::Brief);
         render_files(sink, &self.files);

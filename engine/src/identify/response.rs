@@ -1,0 +1,490 @@
+//! The oscillator's response as a fit compares it ([`VelocityResponse`]): simulate the free
+//! vibration from each record's release state and compare every response channel the record
+//! holds (velocity, displacement, acceleration), stacked.
+//!
+//! Each channel's residuals are weighted by its own noise level (the record's
+//! `<channel>_noise`, else estimated from its third differences, [`crate::record::noise`]).
+//! The fit keeps the unit of its primary channel (the first of velocity, displacement,
+//! acceleration that any record holds): a record's primary-channel residuals are in that
+//! unit as they always were, every other channel's are scaled by sigma_primary / sigma_channel,
+//! so a velocity-only fit is unchanged and a joint fit weighs each sample by 1 / sigma^2. A
+//! record without the primary channel is scaled by the median primary noise of the others.
+//!
+//! The nuisance parameters stay coherent over the channels: one simulation per record from
+//! the fitted x0 and release shift feeds all of them; the velocity offset applies to the
+//! velocity channel (and needs one in every record).
+
+use super::options::FitOptions;
+use super::residuals::{
+    Evaluation, NuisanceKind, NuisanceValues, Residuals, Segment, STEPS_PER_SAMPLE,
+};
+use crate::energy::record_motion;
+use crate::error::EngineError;
+use crate::oscillator::Oscillator;
+use crate::record::{channel_list, Channel, Record};
+use crate::simulate::{simulate, simulate_velocity, Initial, SimOptions};
+use frictionid_models::GuessHint;
+
+/// The response channels, in the order they are stacked.
+const RESPONSE: [Channel; 3] = [
+    Channel::Velocity,
+    Channel::Displacement,
+    Channel::Acceleration,
+];
+
+/// One compared channel of a record.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Stacked {
+    channel: Channel,
+    noise: f64,
+    scale: f64,
+}
+
+/// A record's compared channels and their measured samples, concatenated.
+#[derive(Debug, Clone, PartialEq)]
+struct ResponseTrack {
+    stacked: Vec<Stacked>,
+    measured: Vec<f64>,
+}
+
+/// The response producer. Built by [`VelocityResponse::for_records`] it compares every
+/// response channel; built by [`VelocityResponse::new`] (no records) it compares the velocity
+/// channel alone, unweighted.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VelocityResponse {
+    nuisance: Vec<NuisanceKind>,
+    tracks: Vec<ResponseTrack>,
+    primary: Channel,
+}
+
+impl VelocityResponse {
+    /// A velocity-only response with a per-record velocity offset, release shift and/or
+    /// release displacement.
+    pub fn new(velocity_offset: bool, time_shift: bool, x0: bool) -> Self {
+        let nuisance = NuisanceKind::ALL
+            .into_iter()
+            .filter(|k| match k {
+                NuisanceKind::VelocityOffset => velocity_offset,
+                NuisanceKind::ReleaseShift => time_shift,
+                NuisanceKind::StartDisplacement => x0,
+                NuisanceKind::ForceOffset => false,
+            })
+            .collect();
+        Self {
+            nuisance,
+            tracks: Vec::new(),
+            primary: Channel::Velocity,
+        }
+    }
+
+    /// The response of `records` over every response channel each holds, with the nuisance
+    /// parameters of [`VelocityResponse::new`]. Errors: a record without a response channel;
+    /// a velocity offset asked for a record without velocity.
+    pub fn for_records(
+        records: &[Record],
+        velocity_offset: bool,
+        time_shift: bool,
+        x0: bool,
+    ) -> Result<Self, EngineError> {
+        let mut out = Self::new(velocity_offset, time_shift, x0);
+        let present = |c: Channel| records.iter().any(|r| r.channel(c).is_some());
+        out.primary = RESPONSE
+            .into_iter()
+            .find(|&c| present(c))
+            .unwrap_or(Channel::Velocity);
+        let reference = median_noise(records, out.primary);
+        for record in records {
+            check_response_channels(record, velocity_offset)?;
+            out.tracks.push(track(record, out.primary, reference));
+        }
+        Ok(out)
+    }
+
+    /// The simulated velocity of `record` at its time stamps, released from the nuisance
+    /// values' x0 `shift` seconds after its release instant (the one found or given when the
+    /// record was cut at its release, which may lie between samples; else its first time
+    /// stamp). Samples before the release see the release velocity; no offset. `index` is the
+    /// record's place in the fit (for its work budget, [`super::work`]).
+    pub fn simulate(
+        &self,
+        at: &Evaluation<'_>,
+        index: usize,
+        record: &Record,
+        nuisance: &NuisanceValues,
+    ) -> Result<Vec<f64>, EngineError> {
+        let clock = ReleaseClock::new(record, nuisance);
+        let mut v = vec![record.v0; clock.before];
+        if let Some(&t_end) = clock.times.last() {
+            at.count_simulation();
+            let mut sim = Vec::with_capacity(clock.times.len());
+            let init = initial(record, nuisance);
+            let opts = budgeted(at, index, record, clock.times.len());
+            let stats = simulate_velocity(
+                at.oscillator,
+                at.model,
+                &init,
+                t_end,
+                &clock.times,
+                &opts,
+                &mut sim,
+            )?;
+            at.record_work(index, &stats, clock.times.len());
+            v.extend_from_slice(&sim);
+        }
+        Ok(v)
+    }
+
+    /// The simulated `channels` of `record` (as [`VelocityResponse::simulate`]; before the
+    /// release: x0, v0 and no acceleration), concatenated in the order given.
+    fn simulate_channels(
+        &self,
+        at: &Evaluation<'_>,
+        index: usize,
+        record: &Record,
+        nuisance: &NuisanceValues,
+        channels: &[Channel],
+    ) -> Result<Vec<f64>, EngineError> {
+        let clock = ReleaseClock::new(record, nuisance);
+        let x0 = nuisance.x0_of(record);
+        let trajectory = match clock.times.last() {
+            Some(&t_end) => {
+                at.count_simulation();
+                let opts = budgeted(at, index, record, clock.times.len());
+                let init = initial(record, nuisance);
+                let trajectory =
+                    simulate(at.oscillator, at.model, &init, t_end, &clock.times, &opts)?;
+                at.record_work(index, &trajectory.stats, clock.times.len());
+                Some(trajectory)
+            }
+            None => None,
+        };
+        let mut out = Vec::with_capacity(channels.len() * record.len());
+        for &channel in channels {
+            let (held, series) = match channel {
+                Channel::Displacement => (x0, trajectory.as_ref().map(|t| &t.x)),
+                Channel::Acceleration => (0.0, trajectory.as_ref().map(|t| &t.a)),
+                _ => (record.v0, trajectory.as_ref().map(|t| &t.v)),
+            };
+            out.extend(std::iter::repeat_n(held, clock.before));
+            out.extend(series.into_iter().flatten());
+        }
+        Ok(out)
+    }
+
+    fn track_of(&self, index: usize) -> Option<&ResponseTrack> {
+        self.tracks.get(index)
+    }
+
+    /// The channels compared in record `index`.
+    fn channels_of(&self, index: usize) -> Vec<Channel> {
+        match self.track_of(index) {
+            Some(t) => t.stacked.iter().map(|s| s.channel).collect(),
+            None => vec![Channel::Velocity],
+        }
+    }
+}
+
+/// Sample times of a record on the simulation clock (from the shifted release), and how
+/// many samples lie before the release.
+struct ReleaseClock {
+    before: usize,
+    times: Vec<f64>,
+}
+
+impl ReleaseClock {
+    fn new(record: &Record, nuisance: &NuisanceValues) -> Self {
+        let t0 = record.time().first().copied().unwrap_or(0.0);
+        let release = record.release_time.unwrap_or(t0) + nuisance.shift;
+        let before = record.time().partition_point(|&t| t < release);
+        let times = record.time()[before..]
+            .iter()
+            .map(|&t| t - release)
+            .collect();
+        Self { before, times }
+    }
+}
+
+/// The release state of `record` under `nuisance`.
+fn initial(record: &Record, nuisance: &NuisanceValues) -> Initial {
+    Initial {
+        x0: nuisance.x0_of(record),
+        v0: record.v0,
+        z0: None,
+    }
+}
+
+/// The simulation options of record `index` with `simulated` samples: the step budget of
+/// the record ([`STEPS_PER_SAMPLE`]) and of the fit's work ([`super::work`]).
+fn budgeted(at: &Evaluation<'_>, index: usize, record: &Record, simulated: usize) -> SimOptions {
+    let base = STEPS_PER_SAMPLE * (record.len() as u64).max(100);
+    at.capped(index, simulated, base)
+}
+
+/// The record has a response channel, and velocity when a velocity offset is fitted.
+fn check_response_channels(record: &Record, velocity_offset: bool) -> Result<(), EngineError> {
+    let err = |reason: String| EngineError::Record {
+        record: record.name.clone(),
+        reason,
+    };
+    let has = |c: Channel| record.channel(c).is_some();
+    if !RESPONSE.into_iter().any(has) {
+        return Err(err(format!(
+            "no response channel to fit: a velocity, displacement or acceleration channel is \
+             needed (the record has: {}; a force record is fitted with [fit.options] domain = \
+             \"force\")",
+            channel_list(&record.channels())
+        )));
+    }
+    if velocity_offset && !has(Channel::Velocity) {
+        return Err(err(format!(
+            "[fit.options] velocity_offset = true needs a velocity channel (the record has: {})",
+            channel_list(&record.channels())
+        )));
+    }
+    Ok(())
+}
+
+/// The median noise level of `channel` over the records that hold it (1 when none does).
+fn median_noise(records: &[Record], channel: Channel) -> f64 {
+    let mut levels: Vec<f64> = records
+        .iter()
+        .filter_map(|r| r.noise_level(channel))
+        .collect();
+    levels.sort_by(f64::total_cmp);
+    levels.get(levels.len() / 2).copied().unwrap_or(1.0)
+}
+
+/// The compared channels of `record`, each scaled to the primary channel's noise (its own
+/// where it has the primary channel, else `reference`).
+fn track(record: &Record, primary: Channel, reference: f64) -> ResponseTrack {
+    let own = record.noise_level(primary).unwrap_or(reference);
+    let mut stacked = Vec::new();
+    let mut measured = Vec::new();
+    for channel in RESPONSE {
+        let (Some(values), Some(noise)) = (record.channel(channel), record.noise_level(channel))
+        else {
+            continue;
+        };
+        let scale = if channel == primary { 1.0 } else { own / noise };
+        stacked.push(Stacked {
+            channel,
+            noise,
+            scale,
+        });
+        measured.extend_from_slice(values);
+    }
+    ResponseTrack { stacked, measured }
+}
+
+impl Residuals for VelocityResponse {
+    fn channel(&self) -> &'static str {
+        self.primary.name()
+    }
+
+    /// The record's first compared channel (the one its `measured` and `fitted` series in a
+    /// report hold).
+    fn record_channel(&self, index: usize) -> &'static str {
+        self.channels_of(index)
+            .first()
+            .map_or("velocity", |c| c.name())
+    }
+
+    fn unit(&self) -> &'static str {
+        self.primary.unit()
+    }
+
+    fn nuisance(&self) -> &[NuisanceKind] {
+        &self.nuisance
+    }
+
+    fn measured<'a>(&'a self, index: usize, record: &'a Record) -> &'a [f64] {
+        match self.track_of(index) {
+            Some(t) => &t.measured,
+            None => record.velocity(),
+        }
+    }
+
+    fn predict(
+        &self,
+        at: &Evaluation<'_>,
+        index: usize,
+        record: &Record,
+        nuisance: &NuisanceValues,
+    ) -> Result<Vec<f64>, EngineError> {
+        let channels = self.channels_of(index);
+        let mut out = if channels == [Channel::Velocity] {
+            self.simulate(at, index, record, nuisance)?
+        } else {
+            self.simulate_channels(at, index, record, nuisance, &channels)?
+        };
+        if let Some(v) = channels.iter().position(|&c| c == Channel::Velocity) {
+            let n = record.len();
+            for x in out.iter_mut().skip(v * n).take(n) {
+                *x += nuisance.offset;
+            }
+        }
+        Ok(out)
+    }
+
+    /// Hints from the energy analysis of the velocity; a record without one lends it the
+    /// differentiated displacement ([`record_motion`]).
+    fn hint(&self, osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
+        let with_velocity: Vec<Record> = records
+            .iter()
+            .map(|r| match (r.channel(Channel::Velocity), record_motion(r)) {
+                (None, Some(motion)) => r.clone().with_channel(Channel::Velocity, motion.v),
+                _ => r.clone(),
+            })
+            .collect();
+        super::setup::guess_hint(osc, &with_velocity, opts)
+    }
+
+    /// Prepared records need a response channel (not necessarily velocity); an unprepared
+    /// producer compares velocity, so needs it.
+    fn check_record(&self, record: &Record) -> Result<(), EngineError> {
+        if self.tracks.is_empty() {
+            record.validate(3)
+        } else {
+            record.validate_channels(3)
+        }
+    }
+
+    fn segments(&self, index: usize, record: &Record) -> Vec<Segment> {
+        let Some(t) = self.track_of(index) else {
+            return vec![Segment {
+                channel: "velocity",
+                unit: "m/s",
+                len: record.velocity().len(),
+                noise: None,
+                scale: 1.0,
+            }];
+        };
+        t.stacked
+            .iter()
+            .map(|s| Segment {
+                channel: s.channel.name(),
+                unit: s.channel.unit(),
+                len: record.len(),
+                noise: Some(s.noise),
+                scale: s.scale,
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exact::coulomb_free_vibration;
+    use crate::oscillator::Oscillator;
+    use crate::record::TimeBase;
+    use frictionid_models::Coulomb;
+    use std::sync::atomic::{AtomicU64, Ordering};
+
+    /// A displacement + acceleration record of the exact Coulomb solution: at the true
+    /// parameters the stacked prediction is the exact x then a (to the integrator's
+    /// accuracy), and the acceleration part is scaled by sigma_x / sigma_a.
+    #[test]
+    fn stacked_channels_match_the_exact_solution_and_are_scaled_by_their_noise() {
+        let osc = Oscillator::fmm();
+        let time: Vec<f64> = (0..1500).map(|i| i as f64 * 1e-3).collect();
+        let exact = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.014, &time).unwrap();
+        let mut record = Record::from_time_base("r", TimeBase::new(time).unwrap())
+            .with_channel(Channel::Displacement, exact.x.clone())
+            .with_channel(Channel::Acceleration, exact.a.clone())
+            .with_noise(Channel::Displacement, 5e-7)
+            .with_noise(Channel::Acceleration, 5e-3);
+        record.x0 = 0.014;
+        let producer =
+            VelocityResponse::for_records(std::slice::from_ref(&record), false, false, false)
+                .unwrap();
+        assert_eq!((producer.channel(), producer.unit()), ("displacement", "m"));
+        let segments = producer.segments(0, &record);
+        assert_eq!(segments.len(), 2);
+        assert_eq!(
+            (segments[1].channel, segments[1].noise),
+            ("acceleration", Some(5e-3))
+        );
+        assert!((segments[1].scale - 1e-4).abs() < 1e-18);
+        let counter = AtomicU64::new(0);
+        let sim = SimOptions::default();
+        let model = Coulomb { mu: 0.24 };
+        let at = Evaluation::new(&osc, &model, &sim, &counter);
+        let predicted = producer
+            .predict(&at, 0, &record, &NuisanceValues::default())
+            .unwrap();
+        let (x, a) = predicted.split_at(1500);
+        assert!(x.iter().zip(&exact.x).all(|(p, e)| (p - e).abs() < 1e-8));
+        // Away from the reversals, where a sample may fall on either side of the jump.
+        let mismatched = a
+            .iter()
+            .zip(&exact.a)
+            .filter(|(p, e)| (*p - *e).abs() > 1e-6)
+            .count();
+        assert!(mismatched <= exact.half_cycles(), "{mismatched}");
+        let bare = Record::from_time_base("f", TimeBase::new(vec![0.0, 1.0]).unwrap())
+            .with_channel(Channel::Force, vec![0.0, 1.0]);
+        let e = VelocityResponse::for_records(&[bare], false, false, false).unwrap_err();
+        assert!(e.to_string().contains("no response channel to fit"), "{e}");
+        let e = VelocityResponse::for_records(&[record], true, false, false).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("velocity_offset = true needs a velocity channel"),
+            "{e}"
+        );
+    }
+
+    /// The velocity response of a Coulomb oscillator against the exact piecewise solution:
+    /// residuals are sqrt(w) (exact + offset - measured).
+    #[test]
+    fn velocity_residuals_match_the_exact_coulomb_solution() {
+        let osc = Oscillator::fmm();
+        let model = Coulomb { mu: 0.24 };
+        let time: Vec<f64> = (0..400).map(|i| i as f64 * 2e-3).collect();
+        let exact = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.014, &time)
+            .unwrap()
+            .v;
+        let mut record = Record::new("r", time, vec![0.0; 400], 0.014);
+        record.weight = 4.0;
+        let producer = VelocityResponse::new(true, false, false);
+        assert_eq!(producer.nuisance(), &[NuisanceKind::VelocityOffset]);
+        let counter = AtomicU64::new(0);
+        let sim = SimOptions::default();
+        let at = Evaluation::new(&osc, &model, &sim, &counter);
+        let nuisance = NuisanceValues {
+            offset: 1e-3,
+            ..NuisanceValues::default()
+        };
+        let r = producer.residuals(&at, 0, &record, &nuisance).unwrap();
+        assert_eq!(counter.load(Ordering::Relaxed), 1);
+        for (ri, e) in r.iter().zip(&exact) {
+            assert!((ri - 2.0 * (e + 1e-3)).abs() < 1e-7, "{ri} vs {e}");
+        }
+    }
+
+    #[test]
+    fn samples_before_a_shifted_release_see_the_release_velocity() {
+        let osc = Oscillator::fmm();
+        let model = Coulomb { mu: 0.24 };
+        let time: Vec<f64> = (0..100).map(|i| i as f64 * 1e-3).collect();
+        let record = Record::new("r", time.clone(), vec![0.0; 100], 0.01);
+        let counter = AtomicU64::new(0);
+        let sim = SimOptions::default();
+        let at = Evaluation::new(&osc, &model, &sim, &counter);
+        let shifted = NuisanceValues {
+            shift: 0.0305,
+            ..NuisanceValues::default()
+        };
+        let v = VelocityResponse::new(false, true, false)
+            .simulate(&at, 0, &record, &shifted)
+            .unwrap();
+        assert!(v[..31].iter().all(|&x| x == 0.0));
+        let shifted: Vec<f64> = time[31..].iter().map(|t| t - 0.0305).collect();
+        let exact = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.01, &shifted)
+            .unwrap()
+            .v;
+        for (got, e) in v[31..].iter().zip(&exact) {
+            assert!((got - e).abs() < 1e-8, "{got} vs {e}");
+        }
+    }
+}
