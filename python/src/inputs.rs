@@ -124,7 +124,8 @@ fn add_channel(
     Ok(record.with_channel(channel, values))
 }
 
-/// One record from a dict: `t` and channels as arrays, `x0`, optional `name`, `v0`, `weight`.
+/// One record from a dict: `t` and channels as arrays, `x0`, optional `name`, `v0`, `weight`,
+/// `release_time` and `<channel>_noise` levels.
 pub fn record(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<Record> {
     let default_name = format!("record {}", index + 1);
     let dict = obj
@@ -143,11 +144,34 @@ pub fn record(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<Record> {
     record.release_time = float_key(dict, "release_time", &name)?;
     for (key, value) in dict.iter() {
         let key: String = key.extract()?;
-        if !RECORD_KEYS.contains(&key.as_str()) {
-            record = add_channel(record, &key, &value, &name)?;
+        if RECORD_KEYS.contains(&key.as_str()) {
+            continue;
         }
+        record = match key.strip_suffix("_noise") {
+            Some(channel) => add_noise(record, channel, &value, &name)?,
+            None => add_channel(record, &key, &value, &name)?,
+        };
     }
     Ok(record)
+}
+
+/// Gives `record` the noise level under `<channel>_noise` (a positive number in the channel's
+/// SI unit); without one a fit estimates it from the channel.
+fn add_noise(
+    record: Record,
+    channel: &str,
+    value: &Bound<'_, PyAny>,
+    what: &str,
+) -> PyResult<Record> {
+    let key = format!("{channel}_noise");
+    let channel = channel_of(channel)
+        .ok_or_else(|| value_error(format!("{what}: unknown key `{key}`: `{channel}` is not a channel")))?;
+    match value.extract::<f64>() {
+        Ok(sigma) if sigma > 0.0 && sigma.is_finite() => Ok(record.with_noise(channel, sigma)),
+        _ => Err(value_error(format!(
+            "{what}: `{key}` must be a number > 0 (the channel's noise level in SI units)"
+        ))),
+    }
 }
 
 /// Records from a list of dicts (at least one).

@@ -225,3 +225,27 @@ def test_force_domain_fit_from_arrays_recovers_a_coulomb_law():
     )
     (param,) = [p for p in out["parameters"] if p["name"] == "mu"]
     assert abs(param["value"] / mu - 1.0) < 1e-6
+
+
+def test_channel_noise_keys_weight_a_vibrometer_accelerometer_fit():
+    """A vibrometer + accelerometer record with the sensors' noise levels given as
+    `velocity_noise` and `acceleration_noise`: the fit compares both channels and reports
+    each with the noise it was given (not an estimate), and the truth mu = 0.24 is recovered."""
+    t = np.arange(0, 2001) * 1e-3
+    sim = frictionid.simulate(FMM, {"type": "coulomb", "mu": 0.24}, 0.014, t)
+    rng = np.random.default_rng(5)
+    record = {
+        "name": "pair", "t": t, "x0": 0.014,
+        "v": sim["v"] + rng.normal(0.0, 2e-4, t.size),
+        "a": sim["a"] + rng.normal(0.0, 5e-3, t.size),
+        "velocity_noise": 2e-4, "acceleration_noise": 5e-3,
+    }
+    out = frictionid.fit(FMM, {"type": "coulomb", "mu": 0.2}, [record])
+    channels = out["records"][0]["channels"]
+    assert [(c["channel"], c["noise"]) for c in channels] == [("velocity", 2e-4), ("acceleration", 5e-3)]
+    (mu,) = [p["value"] for p in out["parameters"] if p["name"] == "mu"]
+    assert abs(mu / 0.24 - 1.0) < 1e-2
+    with pytest.raises(ValueError, match="`acceleration_noise` must be a number > 0"):
+        frictionid.fit(FMM, {"type": "coulomb"}, [dict(record, acceleration_noise=-1.0)])
+    with pytest.raises(ValueError, match="unknown key `speed_noise`"):
+        frictionid.fit(FMM, {"type": "coulomb"}, [dict(record, speed_noise=1.0)])
