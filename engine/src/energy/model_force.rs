@@ -6,24 +6,32 @@
 //! between samples. Bristle models are stiff while sliding: LuGre's and Dahl's states relax
 //! at a rate lambda ~ sigma0 |v| / (mu N), about 3e3 1/s for sigma0 = 1e5 N/m at 0.1 m/s with
 //! mu N = 3.5 N, so a plain explicit step of dt = 1 ms (lambda dt ~ 3) would diverge. Each
-//! sample interval is therefore integrated with the embedded Bogacki-Shampine 3(2) pair under
-//! error control (rtol 1e-8, atol 1e-12 per state). The controller shrinks the sub-step to
-//! what accuracy needs in the transients after a reversal and to the method's stability limit
-//! (~2.5 / lambda) while the state sits on its slow manifold, so the result stays stable and
-//! accurate for any stiffness, at a cost of about sigma0 |v| dt / (2.5 mu N) sub-steps per
-//! sample (~1-4 for the paper's case). It needs nothing of the model beyond
+//! sample interval is therefore integrated with the Dormand-Prince 5(4) pair under error
+//! control (rtol 1e-8, atol 1e-12 per state). The controller shrinks the sub-step to what
+//! accuracy needs in the transients after a reversal and to the method's stability limit
+//! (~3.3 / lambda) while the state sits on its slow manifold, so the result stays stable and
+//! accurate for any stiffness. The stepper runs on from one interval into the next (v and N are
+//! continuous at the samples, so its step size and its last stage carry over): on the
+//! tribometer record a GMS force takes about 1.2 steps per sample, where the Bogacki-Shampine
+//! 3(2) pair this replaced took 2.4 at the same tolerance and 19 % more evaluations of f. An
+//! interval in which v changes sign is split at the zero of the linear v: the states' rate,
+//! odd in v, has a kink there that a step's error estimate would not see. It
+//! needs nothing of the model beyond
 //! `state_derivative`, so every registered model works unchanged.
 
 use super::EnergyAnalysis;
 use crate::error::{EngineError, IntegrationFailure};
 use crate::oscillator::Oscillator;
 use crate::record::NormalForce;
-use crate::simulate::{BogackiShampine, OdeSystem, StepOutcome, Stepper};
+use crate::simulate::{Dopri5, OdeSystem, StepOutcome, Stepper};
 use frictionid_models::FrictionModel;
 use serde::Serialize;
 
 const RTOL: f64 = 1e-8;
 const ATOL: f64 = 1e-12;
+/// Fraction of a sample interval next to its ends where a reversal does not split it (a
+/// piece that short could not be resolved in time; its kink is negligible).
+const REVERSAL_MARGIN: f64 = 1e-6;
 /// Total sub-step budget of one call (accepted and rejected).
 const MAX_SUBSTEPS: u64 = 20_000_000;
 
@@ -85,7 +93,7 @@ pub fn model_force_budgeted(
     }
     let mut z = vec![0.0; ns];
     let mut out = Vec::with_capacity(v.len());
-    let mut stepper = BogackiShampine::new(ns, RTOL, ATOL);
+    let mut stepper = Dopri5::new(ns, RTOL, ATOL, f64::INFINITY);
     for i in 0..time.len() {
         if i > 0 {
             let along = AlongMotion {
@@ -97,12 +105,17 @@ pub fn model_force_budgeted(
                 v1: v[i],
                 span: time[i] - time[i - 1],
             };
-            integrate_interval(&mut stepper, &along, &mut z, max_substeps).map_err(|failure| {
-                EngineError::StateIntegration {
+            let start = if i == 1 {
+                Start::Fresh
+            } else {
+                Start::Continued
+            };
+            integrate_interval(&mut stepper, &along, &mut z, start, max_substeps).map_err(
+                |failure| EngineError::StateIntegration {
                     model: model.name().to_string(),
                     failure,
-                }
-            })?;
+                },
+            )?;
         }
         out.push(model.force(v[i], &z, normal.at(i)));
     }
@@ -207,6 +220,17 @@ struct AlongMotion<'a> {
     span: f64,
 }
 
+impl AlongMotion<'_> {
+    /// Where v changes sign inside the interval: the states' rate, odd in v, has a kink there
+    /// that a step must not straddle (its error estimate assumes a smooth right-hand side). A
+    /// reversal within [`REVERSAL_MARGIN`] of an end is left to the step ending there.
+    fn reversal(&self) -> Option<f64> {
+        let share = self.v0 / (self.v0 - self.v1);
+        let inside = REVERSAL_MARGIN..1.0 - REVERSAL_MARGIN;
+        (self.v0 * self.v1 < 0.0 && inside.contains(&share)).then_some(self.t0 + self.span * share)
+    }
+}
+
 impl OdeSystem for AlongMotion<'_> {
     fn rhs(&self, t: f64, z: &[f64], dz: &mut [f64]) {
         let s = (t - self.t0) / self.span;
@@ -216,15 +240,43 @@ impl OdeSystem for AlongMotion<'_> {
     }
 }
 
+/// How an interval's integration begins.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Start {
+    /// From the states `z` (the first interval).
+    Fresh,
+    /// Where the previous interval ended: the stepper's state is `z` and z' is continuous at
+    /// the knot (v and N are), so the stepper carries its last stage over.
+    Continued,
+}
+
 /// Integrates the states `z` over one sample interval (the stepper keeps its step size
 /// across intervals).
 fn integrate_interval(
-    stepper: &mut BogackiShampine,
+    stepper: &mut Dopri5,
     along: &AlongMotion<'_>,
     z: &mut [f64],
+    start: Start,
     max_substeps: u64,
 ) -> Result<(), IntegrationFailure> {
-    stepper.reset(along, along.t0, z, along.t0 + along.span)?;
+    let t_end = along.t0 + along.span;
+    for (k, stop) in along.reversal().into_iter().chain([t_end]).enumerate() {
+        match start {
+            Start::Fresh if k == 0 => stepper.reset(along, along.t0, z, stop)?,
+            _ => stepper.extend_to(stop),
+        }
+        run_to_stop(stepper, along, max_substeps)?;
+    }
+    z.copy_from_slice(stepper.state());
+    Ok(())
+}
+
+/// Steps to the stepper's end time within the sub-step budget, refusing non-finite states.
+fn run_to_stop(
+    stepper: &mut Dopri5,
+    along: &AlongMotion<'_>,
+    max_substeps: u64,
+) -> Result<(), IntegrationFailure> {
     while !stepper.reached_end() {
         if stepper.counts().attempts() >= max_substeps {
             return Err(IntegrationFailure::StepBudgetExceeded {
@@ -242,6 +294,5 @@ fn integrate_interval(
             });
         }
     }
-    z.copy_from_slice(stepper.state());
     Ok(())
 }

@@ -24,6 +24,7 @@ use super::stats::{covariance, Covariance};
 use crate::error::EngineError;
 use frictionid_models::FrictionModel;
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// chi²(1 dof, 95 %) / 2 = 3.8415 / 2: the rise of the cost (half the sum of squares), in
@@ -160,6 +161,9 @@ fn flat_and_delta<R: Residuals>(
     Ok(Some((slots, PROFILE_DELTA * variance)))
 }
 
+/// A profile's standing, and its lowest point when that lies a `delta` below the best.
+type ProfileOutcome = (Standing, Option<DVector<f64>>);
+
 /// Profiles every flat parameter at `best`; with `restart`, stops at the first profile point
 /// a `delta` below the best cost.
 fn profile_all<R: Residuals + 'static>(
@@ -172,13 +176,24 @@ fn profile_all<R: Residuals + 'static>(
     let Some((slots, delta)) = flat_and_delta(reference, best)? else {
         return Ok(Profiled::Standings(standings));
     };
-    for j in slots {
-        let profile = Profile {
-            reference,
-            best,
-            opts,
-        };
-        let (standing, lower) = profile.standing(j, delta);
+    let profile = Profile {
+        reference,
+        best,
+        opts,
+    };
+    let profiled: Vec<(usize, ProfileOutcome)> = if opts.parallel {
+        slots
+            .par_iter()
+            .map(|&j| (j, profile.standing(j, delta)))
+            .collect()
+    } else {
+        slots
+            .iter()
+            .map(|&j| (j, profile.standing(j, delta)))
+            .collect()
+    };
+    // In slot order: the first profile that found a lower cost restarts the fit.
+    for (j, (standing, lower)) in profiled {
         if let Some(u) = lower.filter(|_| restart) {
             return Ok(Profiled::Lower(u));
         }

@@ -26,8 +26,8 @@
 //! [`Stepper`] trait (reset, one step reporting an event sign change, dense output, counters)
 //! over an [`OdeSystem`]: the adaptive Dormand-Prince 5(4) [`Dopri5`] ([`Integrator::Dopri5`],
 //! the default), the paper's fixed-step explicit Euler with step T_n / n [`Euler`]
-//! ([`Integrator::Euler`], linear between steps), and the Bogacki-Shampine 3(2)
-//! [`BogackiShampine`] that integrates model states along a measured motion
+//! ([`Integrator::Euler`], linear between steps), Rodas4 for stiff bristles and the closed
+//! form for affine laws; Dopri5 also integrates model states along a measured motion
 //! (`energy::model_force_along`). A new integrator is one more `Stepper`.
 //!
 //! # Cost
@@ -37,7 +37,6 @@
 //! method would remove that bound. There is no stiffness abort: such runs finish.
 
 mod auto;
-mod bogacki;
 mod closed_form;
 mod dopri;
 mod driver;
@@ -47,7 +46,6 @@ mod rodas;
 mod root;
 mod stepper;
 
-pub use bogacki::BogackiShampine;
 pub use closed_form::ClosedForm;
 pub use dopri::Dopri5;
 pub use euler::Euler;
