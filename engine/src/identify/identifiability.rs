@@ -24,7 +24,6 @@ use super::stats::{covariance, Covariance};
 use crate::error::EngineError;
 use frictionid_models::FrictionModel;
 use nalgebra::{DMatrix, DVector};
-use rayon::prelude::*;
 use serde::Serialize;
 
 /// chi²(1 dof, 95 %) / 2 = 3.8415 / 2: the rise of the cost (half the sum of squares), in
@@ -161,9 +160,6 @@ fn flat_and_delta<R: Residuals>(
     Ok(Some((slots, PROFILE_DELTA * variance)))
 }
 
-/// A profile's standing, and its lowest point when that lies a `delta` below the best.
-type ProfileOutcome = (Standing, Option<DVector<f64>>);
-
 /// Profiles every flat parameter at `best`; with `restart`, stops at the first profile point
 /// a `delta` below the best cost.
 fn profile_all<R: Residuals + 'static>(
@@ -181,19 +177,8 @@ fn profile_all<R: Residuals + 'static>(
         best,
         opts,
     };
-    let profiled: Vec<(usize, ProfileOutcome)> = if opts.parallel {
-        slots
-            .par_iter()
-            .map(|&j| (j, profile.standing(j, delta)))
-            .collect()
-    } else {
-        slots
-            .iter()
-            .map(|&j| (j, profile.standing(j, delta)))
-            .collect()
-    };
-    // In slot order: the first profile that found a lower cost restarts the fit.
-    for (j, (standing, lower)) in profiled {
+    for j in slots {
+        let (standing, lower) = profile.standing(j, delta);
         if let Some(u) = lower.filter(|_| restart) {
             return Ok(Profiled::Lower(u));
         }
@@ -444,8 +429,18 @@ impl<R: Residuals + 'static> Profile<'_, R> {
     /// point (internal coordinates) when its cost lies more than `delta` below the best.
     fn standing(&self, j: usize, delta: f64) -> (Standing, Option<DVector<f64>>) {
         let best = self.best.cost;
-        let below = self.side(j, -1.0, best + delta);
-        let above = self.side(j, 1.0, best + delta);
+        // The two sides are independent refits: side by side on two threads.
+        let (below, above) = if self.opts.parallel {
+            rayon::join(
+                || self.side(j, -1.0, best + delta),
+                || self.side(j, 1.0, best + delta),
+            )
+        } else {
+            (
+                self.side(j, -1.0, best + delta),
+                self.side(j, 1.0, best + delta),
+            )
+        };
         let lowest = below
             .iter()
             .chain(&above)
