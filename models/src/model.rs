@@ -144,6 +144,15 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
     /// Time derivative of the internal states at sliding velocity `v`.
     fn state_derivative(&self, _v: f64, _z: &[f64], _normal: f64, _dz: &mut [f64]) {}
 
+    /// The parameters (indices in [`FrictionModel::params`] order) that enter the force but not
+    /// the states' equation ([`FrictionModel::state_derivative`]): a damping on the states'
+    /// rate, a viscous drag. Along a given motion the states do not depend on them, so a
+    /// force-domain fit keeps the states when only these change. Default: none (always
+    /// correct; a declaration is checked by `testing::check_force_only_params`).
+    fn force_only_params(&self) -> Vec<usize> {
+        Vec::new()
+    }
+
     /// The friction force at velocity `v` with internal states `z`. For static laws `z` is empty
     /// and sgn(0) = 0.
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64;

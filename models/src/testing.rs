@@ -65,6 +65,8 @@ pub enum Check {
     SlipDirection,
     /// Stored energy is >= 0 and 0 in the undeflected state.
     StoredEnergy,
+    /// A parameter declared force-only leaves the state derivative unchanged, exactly.
+    ForceOnlyParams,
     /// (motion) The simulator completes every release.
     Simulates,
     /// (motion) KE + PE + stored never increases.
@@ -121,7 +123,8 @@ pub fn check_model(model: &Model) -> Outcome {
     check_odd_symmetry(model)?;
     check_dissipative(model)?;
     check_slip_direction(model)?;
-    check_stored_energy(model)
+    check_stored_energy(model)?;
+    check_force_only_params(model)
 }
 
 /// [`check_model`] for tests: panics with the violation.
@@ -395,6 +398,53 @@ fn derivative(model: &Model, v: f64, z: &[f64], normal: f64) -> Vec<f64> {
     dz
 }
 
+/// [`Check::ForceOnlyParams`]: each declared index exists, and moving that parameter alone
+/// (to a nearby admissible value) changes no state derivative at any probe point.
+pub fn check_force_only_params(model: &Model) -> Outcome {
+    check_state_free(model, &model.force_only_params())
+}
+
+/// Whether moving each parameter of `indices` alone leaves the state derivative unchanged.
+fn check_state_free(model: &Model, indices: &[usize]) -> Outcome {
+    let info = model.param_info();
+    let values = model.params();
+    for &j in indices {
+        let Some(p) = info.get(j) else {
+            return fail(
+                model,
+                Check::ForceOnlyParams,
+                format!(
+                    "index {j} declared force-only, but the model has {} parameters",
+                    info.len()
+                ),
+            );
+        };
+        let mut moved = crate::clone_model(model);
+        let mut changed = values.clone();
+        changed[j] = perturbed(p, values[j]);
+        if let Err(e) = moved.set_params(&changed) {
+            return fail(model, Check::ForceOnlyParams, e.to_string());
+        }
+        for_each_probe(model, |v, z, normal| {
+            let (before, after) = (
+                derivative(model, v, z, normal),
+                derivative(moved.as_ref(), v, z, normal),
+            );
+            let same = before
+                .iter()
+                .zip(&after)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+            ensure(model, Check::ForceOnlyParams, same, || {
+                format!(
+                    "`{}` is declared force-only but moves dz at v = {v}, z = {z:?}, N = {normal}: {before:?} -> {after:?}",
+                    p.name
+                )
+            })
+        })?;
+    }
+    Ok(())
+}
+
 /// [`Check::Finite`].
 pub fn check_finite(model: &Model) -> Outcome {
     for_each_probe(model, |v, z, normal| {
@@ -548,4 +598,23 @@ pub fn doc_table_mismatch(source: &str, info: &[ParamInfo]) -> Option<String> {
         .collect();
     let table = crate::params::markdown_table(info);
     (!doc.contains(&table)).then_some(table)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::builtin::LuGre;
+
+    /// LuGre's rate dz/dt = v - sigma0 |v| z / g(v) holds sigma0 and not sigma1: the check
+    /// passes the true declaration and names sigma0 when it is declared force-only.
+    #[test]
+    fn a_state_parameter_declared_force_only_is_named() {
+        let lugre = LuGre::default();
+        assert_eq!(check_state_free(&lugre, &[1, 2]), Ok(()));
+        let e = check_state_free(&lugre, &[0]).unwrap_err();
+        assert_eq!(e.check, Check::ForceOnlyParams);
+        assert!(e.message.contains("`sigma0` is declared force-only"), "{e}");
+        let e = check_state_free(&lugre, &[6]).unwrap_err();
+        assert!(e.message.contains("index 6"), "{e}");
+    }
 }

@@ -76,8 +76,8 @@ pub use differentiate::{
 };
 pub use halfcycle::{HalfCycle, MIN_RUN};
 pub use model_force::{
-    force_residuals, model_force_along, model_force_budgeted, model_force_with_normal,
-    ForceResiduals,
+    force_residuals, forces_from_states, model_force_along, model_force_budgeted,
+    model_force_with_normal, states_along, ForceResiduals,
 };
 
 use crate::error::EngineError;

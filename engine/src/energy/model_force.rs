@@ -84,15 +84,28 @@ pub fn model_force_budgeted(
     normal: &NormalForce,
     max_substeps: u64,
 ) -> Result<Vec<f64>, EngineError> {
+    let states = states_along(model, time, v, normal, max_substeps)?;
+    Ok(forces_from_states(model, v, normal, &states))
+}
+
+/// The model's internal states at every sample of the motion (`time`, `v`) under `normal`,
+/// sample after sample (`n_states` values each; empty for a static law), integrated from
+/// relaxed states at the first sample within `max_substeps` sub-steps (see
+/// [`model_force_budgeted`]).
+pub fn states_along(
+    model: &dyn FrictionModel,
+    time: &[f64],
+    v: &[f64],
+    normal: &NormalForce,
+    max_substeps: u64,
+) -> Result<Vec<f64>, EngineError> {
     check_motion(time, v, normal)?;
     let ns = model.n_states();
-    if ns == 0 {
-        return Ok((0..v.len())
-            .map(|i| model.force(v[i], &[], normal.at(i)))
-            .collect());
-    }
     let mut z = vec![0.0; ns];
-    let mut out = Vec::with_capacity(v.len());
+    let mut out = Vec::with_capacity(v.len() * ns);
+    if ns == 0 {
+        return Ok(out);
+    }
     let mut stepper = Dopri5::new(ns, RTOL, ATOL, f64::INFINITY);
     for i in 0..time.len() {
         if i > 0 {
@@ -117,9 +130,22 @@ pub fn model_force_budgeted(
                 },
             )?;
         }
-        out.push(model.force(v[i], &z, normal.at(i)));
+        out.extend_from_slice(&z);
     }
     Ok(out)
+}
+
+/// The model's force at every sample from its states there ([`states_along`]).
+pub fn forces_from_states(
+    model: &dyn FrictionModel,
+    v: &[f64],
+    normal: &NormalForce,
+    states: &[f64],
+) -> Vec<f64> {
+    let ns = model.n_states();
+    (0..v.len())
+        .map(|i| model.force(v[i], &states[i * ns..(i + 1) * ns], normal.at(i)))
+        .collect()
 }
 
 /// Equal lengths, finite samples, strictly increasing time, a finite non-negative normal force.

@@ -22,8 +22,9 @@ use super::fit::{fit_with, FitResult};
 use super::options::{FitDomain, FitOptions, ForceTarget};
 use super::residuals::STEPS_PER_SAMPLE;
 use super::residuals::{Evaluation, NuisanceKind, NuisanceValues, Residuals, SampleAxes, Segment};
-use crate::energy::model_force_budgeted;
+use super::state_cache::StateCache;
 use crate::energy::{analyze_record, record_motion};
+use crate::energy::{forces_from_states, states_along};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::noise::noise_floor_level;
@@ -62,6 +63,8 @@ pub struct ForceTrack {
 pub struct ForceAlongMotion {
     tracks: Vec<ForceTrack>,
     nuisance: Vec<NuisanceKind>,
+    /// States of recent predictions: a force-only parameter's column reuses them.
+    states: StateCache,
 }
 
 /// The oscillator properties a force-domain fit on the energy-based force, a velocity fit or
@@ -142,7 +145,11 @@ impl ForceAlongMotion {
         } else {
             Vec::new()
         };
-        Ok(Self { tracks, nuisance })
+        Ok(Self {
+            tracks,
+            nuisance,
+            states: StateCache::default(),
+        })
     }
 
     /// The prepared record `index`.
@@ -303,19 +310,24 @@ impl Residuals for ForceAlongMotion {
         nuisance: &NuisanceValues,
     ) -> Result<Vec<f64>, EngineError> {
         let track = self.track_of(index, record)?;
-        at.count_simulation();
         let budget = STEPS_PER_SAMPLE * (track.time.len() as u64).max(100);
-        let force = model_force_budgeted(
-            at.model,
-            &track.time,
-            &track.velocity,
-            &track.normal,
-            budget,
-        )
-        .map_err(|e| EngineError::Record {
-            record: record.name.clone(),
-            reason: e.to_string(),
-        })?;
+        let states = self
+            .states
+            .states(index, at.model, || {
+                at.count_simulation();
+                states_along(
+                    at.model,
+                    &track.time,
+                    &track.velocity,
+                    &track.normal,
+                    budget,
+                )
+            })
+            .map_err(|e| EngineError::Record {
+                record: record.name.clone(),
+                reason: e.to_string(),
+            })?;
+        let force = forces_from_states(at.model, &track.velocity, &track.normal, &states);
         Ok(track
             .used
             .iter()

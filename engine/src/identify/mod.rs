@@ -38,6 +38,7 @@ pub mod response;
 pub mod result;
 pub mod setup;
 pub mod starts;
+pub mod state_cache;
 pub mod stats;
 pub mod strategy;
 pub mod work;

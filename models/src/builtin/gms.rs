@@ -569,6 +569,11 @@ impl FrictionModel for Gms {
     fn n_states(&self) -> usize {
         self.elements.len()
     }
+    /// The elements' dampings sigma_i and the viscous term.
+    fn force_only_params(&self) -> Vec<usize> {
+        let n = self.elements.len();
+        (2 * n..3 * n).chain([3 * n + 5]).collect()
+    }
     fn state_derivative(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) {
         let s = self.s(v, normal);
         for ((e, &zi), d) in self.elements.iter().zip(z).zip(dz.iter_mut()) {

@@ -79,6 +79,10 @@ impl FrictionModel for LuGre {
             *d = self.z_dot(v, z0, normal);
         }
     }
+    /// sigma1 and sigma2 (the bristles' damping and the viscous term).
+    fn force_only_params(&self) -> Vec<usize> {
+        vec![1, 2]
+    }
     /// d(dz/dt)/dz = -sigma0 |v| / g(v) (0 without normal load).
     fn state_jacobian(&self, v: f64, _z: &[f64], normal: f64, jac: &mut [f64]) {
         if let Some(j) = jac.first_mut() {
