@@ -3,7 +3,8 @@
 //! from a config, and the one-line errors of channel keys and malformed channel files.
 
 use assert_cmd::Command;
-use frictionid_cli::testing::{fails_with_one_line, scratch_dir};
+use frictionid_cli::testing::Says::Contains;
+use frictionid_cli::testing::{assert_bad_inputs, scratch_dir, BadInput};
 use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
 use frictionid_engine::Oscillator;
@@ -60,53 +61,46 @@ fn a_displacement_only_record_is_fitted_from_a_config() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-fn fails(name: &str, config: &str, files: &[(&str, &str)]) -> String {
-    let binary = Path::new(env!("CARGO_BIN_EXE_frictionid"));
-    fails_with_one_line(binary, ("channels", name), "fit", config, files)
-}
-
+/// Channel-key and channel-file errors: one line naming the file and the key (same checks
+/// as the CLI's other bad-input tables).
 #[test]
 fn channel_errors_name_the_file_and_the_key() {
-    let csv = interferometer_csv();
-    let files = [("x.csv", csv.as_str())];
     let model = "[model]\ntype = \"coulomb\"\n";
-    let e = fails(
-        "bad-noise",
-        &format!("{FMM}{model}{RECORD}displacement_noise = -1.0\n"),
-        &files,
-    );
-    assert!(
-        e.contains("[[records]] entry 1 (`x.csv`): `displacement_noise` must be > 0"),
-        "{e}"
-    );
-    let e = fails(
-        "offset-without-velocity",
-        &format!("{FMM}{model}[fit.options]\nvelocity_offset = true\n{RECORD}"),
-        &files,
-    );
-    assert!(
-        e.contains("record `x.csv`: [fit.options] velocity_offset = true needs a velocity channel (the record has: displacement)"),
-        "{e}"
-    );
-    let e = fails(
-        "no-column",
-        &format!("{FMM}{model}{RECORD}acceleration_column = \"acc\"\n"),
-        &files,
-    );
-    assert!(e.contains("x.csv: line 1: no column `acc`"), "{e}");
-    let short = "t,x_um\n0,14000\n0.001,13999\n0.002\n";
-    let e = fails(
-        "short-row",
-        &format!("{FMM}{model}{RECORD}"),
-        &[("x.csv", short)],
-    );
-    assert!(e.contains("x.csv: line 4"), "{e}");
-    let force_less = format!(
-        "{FMM}{model}[fit.options]\ndomain = \"force\"\nforce_target = \"measured\"\n{RECORD}"
-    );
-    let e = fails("force-less", &force_less, &files);
-    assert!(
-        e.contains("record `x.csv`: [fit.options] force_target = \"measured\" but the record has no force channel (it has: displacement"),
-        "{e}"
+    let interferometer = interferometer_csv();
+    let case = |name, config: String| {
+        BadInput::new(name, "fit", config).with_file("x.csv", interferometer.clone())
+    };
+    let short_row = "t,x_um\n0,14000\n0.001,13999\n0.002\n";
+    let cases = [
+        case(
+            "bad-noise",
+            format!("{FMM}{model}{RECORD}displacement_noise = -1.0\n"),
+        )
+        .says(Contains(
+            "[[records]] entry 1 (`x.csv`): `displacement_noise` must be > 0",
+        )),
+        case(
+            "offset-without-velocity",
+            format!("{FMM}{model}[fit.options]\nvelocity_offset = true\n{RECORD}"),
+        )
+        .says(Contains("record `x.csv`: [fit.options] velocity_offset = true needs a velocity channel (the record has: displacement)")),
+        case(
+            "no-column",
+            format!("{FMM}{model}{RECORD}acceleration_column = \"acc\"\n"),
+        )
+        .says(Contains("x.csv: line 1: no column `acc`")),
+        BadInput::new("short-row", "fit", format!("{FMM}{model}{RECORD}"))
+            .with_file("x.csv", short_row)
+            .says(Contains("x.csv: line 4")),
+        case(
+            "force-less",
+            format!("{FMM}{model}[fit.options]\ndomain = \"force\"\nforce_target = \"measured\"\n{RECORD}"),
+        )
+        .says(Contains("record `x.csv`: [fit.options] force_target = \"measured\" but the record has no force channel (it has: displacement")),
+    ];
+    assert_bad_inputs(
+        Path::new(env!("CARGO_BIN_EXE_frictionid")),
+        "channels",
+        &cases,
     );
 }

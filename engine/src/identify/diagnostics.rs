@@ -381,7 +381,24 @@ pub fn start_agreement(
 }
 
 /// Pass when the solver converged, else fail.
-pub fn convergence(termination: &TerminationReason) -> Finding {
+pub fn convergence(termination: &TerminationReason, model_params: &[String]) -> Finding {
+    if let TerminationReason::ConvergedExceptUnbounded { parameters } = termination {
+        let settled = model_params
+            .iter()
+            .filter(|p| !parameters.contains(p))
+            .count();
+        if settled == 0 {
+            return Finding::new(
+                Check::Convergence,
+                Status::Warn,
+                None,
+                format!(
+                    "no model parameter settled: every one (`{}`) kept running to a value the records do not bound, and the fit converged only with them held; the fitted curve stands, its parameter values are points on the bounds of the identifiability findings",
+                    parameters.join("`, `")
+                ),
+            );
+        }
+    }
     if termination.is_converged() {
         Finding::new(
             Check::Convergence,
@@ -581,12 +598,31 @@ mod tests {
 
     #[test]
     fn non_convergence_fails() {
-        let f = convergence(&TerminationReason::IterationLimit { limit: 3 });
+        let f = convergence(&TerminationReason::IterationLimit { limit: 3 }, &[]);
         assert_eq!(f.status, Status::Fail);
         assert!(f.message.contains("iteration limit (3) reached"));
         assert_eq!(
-            convergence(&TerminationReason::StepBelowTolerance).status,
+            convergence(&TerminationReason::StepBelowTolerance, &[]).status,
             Status::Pass
+        );
+    }
+
+    /// Converged with unbounded parameters held: a pass while a model parameter settled, a
+    /// warning naming them when none did.
+    #[test]
+    fn convergence_with_no_model_parameter_settled_is_a_warning() {
+        let model: Vec<String> = ["sigma0", "mu_c"].map(String::from).to_vec();
+        let held = |names: &[&str]| TerminationReason::ConvergedExceptUnbounded {
+            parameters: names.iter().map(|n| n.to_string()).collect(),
+        };
+        assert_eq!(convergence(&held(&["sigma0"]), &model).status, Status::Pass);
+        let none = convergence(&held(&["sigma0", "mu_c"]), &model);
+        assert_eq!(none.status, Status::Warn);
+        assert!(
+            none.message
+                .starts_with("no model parameter settled: every one (`sigma0`, `mu_c`)"),
+            "{}",
+            none.message
         );
     }
 }

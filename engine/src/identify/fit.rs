@@ -398,7 +398,15 @@ fn diagnose<R: Residuals>(
     fits: &RecordFits,
 ) -> Vec<Finding> {
     let params = &ctx.layout.params;
-    let mut findings = vec![diagnostics::convergence(&runs.best.termination)];
+    let model_params: Vec<String> = params
+        .iter()
+        .filter(|f| matches!(f.kind, ParamKind::Model(_)))
+        .map(|f| f.name.clone())
+        .collect();
+    let mut findings = vec![diagnostics::convergence(
+        &runs.best.termination,
+        &model_params,
+    )];
     findings.extend(start_findings(&runs.outcomes));
     findings.extend(diagnostics::start_agreement(
         &runs.outcomes,

@@ -3,7 +3,7 @@
 use super::fit::{fit_json, parameter_table, verdict_line};
 use super::format::{fmt_criterion, fmt_num, fmt_opt};
 use super::{render_files, render_opening, Render, Role, Sink, Status, Table};
-use crate::identify::{Comparison, FitResult};
+use crate::identify::{Check, Comparison, FitResult};
 use serde::ser::SerializeMap;
 use serde::{Serialize, Serializer};
 
@@ -82,7 +82,7 @@ impl CompareReport {
                     fmt_criterion(f.bic),
                     fmt_num(f.rms_residual),
                     f.free_parameters.to_string(),
-                    if f.converged { "yes" } else { "no" }.into(),
+                    converged_cell(f),
                 ]
             })
             .collect();
@@ -102,6 +102,19 @@ impl CompareReport {
             ],
             rows,
         )
+    }
+}
+
+/// `yes`, `no`, or `yes, no model parameter settled` when the convergence finding warns.
+fn converged_cell(fit: &FitResult) -> String {
+    let warned = fit
+        .diagnostics
+        .iter()
+        .any(|d| d.check == Check::Convergence && d.status == Status::Warn);
+    match (fit.converged, warned) {
+        (false, _) => "no".into(),
+        (true, true) => "yes, no model parameter settled".into(),
+        (true, false) => "yes".into(),
     }
 }
 
