@@ -148,26 +148,27 @@ pub fn record(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<Record> {
             continue;
         }
         record = match key.strip_suffix("_noise") {
-            Some(channel) => add_noise(record, channel, &value, &name)?,
+            Some(channel) => {
+                let (channel, sigma) = noise_level(channel, &value, &name)?;
+                record.with_noise(channel, sigma)
+            }
             None => add_channel(record, &key, &value, &name)?,
         };
     }
     Ok(record)
 }
 
-/// Gives `record` the noise level under `<channel>_noise` (a positive number in the channel's
-/// SI unit); without one a fit estimates it from the channel.
-fn add_noise(
-    record: Record,
-    channel: &str,
-    value: &Bound<'_, PyAny>,
-    what: &str,
-) -> PyResult<Record> {
+/// The channel and noise level of a `<channel>_noise` key (a positive number in the
+/// channel's SI unit); without one a fit estimates the level from the channel.
+fn noise_level(channel: &str, value: &Bound<'_, PyAny>, what: &str) -> PyResult<(Channel, f64)> {
     let key = format!("{channel}_noise");
-    let channel = channel_of(channel)
-        .ok_or_else(|| value_error(format!("{what}: unknown key `{key}`: `{channel}` is not a channel")))?;
+    let channel = channel_of(channel).ok_or_else(|| {
+        value_error(format!(
+            "{what}: unknown key `{key}`: `{channel}` is not a channel"
+        ))
+    })?;
     match value.extract::<f64>() {
-        Ok(sigma) if sigma > 0.0 && sigma.is_finite() => Ok(record.with_noise(channel, sigma)),
+        Ok(sigma) if sigma > 0.0 && sigma.is_finite() => Ok((channel, sigma)),
         _ => Err(value_error(format!(
             "{what}: `{key}` must be a number > 0 (the channel's noise level in SI units)"
         ))),

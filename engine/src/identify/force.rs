@@ -21,7 +21,7 @@
 use super::fit::{fit_with, FitResult};
 use super::options::{FitDomain, FitOptions, ForceTarget};
 use super::residuals::STEPS_PER_SAMPLE;
-use super::residuals::{Evaluation, NuisanceKind, NuisanceValues, Residuals, SampleAxes, Segment};
+use super::residuals::{Evaluation, NuisanceKind, RecordCase, Residuals, SampleAxes, Segment};
 use super::state_cache::StateCache;
 use crate::energy::{analyze_record, record_motion};
 use crate::energy::{forces_from_states, states_along};
@@ -302,13 +302,8 @@ impl Residuals for ForceAlongMotion {
             .unwrap_or_default()
     }
 
-    fn predict(
-        &self,
-        at: &Evaluation<'_>,
-        index: usize,
-        record: &Record,
-        nuisance: &NuisanceValues,
-    ) -> Result<Vec<f64>, EngineError> {
+    fn predict(&self, at: &Evaluation<'_>, case: RecordCase<'_>) -> Result<Vec<f64>, EngineError> {
+        let (index, record, nuisance) = (case.index, case.record, case.nuisance);
         let track = self.track_of(index, record)?;
         let budget = STEPS_PER_SAMPLE * (track.time.len() as u64).max(100);
         let states = self

@@ -7,7 +7,7 @@
 //! any argmin least-squares solver can drive it; ours is [`super::lm::LevenbergMarquardt`].
 
 use super::layout::{FreeParam, ParamKind};
-use super::residuals::{Evaluation, NuisanceValues, Residuals, VelocityResponse};
+use super::residuals::{Evaluation, NuisanceValues, RecordCase, Residuals, VelocityResponse};
 use super::work::WorkBudget;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
@@ -188,8 +188,12 @@ impl<R: Residuals> FitProblem<R> {
             .records
             .get(r)
             .ok_or_else(|| EngineError::InvalidInput(format!("no record {r}")))?;
-        self.residuals
-            .predict(&self.evaluation(world), r, rec, &world.nuisance[r])
+        let case = RecordCase {
+            index: r,
+            record: rec,
+            nuisance: &world.nuisance[r],
+        };
+        self.residuals.predict(&self.evaluation(world), case)
     }
 
     /// Weighted residuals of every record at physical parameters `p`, concatenated.
@@ -197,8 +201,12 @@ impl<R: Residuals> FitProblem<R> {
         let world = self.realise(p)?;
         let at = self.evaluation(&world);
         let run = |r: usize| -> Result<Vec<f64>, EngineError> {
-            self.residuals
-                .residuals(&at, r, &self.records[r], &world.nuisance[r])
+            let case = RecordCase {
+                index: r,
+                record: &self.records[r],
+                nuisance: &world.nuisance[r],
+            };
+            self.residuals.residuals(&at, case)
         };
         let parts: Vec<Result<Vec<f64>, EngineError>> =
             if self.worth_threads() && self.records.len() > 1 {

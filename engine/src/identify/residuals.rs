@@ -247,13 +247,7 @@ pub trait Residuals: Send + Sync {
 
     /// The model's prediction of the measured series of record `index` (nuisance applied),
     /// one value per measured sample.
-    fn predict(
-        &self,
-        at: &Evaluation<'_>,
-        index: usize,
-        record: &Record,
-        nuisance: &NuisanceValues,
-    ) -> Result<Vec<f64>, EngineError>;
+    fn predict(&self, at: &Evaluation<'_>, case: RecordCase<'_>) -> Result<Vec<f64>, EngineError>;
 
     /// Checks a record before a fit (default: a velocity record of at least 3 samples).
     fn check_record(&self, record: &Record) -> Result<(), EngineError> {
@@ -303,11 +297,10 @@ pub trait Residuals: Send + Sync {
     fn residuals(
         &self,
         at: &Evaluation<'_>,
-        index: usize,
-        record: &Record,
-        nuisance: &NuisanceValues,
+        case: RecordCase<'_>,
     ) -> Result<Vec<f64>, EngineError> {
-        let mut out = self.predict(at, index, record, nuisance)?;
+        let (index, record) = (case.index, case.record);
+        let mut out = self.predict(at, case)?;
         let measured = self.measured(index, record);
         if out.len() != measured.len() {
             return Err(EngineError::InvalidInput(format!(
@@ -328,6 +321,18 @@ pub trait Residuals: Send + Sync {
         }
         Ok(out)
     }
+}
+
+/// One record as a producer evaluates it: its place in the fit (for the per-record state of
+/// the producer and the work budget), its data and its nuisance values.
+#[derive(Debug, Clone, Copy)]
+pub struct RecordCase<'a> {
+    /// The record's place in the fit.
+    pub index: usize,
+    /// The record.
+    pub record: &'a Record,
+    /// Its nuisance values at the evaluated point.
+    pub nuisance: &'a NuisanceValues,
 }
 
 /// One compared channel's part of a record's measured series.

@@ -16,7 +16,7 @@
 
 use super::options::FitOptions;
 use super::residuals::{
-    Evaluation, NuisanceKind, NuisanceValues, Residuals, Segment, STEPS_PER_SAMPLE,
+    Evaluation, NuisanceKind, NuisanceValues, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
 };
 use crate::energy::record_motion;
 use crate::error::EngineError;
@@ -108,10 +108,9 @@ impl VelocityResponse {
     pub fn simulate(
         &self,
         at: &Evaluation<'_>,
-        index: usize,
-        record: &Record,
-        nuisance: &NuisanceValues,
+        case: RecordCase<'_>,
     ) -> Result<Vec<f64>, EngineError> {
+        let (index, record, nuisance) = (case.index, case.record, case.nuisance);
         let clock = ReleaseClock::new(record, nuisance);
         let mut v = vec![record.v0; clock.before];
         if let Some(&t_end) = clock.times.last() {
@@ -139,11 +138,10 @@ impl VelocityResponse {
     fn simulate_channels(
         &self,
         at: &Evaluation<'_>,
-        index: usize,
-        record: &Record,
-        nuisance: &NuisanceValues,
+        case: RecordCase<'_>,
         channels: &[Channel],
     ) -> Result<Vec<f64>, EngineError> {
+        let (index, record, nuisance) = (case.index, case.record, case.nuisance);
         let clock = ReleaseClock::new(record, nuisance);
         let x0 = nuisance.x0_of(record);
         let trajectory = match clock.times.last() {
@@ -304,18 +302,13 @@ impl Residuals for VelocityResponse {
         }
     }
 
-    fn predict(
-        &self,
-        at: &Evaluation<'_>,
-        index: usize,
-        record: &Record,
-        nuisance: &NuisanceValues,
-    ) -> Result<Vec<f64>, EngineError> {
+    fn predict(&self, at: &Evaluation<'_>, case: RecordCase<'_>) -> Result<Vec<f64>, EngineError> {
+        let (index, record, nuisance) = (case.index, case.record, case.nuisance);
         let channels = self.channels_of(index);
         let mut out = if channels == [Channel::Velocity] {
-            self.simulate(at, index, record, nuisance)?
+            self.simulate(at, case)?
         } else {
-            self.simulate_channels(at, index, record, nuisance, &channels)?
+            self.simulate_channels(at, case, &channels)?
         };
         if let Some(v) = channels.iter().position(|&c| c == Channel::Velocity) {
             let n = record.len();
@@ -381,6 +374,15 @@ mod tests {
     use frictionid_models::Coulomb;
     use std::sync::atomic::{AtomicU64, Ordering};
 
+    /// The first record of a fit, at `nuisance`.
+    fn case<'a>(record: &'a Record, nuisance: &'a NuisanceValues) -> RecordCase<'a> {
+        RecordCase {
+            index: 0,
+            record,
+            nuisance,
+        }
+    }
+
     /// A displacement + acceleration record of the exact Coulomb solution: at the true
     /// parameters the stacked prediction is the exact x then a (to the integrator's
     /// accuracy), and the acceleration part is scaled by sigma_x / sigma_a.
@@ -411,7 +413,7 @@ mod tests {
         let model = Coulomb { mu: 0.24 };
         let at = Evaluation::new(&osc, &model, &sim, &counter);
         let predicted = producer
-            .predict(&at, 0, &record, &NuisanceValues::default())
+            .predict(&at, case(&record, &NuisanceValues::default()))
             .unwrap();
         let (x, a) = predicted.split_at(1500);
         assert!(x.iter().zip(&exact.x).all(|(p, e)| (p - e).abs() < 1e-8));
@@ -455,7 +457,7 @@ mod tests {
             offset: 1e-3,
             ..NuisanceValues::default()
         };
-        let r = producer.residuals(&at, 0, &record, &nuisance).unwrap();
+        let r = producer.residuals(&at, case(&record, &nuisance)).unwrap();
         assert_eq!(counter.load(Ordering::Relaxed), 1);
         for (ri, e) in r.iter().zip(&exact) {
             assert!((ri - 2.0 * (e + 1e-3)).abs() < 1e-7, "{ri} vs {e}");
@@ -476,7 +478,7 @@ mod tests {
             ..NuisanceValues::default()
         };
         let v = VelocityResponse::new(false, true, false)
-            .simulate(&at, 0, &record, &shifted)
+            .simulate(&at, case(&record, &shifted))
             .unwrap();
         assert!(v[..31].iter().all(|&x| x == 0.0));
         let shifted: Vec<f64> = time[31..].iter().map(|t| t - 0.0305).collect();
