@@ -100,6 +100,11 @@ fn any_model() -> impl Strategy<Value = (String, Vec<f64>)> {
     )
 }
 
+/// A release of any built-in law on any oscillator: (oscillator, law, x0 \[m\], v0 [m/s]).
+fn any_release() -> impl Strategy<Value = (Oscillator, (String, Vec<f64>), f64, f64)> {
+    (oscillator(), any_model(), -0.03..0.03f64, -0.1..0.1f64)
+}
+
 fn sample_times(t_end: f64, n: usize) -> Vec<f64> {
     (0..n)
         .map(|i| (t_end * i as f64 / (n - 1) as f64).min(t_end))
@@ -130,10 +135,7 @@ proptest! {
     /// KE + PE + stored energy never increases for a passive law (beyond integration error).
     #[test]
     fn energy_never_increases_for_passive_laws(
-        osc in oscillator(),
-        (name, factors) in any_model(),
-        x0 in -0.03..0.03f64,
-        v0 in -0.1..0.1f64,
+        (osc, (name, factors), x0, v0) in any_release(),
     ) {
         let model = model_from(&name, &factors, true);
         let t_end = 3.0 * osc.natural_period();
@@ -152,10 +154,7 @@ proptest! {
     /// mirrored motion.
     #[test]
     fn mirrored_release_gives_the_mirrored_motion(
-        osc in oscillator(),
-        (name, factors) in any_model(),
-        x0 in -0.03..0.03f64,
-        v0 in -0.1..0.1f64,
+        (osc, (name, factors), x0, v0) in any_release(),
     ) {
         let model = model_from(&name, &factors, false);
         let t_end = 2.0 * osc.natural_period();

@@ -24,14 +24,14 @@ pub struct ExactCoulomb {
     pub v: Vec<f64>,
     /// Acceleration [m/s^2] (0 once at rest).
     pub a: Vec<f64>,
-    /// Times of the turning points (zero velocity), excluding t = 0.
-    pub turning_times: Vec<f64>,
-    /// Displacements at the turning points.
-    pub turning_displacements: Vec<f64>,
     /// Time at which the mass sticks for good.
     pub rest_time: f64,
     /// Displacement at rest.
     pub final_displacement: f64,
+    /// Times of the turning points (zero velocity), excluding t = 0.
+    pub turning_times: Vec<f64>,
+    /// Displacements at the turning points.
+    pub turning_displacements: Vec<f64>,
 }
 
 impl ExactCoulomb {

@@ -19,7 +19,7 @@ pub mod testing;
 
 pub use energy::{
     analyze_record, analyze_states, force_residuals, model_force_along, percent_difference,
-    Differentiator, EnergyAnalysis, EnergyOptions, ForceResiduals, HalfCycle,
+    Differentiator, EnergyAnalysis, EnergyOptions, ForceResiduals, HalfCycle, MechanicalEnergy,
 };
 pub use error::EngineError;
 pub use jobs::JobError;

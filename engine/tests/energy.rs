@@ -327,9 +327,12 @@ fn series_energies_and_masking() {
     for i in 0..an.time.len() {
         assert!((an.x[i] - ex.x[i]).abs() < 1e-6, "x at {}", an.time[i]);
         let (x, v, a) = (an.x[i], an.v[i], an.a[i]);
-        assert!((an.kinetic[i] - 0.5 * osc.mass * v * v).abs() < 1e-15);
-        assert!((an.potential[i] - 0.5 * osc.stiffness * x * x).abs() < 1e-15);
-        assert!((an.energy[i] - an.kinetic[i] - an.potential[i]).abs() < 1e-15);
+        assert!((an.mechanical.kinetic[i] - 0.5 * osc.mass * v * v).abs() < 1e-15);
+        assert!((an.mechanical.potential[i] - 0.5 * osc.stiffness * x * x).abs() < 1e-15);
+        assert!(
+            (an.mechanical.energy[i] - an.mechanical.kinetic[i] - an.mechanical.potential[i]).abs()
+                < 1e-15
+        );
         let rate = v * (osc.mass * a + osc.stiffness * x);
         assert!((an.de_dt[i] - rate).abs() <= 1e-12 * rate.abs().max(1e-12));
         let is_masked = ex.v[i].abs() <= opts.velocity_threshold;

@@ -297,7 +297,7 @@ fn energy_never_increases_for_any_built_in_model() {
             // Sanity of the columns: E = KE + PE.
             for i in 0..total.len() {
                 let e = 0.5 * 10.391 * sim.v[i].powi(2) + 0.5 * 1982.0 * sim.x[i].powi(2);
-                assert!((sim.energy[i] - e).abs() <= 1e-12 * scale.max(1.0));
+                assert!((sim.mechanical.energy[i] - e).abs() <= 1e-12 * scale.max(1.0));
             }
         }
     }

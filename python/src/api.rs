@@ -201,13 +201,11 @@ fn models_to_compare(
     let Some(list) = models.filter(|m| !m.is_none()) else {
         return spec.models_to_compare(None).map_err(value_error);
     };
-    let items: Vec<Bound<'_, PyAny>> = list
-        .try_iter()
-        .map_err(|_| value_error("models: expected a list of names or model dicts"))?
-        .collect::<PyResult<_>>()?;
-    if items.is_empty() {
-        return Err(value_error("no models to compare"));
-    }
+    let items = inputs::non_empty_list(
+        &list,
+        "models: expected a list of names or model dicts",
+        "no models to compare",
+    )?;
     items
         .iter()
         .map(|item| match item.cast::<PyString>() {

@@ -177,12 +177,27 @@ fn noise_level(channel: &str, value: &Bound<'_, PyAny>, what: &str) -> PyResult<
 
 /// Records from a list of dicts (at least one).
 pub fn records(obj: &Bound<'_, PyAny>) -> PyResult<Vec<Record>> {
-    let list: Vec<Bound<'_, PyAny>> = obj
-        .try_iter()
-        .map_err(|_| value_error("records: expected a list of dicts"))?
-        .collect::<PyResult<_>>()?;
-    if list.is_empty() {
-        return Err(value_error("records: no records given"));
-    }
+    let list = non_empty_list(
+        obj,
+        "records: expected a list of dicts",
+        "records: no records given",
+    )?;
     list.iter().enumerate().map(|(i, r)| record(r, i)).collect()
+}
+
+/// The items of the Python iterable `obj`: a ValueError `not_a_list` when it is not iterable,
+/// `empty` when it has no items.
+pub fn non_empty_list<'py>(
+    obj: &Bound<'py, PyAny>,
+    not_a_list: &str,
+    empty: &str,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let items: Vec<Bound<'py, PyAny>> = obj
+        .try_iter()
+        .map_err(|_| value_error(not_a_list))?
+        .collect::<PyResult<_>>()?;
+    if items.is_empty() {
+        return Err(value_error(empty));
+    }
+    Ok(items)
 }

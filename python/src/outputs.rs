@@ -2,7 +2,7 @@
 //! form) plus numpy arrays for the series report.json leaves out.
 
 use crate::convert::{serialized, set_array};
-use frictionid_engine::identify::{FitResult, RecordFit};
+use frictionid_engine::identify::{FitResult, FitSeries};
 use frictionid_engine::report::{
     CompareReport, EnergyRecord, EnergyReport, FitReport, SimulateReport,
 };
@@ -35,17 +35,17 @@ pub fn simulate_dict<'py>(
     let dict = report_dict(py, report)?;
     let traj = &report.trajectory;
     for (key, values) in [
-        ("t", &traj.time),
+        ("t", traj.time.as_slice()),
         ("x", &traj.x),
         ("v", &traj.v),
         ("a", &traj.a),
         ("force", &traj.friction),
-        ("energy", &traj.energy),
-        ("kinetic", &traj.kinetic),
-        ("potential", &traj.potential),
         ("stored", &traj.stored),
         ("energy_rate", &report.energy_rate),
-    ] {
+    ]
+    .into_iter()
+    .chain(traj.mechanical.named_series())
+    {
         set_array(&dict, key, values)?;
     }
     let states = PyList::empty(py);
@@ -66,16 +66,14 @@ fn add_record_series(fit_dict: &Bound<'_, PyDict>, fit: &FitResult) -> PyResult<
     let records = list_at(fit_dict, "records")?;
     for (item, r) in records.iter().zip(&fit.records) {
         let d = item.cast_into::<PyDict>()?;
-        let RecordFit {
-            time,
+        let FitSeries {
             measured,
             fitted,
             energy_based_force,
             model_force,
-            ..
-        } = r;
+        } = &r.series;
         for (key, values) in [
-            ("time", time),
+            ("time", &r.axes.time),
             ("measured", measured),
             ("fitted", fitted),
             ("energy_based_force", energy_based_force),
@@ -108,16 +106,16 @@ pub fn compare_dict<'py>(py: Python<'py>, report: &CompareReport) -> PyResult<Bo
 fn add_energy_series(d: &Bound<'_, PyDict>, r: &EnergyRecord) -> PyResult<()> {
     let a = &r.analysis;
     for (key, values) in [
-        ("time", &a.time),
+        ("time", a.time.as_slice()),
         ("x", &a.x),
         ("v", &a.v),
         ("a", &a.a),
-        ("kinetic", &a.kinetic),
-        ("potential", &a.potential),
-        ("energy", &a.energy),
         ("de_dt", &a.de_dt),
         ("friction", &a.friction),
-    ] {
+    ]
+    .into_iter()
+    .chain(a.mechanical.named_series())
+    {
         set_array(d, key, values)?;
     }
     if let Some(f) = &r.model_force {

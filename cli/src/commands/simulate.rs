@@ -25,10 +25,10 @@ fn trajectory_csv(traj: &Trajectory) -> String {
     }
     cols.extend([
         ("friction", traj.friction.as_slice()),
-        ("kinetic", traj.kinetic.as_slice()),
-        ("potential", traj.potential.as_slice()),
+        ("kinetic", traj.mechanical.kinetic.as_slice()),
+        ("potential", traj.mechanical.potential.as_slice()),
         ("stored", traj.stored.as_slice()),
-        ("energy", traj.energy.as_slice()),
+        ("energy", traj.mechanical.energy.as_slice()),
     ]);
     csv_columns(&cols)
 }

@@ -94,9 +94,9 @@ pub fn simulate_plots(out: &OutputDir, report: &SimulateReport) -> Result<Vec<St
             format!("Energy: {title}"),
             vec![
                 Panel::new("energy", "J")
-                    .with(Series::solid("kinetic", t, &traj.kinetic))
-                    .with(Series::solid("potential", t, &traj.potential))
-                    .with(Series::solid("E = KE + PE", t, &traj.energy)),
+                    .with(Series::solid("kinetic", t, &traj.mechanical.kinetic))
+                    .with(Series::solid("potential", t, &traj.mechanical.potential))
+                    .with(Series::solid("E = KE + PE", t, &traj.mechanical.energy)),
                 Panel::new("dE/dt", "W").with(Series::solid(
                     "dE/dt = -(c v + F) v",
                     t,
@@ -118,8 +118,8 @@ fn fit_force_plot(
     fit: &FitResult,
     r: &RecordFit,
 ) -> Result<(), CliError> {
-    let energy = break_at_reversals(&r.energy_based_force, &r.measured);
-    let shown = where_defined(&r.model_force, &energy);
+    let energy = break_at_reversals(&r.series.energy_based_force, &r.series.measured);
+    let shown = where_defined(&r.series.model_force, &energy);
     let label = format!("model ({})", fit.model);
     let reference = r.energy_force.as_ref().map(|e| e.reference);
     let ref_label = reference
@@ -128,7 +128,7 @@ fn fit_force_plot(
     super::friction_force(
         &out.path(name),
         &format!("{}: energy-based and model friction force", r.file),
-        &r.time,
+        &r.axes.time,
         &energy,
         Some((label.as_str(), shown.as_slice())),
         reference
@@ -147,7 +147,7 @@ pub fn fit_record_plots(
     let mut files = Vec::new();
     let names: Vec<&str> = fit.records.iter().map(|r| r.file.as_str()).collect();
     for (r, stem) in fit.records.iter().zip(unique_stems(&names)) {
-        if !r.displacement.is_empty() {
+        if !r.axes.displacement.is_empty() {
             files.extend(force_record_plots(out, fit, r, &format!("{prefix}{stem}"))?);
             continue;
         }
@@ -156,12 +156,12 @@ pub fn fit_record_plots(
             &out.path(&vf),
             &r.file,
             (&r.channel, &fit.residual_unit),
-            &r.time,
-            (&r.measured, &r.fitted),
+            &r.axes.time,
+            (&r.series.measured, &r.series.fitted),
             &fit.model,
         )?;
         files.push(vf);
-        if !r.energy_based_force.is_empty() {
+        if !r.series.energy_based_force.is_empty() {
             let ff = format!("{prefix}{stem}_friction_force.svg");
             fit_force_plot(out, &ff, fit, r)?;
             files.push(ff);
@@ -197,8 +197,8 @@ fn force_record_plots(
     r: &RecordFit,
     stem: &str,
 ) -> Result<Vec<String>, CliError> {
-    let measured = break_at_gaps(&r.time, &r.measured);
-    let fitted = break_at_gaps(&r.time, &r.fitted);
+    let measured = break_at_gaps(&r.axes.time, &r.series.measured);
+    let fitted = break_at_gaps(&r.axes.time, &r.series.fitted);
     let label = if r.channel == "energy_based_force" {
         "energy-based (Eq. 7)"
     } else {
@@ -209,7 +209,7 @@ fn force_record_plots(
         (
             "force_displacement",
             "hysteresis loops",
-            &r.displacement,
+            &r.axes.displacement,
             super::MotionAxis {
                 quantity: "displacement",
                 unit: "mm",
@@ -219,7 +219,7 @@ fn force_record_plots(
         (
             "force_velocity",
             "friction force against velocity",
-            &r.velocity,
+            &r.axes.velocity,
             super::MotionAxis {
                 quantity: "velocity",
                 unit: "mm/s",
@@ -248,10 +248,10 @@ pub fn peak_speed(fit: &FitResult) -> f64 {
     fit.records
         .iter()
         .flat_map(|r| {
-            if r.velocity.is_empty() {
-                r.measured.iter()
+            if r.axes.velocity.is_empty() {
+                r.series.measured.iter()
             } else {
-                r.velocity.iter()
+                r.axes.velocity.iter()
             }
         })
         .fold(0.0f64, |m, v| m.max(v.abs()))
@@ -299,7 +299,10 @@ fn energy_record_plots(
         (
             "energy",
             "energy and dissipation rate",
-            [Quantity::Energy(&a.energy), Quantity::EnergyRate(&a.de_dt)],
+            [
+                Quantity::Energy(&a.mechanical.energy),
+                Quantity::EnergyRate(&a.de_dt),
+            ],
         ),
     ] {
         let file = format!("{stem}_{kind}.svg");

@@ -68,6 +68,7 @@
 
 pub mod differentiate;
 pub mod halfcycle;
+pub mod mechanical;
 pub mod model_force;
 
 pub use differentiate::{
@@ -75,9 +76,10 @@ pub use differentiate::{
     savitzky_golay_derivative, Differentiator, PAPER_SPAN,
 };
 pub use halfcycle::{HalfCycle, MIN_RUN};
+pub use mechanical::MechanicalEnergy;
 pub use model_force::{
-    force_residuals, forces_from_states, model_force_along, model_force_budgeted,
-    model_force_with_normal, states_along, ForceResiduals,
+    force_residuals, forces_from_states, model_force_along, model_force_with_normal, states_along,
+    ForceResiduals,
 };
 
 use crate::error::EngineError;
@@ -132,12 +134,9 @@ pub struct EnergyAnalysis {
     pub v: Vec<f64>,
     /// Acceleration [m/s^2] (measured or differentiated for a record, exact for states).
     pub a: Vec<f64>,
-    /// Kinetic energy m v^2 / 2 \[J\] (Eq. 3).
-    pub kinetic: Vec<f64>,
-    /// Potential energy k x^2 / 2 \[J\] (Eq. 2).
-    pub potential: Vec<f64>,
-    /// Mechanical energy KE + PE \[J\].
-    pub energy: Vec<f64>,
+    /// Kinetic, potential and mechanical energy (Eqs. 2-3).
+    #[serde(flatten)]
+    pub mechanical: MechanicalEnergy,
     /// Energy rate v (m a + k x) \[W\] (Eq. 4).
     pub de_dt: Vec<f64>,
     /// Friction force -(dE/dt)/v - c v \[N\] (Eq. 7, model sign convention); NaN where masked.
@@ -416,9 +415,7 @@ fn assemble(
 ) -> EnergyAnalysis {
     let (m, c, k) = (osc.mass, osc.damping, osc.stiffness);
     let n = s.time.len();
-    let kinetic: Vec<f64> = s.v.iter().map(|v| 0.5 * m * v * v).collect();
-    let potential: Vec<f64> = s.x.iter().map(|x| 0.5 * k * x * x).collect();
-    let energy: Vec<f64> = kinetic.iter().zip(&potential).map(|(a, b)| a + b).collect();
+    let mechanical = MechanicalEnergy::of(m, k, s.x, s.v);
     let de_dt: Vec<f64> = (0..n).map(|i| s.v[i] * (m * s.a[i] + k * s.x[i])).collect();
     let friction: Vec<f64> = (0..n)
         .map(|i| {
@@ -445,9 +442,7 @@ fn assemble(
         x: s.x.to_vec(),
         v: s.v.to_vec(),
         a: s.a.to_vec(),
-        kinetic,
-        potential,
-        energy,
+        mechanical,
         de_dt,
         friction,
         masked: n - used,

@@ -71,27 +71,16 @@ pub fn model_force_with_normal(
     v: &[f64],
     normal: &NormalForce,
 ) -> Result<Vec<f64>, EngineError> {
-    model_force_budgeted(model, time, v, normal, MAX_SUBSTEPS)
-}
-
-/// [`model_force_with_normal`] with at most `max_substeps` sub-steps (accepted and rejected)
-/// for the whole motion: a fit rejects trial parameters whose states are so stiff, or so
-/// little smooth, that they would need more (see [`crate::identify::residuals::STEPS_PER_SAMPLE`]).
-pub fn model_force_budgeted(
-    model: &dyn FrictionModel,
-    time: &[f64],
-    v: &[f64],
-    normal: &NormalForce,
-    max_substeps: u64,
-) -> Result<Vec<f64>, EngineError> {
-    let states = states_along(model, time, v, normal, max_substeps)?;
+    let states = states_along(model, time, v, normal, MAX_SUBSTEPS)?;
     Ok(forces_from_states(model, v, normal, &states))
 }
 
 /// The model's internal states at every sample of the motion (`time`, `v`) under `normal`,
 /// sample after sample (`n_states` values each; empty for a static law), integrated from
-/// relaxed states at the first sample within `max_substeps` sub-steps (see
-/// [`model_force_budgeted`]).
+/// relaxed states at the first sample within `max_substeps` sub-steps (accepted and
+/// rejected) for the whole motion: a fit rejects trial parameters whose states are so stiff,
+/// or so little smooth, that they would need more (see
+/// [`crate::identify::residuals::STEPS_PER_SAMPLE`]).
 pub fn states_along(
     model: &dyn FrictionModel,
     time: &[f64],

@@ -136,19 +136,21 @@ fn moving_part(r: &RecordFit, osc: &Oscillator, threshold: f64) -> Option<Moving
         // The statistics read the fitted series as a velocity.
         return None;
     }
-    let end = r.fitted.iter().rposition(|v| v.abs() > threshold)? + 1;
-    if end < 3 || r.time.len() < end || r.measured.len() < end {
+    let end = r.series.fitted.iter().rposition(|v| v.abs() > threshold)? + 1;
+    if end < 3 || r.axes.time.len() < end || r.series.measured.len() < end {
         return None;
     }
-    let residual: Vec<f64> = (0..end).map(|i| r.fitted[i] - r.measured[i]).collect();
-    let x = cumulative_trapezoid(&r.time[..end], &r.fitted[..end], r.x0);
-    let dt = (r.time[end - 1] - r.time[0]) / (end - 1) as f64;
+    let residual: Vec<f64> = (0..end)
+        .map(|i| r.series.fitted[i] - r.series.measured[i])
+        .collect();
+    let x = cumulative_trapezoid(&r.axes.time[..end], &r.series.fitted[..end], r.x0);
+    let dt = (r.axes.time[end - 1] - r.axes.time[0]) / (end - 1) as f64;
     let wd = osc.omega_n() * (1.0 - osc.damping_ratio().powi(2)).max(0.0).sqrt();
     let period = 2.0 * std::f64::consts::PI / wd / dt;
     Some(Moving {
         residual: demeaned(&residual),
         sign: demeaned(
-            &r.fitted[..end]
+            &r.series.fitted[..end]
                 .iter()
                 .map(|v| v.signum())
                 .collect::<Vec<_>>(),
@@ -226,7 +228,13 @@ pub fn residual_structure(records: &[RecordFit], osc: &Oscillator, threshold: f6
 fn mean_statistic(records: &[RecordFit], phi: f64) -> Statistic {
     let residual: Vec<f64> = records
         .iter()
-        .flat_map(|r| r.fitted.iter().zip(&r.measured).map(|(f, m)| f - m))
+        .flat_map(|r| {
+            r.series
+                .fitted
+                .iter()
+                .zip(&r.series.measured)
+                .map(|(f, m)| f - m)
+        })
         .collect();
     let n = residual.len().max(1) as f64;
     let mean = residual.iter().sum::<f64>() / n;
@@ -421,6 +429,8 @@ mod tests {
     use super::*;
     use crate::exact::coulomb_free_vibration;
     use crate::identify::layout::ParamKind;
+    use crate::identify::residuals::SampleAxes;
+    use crate::identify::result::FitSeries;
     use rand::rngs::StdRng;
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
@@ -468,13 +478,15 @@ mod tests {
             rms_residual: 0.0,
             channels: Vec::new(),
             energy_force: None,
-            time,
-            displacement: Vec::new(),
-            velocity: Vec::new(),
-            measured,
-            fitted,
-            energy_based_force: Vec::new(),
-            model_force: Vec::new(),
+            axes: SampleAxes {
+                time,
+                ..SampleAxes::default()
+            },
+            series: FitSeries {
+                measured,
+                fitted,
+                ..FitSeries::default()
+            },
         }
     }
 

@@ -18,7 +18,7 @@ use super::setup::{build_layout, Layout};
 use super::starts::{run_starts, start_count, MultiStart, StartRun};
 use super::stats::{self, aic, bic, t_quantile_975, Covariance};
 use super::strategy::{self, plan_starts, Search, Seeded, StartPlan};
-use crate::energy::{analyze_record, model_force_budgeted};
+use crate::energy::{analyze_record, forces_from_states, states_along};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::{NormalForce, Record};
@@ -27,7 +27,7 @@ use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use super::result::{ChannelFit, Derived, FitResult, FittedParam, Rank, RecordFit};
+pub use super::result::{ChannelFit, Derived, FitResult, FitSeries, FittedParam, Rank, RecordFit};
 pub use super::setup::guess_hint;
 pub use super::starts::{DEFAULT_STARTS, MAX_STARTS, PROMOTED_STARTS, SCREEN_ITERATIONS};
 
@@ -612,13 +612,13 @@ fn record_fits<R: Residuals>(
             rms_residual: (ss / measured.len() as f64).sqrt(),
             channels,
             energy_force,
-            time: axes.time,
-            displacement: axes.displacement,
-            velocity: axes.velocity,
-            measured: measured.to_vec(),
-            fitted,
-            energy_based_force: ebf,
-            model_force: mf,
+            axes,
+            series: FitSeries {
+                measured: measured.to_vec(),
+                fitted,
+                energy_based_force: ebf,
+                model_force: mf,
+            },
         });
     }
     Ok(out)
@@ -669,13 +669,10 @@ fn energy_check(
     // The fit's step budget: bristles too stiff to replay cheaply (sigma0 far inside a
     // one-sided bound) leave the check out, with a warning, instead of taking seconds.
     let budget = STEPS_PER_SAMPLE * (analysis.time.len() as u64).max(100);
-    let model_force = model_force_budgeted(
-        world.model.as_ref(),
-        &analysis.time,
-        &analysis.v,
-        &NormalForce::Constant(osc.normal_force),
-        budget,
-    )?;
+    let model = world.model.as_ref();
+    let normal = NormalForce::Constant(osc.normal_force);
+    let states = states_along(model, &analysis.time, &analysis.v, &normal, budget)?;
+    let model_force = forces_from_states(model, &analysis.v, &normal, &states);
     let ef = energy_force_check(&analysis, ForceReference::ModelForce(&model_force))?;
     Ok((ef, analysis.friction, model_force))
 }

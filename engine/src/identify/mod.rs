@@ -46,7 +46,7 @@ pub mod work;
 pub use budget::{PropertyUncertainty, StdErrorComponents};
 pub use compare::{compare, Comparison, ComparisonVerdict, FailedFit};
 pub use energy_check::{energy_force_check, EnergyForce, ForceReference};
-pub use fit::{fit, fit_with, guess_hint, Derived, FitResult, FittedParam, RecordFit};
+pub use fit::{fit, fit_with, guess_hint, Derived, FitResult, FitSeries, FittedParam, RecordFit};
 pub use force::{fit_force, require_mechanics, require_oscillator, ForceAlongMotion};
 pub use identifiability::Identifiability;
 pub use lm::LevenbergMarquardt;

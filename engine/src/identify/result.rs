@@ -4,6 +4,7 @@ use super::budget::StdErrorComponents;
 use super::energy_check::EnergyForce;
 use super::identifiability::Identifiability;
 use super::outcome::{as_display, worst_status, Finding, StartOutcome, Status, TerminationReason};
+use super::residuals::SampleAxes;
 use super::strategy::Search;
 use crate::oscillator::Oscillator;
 use frictionid_models::FrictionModel;
@@ -58,26 +59,24 @@ pub struct RecordFit {
     pub channels: Vec<ChannelFit>,
     /// Energy-based force check (absent when the record cannot be analysed).
     pub energy_force: Option<EnergyForce>,
-    /// Time stamps of the compared samples (for plots).
+    /// Time stamps and motion of the compared samples (for plots).
     #[serde(skip)]
-    pub time: Vec<f64>,
-    /// Displacement of the motion at the compared samples (force-domain fits; else empty).
+    pub axes: SampleAxes,
+    /// The measured and fitted series and the forces along the motion (for plots).
     #[serde(skip)]
-    pub displacement: Vec<f64>,
-    /// Velocity of the motion at the compared samples (force-domain fits; else empty).
-    #[serde(skip)]
-    pub velocity: Vec<f64>,
+    pub series: FitSeries,
+}
+
+/// A record's series at the compared samples, for plots and the Python package.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FitSeries {
     /// The measured series compared.
-    #[serde(skip)]
     pub measured: Vec<f64>,
     /// The fitted series (the model's prediction, nuisance applied).
-    #[serde(skip)]
     pub fitted: Vec<f64>,
-    /// Energy-based friction force (NaN where masked).
-    #[serde(skip)]
+    /// Energy-based friction force (NaN where masked; empty without the energy check).
     pub energy_based_force: Vec<f64>,
-    /// The model's force along the measured motion.
-    #[serde(skip)]
+    /// The model's force along the measured motion (empty without the energy check).
     pub model_force: Vec<f64>,
 }
 

@@ -16,8 +16,7 @@
 //! round-off level.
 
 use super::stepper::{
-    current_point_accessors, ensure_resolvable, last_step, OdeSystem, StepCounts, StepOutcome,
-    StepResult, Stepper, Tolerance,
+    current_point_accessors, OdeSystem, StepControl, StepCounts, StepOutcome, StepResult, Stepper,
 };
 
 /// Stage times c_i.
@@ -89,22 +88,12 @@ const MIN_OLD_ERROR: f64 = 1e-4;
 /// Dormand-Prince 5(4) with error control and dense output over `Vec<f64>` states.
 #[derive(Debug, Clone)]
 pub struct Dopri5 {
-    tol: Tolerance,
-    h_max: f64,
-    t: f64,
-    t_prev: f64,
-    t_end: f64,
-    h: f64,
-    last: bool,
-    reached: bool,
+    ctrl: StepControl,
     old_error: f64,
-    after_reject: bool,
     y: Vec<f64>,
     y_next: Vec<f64>,
     /// The embedded error estimate of the last attempt.
     err_est: Vec<f64>,
-    /// Size of the last accepted step.
-    h_last: f64,
     /// Stages k_1..k_7 (k[0] holds f at the current state: first same as last).
     k: [Vec<f64>; 7],
     /// Dense-output coefficients of the last accepted step.
@@ -123,20 +112,11 @@ impl Dopri5 {
     pub fn new(dim: usize, rtol: f64, atol: f64, h_max: f64) -> Self {
         let zeros = || vec![0.0; dim];
         Self {
-            tol: Tolerance { rtol, atol },
-            h_max: h_max.abs(),
-            t: 0.0,
-            t_prev: 0.0,
-            t_end: 0.0,
-            h: 0.0,
-            last: false,
-            reached: false,
+            ctrl: StepControl::new(rtol, atol, h_max),
             old_error: MIN_OLD_ERROR,
-            after_reject: false,
             y: zeros(),
             y_next: zeros(),
             err_est: zeros(),
-            h_last: 0.0,
             k: std::array::from_fn(|_| zeros()),
             cont: std::array::from_fn(|_| zeros()),
             counts: StepCounts::default(),
@@ -150,25 +130,23 @@ impl Dopri5 {
     /// the sample knots of a motion taken linear between samples; it saves the two
     /// evaluations of f a reset makes.
     pub fn extend_to(&mut self, t_end: f64) {
-        self.t_end = t_end;
-        self.last = false;
-        self.reached = false;
+        self.ctrl.extend_to(t_end);
     }
 
     /// The starting step of Hairer's DOPRI5 (two RHS evaluations, the first kept in k[0]).
     fn initial_step<S: OdeSystem>(&mut self, system: &S) -> f64 {
         let (f0, rest) = self.k.split_at_mut(1);
         let (f0, f1) = (&mut f0[0], &mut rest[0]);
-        system.rhs(self.t, &self.y, f0);
-        let (h0, _, d1) = self.tol.first_step_guess(&self.y, f0);
-        let h0 = h0.min(self.h_max);
+        system.rhs(self.ctrl.t, &self.y, f0);
+        let (h0, _, d1) = self.ctrl.tol.first_step_guess(&self.y, f0);
+        let h0 = h0.min(self.ctrl.h_max);
         for ((yn, &yi), &fi) in self.y_next.iter_mut().zip(&self.y).zip(f0.iter()) {
             *yn = yi + fi * h0;
         }
-        system.rhs(self.t + h0, &self.y_next, f1);
+        system.rhs(self.ctrl.t + h0, &self.y_next, f1);
         let mut d2 = 0.0;
         for ((&yi, &a), &b) in self.y.iter().zip(f0.iter()).zip(f1.iter()) {
-            let sc = self.tol.scale(yi, yi);
+            let sc = self.ctrl.tol.scale(yi, yi);
             d2 += ((b - a) / sc) * ((b - a) / sc);
         }
         let d2 = d2.sqrt() / h0;
@@ -178,7 +156,7 @@ impl Dopri5 {
         } else {
             (0.01 / d1.max(d2)).powf(0.2)
         };
-        (100.0 * h0).min(h1.min(self.h_max))
+        (100.0 * h0).min(h1.min(self.ctrl.h_max))
     }
 
     /// The six stages after k[0]; leaves the 5th-order solution in `y_next` and f there in k[6].
@@ -191,7 +169,7 @@ impl Dopri5 {
                     *yn += kv * h * a;
                 }
             }
-            system.rhs(self.t + h * C[s], &self.y_next, &mut todo[0]);
+            system.rhs(self.ctrl.t + h * C[s], &self.y_next, &mut todo[0]);
         }
         self.counts.rhs_evaluations += 6;
     }
@@ -212,7 +190,7 @@ impl Dopri5 {
     /// The RMS error norm of the embedded estimate.
     fn error_norm(&mut self, h: f64) -> f64 {
         Self::combine(&self.k, &E, h, &mut self.err_est);
-        self.tol.rms_norm(&self.y, &self.y_next, &self.err_est)
+        self.ctrl.tol.rms_norm(&self.y, &self.y_next, &self.err_est)
     }
 
     /// The PI controller: the next step size, and whether the step is accepted.
@@ -226,21 +204,21 @@ impl Dopri5 {
         let h_new = h / fac;
         if err <= 1.0 {
             self.old_error = err.max(MIN_OLD_ERROR);
-            let mut h_new = h_new.min(self.h_max);
-            if self.after_reject {
+            let mut h_new = h_new.min(self.ctrl.h_max);
+            if self.ctrl.after_reject {
                 h_new = h_new.min(h);
             }
-            self.after_reject = false;
+            self.ctrl.after_reject = false;
             (true, h_new)
         } else {
-            self.after_reject = true;
+            self.ctrl.after_reject = true;
             (false, h / MAX_SHRINK.min(err_alpha / SAFETY))
         }
     }
 
     /// Stores the dense output of the accepted step and moves to its end.
     fn accept(&mut self, h: f64) {
-        if self.t_prev < self.t {
+        if self.ctrl.t_prev < self.ctrl.t {
             for ((s, &c0), &c1) in self
                 .start_value
                 .iter_mut()
@@ -265,44 +243,31 @@ impl Dopri5 {
         let [k0, .., k6] = &mut self.k;
         k0.copy_from_slice(k6);
         std::mem::swap(&mut self.y, &mut self.y_next);
-        self.t_prev = self.t;
-        self.t += h;
-        self.h_last = h;
-        self.reached = self.last;
+        self.ctrl.advance(h);
     }
 }
 
 impl Stepper for Dopri5 {
-    current_point_accessors!();
+    current_point_accessors!(ctrl);
 
     fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()> {
-        self.t = t;
-        self.t_prev = t;
-        self.t_end = t_end;
+        self.ctrl.restart(t, t_end);
         self.y.copy_from_slice(y);
         self.old_error = MIN_OLD_ERROR;
-        self.after_reject = false;
-        self.last = false;
-        self.reached = false;
         // Leaves f(t, y) in k[0], ready for the first step.
-        self.h = self.initial_step(system);
+        self.ctrl.h = self.initial_step(system);
         self.counts.rhs_evaluations += 2;
         Ok(())
     }
 
     fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome> {
-        ensure_resolvable(self.t, self.h)?;
-        if let Some(rest) = last_step(self.t, self.h, self.t_end) {
-            self.h = rest;
-            self.last = true;
-        }
-        let h = self.h;
+        let h = self.ctrl.next_attempt()?;
         self.stages(system, h);
         let err = self.error_norm(h);
         let (accepted, h_new) = self.control(err, h);
-        self.h = h_new;
+        self.ctrl.h = h_new;
         if !accepted {
-            self.last = false;
+            self.ctrl.last = false;
             self.counts.rejected += 1;
             return Ok(StepOutcome::Rejected);
         }
@@ -311,20 +276,12 @@ impl Stepper for Dopri5 {
         Ok(StepOutcome::Accepted)
     }
 
-    fn reached_end(&self) -> bool {
-        self.reached
-    }
-
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        if t == self.t_prev {
+        if t == self.ctrl.t_prev {
             out.copy_from_slice(&self.start_value);
             return;
         }
-        let theta = if self.h_last > 0.0 {
-            (t.clamp(self.t_prev, self.t) - self.t_prev) / self.h_last
-        } else {
-            1.0
-        };
+        let theta = self.ctrl.fraction_of_last_step(t);
         let theta1 = 1.0 - theta;
         let [c0, c1, c2, c3, c4] = &self.cont;
         for (i, o) in out.iter_mut().enumerate() {

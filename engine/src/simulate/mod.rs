@@ -55,6 +55,7 @@ pub use stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper, Tol
 use auto::resolve_method;
 use driver::Driver;
 
+use crate::energy::MechanicalEnergy;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use frictionid_models::{sgn, FrictionModel};
@@ -228,12 +229,9 @@ pub struct Trajectory {
     pub states: Vec<Vec<f64>>,
     /// Friction force [N] (at rest: the static force balancing the spring, -k x).
     pub friction: Vec<f64>,
-    /// Kinetic energy m v^2 / 2 [J].
-    pub kinetic: Vec<f64>,
-    /// Potential energy k x^2 / 2 [J].
-    pub potential: Vec<f64>,
-    /// Mechanical energy E = KE + PE [J] (the paper's E; without `stored`).
-    pub energy: Vec<f64>,
+    /// Kinetic, potential and mechanical energy (the paper's E; without `stored`).
+    #[serde(flatten)]
+    pub mechanical: MechanicalEnergy,
     /// Energy stored in the friction model's internal states [J].
     pub stored: Vec<f64>,
     /// Events in time order.
@@ -248,7 +246,8 @@ impl Trajectory {
     /// The total energy at each sample: mechanical (KE + PE) plus the energy stored in the
     /// friction model's states \[J\]. A passive contact never lets it rise.
     pub fn total_energy(&self) -> Vec<f64> {
-        self.energy
+        self.mechanical
+            .energy
             .iter()
             .zip(&self.stored)
             .map(|(e, s)| e + s)
@@ -346,9 +345,6 @@ impl<'a> FullRecorder<'a> {
                 a: col(),
                 states: (0..n_states).map(|_| col()).collect(),
                 friction: col(),
-                kinetic: col(),
-                potential: col(),
-                energy: col(),
                 stored: col(),
                 ..Trajectory::default()
             },
@@ -380,14 +376,7 @@ impl FullRecorder<'_> {
     fn finish_energies(&mut self) {
         let (m, k) = (self.mass, self.stiffness);
         let out = &mut self.series;
-        out.kinetic.extend(out.v.iter().map(|&v| 0.5 * m * v * v));
-        out.potential.extend(out.x.iter().map(|&x| 0.5 * k * x * x));
-        out.energy.extend(
-            out.kinetic
-                .iter()
-                .zip(&out.potential)
-                .map(|(ke, pe)| ke + pe),
-        );
+        out.mechanical = MechanicalEnergy::of(m, k, &out.x, &out.v);
         if out.stored.len() < out.time.len() {
             out.stored.resize(out.time.len(), 0.0);
         }

@@ -21,8 +21,7 @@
 //! steps set by the accuracy of the motion, not by 3.3 / (sigma0 |v| / g).
 
 use super::stepper::{
-    current_point_accessors, ensure_resolvable, last_step, OdeSystem, StepCounts, StepOutcome,
-    StepResult, Stepper, Tolerance,
+    current_point_accessors, OdeSystem, StepControl, StepCounts, StepOutcome, StepResult, Stepper,
 };
 use nalgebra::{DMatrix, DVectorViewMut, Dyn, LU};
 
@@ -106,17 +105,8 @@ const MAX_SHRINK: f64 = 5.0;
 /// The Rodas4 stepper over `Vec<f64>` states (see the module docs).
 #[derive(Debug, Clone)]
 pub struct Rodas4 {
-    tol: Tolerance,
-    h_max: f64,
-    t: f64,
-    t_prev: f64,
-    t_end: f64,
-    h: f64,
-    h_last: f64,
+    ctrl: StepControl,
     first: bool,
-    after_reject: bool,
-    last: bool,
-    reached: bool,
     /// Whether f and J at the current point are stale (a new point was accepted).
     stale: bool,
     /// Size and error of the previous accepted step (Gustafsson's controller).
@@ -142,17 +132,8 @@ impl Rodas4 {
     pub fn new(dim: usize, rtol: f64, atol: f64, h_max: f64) -> Self {
         let zeros = || vec![0.0; dim];
         Self {
-            tol: Tolerance { rtol, atol },
-            h_max: h_max.abs(),
-            t: 0.0,
-            t_prev: 0.0,
-            t_end: 0.0,
-            h: 0.0,
-            h_last: 0.0,
+            ctrl: StepControl::new(rtol, atol, h_max),
             first: true,
-            after_reject: false,
-            last: false,
-            reached: false,
             stale: true,
             h_acc: 0.0,
             err_acc: 1e-2,
@@ -171,8 +152,8 @@ impl Rodas4 {
 
     /// Evaluates f and J at the current point.
     fn refresh<S: OdeSystem>(&mut self, system: &S) {
-        system.rhs(self.t, &self.y, &mut self.fx);
-        system.jacobian(self.t, &self.y, &mut self.jac);
+        system.rhs(self.ctrl.t, &self.y, &mut self.fx);
+        system.jacobian(self.ctrl.t, &self.y, &mut self.jac);
         self.counts.rhs_evaluations += 1;
         self.counts.jacobian_evaluations += 1;
         self.stale = false;
@@ -182,7 +163,7 @@ impl Rodas4 {
     /// scale 1 / ||J||_inf (a fourth-order method's first step need not resolve more).
     fn initial_step(&self) -> f64 {
         let n = self.y.len();
-        let (h0, _, _) = self.tol.first_step_guess(&self.y, &self.fx);
+        let (h0, _, _) = self.ctrl.tol.first_step_guess(&self.y, &self.fx);
         let norm_j = self
             .jac
             .chunks(n.max(1))
@@ -193,7 +174,7 @@ impl Rodas4 {
         } else {
             h0
         };
-        h.min(self.h_max).min(self.t_end - self.t)
+        h.min(self.ctrl.h_max).min(self.ctrl.t_end - self.ctrl.t)
     }
 
     /// Factors E = I / (gamma h) - J and sets the coupling coefficients c_ij / h; false when
@@ -229,7 +210,7 @@ impl Rodas4 {
     /// k[s-1], where `arg` is in `y_new` (f at the step's start time: the system is
     /// autonomous).
     fn stage<S: OdeSystem>(&mut self, system: &S, s: usize) {
-        system.rhs(self.t, &self.y_new, &mut self.dy);
+        system.rhs(self.ctrl.t, &self.y_new, &mut self.dy);
         self.counts.rhs_evaluations += 1;
         let coupling = &self.c_h[s - 2][..s - 1];
         let (done, todo) = self.k.split_at_mut(s - 1);
@@ -278,7 +259,7 @@ impl Rodas4 {
 
     /// The RMS norm of the error estimate k_6.
     fn error_norm(&self) -> f64 {
-        self.tol.rms_norm(&self.y, &self.y_new, &self.k[5])
+        self.ctrl.tol.rms_norm(&self.y, &self.y_new, &self.k[5])
     }
 
     /// The step-size factor h / h_new for error `err`.
@@ -308,8 +289,8 @@ impl Rodas4 {
         }
         self.h_acc = h;
         self.err_acc = err.max(1e-2);
-        let mut h_new = (h / fac).min(self.h_max);
-        if self.after_reject {
+        let mut h_new = (h / fac).min(self.ctrl.h_max);
+        if self.ctrl.after_reject {
             h_new = h_new.min(h);
         }
         h_new
@@ -325,61 +306,48 @@ impl Rodas4 {
         c0.copy_from_slice(&self.y);
         c1.copy_from_slice(&self.y_new);
         std::mem::swap(&mut self.y, &mut self.y_new);
-        self.t_prev = self.t;
-        self.t += h;
-        if self.last {
-            self.t = self.t_end;
+        self.ctrl.advance(h);
+        if self.ctrl.reached {
+            self.ctrl.t = self.ctrl.t_end;
         }
-        self.h_last = h;
-        self.reached = self.last;
         self.stale = true;
         self.first = false;
     }
 
     /// Handles a rejected attempt of size `h` with next size `h_new`.
     fn reject(&mut self, h: f64, h_new: f64) -> StepOutcome {
-        self.h = if self.first { 0.1 * h } else { h_new };
-        self.after_reject = true;
-        self.last = false;
+        self.ctrl.h = if self.first { 0.1 * h } else { h_new };
+        self.ctrl.after_reject = true;
+        self.ctrl.last = false;
         self.counts.rejected += 1;
         StepOutcome::Rejected
     }
 }
 
 impl Stepper for Rodas4 {
-    current_point_accessors!();
+    current_point_accessors!(ctrl);
 
     fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()> {
-        self.t = t;
-        self.t_prev = t;
-        self.t_end = t_end;
+        self.ctrl.restart(t, t_end);
         self.y.copy_from_slice(y);
         self.cont[0].copy_from_slice(y);
         self.cont[1].copy_from_slice(y);
         self.cont[2].fill(0.0);
         self.cont[3].fill(0.0);
-        self.h_last = 0.0;
+        self.ctrl.h_last = 0.0;
         self.first = true;
-        self.after_reject = false;
-        self.last = false;
-        self.reached = false;
         self.h_acc = 0.0;
         self.err_acc = 1e-2;
         self.refresh(system);
-        self.h = self.initial_step();
+        self.ctrl.h = self.initial_step();
         Ok(())
     }
 
     fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome> {
-        ensure_resolvable(self.t, self.h)?;
+        let h = self.ctrl.next_attempt()?;
         if self.stale {
             self.refresh(system);
         }
-        if let Some(rest) = last_step(self.t, self.h, self.t_end) {
-            self.h = rest;
-            self.last = true;
-        }
-        let h = self.h;
         if !self.stages(system, h) {
             return Ok(self.reject(h, 0.5 * h));
         }
@@ -388,23 +356,15 @@ impl Stepper for Rodas4 {
         if !within {
             return Ok(self.reject(h, h / Self::shrink(err)));
         }
-        self.h = self.next_after_accept(h, err);
-        self.after_reject = false;
+        self.ctrl.h = self.next_after_accept(h, err);
+        self.ctrl.after_reject = false;
         self.counts.accepted += 1;
         self.accept(h);
         Ok(StepOutcome::Accepted)
     }
 
-    fn reached_end(&self) -> bool {
-        self.reached
-    }
-
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let s = if self.h_last > 0.0 {
-            (t.clamp(self.t_prev, self.t) - self.t_prev) / self.h_last
-        } else {
-            1.0
-        };
+        let s = self.ctrl.fraction_of_last_step(t);
         let s1 = 1.0 - s;
         let [c0, c1, c2, c3] = &self.cont;
         for (i, o) in out.iter_mut().enumerate() {

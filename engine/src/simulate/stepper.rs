@@ -133,19 +133,20 @@ pub(crate) fn last_step(t: f64, h: f64, t_end: f64) -> Option<f64> {
 
 /// Implements the [`Stepper`] accessors `time`, `previous_time`, `end_time`, `state` and
 /// `counts` for a stepper that keeps its current time in `t`, the previous one in `t_prev`, the
-/// end time in `t_end`, the state in `y` and its work counters in `counts`.
+/// end time in `t_end` (fields of the stepper, or of its field `$clock`, a [`StepControl`]),
+/// the state in `y` and its work counters in `counts`; with a clock, `reached_end` too.
 macro_rules! current_point_accessors {
-    () => {
+    ($($clock:ident)?) => {
         fn time(&self) -> f64 {
-            self.t
+            self.$($clock.)?t
         }
 
         fn end_time(&self) -> f64 {
-            self.t_end
+            self.$($clock.)?t_end
         }
 
         fn previous_time(&self) -> f64 {
-            self.t_prev
+            self.$($clock.)?t_prev
         }
 
         fn state(&self) -> &[f64] {
@@ -155,9 +156,108 @@ macro_rules! current_point_accessors {
         fn counts(&self) -> StepCounts {
             self.counts
         }
+
+        $(
+            fn reached_end(&self) -> bool {
+                self.$clock.reached
+            }
+        )?
     };
 }
 pub(crate) use current_point_accessors;
+
+/// The step-size control of an adaptive one-step method: its tolerance and largest step, and
+/// where it stands (the ends of its last accepted step, the end of the interval, the size of
+/// its next attempt and the flags of its last attempts).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepControl {
+    /// The error tolerance.
+    pub tol: Tolerance,
+    /// The largest step.
+    pub h_max: f64,
+    /// Current time: the end of the last accepted step.
+    pub t: f64,
+    /// The start of the last accepted step.
+    pub t_prev: f64,
+    /// The end of the interval.
+    pub t_end: f64,
+    /// The size of the next attempt.
+    pub h: f64,
+    /// The size of the last accepted step.
+    pub h_last: f64,
+    /// The current attempt ends the interval.
+    pub last: bool,
+    /// The last accepted step reached the end of the interval.
+    pub reached: bool,
+    /// The attempt before was rejected.
+    pub after_reject: bool,
+}
+
+impl StepControl {
+    /// A control with tolerances `rtol`, `atol` and largest step |`h_max`|.
+    pub fn new(rtol: f64, atol: f64, h_max: f64) -> Self {
+        Self {
+            tol: Tolerance { rtol, atol },
+            h_max: h_max.abs(),
+            t: 0.0,
+            t_prev: 0.0,
+            t_end: 0.0,
+            h: 0.0,
+            h_last: 0.0,
+            last: false,
+            reached: false,
+            after_reject: false,
+        }
+    }
+
+    /// Starts over at `t` in an interval ending at `t_end` (step sizes kept).
+    pub fn restart(&mut self, t: f64, t_end: f64) {
+        *self = Self {
+            t,
+            t_prev: t,
+            t_end,
+            last: false,
+            reached: false,
+            after_reject: false,
+            ..*self
+        };
+    }
+
+    /// Moves the end of the interval on to `t_end`; the next step starts where the last ended.
+    pub fn extend_to(&mut self, t_end: f64) {
+        self.t_end = t_end;
+        self.last = false;
+        self.reached = false;
+    }
+
+    /// The size of the next attempt: an error when it is too small to resolve at the current
+    /// time; shortened to the rest of the interval (and marked last) near its end.
+    pub fn next_attempt(&mut self) -> StepResult<f64> {
+        ensure_resolvable(self.t, self.h)?;
+        if let Some(rest) = last_step(self.t, self.h, self.t_end) {
+            self.h = rest;
+            self.last = true;
+        }
+        Ok(self.h)
+    }
+
+    /// Moves past an accepted step of size `h`.
+    pub fn advance(&mut self, h: f64) {
+        self.t_prev = self.t;
+        self.t += h;
+        self.h_last = h;
+        self.reached = self.last;
+    }
+
+    /// The theta in [0, 1] of `t` within the last accepted step (1 before any step).
+    pub fn fraction_of_last_step(&self, t: f64) -> f64 {
+        if self.h_last > 0.0 {
+            (t.clamp(self.t_prev, self.t) - self.t_prev) / self.h_last
+        } else {
+            1.0
+        }
+    }
+}
 
 /// Work counters of a stepper, summed since it was built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

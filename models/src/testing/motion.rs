@@ -33,14 +33,14 @@ pub struct Motion {
     pub x: Vec<f64>,
     /// Velocity [m/s].
     pub v: Vec<f64>,
+    /// Number of events (turning points, sticks, ...).
+    pub events: usize,
+    /// Where the mass came to rest for good, if it did.
+    pub rest_displacement: Option<f64>,
     /// Friction force \[N\].
     pub friction: Vec<f64>,
     /// Kinetic + potential + stored energy \[J\].
     pub total_energy: Vec<f64>,
-    /// Where the mass came to rest for good, if it did.
-    pub rest_displacement: Option<f64>,
-    /// Number of events (turning points, sticks, ...).
-    pub events: usize,
 }
 
 /// An oscillator and a solver: releases a mass from rest with a given friction model.
