@@ -201,6 +201,7 @@ fn restart_from<R: Residuals + 'static>(
         start: runs.best_start,
         starts: 1,
         max_iterations: opts.max_iterations,
+        pace: None,
     };
     let Ok(run) = run_start(problem, u, opts, slot) else {
         return false;
@@ -353,6 +354,7 @@ fn pinned_fit<R: Residuals + 'static>(
             start: 0,
             starts: 1,
             max_iterations: iterations,
+            pace: None,
         };
         run_start(sub, others.clone(), opts, slot).ok()?
     };

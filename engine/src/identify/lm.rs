@@ -18,9 +18,41 @@ use argmin::core::{
     TerminationReason as ArgminReason, TerminationStatus, KV,
 };
 use nalgebra::{DMatrix, DVector};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 /// The argmin state used by [`LevenbergMarquardt`].
 pub type LmState = IterState<DVector<f64>, (), DMatrix<f64>, (), DVector<f64>, f64>;
+
+/// A run still this many times above the cost another run of the same fit converged to is
+/// abandoned (its residual RMS is more than 1.4 times the other's: it cannot be the best fit
+/// short of a descent far larger than any it has made since its screening).
+pub const OUTPACE_FACTOR: f64 = 2.0;
+
+/// The lowest cost any of a group of concurrent runs has converged to, shared between them
+/// (+inf until one converges).
+#[derive(Debug)]
+pub struct Pace(AtomicU64);
+
+impl Default for Pace {
+    fn default() -> Self {
+        Self(AtomicU64::new(f64::INFINITY.to_bits()))
+    }
+}
+
+impl Pace {
+    /// A run converged at `cost` (finite, >= 0: their bit patterns order as the values do).
+    pub fn converged_at(&self, cost: f64) {
+        if cost.is_finite() && cost >= 0.0 {
+            self.0.fetch_min(cost.to_bits(), Ordering::Relaxed);
+        }
+    }
+
+    /// The lowest converged cost so far.
+    pub fn best(&self) -> f64 {
+        f64::from_bits(self.0.load(Ordering::Relaxed))
+    }
+}
 
 /// Bounded Levenberg-Marquardt.
 #[derive(Debug, Clone)]
@@ -52,6 +84,9 @@ pub struct LevenbergMarquardt {
     jacobian: DMatrix<f64>,
     cost: f64,
     converged: Option<TerminationReason>,
+    /// Converged costs of the other runs of the fit: the run stops when it falls behind
+    /// them by [`OUTPACE_FACTOR`].
+    pub pace: Option<Arc<Pace>>,
 }
 
 impl LevenbergMarquardt {
@@ -74,6 +109,7 @@ impl LevenbergMarquardt {
             jacobian: DMatrix::zeros(0, 0),
             cost: f64::INFINITY,
             converged: None,
+            pace: None,
         }
     }
 
@@ -160,6 +196,13 @@ where
         let p = state
             .take_param()
             .ok_or_else(|| Error::msg("Levenberg-Marquardt lost its parameter vector"))?;
+        if let Some(best) = self.outpaced_by() {
+            self.converged = Some(TerminationReason::Outpaced {
+                best,
+                cost: self.cost,
+            });
+            return Ok((state.param(p).cost(self.cost), None));
+        }
         if self.stagnated() {
             self.converged = Some(TerminationReason::Stagnation {
                 tolerance: self.stall_tol,
@@ -247,6 +290,12 @@ impl LevenbergMarquardt {
     /// stopped from outside, e.g. by the iteration limit).
     pub fn termination(&self) -> Option<&TerminationReason> {
         self.converged.as_ref()
+    }
+
+    /// The converged cost of another run that this run is [`OUTPACE_FACTOR`] times above.
+    fn outpaced_by(&self) -> Option<f64> {
+        let best = self.pace.as_ref()?.best();
+        (self.cost > OUTPACE_FACTOR * best).then_some(best)
     }
 
     /// Whether the cost fell by less than `stall_tol` relative over the last `stall_window`
@@ -385,6 +434,52 @@ mod tests {
             .unwrap();
         let reason = termination_reason(&res.solver, &res.state().termination_status, 500);
         (res.state().clone(), reason)
+    }
+
+    /// Rosenbrock from (-1.2, 1) (cost 12.1) racing runs that converged at `best`.
+    fn race_rosenbrock(best: f64) -> (u64, TerminationReason) {
+        let pace = Arc::new(Pace::default());
+        pace.converged_at(best);
+        let inf = f64::INFINITY;
+        let mut solver = LevenbergMarquardt::new(
+            DVector::from_vec(vec![-inf; 2]),
+            DVector::from_vec(vec![inf; 2]),
+        );
+        solver.pace = Some(pace);
+        let res = Executor::new(Rosenbrock, solver)
+            .configure(|s| s.param(DVector::from_vec(vec![-1.2, 1.0])).max_iters(500))
+            .run()
+            .unwrap();
+        let reason = termination_reason(&res.solver, &res.state().termination_status, 500);
+        (res.state().get_iter(), reason)
+    }
+
+    #[test]
+    fn a_run_far_behind_a_converged_one_is_abandoned_at_once() {
+        let (iterations, reason) = race_rosenbrock(1.0);
+        assert_eq!(iterations, 1);
+        let TerminationReason::Outpaced { best, cost } = reason else {
+            panic!("not outpaced: {reason:?}");
+        };
+        // The starting cost, 0.5 ((10 (1 - 1.44))^2 + 2.2^2).
+        assert!((cost - 12.1).abs() < 1e-12 && best == 1.0, "{cost} {best}");
+        assert!(!reason.is_converged());
+    }
+
+    #[test]
+    fn a_run_within_the_factor_of_the_others_runs_to_convergence() {
+        let (_, reason) = race_rosenbrock(12.1 / OUTPACE_FACTOR);
+        assert!(reason.is_converged(), "{reason:?}");
+    }
+
+    #[test]
+    fn the_pace_keeps_the_lowest_finite_converged_cost() {
+        let pace = Pace::default();
+        assert_eq!(pace.best(), f64::INFINITY);
+        for cost in [3.0, 1.0, f64::NAN, 2.0, -1.0, f64::INFINITY] {
+            pace.converged_at(cost);
+        }
+        assert_eq!(pace.best(), 1.0);
     }
 
     #[test]

@@ -40,6 +40,14 @@ pub enum TerminationReason {
         /// The unbounded parameters.
         parameters: Vec<String>,
     },
+    /// Abandoned: another start of the same fit had converged to a cost `factor` times lower
+    /// or more ([`super::lm::Pace`]); this one could not have become the best within reach.
+    Outpaced {
+        /// The cost the other start converged to.
+        best: f64,
+        /// This run's cost when it was abandoned.
+        cost: f64,
+    },
     /// Any other stop reported by the solver framework (e.g. an interrupt).
     Other {
         /// The framework's text.
@@ -50,7 +58,10 @@ pub enum TerminationReason {
 impl TerminationReason {
     /// Whether this reason counts as convergence.
     pub fn is_converged(&self) -> bool {
-        !matches!(self, Self::IterationLimit { .. } | Self::Other { .. })
+        !matches!(
+            self,
+            Self::IterationLimit { .. } | Self::Outpaced { .. } | Self::Other { .. }
+        )
     }
 }
 
@@ -75,6 +86,10 @@ impl fmt::Display for TerminationReason {
                 f,
                 "converged for the other parameters: `{}` kept running to a value the records do not bound",
                 parameters.join("`, `")
+            ),
+            Self::Outpaced { best, cost } => write!(
+                f,
+                "abandoned at cost {cost:.6e}: another start converged to {best:.6e}"
             ),
             Self::Other { text } => f.write_str(text),
         }

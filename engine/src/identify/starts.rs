@@ -2,7 +2,7 @@
 //! screening of every start and the continuation of the most promising one.
 
 use super::layout::{FreeParam, ParamKind};
-use super::lm::{termination_reason, LevenbergMarquardt, LmState};
+use super::lm::{termination_reason, LevenbergMarquardt, LmState, Pace};
 use super::options::{FitOptions, Progress, ProgressFn};
 use super::outcome::{StartOutcome, TerminationReason};
 use super::problem::FitProblem;
@@ -13,6 +13,7 @@ use argmin::core::{Executor, State, KV};
 use frictionid_models::FrictionModel;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// Starts of a multi-start fit when more than two model parameters are free.
 pub const DEFAULT_STARTS: usize = 4;
@@ -175,8 +176,8 @@ fn solver_for<R: Residuals>(problem: &FitProblem<R>, opts: &FitOptions) -> Leven
     solver
 }
 
-/// Which start of how many a run is, and its iteration budget.
-#[derive(Debug, Clone, Copy)]
+/// Which start of how many a run is, its iteration budget and the runs it races.
+#[derive(Debug, Clone)]
 pub struct RunSlot {
     /// Index of the start.
     pub start: usize,
@@ -184,6 +185,9 @@ pub struct RunSlot {
     pub starts: usize,
     /// Iteration limit of this run.
     pub max_iterations: u64,
+    /// The costs the concurrent runs of the fit converged to (the run is abandoned when it
+    /// falls behind them, and reports its own when it converges); `None`: a run on its own.
+    pub pace: Option<Arc<Pace>>,
 }
 
 /// Runs the solver on `problem` from `u0`.
@@ -193,7 +197,8 @@ pub fn run_start<R: Residuals + 'static>(
     opts: &FitOptions,
     slot: RunSlot,
 ) -> Result<StartRun, EngineError> {
-    let solver = solver_for(&problem, opts);
+    let mut solver = solver_for(&problem, opts);
+    solver.pace = slot.pace.clone();
     let model_name = problem.model.name().to_string();
     let mut exec = Executor::new(problem, solver)
         .configure(|s| s.param(u0).max_iters(slot.max_iterations))
@@ -226,7 +231,7 @@ pub fn run_start<R: Residuals + 'static>(
     let (jac, r) = res.solver.linearisation();
     let linearisation =
         (jac.ncols() == u.len() && r.len() == jac.nrows()).then(|| (jac.clone(), r.clone()));
-    Ok(StartRun {
+    let run = StartRun {
         u,
         linearisation,
         cost: state.get_best_cost(),
@@ -237,7 +242,11 @@ pub fn run_start<R: Residuals + 'static>(
             &state.termination_status,
             slot.max_iterations,
         ),
-    })
+    };
+    if let (Some(pace), true) = (&slot.pace, run.converged()) {
+        pace.converged_at(run.cost);
+    }
+    Ok(run)
 }
 
 /// The result of every start: the best run and what became of each start.
@@ -313,6 +322,7 @@ where
             start: s,
             starts: n_starts,
             max_iterations: screen,
+            pace: None,
         };
         run_start(problem, u0, opts, slot)
     };
@@ -342,7 +352,9 @@ struct Phase {
     promote: usize,
 }
 
-/// Phase 2: continues the best screened starts (unless converged) to the iteration limit.
+/// Phase 2: continues the best screened starts (unless converged) to the iteration limit; a
+/// continued start still [`super::lm::OUTPACE_FACTOR`] times above the cost another start
+/// converged to is abandoned.
 fn continue_best<R, F>(make_problem: &F, screened: &mut Screened, opts: &FitOptions, phase: Phase)
 where
     R: Residuals + 'static,
@@ -360,10 +372,16 @@ where
         .filter(|(_, o)| !o.converged())
         .map(|(s, o)| (*s, o.u.clone()))
         .collect();
+    // The promoted runs race each other and any start that converged while screening.
+    let pace = Arc::new(Pace::default());
+    for (_, o) in screened.ok.iter().filter(|(_, o)| o.converged()) {
+        pace.converged_at(o.cost);
+    }
     let slot = |start| RunSlot {
         start,
         starts: n_starts,
         max_iterations: opts.max_iterations - screen,
+        pace: Some(pace.clone()),
     };
     let finish =
         |(s, u): &(usize, DVector<f64>)| (*s, run_start(make_problem(), u.clone(), opts, slot(*s)));
