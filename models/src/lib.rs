@@ -17,7 +17,9 @@ pub mod testing;
 
 pub use builtin::*;
 pub use error::ModelError;
-pub use model::{check_bounds, check_len, clone_model, sgn, FrictionModel, GuessHint, ParamInfo};
+pub use model::{
+    check_bounds, check_len, clone_model, decay, sgn, FrictionModel, GuessHint, ParamInfo,
+};
 pub use params::{DeclaredParams, ParamSpec};
 pub use registry::{build_json, build_toml, default_model, listings, names, Built, ModelListing};
 pub use start::{StartContext, StribeckLevels};

@@ -157,6 +157,15 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
     /// and sgn(0) = 0.
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64;
 
+    /// [`state_derivative`](Self::state_derivative) into `dz` and [`force`](Self::force), in
+    /// one call: what a simulation's right-hand side needs. A law whose force uses its state
+    /// derivative (LuGre, GMS) computes the shared terms once; the results must equal the two
+    /// calls bit for bit (checked by `testing::check_combined_rhs`).
+    fn state_derivative_and_force(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) -> f64 {
+        self.state_derivative(v, z, normal, dz);
+        self.force(v, z, normal)
+    }
+
     /// For static laws with a set-valued force at zero velocity: the breakaway force limit
     /// used to decide sticking (coulomb: mu N). `None` for smooth laws and dynamic models.
     fn static_limit(&self, _normal: f64) -> Option<f64> {
@@ -338,6 +347,18 @@ pub fn check_len(model: &str, expected: usize, got: usize) -> Result<(), ModelEr
             expected,
             got,
         })
+    }
+}
+
+/// exp(-x) for x >= 0, without calling `exp` where the result is 0 anyway (x > 745.2: below
+/// half the smallest subnormal). The Stribeck decays exp(-|v/v_s|^delta) underflow there at
+/// most sliding speeds, and libm's underflow path costs several times a plain `exp`.
+#[inline]
+pub fn decay(x: f64) -> f64 {
+    if x > 745.2 {
+        0.0
+    } else {
+        (-x).exp()
     }
 }
 

@@ -67,6 +67,8 @@ pub enum Check {
     StoredEnergy,
     /// A parameter declared force-only leaves the state derivative unchanged, exactly.
     ForceOnlyParams,
+    /// `state_derivative_and_force` equals `state_derivative` and `force`, bit for bit.
+    CombinedRhs,
     /// (motion) The simulator completes every release.
     Simulates,
     /// (motion) KE + PE + stored never increases.
@@ -124,7 +126,8 @@ pub fn check_model(model: &Model) -> Outcome {
     check_dissipative(model)?;
     check_slip_direction(model)?;
     check_stored_energy(model)?;
-    check_force_only_params(model)
+    check_force_only_params(model)?;
+    check_combined_rhs(model)
 }
 
 /// [`check_model`] for tests: panics with the violation.
@@ -445,6 +448,25 @@ fn check_state_free(model: &Model, indices: &[usize]) -> Outcome {
     Ok(())
 }
 
+/// [`Check::CombinedRhs`]: at every probe point the one-call state derivative and force are
+/// those of the two separate calls, to the bit.
+pub fn check_combined_rhs(model: &Model) -> Outcome {
+    for_each_probe(model, |v, z, normal| {
+        let separate = (derivative(model, v, z, normal), model.force(v, z, normal));
+        let mut dz = vec![0.0; model.n_states()];
+        let force = model.state_derivative_and_force(v, z, normal, &mut dz);
+        let bits = |x: &f64| x.to_bits();
+        let same = force.to_bits() == separate.1.to_bits()
+            && dz.iter().map(bits).eq(separate.0.iter().map(bits));
+        ensure(model, Check::CombinedRhs, same, || {
+            format!(
+                "at v = {v}, z = {z:?}, N = {normal}: one call gives dz {dz:?}, F {force}; separate {:?}, {}",
+                separate.0, separate.1
+            )
+        })
+    })
+}
+
 /// [`Check::Finite`].
 pub fn check_finite(model: &Model) -> Outcome {
     for_each_probe(model, |v, z, normal| {
@@ -604,6 +626,50 @@ pub fn doc_table_mismatch(source: &str, info: &[ParamInfo]) -> Option<String> {
 mod tests {
     use super::*;
     use crate::builtin::LuGre;
+    use serde::{Deserialize, Serialize};
+
+    /// LuGre with a one-call right-hand side that forgets the bristle damping.
+    #[derive(Debug, Clone, Default, Serialize, Deserialize)]
+    struct ForgetfulLuGre(LuGre);
+
+    #[typetag::serde(name = "testing_rs_forgetful_lugre")]
+    impl FrictionModel for ForgetfulLuGre {
+        crate::declared_param_methods!(
+            name: "testing_rs_forgetful_lugre",
+            equation: "",
+            no_params
+        );
+        fn n_states(&self) -> usize {
+            1
+        }
+        fn state_derivative(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) {
+            self.0.state_derivative(v, z, normal, dz);
+        }
+        fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
+            self.0.force(v, z, normal)
+        }
+        fn steady_state(&self, v: f64, normal: f64) -> f64 {
+            self.0.steady_state(v, normal)
+        }
+        fn state_derivative_and_force(
+            &self,
+            v: f64,
+            z: &[f64],
+            normal: f64,
+            dz: &mut [f64],
+        ) -> f64 {
+            self.0.state_derivative(v, z, normal, dz);
+            self.0.sigma0 * z[0] + self.0.sigma2 * v
+        }
+    }
+
+    #[test]
+    fn a_one_call_rhs_that_differs_from_the_two_calls_is_caught() {
+        assert_eq!(check_combined_rhs(&LuGre::default()), Ok(()));
+        let e = check_combined_rhs(&ForgetfulLuGre::default()).unwrap_err();
+        assert_eq!(e.check, Check::CombinedRhs);
+        assert!(e.message.contains("one call gives"), "{e}");
+    }
 
     /// LuGre's rate dz/dt = v - sigma0 |v| z / g(v) holds sigma0 and not sigma1: the check
     /// passes the true declaration and names sigma0 when it is declared force-only.

@@ -44,6 +44,7 @@ mod euler;
 mod jacobian;
 mod rodas;
 mod root;
+mod small_lu;
 mod stepper;
 
 pub use closed_form::ClosedForm;
@@ -461,10 +462,9 @@ impl Dynamics<'_> {
             return;
         };
         let f = match self.law {
-            Law::Dynamic => {
-                self.model.state_derivative(*v, z, self.normal, dz);
-                self.model.force(*v, z, self.normal)
-            }
+            Law::Dynamic => self
+                .model
+                .state_derivative_and_force(*v, z, self.normal, dz),
             _ => self.model.slip_force(*v, dir, self.normal),
         };
         *dx = *v;

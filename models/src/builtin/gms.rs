@@ -87,7 +87,7 @@
 
 use crate::builtin::stribeck::mu_s_warning;
 use crate::error::ModelError;
-use crate::model::{check_bounds, check_len, sgn, FrictionModel, GuessHint, ParamInfo};
+use crate::model::{check_bounds, check_len, decay, sgn, FrictionModel, GuessHint, ParamInfo};
 use crate::params::ParamSpec;
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 use serde::de::{self, SeqAccess, Visitor};
@@ -225,7 +225,7 @@ impl Gms {
     /// The Stribeck curve s(v) \[N\] (the total sliding force for weights summing to 1).
     pub fn s(&self, v: f64, normal: f64) -> f64 {
         normal
-            * (self.mu_c + (self.mu_s - self.mu_c) * (-(v / self.v_s).abs().powf(self.delta)).exp())
+            * (self.mu_c + (self.mu_s - self.mu_c) * decay((v / self.v_s).abs().powf(self.delta)))
     }
 
     /// The element's sliding force w s and its load sgn(v) k z / (w s): how far the motion
@@ -239,6 +239,16 @@ impl Gms {
         }
         let rho = e.stiffness * z / limit;
         Some((limit, if v >= 0.0 { rho } else { -rho }))
+    }
+
+    /// An element's force k z + sigma dz/dt (k z alone for an undamped element).
+    fn element_force(e: &GmsElement, z: f64, z_dot: f64) -> f64 {
+        let spring = e.stiffness * z;
+        if e.damping == 0.0 {
+            spring
+        } else {
+            spring + e.damping * z_dot
+        }
     }
 
     /// The element law dz/dt = v (1 - max(0, sgn(v) rho)^m).
@@ -600,12 +610,27 @@ impl FrictionModel for Gms {
             .enumerate()
             .map(|(i, e)| {
                 let zi = z.get(i).copied().unwrap_or(0.0);
-                let spring = e.stiffness * zi;
                 if e.damping == 0.0 {
-                    spring
+                    e.stiffness * zi
                 } else {
-                    spring + e.damping * self.z_dot(e, v, zi, s)
+                    Self::element_force(e, zi, self.z_dot(e, v, zi, s))
                 }
+            })
+            .sum();
+        elements + self.viscous * v
+    }
+    /// The Stribeck curve once, and each element's rate once for its derivative and force.
+    fn state_derivative_and_force(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) -> f64 {
+        let s = self.s(v, normal);
+        let elements: f64 = self
+            .elements
+            .iter()
+            .zip(dz.iter_mut())
+            .enumerate()
+            .map(|(i, (e, d))| {
+                let zi = z.get(i).copied().unwrap_or(0.0);
+                *d = self.z_dot(e, v, zi, s);
+                Self::element_force(e, zi, *d)
             })
             .sum();
         elements + self.viscous * v

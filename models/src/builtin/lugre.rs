@@ -19,7 +19,7 @@
 
 use crate::builtin::stribeck::mu_s_warning;
 use crate::error::ModelError;
-use crate::model::{check_bounds, sgn, FrictionModel, GuessHint};
+use crate::model::{check_bounds, decay, sgn, FrictionModel, GuessHint};
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
 crate::declare_params! {
@@ -38,7 +38,7 @@ impl LuGre {
     /// The Stribeck level g(v) \[N\].
     pub fn g(&self, v: f64, normal: f64) -> f64 {
         let r = v / self.v_s;
-        normal * (self.mu_c + (self.mu_s - self.mu_c) * (-r * r).exp())
+        normal * (self.mu_c + (self.mu_s - self.mu_c) * decay(r * r))
     }
 
     /// The partial derivatives (d/dz, d/dv) of dz/dt; (0, 0) without normal load.
@@ -48,9 +48,14 @@ impl LuGre {
             return (0.0, 0.0);
         }
         let r = v / self.v_s;
-        let dg = normal * (self.mu_s - self.mu_c) * (-r * r).exp() * (-2.0 * r / self.v_s);
+        let dg = normal * (self.mu_s - self.mu_c) * decay(r * r) * (-2.0 * r / self.v_s);
         let d_ratio = (sgn(v) * g - v.abs() * dg) / (g * g);
         (-self.sigma0 * v.abs() / g, 1.0 - self.sigma0 * z * d_ratio)
+    }
+
+    /// F = sigma0 z + sigma1 dz/dt + sigma2 v.
+    fn force_at(&self, v: f64, z: f64, z_dot: f64) -> f64 {
+        self.sigma0 * z + self.sigma1 * z_dot + self.sigma2 * v
     }
 
     fn z_dot(&self, v: f64, z: f64, normal: f64) -> f64 {
@@ -111,7 +116,16 @@ impl FrictionModel for LuGre {
     }
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
         let z0 = z.first().copied().unwrap_or(0.0);
-        self.sigma0 * z0 + self.sigma1 * self.z_dot(v, z0, normal) + self.sigma2 * v
+        self.force_at(v, z0, self.z_dot(v, z0, normal))
+    }
+    /// dz/dt once for both (it holds the Stribeck level's exponential).
+    fn state_derivative_and_force(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) -> f64 {
+        let z0 = z.first().copied().unwrap_or(0.0);
+        let z_dot = self.z_dot(v, z0, normal);
+        if let Some(d) = dz.first_mut() {
+            *d = z_dot;
+        }
+        self.force_at(v, z0, z_dot)
     }
     fn steady_state(&self, v: f64, normal: f64) -> f64 {
         self.g(v, normal) * sgn(v) + self.sigma2 * v

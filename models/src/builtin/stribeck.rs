@@ -17,7 +17,7 @@
 //! Z. VDI 46, 1902; the exponential form as in Armstrong-Hélouvry et al., Automatica 30(7), 1994.
 
 use crate::error::ModelError;
-use crate::model::{check_bounds, sgn, FrictionModel, GuessHint};
+use crate::model::{check_bounds, decay, sgn, FrictionModel, GuessHint};
 use crate::start::{StartContext, StribeckLevels};
 
 crate::declare_params! {
@@ -36,7 +36,7 @@ crate::start::stribeck_levels_setter!(Stribeck);
 impl Stribeck {
     /// The velocity-dependent coefficient mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta).
     pub fn coefficient(&self, v: f64) -> f64 {
-        self.mu_c + (self.mu_s - self.mu_c) * (-(v / self.v_s).abs().powf(self.delta)).exp()
+        self.mu_c + (self.mu_s - self.mu_c) * decay((v / self.v_s).abs().powf(self.delta))
     }
 }
 
