@@ -56,7 +56,9 @@ fn fmm_models(c: &mut Criterion) {
 }
 
 /// The stiff end of the bristle models (issue 13: sigma0 = 1e7 N/m, LuGre with sigma1 =
-/// 5000 N s/m) with the explicit integrator and with Rodas4, and Rodas4 at 1e8 and 1e9.
+/// 5000 N s/m) with the explicit integrator and with Rodas4, and Rodas4 at 1e8 and 1e9; and
+/// Rodas4 at the default 1e5 (against the `fmm_22mm_2s_1kHz` Dopri5 rows: where `auto`
+/// should switch).
 fn fmm_stiff(c: &mut Criterion) {
     let osc = Oscillator::fmm();
     let times = uniform_times(2.0, 1000.0);
@@ -64,6 +66,7 @@ fn fmm_stiff(c: &mut Criterion) {
     group.sample_size(10);
     group.measurement_time(Duration::from_secs(3));
     let cases = [
+        ("rodas", 1e5),
         ("dopri5", 1e7),
         ("rodas", 1e7),
         ("rodas", 1e8),

@@ -220,6 +220,16 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
     /// Steady-state friction curve F_ss(v) (the force at constant sliding velocity).
     fn steady_state(&self, v: f64, normal: f64) -> f64;
 
+    /// The internal states of steady sliding at velocity `v` (written into `out`, length
+    /// `n_states`), where the law states them; `false` (the default) when it does not. The
+    /// engine's `auto` integrator choice looks for stiffness there as well as at the initial
+    /// states: a law whose states are soft when relaxed and stiff when loaded (GMS) would
+    /// otherwise be given the explicit method. The harness (`testing::check_sliding_states`)
+    /// requires dz/dt = 0 and the steady-state force there.
+    fn sliding_states(&self, _v: f64, _normal: f64, _out: &mut [f64]) -> bool {
+        false
+    }
+
     /// Energy stored in the internal states (bristle deflection), 0 for static laws. Used by
     /// the engine's energy checks: KE + PE + stored never increases for a passive model.
     fn stored_energy(&self, _z: &[f64], _normal: f64) -> f64 {

@@ -69,6 +69,8 @@ pub enum Check {
     ForceOnlyParams,
     /// `state_derivative_and_force` equals `state_derivative` and `force`, bit for bit.
     CombinedRhs,
+    /// Stated sliding states are a fixed point of the states with the steady-state force.
+    SlidingStates,
     /// (motion) The simulator completes every release.
     Simulates,
     /// (motion) KE + PE + stored never increases.
@@ -127,7 +129,8 @@ pub fn check_model(model: &Model) -> Outcome {
     check_slip_direction(model)?;
     check_stored_energy(model)?;
     check_force_only_params(model)?;
-    check_combined_rhs(model)
+    check_combined_rhs(model)?;
+    check_sliding_states(model)
 }
 
 /// [`check_model`] for tests: panics with the violation.
@@ -465,6 +468,29 @@ pub fn check_combined_rhs(model: &Model) -> Outcome {
             )
         })
     })
+}
+
+/// [`Check::SlidingStates`]: where the law states its steady sliding states, at sliding
+/// speeds of both signs dz/dt vanishes (to 1e-9 of |v| per state) and the force is the
+/// steady-state force (to 1e-9 relative).
+pub fn check_sliding_states(model: &Model) -> Outcome {
+    let normal = 10.0;
+    for v in [1e-3, 0.05, 0.3, 2.0].into_iter().flat_map(|v| [v, -v]) {
+        let mut z = vec![0.0; model.n_states()];
+        if !model.sliding_states(v, normal, &mut z) {
+            return Ok(());
+        }
+        let dz = derivative(model, v, &z, normal);
+        let (force, steady) = (model.force(v, &z, normal), model.steady_state(v, normal));
+        let settled = dz.iter().all(|d| d.abs() <= 1e-9 * v.abs());
+        let on_curve = (force - steady).abs() <= 1e-9 * steady.abs().max(1e-12);
+        ensure(model, Check::SlidingStates, settled && on_curve, || {
+            format!(
+                "at v = {v}, N = {normal}, sliding states {z:?}: dz/dt {dz:?}, force {force} against the steady-state {steady}"
+            )
+        })?;
+    }
+    Ok(())
 }
 
 /// [`Check::Finite`].

@@ -4,12 +4,16 @@
 //!
 //! Stiffness estimate: the spectral radius rho of the Jacobian of the full system at a
 //! representative sliding state (x = 0, v = the larger of |v0| and omega_n |x0|, the initial
-//! internal states), times the step Dopri5 takes for accuracy on a free vibration at the
+//! internal states, and the law's steady sliding states where it states them:
+//! `FrictionModel::sliding_states`; GMS elements are soft when relaxed and stiff when
+//! loaded), times the step Dopri5 takes for accuracy on a free vibration at the
 //! default tolerances (about T_n / 100). Dopri5's stability region reaches about 3.3 along
-//! the negative real axis: beyond `STIFF_RATIO` its steps are set by stability, not accuracy,
-//! and Rodas4 (a few times the cost per step, no stability bound) becomes the cheaper method
-//! once the ratio reaches a few hundred ([`STIFF_RATIO`]). On the FMM rig LuGre and Dahl at
-//! the default sigma0 = 1e5 N/m give about 48 (Dopri5), at 1e7 about 4 800 (Rodas4).
+//! the negative real axis: beyond that its steps are set by stability, not accuracy, and its
+//! cost grows with the ratio, while Rodas4 (a few times the cost per step, no stability
+//! bound) takes about the same steps at any stiffness. They break even near a ratio of 50
+//! ([`STIFF_RATIO`]): on the FMM rig LuGre and Dahl at the default sigma0 = 1e5 N/m give 48
+//! (Dopri5 1.15 and 1.43 ms, Rodas4 1.22 and 1.19 ms), at 1e7 about 4 800; the default GMS
+//! gives 286 (Dopri5 66 000 RHS, Rodas4 6 800).
 
 use super::{Dynamics, Integrator, Law};
 use crate::error::EngineError;
@@ -18,12 +22,11 @@ use nalgebra::DMatrix;
 /// Dopri5's accuracy-limited step on a free vibration, as a fraction of T_n.
 const ACCURACY_STEP_PERIODS: f64 = 1.0 / 100.0;
 
-/// rho(J) h above which the stiff method is chosen. Dopri5's real stability limit is 3.3,
-/// but up to a few hundred its stability-limited steps stay cheap (LuGre at the default
-/// sigma0 = 1e5 N/m, ratio 48: 15 000 RHS, 1.1 ms), and inside a fit, where trial points
-/// wander, the explicit method measured faster: `compare` of the five classical models took
-/// 5.4 s with Dopri5 everywhere against 19 s with Rodas4 from a ratio of 10 (loaded machine).
-pub(crate) const STIFF_RATIO: f64 = 500.0;
+/// rho(J) h above which the stiff method is chosen: where the two methods break even (see
+/// the module docs). Inside a fit, where trial points wander, the FMM five-model `compare`
+/// took 3.4 s with 50, 4.0 s with 100 and 4.3-7 s with 500 (back to back, median of 3); with
+/// 5 it took 9.9 s (Dahl's Rodas4 steps cost a `powf` per Jacobian as well).
+pub(crate) const STIFF_RATIO: f64 = 50.0;
 
 /// The concrete method for `requested`: `Auto` picks the exact propagator where it applies,
 /// Rodas4 where the motion is stiff, Dopri5 otherwise; `Exact` where it does not apply is an
@@ -63,20 +66,35 @@ pub(crate) fn stiffness_ratio(dynamics: &Dynamics<'_>, y0: &[f64], period: f64) 
     if !(speed.is_finite() && speed > 0.0) {
         return 0.0;
     }
+    let mut loaded = vec![0.0; z0.len()];
+    let sliding = dynamics
+        .model
+        .sliding_states(speed, dynamics.normal, &mut loaded)
+        .then_some(loaded);
+    let radius = [Some(z0.to_vec()), sliding]
+        .into_iter()
+        .flatten()
+        .map(|z| spectral_radius(dynamics, speed, &z))
+        .fold(0.0, f64::max);
+    radius * period * ACCURACY_STEP_PERIODS
+}
+
+/// rho(J) of the full system at x = 0, v = `speed` and states `z` (infinite when J is not
+/// finite).
+fn spectral_radius(dynamics: &Dynamics<'_>, speed: f64, z: &[f64]) -> f64 {
     let mut y = vec![0.0, speed];
-    y.extend_from_slice(z0);
+    y.extend_from_slice(z);
     let n = y.len();
     let mut jac = vec![0.0; n * n];
     dynamics.jacobian(&y, 1.0, &mut jac);
     if jac.iter().any(|j| !j.is_finite()) {
         return f64::INFINITY;
     }
-    let radius = DMatrix::from_row_slice(n, n, &jac)
+    DMatrix::from_row_slice(n, n, &jac)
         .complex_eigenvalues()
         .iter()
         .map(|l| l.norm())
-        .fold(0.0, f64::max);
-    radius * period * ACCURACY_STEP_PERIODS
+        .fold(0.0, f64::max)
 }
 
 #[cfg(test)]
@@ -118,5 +136,20 @@ mod tests {
             ratio(model(serde_json::json!({"type": "stribeck"})).as_ref()),
             0.0
         );
+    }
+
+    /// GMS elements have no stiffness while relaxed (the rate's slope vanishes at z = 0 for a
+    /// sharpness above 1) and much when loaded: the estimate at the steady sliding states
+    /// picks Rodas4 for the default law (Dopri5 took 66 000 RHS on the FMM release, Rodas4
+    /// 6 800), and only there.
+    #[test]
+    fn loaded_gms_elements_are_stiff() {
+        let gms = model(serde_json::json!({"type": "gms"}));
+        assert!(ratio(gms.as_ref()) > STIFF_RATIO, "{}", ratio(gms.as_ref()));
+        let osc = Oscillator::fmm();
+        let dynamics = Dynamics::new(&osc, gms.as_ref()).expect("a classifiable law");
+        let relaxed = vec![0.0; gms.n_states()];
+        let at_rest = spectral_radius(&dynamics, 0.3, &relaxed);
+        assert!(at_rest * osc.natural_period() * ACCURACY_STEP_PERIODS < STIFF_RATIO);
     }
 }

@@ -635,6 +635,19 @@ impl FrictionModel for Gms {
             .sum();
         elements + self.viscous * v
     }
+    /// Every element fully loaded: z_i = sgn(v) w_i s(v) / k_i (rho_i = 1, where its rate is
+    /// stiffest); an element without stiffness stays at 0.
+    fn sliding_states(&self, v: f64, normal: f64, out: &mut [f64]) -> bool {
+        let s = self.s(v, normal);
+        for (e, z) in self.elements.iter().zip(out.iter_mut()) {
+            *z = if e.stiffness > 0.0 {
+                sgn(v) * e.weight * s / e.stiffness
+            } else {
+                0.0
+            };
+        }
+        true
+    }
     fn steady_state(&self, v: f64, normal: f64) -> f64 {
         let total_weight: f64 = self.elements.iter().map(|e| e.weight).sum();
         total_weight * self.s(v, normal) * sgn(v) + self.viscous * v
