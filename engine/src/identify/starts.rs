@@ -352,9 +352,9 @@ struct Phase {
     promote: usize,
 }
 
-/// Phase 2: continues the best screened starts (unless converged) to the iteration limit; a
-/// continued start still [`super::lm::OUTPACE_FACTOR`] times above the cost another start
-/// converged to is abandoned.
+/// Phase 2: continues the best screened starts (unless converged) to the iteration limit, in
+/// the order of their screened costs; a continued start still [`super::lm::OUTPACE_FACTOR`]
+/// times above the cost an earlier start converged to is abandoned.
 fn continue_best<R, F>(make_problem: &F, screened: &mut Screened, opts: &FitOptions, phase: Phase)
 where
     R: Residuals + 'static,
@@ -385,11 +385,11 @@ where
     };
     let finish =
         |(s, u): &(usize, DVector<f64>)| (*s, run_start(make_problem(), u.clone(), opts, slot(*s)));
-    let finished: Vec<(usize, Result<StartRun, EngineError>)> = if opts.parallel {
-        promoted.par_iter().map(finish).collect()
-    } else {
-        promoted.iter().map(finish).collect()
-    };
+    // One after the other, best screened first: which start is abandoned then depends on the
+    // costs alone, never on which thread ran faster (each run still simulates its records
+    // and Jacobian columns in parallel).
+    let finished: Vec<(usize, Result<StartRun, EngineError>)> =
+        promoted.iter().map(finish).collect();
     for (start, run) in finished {
         match run {
             Ok(o) if o.cost.is_finite() => {
