@@ -660,23 +660,6 @@ mod tests {
 
     #[typetag::serde(name = "testing_rs_forgetful_lugre")]
     impl FrictionModel for ForgetfulLuGre {
-        crate::declared_param_methods!(
-            name: "testing_rs_forgetful_lugre",
-            equation: "",
-            no_params
-        );
-        fn n_states(&self) -> usize {
-            1
-        }
-        fn state_derivative(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) {
-            self.0.state_derivative(v, z, normal, dz);
-        }
-        fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
-            self.0.force(v, z, normal)
-        }
-        fn steady_state(&self, v: f64, normal: f64) -> f64 {
-            self.0.steady_state(v, normal)
-        }
         fn state_derivative_and_force(
             &self,
             v: f64,
@@ -686,6 +669,23 @@ mod tests {
         ) -> f64 {
             self.0.state_derivative(v, z, normal, dz);
             self.0.sigma0 * z[0] + self.0.sigma2 * v
+        }
+        crate::declared_param_methods!(
+            name: "testing_rs_forgetful_lugre",
+            equation: "",
+            no_params
+        );
+        fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
+            self.0.force(v, z, normal)
+        }
+        fn state_derivative(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) {
+            self.0.state_derivative(v, z, normal, dz);
+        }
+        fn steady_state(&self, v: f64, normal: f64) -> f64 {
+            self.0.steady_state(v, normal)
+        }
+        fn n_states(&self) -> usize {
+            self.0.n_states()
         }
     }
 
