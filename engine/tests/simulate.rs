@@ -766,6 +766,44 @@ fn rodas_agrees_with_a_tight_dopri5_reference_on_stiff_bristles() {
     assert!(lugre.stats.rhs_evaluations <= 10_000, "{:?}", lugre.stats);
 }
 
+/// A Dopri5 run of the FMM case at rtol 1e-14 and atol 1e-16: every state held far tighter
+/// than the scaled tolerances of a default run (Dahl's force to about 1e-9 N).
+fn tightest_dopri5_run(model: &dyn FrictionModel) -> Trajectory {
+    let times = uniform_times(2.0, 1000.0);
+    let opts = SimOptions {
+        rtol: 1e-14,
+        atol: 1e-16,
+        ..SimOptions::default()
+    };
+    simulate(
+        &Oscillator::fmm(),
+        model,
+        &Initial::at_rest(0.022),
+        2.0,
+        &times,
+        &opts,
+    )
+    .unwrap()
+}
+
+#[test]
+fn auto_integrates_stiff_dahl_within_issue_13s_budget() {
+    // Issue 13's target: Dahl at sigma0 = 1e7 N/m (state: the force in newtons, elastic tail
+    // of 72 restarts in the last 0.4 s) within 10 000 RHS evaluations, to 1e-8 m of x.
+    let model = stiff("dahl", 1e7);
+    let sim = fmm_run_with(model.as_ref(), 0.022, 2.0, Integrator::Auto);
+    let reference = tightest_dopri5_run(model.as_ref());
+    let gap = max_gap(&sim.x, &reference.x);
+    eprintln!("dahl 1e7 auto: {:?}, gap {gap:.2e} m", sim.stats);
+    assert!(
+        sim.stats.jacobian_evaluations > 0,
+        "not Rodas4: {:?}",
+        sim.stats
+    );
+    assert!(sim.stats.rhs_evaluations <= 10_000, "{:?}", sim.stats);
+    assert!(gap <= 1e-8, "{gap} m");
+}
+
 #[test]
 fn rodas_completes_at_the_stiffest_bristles() {
     // sigma0 = 1e8 and 1e9 N/m: out of the explicit method's reach; compared with Rodas

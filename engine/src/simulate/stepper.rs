@@ -58,28 +58,44 @@ pub struct AffineMotion {
     pub offset: f64,
 }
 
-/// The error tolerances of an adaptive stepper: a component y is resolved to
-/// atol + rtol |y|.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The error tolerances of an adaptive stepper: component i is resolved to
+/// atol_i + rtol |y_i|.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Tolerance {
     /// Relative tolerance.
     pub rtol: f64,
-    /// Absolute tolerance.
-    pub atol: f64,
+    /// Absolute tolerance of each component.
+    pub atol: Vec<f64>,
 }
 
 impl Tolerance {
-    /// The error scale of a component that moves from `a` to `b` in a step.
-    pub fn scale(&self, a: f64, b: f64) -> f64 {
-        self.atol + a.abs().max(b.abs()) * self.rtol
+    /// The same absolute tolerance `atol` for all `dim` components.
+    pub fn uniform(dim: usize, rtol: f64, atol: f64) -> Self {
+        Self {
+            rtol,
+            atol: vec![atol; dim],
+        }
+    }
+
+    /// Multiplies each component's absolute tolerance by its entry of `scales` (components
+    /// beyond `scales` keep theirs).
+    pub fn scale_atol(&mut self, scales: &[f64]) {
+        for (a, s) in self.atol.iter_mut().zip(scales) {
+            *a *= s;
+        }
+    }
+
+    /// The error scale of component `i` when it moves from `a` to `b` in a step.
+    pub fn scale(&self, i: usize, a: f64, b: f64) -> f64 {
+        self.atol[i] + a.abs().max(b.abs()) * self.rtol
     }
 
     /// The RMS over components of error / scale (Hairer's norm), for a step from `y` to
     /// `y_new` with local error estimate `err`.
     pub fn rms_norm(&self, y: &[f64], y_new: &[f64], err: &[f64]) -> f64 {
         let mut sum = 0.0;
-        for ((&a, &b), &e) in y.iter().zip(y_new).zip(err) {
-            let sc = self.scale(a, b);
+        for (((&a, &b), &e), &atol) in y.iter().zip(y_new).zip(err).zip(&self.atol) {
+            let sc = atol + a.abs().max(b.abs()) * self.rtol;
             sum += (e / sc) * (e / sc);
         }
         (sum / y.len().max(1) as f64).sqrt()
@@ -90,8 +106,8 @@ impl Tolerance {
     /// squared norms it was made from (Hairer, Norsett & Wanner, Sec. II.4).
     pub fn first_step_guess(&self, y: &[f64], f: &[f64]) -> (f64, f64, f64) {
         let (mut d0, mut d1) = (0.0, 0.0);
-        for (&yi, &fi) in y.iter().zip(f) {
-            let sc = self.scale(yi, yi);
+        for (i, (&yi, &fi)) in y.iter().zip(f).enumerate() {
+            let sc = self.scale(i, yi, yi);
             d0 += (yi / sc) * (yi / sc);
             d1 += (fi / sc) * (fi / sc);
         }
@@ -294,6 +310,18 @@ mod tests {
         let mut y = [0.0; 2];
         s.interpolate(pi, &mut y);
         assert!((y[0] + 1.0).abs() < 1e-8 && y[1].abs() < 1e-8, "{y:?}");
+    }
+
+    #[test]
+    fn scaled_absolute_tolerances_weigh_each_component_by_its_own() {
+        let mut tol = Tolerance::uniform(3, 0.0, 1e-9);
+        tol.scale_atol(&[1.0, 1.0, 1e7]);
+        assert_eq!(tol.atol, vec![1e-9, 1e-9, 1e-2]);
+        // An error of 1e-2 in the scaled component weighs as 1e-9 in the others.
+        let (y, err) = ([0.0; 3], [1e-9, 0.0, 1e-2]);
+        let norm = tol.rms_norm(&y, &y, &err);
+        assert!((norm - (2.0f64 / 3.0).sqrt()).abs() < 1e-12, "{norm}");
+        assert_eq!(tol.scale(2, 0.0, 0.0), 1e-2);
     }
 
     #[test]
