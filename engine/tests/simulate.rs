@@ -727,10 +727,16 @@ fn stiff(name: &str, sigma0: f64) -> Box<dyn FrictionModel> {
 
 /// A tight-tolerance run of the FMM case (same rest threshold as the default options).
 fn tight_run(model: &dyn FrictionModel, integrator: Integrator) -> Trajectory {
+    tight_run_at(model, integrator, SimOptions::default().atol)
+}
+
+/// The FMM case at rtol 1e-14 and absolute tolerance `atol`.
+fn tight_run_at(model: &dyn FrictionModel, integrator: Integrator, atol: f64) -> Trajectory {
     let times = uniform_times(2.0, 1000.0);
     let opts = SimOptions {
         integrator,
         rtol: 1e-14,
+        atol,
         ..SimOptions::default()
     };
     simulate(
@@ -764,6 +770,30 @@ fn rodas_agrees_with_a_tight_dopri5_reference_on_stiff_bristles() {
     }
     let lugre = fmm_run_with(stiff("lugre", 1e7).as_ref(), 0.022, 2.0, Integrator::Rodas);
     assert!(lugre.stats.rhs_evaluations <= 10_000, "{:?}", lugre.stats);
+}
+
+/// A Dopri5 run of the FMM case at rtol 1e-14 and atol 1e-16: every state held far tighter
+/// than the scaled tolerances of a default run (Dahl's force to about 1e-9 N).
+fn tightest_dopri5_run(model: &dyn FrictionModel) -> Trajectory {
+    tight_run_at(model, Integrator::Dopri5, 1e-16)
+}
+
+#[test]
+fn auto_integrates_stiff_dahl_within_issue_13s_budget() {
+    // Issue 13's target: Dahl at sigma0 = 1e7 N/m (state: the force in newtons, elastic tail
+    // of 72 restarts in the last 0.4 s) within 10 000 RHS evaluations, to 1e-8 m of x.
+    let model = stiff("dahl", 1e7);
+    let sim = fmm_run_with(model.as_ref(), 0.022, 2.0, Integrator::Auto);
+    let reference = tightest_dopri5_run(model.as_ref());
+    let gap = max_gap(&sim.x, &reference.x);
+    eprintln!("dahl 1e7 auto: {:?}, gap {gap:.2e} m", sim.stats);
+    assert!(
+        sim.stats.jacobian_evaluations > 0,
+        "not Rodas4: {:?}",
+        sim.stats
+    );
+    assert!(sim.stats.rhs_evaluations <= 10_000, "{:?}", sim.stats);
+    assert!(gap <= 1e-8, "{gap} m");
 }
 
 #[test]

@@ -144,6 +144,17 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
     /// Time derivative of the internal states at sliding velocity `v`.
     fn state_derivative(&self, _v: f64, _z: &[f64], _normal: f64, _dz: &mut [f64]) {}
 
+    /// How large an error in each internal state is, measured as a displacement: state j
+    /// changes by `scales[j]` state units per metre (n_states entries, each finite and > 0).
+    /// The integrators resolve state j to `scales[j]` times their absolute tolerance, which
+    /// is given in metres; the default, 1 for every state, fits states that are deflections
+    /// in metres (LuGre's z, GMS's z_i). A state that is a force in newtons declares the
+    /// stiffness that turns a deflection into it (Dahl: sigma0), so that the integrators hold
+    /// it no tighter than a displacement state.
+    fn state_tolerance_scales(&self) -> Vec<f64> {
+        vec![1.0; self.n_states()]
+    }
+
     /// The parameters (indices in [`FrictionModel::params`] order) that enter the force but not
     /// the states' equation ([`FrictionModel::state_derivative`]): a damping on the states'
     /// rate, a viscous drag. Along a given motion the states do not depend on them, so a

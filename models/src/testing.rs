@@ -44,7 +44,8 @@ pub enum Check {
     /// The model's name is registered, and its default instance builds by name.
     Registered,
     /// `param_info` and `params` agree in length, names are unique, the default instance's
-    /// values are its declared defaults and lie inside the bounds.
+    /// values are its declared defaults and lie inside the bounds; the state tolerance scales
+    /// are one per state, finite and > 0.
     Declarations,
     /// `set_params` then `params` gives the values back; a wrong length is a `ParamCount` error.
     ParamVector,
@@ -179,6 +180,7 @@ pub fn check_declarations(model: &Model) -> Outcome {
             || format!("the name `{}` is declared twice", p.name),
         )?;
     }
+    check_state_tolerance_scales(model)?;
     let Ok(default) = default_model(model.name()) else {
         return fail(model, Check::Declarations, "no default instance".into());
     };
@@ -198,6 +200,22 @@ pub fn check_declarations(model: &Model) -> Outcome {
         )?;
     }
     Ok(())
+}
+
+/// Part of [`Check::Declarations`]: one tolerance scale per state, each finite and > 0.
+fn check_state_tolerance_scales(model: &Model) -> Outcome {
+    let scales = model.state_tolerance_scales();
+    ensure(
+        model,
+        Check::Declarations,
+        scales.len() == model.n_states() && scales.iter().all(|s| s.is_finite() && *s > 0.0),
+        || {
+            format!(
+                "state tolerance scales {scales:?} for {} states (each must be finite and > 0)",
+                model.n_states()
+            )
+        },
+    )
 }
 
 /// A value near `x` other than `x`, inside the bounds of `p` where possible.

@@ -112,7 +112,7 @@ impl Dopri5 {
     pub fn new(dim: usize, rtol: f64, atol: f64, h_max: f64) -> Self {
         let zeros = || vec![0.0; dim];
         Self {
-            ctrl: StepControl::new(rtol, atol, h_max),
+            ctrl: StepControl::new(dim, rtol, atol, h_max),
             old_error: MIN_OLD_ERROR,
             y: zeros(),
             y_next: zeros(),
@@ -122,6 +122,13 @@ impl Dopri5 {
             counts: StepCounts::default(),
             start_value: zeros(),
         }
+    }
+
+    /// The same stepper with each component's absolute tolerance multiplied by its entry of
+    /// `scales` (see [`Tolerance::scale_atol`]).
+    pub fn with_atol_scales(mut self, scales: &[f64]) -> Self {
+        self.ctrl.tol.scale_atol(scales);
+        self
     }
 
     /// Moves the end time on to `t_end` (after the current time) without starting afresh: the
@@ -145,8 +152,8 @@ impl Dopri5 {
         }
         system.rhs(self.ctrl.t + h0, &self.y_next, f1);
         let mut d2 = 0.0;
-        for ((&yi, &a), &b) in self.y.iter().zip(f0.iter()).zip(f1.iter()) {
-            let sc = self.ctrl.tol.scale(yi, yi);
+        for (i, ((&yi, &a), &b)) in self.y.iter().zip(f0.iter()).zip(f1.iter()).enumerate() {
+            let sc = self.ctrl.tol.scale(i, yi, yi);
             d2 += ((b - a) / sc) * ((b - a) / sc);
         }
         let d2 = d2.sqrt() / h0;

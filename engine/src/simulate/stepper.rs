@@ -58,28 +58,44 @@ pub struct AffineMotion {
     pub offset: f64,
 }
 
-/// The error tolerances of an adaptive stepper: a component y is resolved to
-/// atol + rtol |y|.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The error tolerances of an adaptive stepper: component i is resolved to
+/// atol_i + rtol |y_i|.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Tolerance {
     /// Relative tolerance.
     pub rtol: f64,
-    /// Absolute tolerance.
-    pub atol: f64,
+    /// Absolute tolerance of each component.
+    pub atol: Vec<f64>,
 }
 
 impl Tolerance {
-    /// The error scale of a component that moves from `a` to `b` in a step.
-    pub fn scale(&self, a: f64, b: f64) -> f64 {
-        self.atol + a.abs().max(b.abs()) * self.rtol
+    /// The same absolute tolerance `atol` for all `dim` components.
+    pub fn uniform(dim: usize, rtol: f64, atol: f64) -> Self {
+        Self {
+            rtol,
+            atol: vec![atol; dim],
+        }
+    }
+
+    /// Multiplies each component's absolute tolerance by its entry of `scales` (components
+    /// beyond `scales` keep theirs).
+    pub fn scale_atol(&mut self, scales: &[f64]) {
+        for (a, s) in self.atol.iter_mut().zip(scales) {
+            *a *= s;
+        }
+    }
+
+    /// The error scale of component `i` when it moves from `a` to `b` in a step.
+    pub fn scale(&self, i: usize, a: f64, b: f64) -> f64 {
+        self.atol[i] + a.abs().max(b.abs()) * self.rtol
     }
 
     /// The RMS over components of error / scale (Hairer's norm), for a step from `y` to
     /// `y_new` with local error estimate `err`.
     pub fn rms_norm(&self, y: &[f64], y_new: &[f64], err: &[f64]) -> f64 {
         let mut sum = 0.0;
-        for ((&a, &b), &e) in y.iter().zip(y_new).zip(err) {
-            let sc = self.scale(a, b);
+        for (((&a, &b), &e), &atol) in y.iter().zip(y_new).zip(err).zip(&self.atol) {
+            let sc = atol + a.abs().max(b.abs()) * self.rtol;
             sum += (e / sc) * (e / sc);
         }
         (sum / y.len().max(1) as f64).sqrt()
@@ -90,8 +106,8 @@ impl Tolerance {
     /// squared norms it was made from (Hairer, Norsett & Wanner, Sec. II.4).
     pub fn first_step_guess(&self, y: &[f64], f: &[f64]) -> (f64, f64, f64) {
         let (mut d0, mut d1) = (0.0, 0.0);
-        for (&yi, &fi) in y.iter().zip(f) {
-            let sc = self.scale(yi, yi);
+        for (i, (&yi, &fi)) in y.iter().zip(f).enumerate() {
+            let sc = self.scale(i, yi, yi);
             d0 += (yi / sc) * (yi / sc);
             d1 += (fi / sc) * (fi / sc);
         }
@@ -169,7 +185,7 @@ pub(crate) use current_point_accessors;
 /// The step-size control of an adaptive one-step method: its tolerance and largest step, and
 /// where it stands (the ends of its last accepted step, the end of the interval, the size of
 /// its next attempt and the flags of its last attempts).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub(crate) struct StepControl {
     /// The error tolerance.
     pub tol: Tolerance,
@@ -194,10 +210,11 @@ pub(crate) struct StepControl {
 }
 
 impl StepControl {
-    /// A control with tolerances `rtol`, `atol` and largest step |`h_max`|.
-    pub fn new(rtol: f64, atol: f64, h_max: f64) -> Self {
+    /// A control for `dim` components with tolerances `rtol`, `atol` and largest step
+    /// |`h_max`|.
+    pub fn new(dim: usize, rtol: f64, atol: f64, h_max: f64) -> Self {
         Self {
-            tol: Tolerance { rtol, atol },
+            tol: Tolerance::uniform(dim, rtol, atol),
             h_max: h_max.abs(),
             t: 0.0,
             t_prev: 0.0,
@@ -212,15 +229,8 @@ impl StepControl {
 
     /// Starts over at `t` in an interval ending at `t_end` (step sizes kept).
     pub fn restart(&mut self, t: f64, t_end: f64) {
-        *self = Self {
-            t,
-            t_prev: t,
-            t_end,
-            last: false,
-            reached: false,
-            after_reject: false,
-            ..*self
-        };
+        (self.t, self.t_prev, self.t_end) = (t, t, t_end);
+        (self.after_reject, self.last, self.reached) = (false, false, false);
     }
 
     /// Moves the end of the interval on to `t_end`; the next step starts where the last ended.
@@ -394,6 +404,18 @@ mod tests {
         let mut y = [0.0; 2];
         s.interpolate(pi, &mut y);
         assert!((y[0] + 1.0).abs() < 1e-8 && y[1].abs() < 1e-8, "{y:?}");
+    }
+
+    #[test]
+    fn scaled_absolute_tolerances_weigh_each_component_by_its_own() {
+        let mut tol = Tolerance::uniform(3, 0.0, 1e-9);
+        tol.scale_atol(&[1.0, 1.0, 1e7]);
+        assert_eq!(tol.atol, vec![1e-9, 1e-9, 1e-2]);
+        // An error of 1e-2 in the scaled component weighs as 1e-9 in the others.
+        let (y, err) = ([0.0; 3], [1e-9, 0.0, 1e-2]);
+        let norm = tol.rms_norm(&y, &y, &err);
+        assert!((norm - (2.0f64 / 3.0).sqrt()).abs() < 1e-12, "{norm}");
+        assert_eq!(tol.scale(2, 0.0, 0.0), 1e-2);
     }
 
     #[test]

@@ -11,6 +11,10 @@
 //!
 //! The rest stiffness sigma0 is the slope of F against the displacement at F = 0.
 //!
+//! The integrators hold F to sigma0 times their absolute tolerance (in metres): an error in the
+//! force weighs as the deflection of the contact spring that makes it
+//! (`state_tolerance_scales`).
+//!
 //! Stored energy: F^2 / (2 sigma0) (exact for alpha = 1: the model then dissipates
 //! F^2 |v| / (mu_c N) >= 0).
 //!
@@ -51,6 +55,10 @@ impl FrictionModel for Dahl {
     }
     fn n_states(&self) -> usize {
         1
+    }
+    /// The state is the force of the contact spring, sigma0 N per metre of deflection.
+    fn state_tolerance_scales(&self) -> Vec<f64> {
+        vec![self.sigma0]
     }
     /// d(dF/dt)/dF = -sigma0 |v| alpha |r|^(alpha - 1) / (mu_c N), r = 1 - F sgn(v) / (mu_c N);
     /// 0 without normal load. At r = 0 with alpha < 1 the derivative is unbounded: there
