@@ -647,6 +647,55 @@ impl Lcg {
     }
 }
 
+/// The stateless samples go to the recorder in blocks swept by the closed form's recurrence;
+/// on an irregular grid (jittered spacing, repeated times, gaps longer than a half-cycle,
+/// more samples than a block) each sample must still be the oracle's, and each friction force
+/// and acceleration the equation of motion's at that sample: mu N against the motion while
+/// sliding, the spring force at rest.
+#[test]
+fn exact_propagator_samples_an_irregular_grid_exactly() {
+    let osc = paper_osc();
+    let mu = paper_coulomb().mu;
+    let mut rng = Lcg(14);
+    let mut times = vec![0.0];
+    while times.len() < 3000 {
+        let last = times[times.len() - 1];
+        let gap = match times.len() % 97 {
+            0 => 0.0,
+            1 => rng.uniform(0.2, 0.4),
+            _ => rng.uniform(1e-5, 1.2e-3),
+        };
+        times.push(last + gap);
+    }
+    let t_end = times[times.len() - 1];
+    let sim = simulate(
+        &osc,
+        &Coulomb { mu },
+        &Initial::at_rest(0.140),
+        t_end,
+        &times,
+        &exact_opts(),
+    )
+    .unwrap();
+    let exact = coulomb_free_vibration(&osc, mu * osc.normal_force, 0.140, &times).unwrap();
+    assert_eq!(first_mismatch(&sim.x, &exact.x, 1e-12), None, "x");
+    assert_eq!(first_mismatch(&sim.v, &exact.v, 1e-11), None, "v");
+    let slip = mu * osc.normal_force;
+    let rest = sim.rest.expect("the mass comes to rest").time;
+    assert!(times.iter().filter(|&&t| t > rest).count() > 300);
+    for i in 0..times.len() {
+        let (t, x, v, f) = (times[i], sim.x[i], sim.v[i], sim.friction[i]);
+        if t > rest {
+            assert_eq!((v, f), (0.0, -osc.stiffness * x), "at rest, t = {t}");
+        } else {
+            assert_eq!(f.abs(), slip, "sliding, t = {t}");
+            assert!(f * v >= 0.0, "friction along the motion at t = {t}");
+        }
+        let a = -(osc.damping * v + osc.stiffness * x + f) / osc.mass;
+        assert!((sim.a[i] - a).abs() <= 1e-12 * a.abs().max(1.0), "a at {t}");
+    }
+}
+
 #[test]
 fn exact_propagator_agrees_with_dopri5_on_random_cases() {
     let mut rng = Lcg(2026);

@@ -4,6 +4,7 @@
 use crate::error::EngineError;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
+use std::sync::{Arc, Mutex};
 
 /// The moving-average span of the paper's recipe (section 5: "a moving average filter with a
 /// span of 10 points").
@@ -138,9 +139,46 @@ pub fn paper_derivative(time: &[f64], v: &[f64]) -> Vec<f64> {
     moving_average(&central_difference(time, v), PAPER_SPAN)
 }
 
-/// Savitzky-Golay weights of one window size and degree, by the sample's place in its window
-/// (filled on first use).
-type WeightsByPlace = Vec<Option<Vec<f64>>>;
+/// Savitzky-Golay weights on a uniform grid of unit spacing, by window size and degree, each
+/// by the sample's place in its window. They depend on nothing else, so one table serves
+/// every record and every call (a fit analyses each record twice: for its starting hint and
+/// for its energy check).
+type WeightTable = Arc<Vec<Vec<f64>>>;
+
+/// Tables kept at most: window sizes other than the configured one come only from segments
+/// shorter than it.
+const MAX_TABLES: usize = 64;
+
+static UNIT_WEIGHTS: Mutex<Vec<((usize, usize), WeightTable)>> = Mutex::new(Vec::new());
+
+/// The unit-spacing weight table of `window` samples and degree `order`.
+fn unit_weights(window: usize, order: usize) -> Result<WeightTable, EngineError> {
+    let key = (window, order);
+    let cached = |tables: &[((usize, usize), WeightTable)]| {
+        tables
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, t)| t.clone())
+    };
+    if let Some(table) = UNIT_WEIGHTS.lock().ok().and_then(|t| cached(&t)) {
+        return Ok(table);
+    }
+    let table: WeightTable = Arc::new(
+        (0..window)
+            .map(|place| {
+                let offsets: Vec<f64> = (0..window).map(|j| j as f64 - place as f64).collect();
+                derivative_weights(&offsets, order)
+            })
+            .collect::<Result<_, _>>()?,
+    );
+    if let Ok(mut tables) = UNIT_WEIGHTS.lock() {
+        if tables.len() >= MAX_TABLES {
+            tables.clear();
+        }
+        tables.push((key, table.clone()));
+    }
+    Ok(table)
+}
 
 /// Savitzky-Golay derivative of `v` sampled at `time`.
 ///
@@ -154,9 +192,10 @@ type WeightsByPlace = Vec<Option<Vec<f64>>>;
 /// length minus one; a one-sample segment borrows its neighbours.
 ///
 /// The weights come from a small least-squares solve (normal equations of the scaled
-/// Vandermonde matrix, Cholesky). On a uniform grid (spacing equal to 1e-6 relative) they are
-/// computed once per window position and reused; otherwise every sample gets its own fit in
-/// the actual time offsets.
+/// Vandermonde matrix, Cholesky). On a uniform grid (spacing equal to 1e-6 relative) they come
+/// from a unit-spacing table per window size and degree, shared by every call, and the slope
+/// is divided by the spacing; otherwise every sample gets its own fit in the actual time
+/// offsets.
 pub fn savitzky_golay_derivative(
     time: &[f64],
     v: &[f64],
@@ -171,9 +210,6 @@ pub fn savitzky_golay_derivative(
         return Ok(out);
     }
     let uniform_dt = uniform_spacing(&time[..n]);
-    // Uniform grid: the weights depend only on the sample's place in its window, per window
-    // size and degree.
-    let mut cache: Vec<((usize, usize), WeightsByPlace)> = Vec::new();
     let mut bounds: Vec<usize> = Vec::with_capacity(breaks.len() + 2);
     bounds.push(0);
     bounds.extend(breaks.iter().copied().filter(|&b| b > 0 && b < n));
@@ -190,37 +226,45 @@ pub fn savitzky_golay_derivative(
         } else {
             (len, order.min(len - 1))
         };
-        let slot = match cache.iter().position(|(key, _)| *key == (w, p)) {
-            Some(k) => k,
-            None => {
-                cache.push(((w, p), vec![None; w]));
-                cache.len() - 1
-            }
+        // Uniform grid: the weights depend only on the sample's place in its window.
+        let table = match uniform_dt {
+            Some(_) => Some(unit_weights(w, p)?),
+            None => None,
         };
         for i in seg[0]..seg[1] {
             let lo = i.saturating_sub(w / 2).clamp(s, e - w);
             let hi = lo + w;
-            let fresh;
-            let weights: &[f64] = match uniform_dt {
-                Some(dt) => {
-                    let place = &mut cache[slot].1[i - lo];
-                    if place.is_none() {
-                        let offsets: Vec<f64> = (lo..hi).map(|j| j as f64 - i as f64).collect();
-                        let wts = derivative_weights(&offsets, p)?;
-                        *place = Some(wts.into_iter().map(|x| x / dt).collect());
-                    }
-                    place.as_deref().unwrap_or_default()
-                }
-                None => {
+            let slope = match (&table, uniform_dt) {
+                (Some(table), Some(dt)) => dot(&table[i - lo], &v[lo..hi]) / dt,
+                _ => {
                     let offsets: Vec<f64> = (lo..hi).map(|j| time[j] - time[i]).collect();
-                    fresh = derivative_weights(&offsets, p)?;
-                    &fresh
+                    dot(&derivative_weights(&offsets, p)?, &v[lo..hi])
                 }
             };
-            out[i] = weights.iter().zip(&v[lo..hi]).map(|(w, y)| w * y).sum();
+            out[i] = slope;
         }
     }
     Ok(out)
+}
+
+/// sum a_j b_j in four interleaved partial sums (independent chains the CPU overlaps; a
+/// 31-tap window costs about a quarter of the serial sum).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a4, b4) = (a[..n].chunks_exact(4), b[..n].chunks_exact(4));
+    let tail: f64 = a4
+        .remainder()
+        .iter()
+        .zip(b4.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    let mut acc = [0.0; 4];
+    for (x, y) in a4.zip(b4) {
+        for k in 0..4 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 /// The common spacing of `time` if it is uniform to 1e-6 relative.

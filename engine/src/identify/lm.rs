@@ -176,7 +176,7 @@ where
             ));
         }
         let j = problem.jacobian(&p0)?;
-        let a = j.transpose() * &j;
+        let a = j.tr_mul(&j);
         let max_diag = a.diagonal().iter().cloned().fold(0.0, f64::max);
         self.mu = self.tau * max_diag.max(1e-300);
         self.nu = 2.0;
@@ -270,8 +270,8 @@ struct NormalEquations {
 
 impl NormalEquations {
     fn new(j: &DMatrix<f64>, r: &DVector<f64>) -> Self {
-        let a = j.transpose() * j;
-        let g = j.transpose() * r;
+        let a = j.tr_mul(j);
+        let g = j.tr_mul(r);
         let diag: Vec<f64> = (0..a.nrows())
             .map(|i| a[(i, i)].max(1e-12 * (1.0 + a[(i, i)])))
             .collect();

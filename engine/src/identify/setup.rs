@@ -5,7 +5,7 @@
 use super::layout::{FreeParam, ParamKind};
 use super::options::{FitOptions, OscillatorParam};
 use super::residuals::{NuisanceKind, Residuals};
-use crate::energy::analyze_record;
+use crate::energy::{analyze_record, half_cycle_force};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -24,12 +24,8 @@ pub fn guess_hint(osc: &Oscillator, records: &[Record], opts: &FitOptions) -> Gu
     let mut levels = Vec::new();
     let mut speeds = Vec::new();
     for rec in records {
-        if let Ok(a) = analyze_record(rec, osc, &opts.energy) {
-            if a.half_cycle_mean.is_finite() && a.half_cycle_mean > 0.0 {
-                levels.push(a.half_cycle_mean);
-            } else if a.mean_abs_force.is_finite() && a.mean_abs_force > 0.0 {
-                levels.push(a.mean_abs_force);
-            }
+        if let Some(level) = friction_level(rec, osc, opts) {
+            levels.push(level);
         }
         let peak = rec.velocity().iter().fold(0.0f64, |m, v| m.max(v.abs()));
         if peak > 0.0 {
@@ -54,6 +50,17 @@ pub fn guess_hint(osc: &Oscillator, records: &[Record], opts: &FitOptions) -> Gu
         stiffness: osc.stiffness,
         mass: osc.mass,
     }
+}
+
+/// A record's friction level: its half-cycle energy estimate, else (no complete half-cycle
+/// with a positive loss) the mean |F| of Eq. 7 along it.
+fn friction_level(record: &Record, osc: &Oscillator, opts: &FitOptions) -> Option<f64> {
+    let usable = |f: f64| (f.is_finite() && f > 0.0).then_some(f);
+    let half_cycles = half_cycle_force(record, osc, &opts.energy).ok()?;
+    half_cycles.and_then(usable).or_else(|| {
+        let analysis = analyze_record(record, osc, &opts.energy).ok()?;
+        usable(analysis.mean_abs_force)
+    })
 }
 
 fn unknown_name(kind: &str, name: &str, valid: &[String]) -> EngineError {

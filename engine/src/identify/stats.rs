@@ -63,7 +63,7 @@ pub fn covariance(j: &DMatrix<f64>, ssr: f64) -> Covariance {
             singular: false,
         };
     }
-    let jtj = j.transpose() * j;
+    let jtj = j.tr_mul(j);
     // Scale to unit diagonal before inverting, so the condition test is unit-free.
     let d: Vec<f64> = (0..p).map(|i| jtj[(i, i)].max(0.0).sqrt()).collect();
     let mut scaled = jtj.clone();
@@ -124,7 +124,7 @@ pub fn newey_west(
 ) -> DMatrix<f64> {
     let (n, p) = j.shape();
     let scores = DMatrix::from_fn(n, p, |t, c| j[(t, c)] * r[t]);
-    let mut meat = scores.transpose() * &scores;
+    let mut meat = scores.tr_mul(&scores);
     let mut start = 0;
     for &len in segments {
         let end = (start + len).min(n);
@@ -132,7 +132,7 @@ pub fn newey_west(
             let w = 1.0 - l as f64 / (lags as f64 + 1.0);
             let lead = scores.rows(start + l, end - start - l);
             let lag = scores.rows(start, end - start - l);
-            let cross = lead.transpose() * lag;
+            let cross = lead.tr_mul(&lag);
             meat += (&cross + cross.transpose()) * w;
         }
         start = end;

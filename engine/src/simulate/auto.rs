@@ -55,10 +55,13 @@ pub(crate) fn resolve_method(
     }
 }
 
-/// rho(J) times Dopri5's accuracy step at a representative sliding state (0 for static
-/// laws, whose mechanics alone are never stiff at the accuracy step).
+/// rho(J) times Dopri5's accuracy step at a representative motion: sliding at x = 0 for a
+/// dynamic law (with its initial and its steady sliding states), passing through v = 0 and
+/// sliding for a smooth static law (a steep smoothed Coulomb step, makkar's g5 or a tanh
+/// formula, is stiff only near rest), 0 for a switched law (its stick is an event, not a
+/// stiff stretch of motion).
 pub(crate) fn stiffness_ratio(dynamics: &Dynamics<'_>, y0: &[f64], period: f64) -> f64 {
-    let ([x0, v0, z0 @ ..], Law::Dynamic) = (y0, dynamics.law) else {
+    let [x0, v0, z0 @ ..] = y0 else {
         return 0.0;
     };
     let omega = 2.0 * std::f64::consts::PI / period;
@@ -66,17 +69,31 @@ pub(crate) fn stiffness_ratio(dynamics: &Dynamics<'_>, y0: &[f64], period: f64) 
     if !(speed.is_finite() && speed > 0.0) {
         return 0.0;
     }
+    let radius = match dynamics.law {
+        Law::Switched { .. } => 0.0,
+        Law::Smooth => [0.0, speed]
+            .map(|v| spectral_radius(dynamics, v, &[]))
+            .into_iter()
+            .fold(0.0, f64::max),
+        Law::Dynamic => dynamic_radius(dynamics, speed, z0),
+    };
+    radius * period * ACCURACY_STEP_PERIODS
+}
+
+/// The larger rho(J) of a dynamic law sliding at `speed` with its initial states `z0` and
+/// with its steady sliding states (`FrictionModel::sliding_states`, where the law states
+/// them).
+fn dynamic_radius(dynamics: &Dynamics<'_>, speed: f64, z0: &[f64]) -> f64 {
     let mut loaded = vec![0.0; z0.len()];
     let sliding = dynamics
         .model
         .sliding_states(speed, dynamics.normal, &mut loaded)
         .then_some(loaded);
-    let radius = [Some(z0.to_vec()), sliding]
+    [Some(z0.to_vec()), sliding]
         .into_iter()
         .flatten()
         .map(|z| spectral_radius(dynamics, speed, &z))
-        .fold(0.0, f64::max);
-    radius * period * ACCURACY_STEP_PERIODS
+        .fold(0.0, f64::max)
 }
 
 /// rho(J) of the full system at x = 0, v = `speed` and states `z` (infinite when J is not
@@ -131,11 +148,34 @@ mod tests {
             assert!(stiff > 5.0 * STIFF_RATIO, "{name} {stiff}");
             assert!(soft < mid && mid < stiff);
         }
-        // Static laws are never stiff.
+        // Switched static laws are never stiff: their stick is an event.
         assert_eq!(
             ratio(model(serde_json::json!({"type": "stribeck"})).as_ref()),
             0.0
         );
+    }
+
+    /// A smooth static law is stiff where its smoothed Coulomb step is steep: makkar's
+    /// rho(J) near rest is about g4 g5 / m. Its default g5 = 1000 s/m is not stiff (ratio about
+    /// 1.4 on the FMM rig); the FMM Coulomb records pull g5 to about 4.5e5 s/m.
+    #[test]
+    fn a_steep_smooth_static_law_is_stiff_near_rest() {
+        let makkar = |g5: f64| model(serde_json::json!({"type": "makkar", "g5": g5}));
+        let osc = Oscillator::fmm();
+        let expected = |g5: f64| {
+            let slope = 1.9 * (200.0 - 20.0) + 2.9 * g5 + 0.5 + osc.damping;
+            slope / osc.mass * osc.natural_period() * ACCURACY_STEP_PERIODS
+        };
+        for g5 in [1e3, 1e5, 4.5e5] {
+            let r = ratio(makkar(g5).as_ref());
+            assert!(
+                (r / expected(g5) - 1.0).abs() < 0.01,
+                "g5 {g5}: {r} vs {}",
+                expected(g5)
+            );
+        }
+        assert!(ratio(makkar(1e3).as_ref()) < STIFF_RATIO);
+        assert!(ratio(makkar(4.5e5).as_ref()) > STIFF_RATIO);
     }
 
     /// GMS elements have no stiffness while relaxed (the rate's slope vanishes at z = 0 for a

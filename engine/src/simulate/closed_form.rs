@@ -111,41 +111,48 @@ impl ClosedForm {
     /// after it (uniform grids), directly otherwise.
     #[inline]
     fn pq_at(&self, t: f64) -> (f64, f64) {
-        if let Some(r) = self.cache.get() {
-            let step = t - r.t;
-            if step == 0.0 {
-                return (r.p, r.q);
-            }
-            if (step - r.dt).abs() <= 8.0 * f64::EPSILON * t.abs().max(1.0) {
-                let e = r.rot_c;
-                let p = e * r.p - r.rot_s * r.q;
-                let q = e * r.q + r.rot_s * r.p;
-                self.cache.set(Some(Recurrence { t, p, q, ..r }));
-                return (p, q);
-            }
-            let (p, q) = self.mode.pq(t);
-            let decay = (-self.mode.sigma * step).exp();
-            let (s, c) = (self.mode.omega_d * step).sin_cos();
-            self.cache.set(Some(Recurrence {
+        let next = self.mode.advance(self.cache.get(), t);
+        self.cache.set(Some(next));
+        (next.p, next.q)
+    }
+}
+
+impl Mode {
+    /// The recurrence moved from `last` to `t`: one rotation when `t` is one sample spacing
+    /// after `last`, a direct evaluation (and the rotation of the new spacing) otherwise.
+    #[inline]
+    fn advance(&self, last: Option<Recurrence>, t: f64) -> Recurrence {
+        let Some(r) = last else {
+            let (p, q) = self.pq(t);
+            return Recurrence {
                 t,
                 p,
                 q,
-                dt: step,
-                rot_c: decay * c,
-                rot_s: decay * s,
-            }));
-            return (p, q);
+                dt: f64::NAN,
+                rot_c: 0.0,
+                rot_s: 0.0,
+            };
+        };
+        let step = t - r.t;
+        if step == 0.0 {
+            return r;
         }
-        let (p, q) = self.mode.pq(t);
-        self.cache.set(Some(Recurrence {
+        if (step - r.dt).abs() <= 8.0 * f64::EPSILON * t.abs().max(1.0) {
+            let p = r.rot_c * r.p - r.rot_s * r.q;
+            let q = r.rot_c * r.q + r.rot_s * r.p;
+            return Recurrence { t, p, q, ..r };
+        }
+        let (p, q) = self.pq(t);
+        let decay = (-self.sigma * step).exp();
+        let (s, c) = (self.omega_d * step).sin_cos();
+        Recurrence {
             t,
             p,
             q,
-            dt: f64::NAN,
-            rot_c: 0.0,
-            rot_s: 0.0,
-        }));
-        (p, q)
+            dt: step,
+            rot_c: decay * c,
+            rot_s: decay * s,
+        }
     }
 }
 
@@ -195,6 +202,18 @@ impl Stepper for ClosedForm {
         self.y = [x, v];
         self.counts.accepted += 1;
         Ok(StepOutcome::Accepted)
+    }
+
+    /// One sweep of the recurrence over the grid (the same values as time-by-time
+    /// interpolation, without the per-sample cache round trip).
+    fn interpolate_motion(&self, times: &[f64], x: &mut [f64], v: &mut [f64], _buf: &mut [f64]) {
+        let mut last = self.cache.get();
+        for ((&t, xo), vo) in times.iter().zip(x).zip(v) {
+            let r = self.mode.advance(last, t.clamp(self.t_prev, self.t));
+            (*xo, *vo) = self.mode.state_at_pq(r.p, r.q);
+            last = Some(r);
+        }
+        self.cache.set(last);
     }
 
     #[inline]

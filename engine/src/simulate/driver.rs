@@ -2,6 +2,7 @@
 //! (slip+, slip-, stick), event location on the stepper's dense output, sampling onto the
 //! output grid, budgets and statistics. Any [`Stepper`] plugs in.
 
+use super::block::{BlockBuffer, BLOCK};
 use super::root::illinois;
 use super::stepper::{AffineMotion, OdeSystem, StepOutcome, Stepper};
 use super::{Dynamics, Event, EventKind, Law, Recorder, Rest, SimStats, Start};
@@ -54,6 +55,8 @@ pub(crate) struct Driver<'s, R: Recorder> {
     pub last_turn: Option<f64>,
     /// Swing below which smooth and dynamic motions are declared at rest.
     pub rest_swing: f64,
+    /// The columns of stateless samples on their way to the recorder.
+    pub block: BlockBuffer,
 }
 
 impl<R: Recorder> Driver<'_, R> {
@@ -174,6 +177,9 @@ impl<R: Recorder> Driver<'_, R> {
 
     /// Writes the samples with time <= `until` from the dense output of the last step.
     fn write_samples<S: Stepper>(&mut self, stepper: &S, until: f64, dir: f64, buf: &mut [f64]) {
+        if buf.len() == 2 {
+            return self.write_stateless_samples(stepper, until, dir, buf);
+        }
         let samples = self.samples;
         while let Some(&ts) = samples.get(self.next) {
             if ts > until {
@@ -182,6 +188,24 @@ impl<R: Recorder> Driver<'_, R> {
             stepper.interpolate(ts, buf);
             self.write_moving(ts, buf, dir);
         }
+    }
+
+    /// [`Driver::write_samples`] for a law without internal states: in blocks.
+    fn write_stateless_samples<S: Stepper>(
+        &mut self,
+        stepper: &S,
+        until: f64,
+        dir: f64,
+        scratch: &mut [f64],
+    ) {
+        let pending = self.samples.get(self.next..).unwrap_or_default();
+        let due = &pending[..pending.partition_point(|&t| t <= until)];
+        let motion = self.rec.wants_forces().then_some((&self.dynamics, dir));
+        for times in due.chunks(BLOCK) {
+            self.block.moving(stepper, times, scratch, motion);
+            self.rec.sample_block(&self.block.view(times));
+        }
+        self.next += due.len();
     }
 
     /// Writes one sample of a moving state in direction `dir`.
@@ -196,7 +220,15 @@ impl<R: Recorder> Driver<'_, R> {
 
     /// Fills every remaining sample with the state at rest `y` (v = 0, a = 0).
     fn fill_rest(&mut self, y: &[f64]) {
-        if let [x, _, z @ ..] = y {
+        if let [x, _] = y {
+            let pending = self.samples.get(self.next..).unwrap_or_default();
+            for times in pending.chunks(BLOCK) {
+                self.block
+                    .at_rest(times.len(), *x, -self.dynamics.stiffness * x);
+                self.rec.sample_block(&self.block.view(times));
+            }
+            self.next += pending.len();
+        } else if let [x, _, z @ ..] = y {
             let f = -self.dynamics.stiffness * x;
             while let Some(&ts) = self.samples.get(self.next) {
                 self.rec.sample(ts, *x, 0.0, z, 0.0, f);

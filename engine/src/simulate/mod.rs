@@ -37,6 +37,8 @@
 //! method would remove that bound. There is no stiffness abort: such runs finish.
 
 mod auto;
+mod block;
+use block::BlockBuffer;
 mod closed_form;
 mod dopri;
 mod driver;
@@ -321,6 +323,30 @@ pub(crate) struct RunOutput {
 pub(crate) trait Recorder {
     /// One sample: time, state, acceleration and friction force.
     fn sample(&mut self, t: f64, x: f64, v: f64, z: &[f64], a: f64, friction: f64);
+
+    /// Whether the recorder reads accelerations and friction forces (when it does not, the
+    /// driver may skip computing them: the values it passes are then meaningless).
+    fn wants_forces(&self) -> bool {
+        true
+    }
+
+    /// Consecutive samples of a law without internal states, as columns of equal length;
+    /// the default records them one by one.
+    fn sample_block(&mut self, block: &SampleBlock<'_>) {
+        let columns = block.t.iter().zip(block.x).zip(block.v);
+        for (((&t, &x), &v), (&a, &f)) in columns.zip(block.a.iter().zip(block.friction)) {
+            self.sample(t, x, v, &[], a, f);
+        }
+    }
+}
+
+/// A run of samples of a law without internal states, one column per output.
+pub(crate) struct SampleBlock<'a> {
+    pub t: &'a [f64],
+    pub x: &'a [f64],
+    pub v: &'a [f64],
+    pub a: &'a [f64],
+    pub friction: &'a [f64],
 }
 
 /// Records every output into the series of a [`Trajectory`] (events, rest and statistics are
@@ -371,6 +397,15 @@ impl Recorder for FullRecorder<'_> {
             out.stored.push(self.model.stored_energy(z, self.normal));
         }
     }
+
+    fn sample_block(&mut self, block: &SampleBlock<'_>) {
+        let out = &mut self.series;
+        out.time.extend_from_slice(block.t);
+        out.x.extend_from_slice(block.x);
+        out.v.extend_from_slice(block.v);
+        out.a.extend_from_slice(block.a);
+        out.friction.extend_from_slice(block.friction);
+    }
 }
 
 impl FullRecorder<'_> {
@@ -393,6 +428,14 @@ struct VelocityRecorder<'a> {
 impl Recorder for VelocityRecorder<'_> {
     fn sample(&mut self, _t: f64, _x: f64, v: f64, _z: &[f64], _a: f64, _friction: f64) {
         self.v.push(v);
+    }
+
+    fn wants_forces(&self) -> bool {
+        false
+    }
+
+    fn sample_block(&mut self, block: &SampleBlock<'_>) {
+        self.v.extend_from_slice(block.v);
     }
 }
 
@@ -554,6 +597,7 @@ pub(crate) fn run<R: Recorder>(
         max_steps: opts.max_steps,
         last_turn: None,
         rest_swing: REST_SWING_ATOLS * opts.atol,
+        block: BlockBuffer::new(),
     };
     let period = osc.natural_period();
     let atol_scales = component_tolerance_scales(model, y0.len());

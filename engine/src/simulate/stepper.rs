@@ -325,6 +325,19 @@ pub trait Stepper {
     /// The dense output of the last accepted step at time `t` (clamped to the step) into `out`.
     fn interpolate(&self, t: f64, out: &mut [f64]);
 
+    /// The dense output's displacement and velocity at each of `times` (ascending, within the
+    /// last step) into `x` and `v` (as long as `times`), for a state without internal
+    /// components; `buf` is scratch of the state's length. The default interpolates time by
+    /// time; steppers with a cheaper sweep over a grid override it.
+    fn interpolate_motion(&self, times: &[f64], x: &mut [f64], v: &mut [f64], buf: &mut [f64]) {
+        for ((&t, xo), vo) in times.iter().zip(x).zip(v) {
+            self.interpolate(t, buf);
+            if let [xi, vi, ..] = *buf {
+                (*xo, *vo) = (xi, vi);
+            }
+        }
+    }
+
     /// Work counters since the stepper was built.
     fn counts(&self) -> StepCounts;
 }
