@@ -199,7 +199,9 @@ impl<R: Recorder> Driver<'_, R> {
         scratch: &mut [f64],
     ) {
         let pending = self.samples.get(self.next..).unwrap_or_default();
-        let due = &pending[..pending.partition_point(|&t| t <= until)];
+        // A linear scan: an ODE step holds a few samples, a binary search over the rest of
+        // the record cost more than the step's dense output.
+        let due = &pending[..pending.iter().take_while(|&&t| t <= until).count()];
         let motion = self.rec.wants_forces().then_some((&self.dynamics, dir));
         for times in due.chunks(BLOCK) {
             self.block.moving(stepper, times, scratch, motion);
