@@ -106,15 +106,6 @@ impl ClosedForm {
         let sigma = 0.5 * (motion.damping) / motion.mass;
         motion.mass > 0.0 && motion.stiffness > 0.0 && sigma >= 0.0 && sigma * sigma < w0_sq
     }
-
-    /// (P, Q) at `t`, by one rotation from the last evaluation when `t` is one sample spacing
-    /// after it (uniform grids), directly otherwise.
-    #[inline]
-    fn pq_at(&self, t: f64) -> (f64, f64) {
-        let next = self.mode.advance(self.cache.get(), t);
-        self.cache.set(Some(next));
-        (next.p, next.q)
-    }
 }
 
 impl Mode {
@@ -217,8 +208,10 @@ impl Stepper for ClosedForm {
     }
 
     #[inline]
+    /// A single time (the driver's turning-point search): evaluated directly, leaving the
+    /// sample recurrence of [`Stepper::interpolate_motion`] where it stands.
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let (p, q) = self.pq_at(t.clamp(self.t_prev, self.t));
+        let (p, q) = self.mode.pq(t.clamp(self.t_prev, self.t));
         let (x, v) = self.mode.state_at_pq(p, q);
         if let [xo, vo, ..] = out {
             *xo = x;

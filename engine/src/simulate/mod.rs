@@ -702,12 +702,12 @@ fn check_times(t_end: f64, times: &[f64]) -> Result<(), EngineError> {
             "the end time must be finite and >= 0, got {t_end}"
         )));
     }
-    // One pass for the common case (NaN fails every comparison); the diagnosis below names
-    // the first bad sample.
-    let in_order = times
-        .iter()
-        .try_fold(0.0, |floor, &t| (t >= floor && t <= t_end).then_some(t))
-        .is_some();
+    // One branch-free pass for the common case (NaN fails every comparison, and ascending
+    // times between a first >= 0 and a last <= t_end all lie in [0, t_end]); the diagnosis
+    // below names the first bad sample.
+    let in_order = times.first().is_none_or(|&t| t >= 0.0)
+        && times.last().is_none_or(|&t| t <= t_end)
+        && times.windows(2).fold(true, |ok, w| ok & (w[0] <= w[1]));
     if in_order {
         return Ok(());
     }
