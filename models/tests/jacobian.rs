@@ -1,8 +1,12 @@
 //! Closed-form state Jacobians of the dynamic models (dahl, lugre, gms) against the
 //! finite-difference default (`finite_difference_jacobian`), at many pseudo-random states,
-//! velocities and normal forces.
+//! velocities and normal forces; GMS's and LuGre's closed-form force gradients and velocity
+//! derivatives of the rates against theirs.
 
-use frictionid_models::model::finite_difference_jacobian;
+use frictionid_models::model::{
+    finite_difference_force_gradient, finite_difference_jacobian,
+    finite_difference_velocity_derivative, CBRT_EPSILON,
+};
 use frictionid_models::*;
 
 /// xorshift64*: a reproducible stream of uniform numbers in [0, 1).
@@ -150,6 +154,95 @@ fn gms_jacobian_matches_finite_differences() {
                 .collect();
             assert_jacobian_matches(&m, v, &z, normal);
         }
+    }
+}
+
+/// `a` within the central-difference error of `b`: 1e-6 relative (truncation) plus the
+/// rounding of values of size `scale` over the step.
+fn close_to_differences(a: f64, b: f64, scale: f64, step: f64) -> bool {
+    a.is_finite()
+        && (a - b).abs() <= 1e-6 * a.abs().max(b.abs()) + 1e3 * f64::EPSILON * scale / step
+}
+
+/// dF/dv, dF/dz and d(dz/dt)/dv against central differences at (v, z, N).
+fn assert_gradients_match(m: &dyn FrictionModel, v: f64, z: &[f64], normal: f64) {
+    let n = z.len();
+    let (mut dfdz, mut dfdz_fd) = (vec![f64::NAN; n], vec![f64::NAN; n]);
+    let df_dv = m.force_gradient(v, z, normal, &mut dfdz);
+    let df_dv_fd = finite_difference_force_gradient(m, v, z, normal, &mut dfdz_fd);
+    let force = m.force(v, z, normal).abs().max(normal);
+    let v_step = CBRT_EPSILON * v.abs().max(1e-6);
+    let at = format!("{} at v = {v:e}, z = {z:?}, N = {normal}", m.name());
+    assert!(
+        close_to_differences(df_dv, df_dv_fd, force, v_step),
+        "dF/dv {df_dv} vs {df_dv_fd}: {at}"
+    );
+    for j in 0..n {
+        let step = CBRT_EPSILON * z[j].abs().max(1e-6);
+        let (a, b) = (dfdz[j], dfdz_fd[j]);
+        assert!(
+            close_to_differences(a, b, force, step),
+            "dF/dz_{j} {a} vs {b}: {at}"
+        );
+    }
+    let (mut dv, mut dv_fd) = (vec![f64::NAN; n], vec![f64::NAN; n]);
+    m.state_velocity_derivative(v, z, normal, &mut dv);
+    finite_difference_velocity_derivative(m, v, z, normal, &mut dv_fd);
+    let rates = derivative(m, v, z, normal);
+    let rate_scale = rates.iter().fold(v.abs(), |a, d| a.max(d.abs()));
+    for i in 0..n {
+        let (a, b) = (dv[i], dv_fd[i]);
+        assert!(
+            close_to_differences(a, b, rate_scale, v_step),
+            "d(dz_{i})/dv {a} vs {b}: {at}"
+        );
+    }
+}
+
+/// GMS's closed-form gradients (damped and undamped elements, every sharpness, Stribeck
+/// exponents below, at and above 2) and LuGre's agree with finite differences.
+#[test]
+fn closed_form_force_gradients_match_finite_differences() {
+    let mut rng = Uniform(0x1234_5678_9abc_def0);
+    for (sharpness, delta) in [(1.0, 2.0), (2.0, 0.7), (3.5, 2.0), (20.0, 3.0)] {
+        let m = Gms {
+            elements: vec![
+                GmsElement {
+                    stiffness: 4e5,
+                    weight: 0.5,
+                    damping: 2.0,
+                },
+                GmsElement {
+                    stiffness: 1e5,
+                    weight: 0.3,
+                    damping: 0.0,
+                },
+                GmsElement {
+                    stiffness: 2.5e4,
+                    weight: 0.2,
+                    damping: 0.7,
+                },
+            ],
+            sharpness,
+            delta,
+            ..Gms::default()
+        };
+        for _ in 0..2000 {
+            let (v, normal) = (rng.velocity(), rng.between(1.0, 30.0));
+            let s = m.s(v, normal);
+            let z: Vec<f64> = m
+                .elements
+                .iter()
+                .map(|e| rng.between(-1.5, 1.5) * e.weight * s / e.stiffness)
+                .collect();
+            assert_gradients_match(&m, v, &z, normal);
+        }
+    }
+    let lugre = LuGre::default();
+    for _ in 0..2000 {
+        let (v, normal) = (rng.velocity(), rng.between(1.0, 30.0));
+        let z = [rng.between(-1.5, 1.5) * lugre.g(v, normal) / lugre.sigma0];
+        assert_gradients_match(&lugre, v, &z, normal);
     }
 }
 

@@ -87,7 +87,10 @@
 
 use crate::builtin::stribeck::mu_s_warning;
 use crate::error::ModelError;
-use crate::model::{check_bounds, check_len, decay, sgn, FrictionModel, GuessHint, ParamInfo};
+use crate::model::{
+    check_bounds, check_len, decay, finite_difference_force_gradient,
+    finite_difference_velocity_derivative, sgn, FrictionModel, GuessHint, ParamInfo,
+};
 use crate::params::ParamSpec;
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 use serde::de::{self, SeqAccess, Visitor};
@@ -226,6 +229,37 @@ impl Gms {
     pub fn s(&self, v: f64, normal: f64) -> f64 {
         normal
             * (self.mu_c + (self.mu_s - self.mu_c) * decay((v / self.v_s).abs().powf(self.delta)))
+    }
+
+    /// The Stribeck curve s(v) and its slope ds/dv from one power: with u = |v / v_s|,
+    /// d(u^delta)/dv = delta u^delta / v (0 at v = 0).
+    fn s_and_slope(&self, v: f64, normal: f64) -> (f64, f64) {
+        let power = (v / self.v_s).abs().powf(self.delta);
+        let e = decay(power);
+        let s = normal * (self.mu_c + (self.mu_s - self.mu_c) * e);
+        let slope = if v == 0.0 {
+            0.0
+        } else {
+            -normal * (self.mu_s - self.mu_c) * e * self.delta * power / v
+        };
+        (s, slope)
+    }
+
+    /// The partial derivatives (d/dz, d/dv) of an element's rate at the Stribeck level `s`
+    /// with slope `ds`: while loading, p = load^m, d/dz = -|v| m p k / (load w s) and
+    /// d/dv = 1 - p + v m p ds / s (the load falls as s rises); (0, 1) while unloading;
+    /// (0, 0) for a frozen element.
+    fn element_partials(&self, e: &GmsElement, v: f64, z: f64, s: f64, ds: f64) -> (f64, f64) {
+        match Self::element_load(e, v, z, s) {
+            None => (0.0, 0.0),
+            Some((limit, load)) if load > 0.0 => {
+                let m = self.sharpness;
+                let p = if m == 1.0 { load } else { load.powf(m) };
+                let d_dz = -v.abs() * m * (p / load) * e.stiffness / limit;
+                (d_dz, 1.0 - p + v * m * p * ds / s)
+            }
+            Some(_) => (0.0, 1.0),
+        }
     }
 
     /// The element's sliding force w s and its load sgn(v) k z / (w s): how far the motion
@@ -600,6 +634,37 @@ impl FrictionModel for Gms {
             if let Some(j) = jac.get_mut(i * n + i) {
                 *j = self.z_dot_slope(e, v, zi, s);
             }
+        }
+    }
+    /// dF/dv = sum_i sigma_i d(dz_i/dt)/dv + viscous, dF/dz_i = k_i + sigma_i d(dz_i/dt)/dz_i
+    /// (no power at all for undamped elements); finite differences where the closed form is
+    /// not finite (a Stribeck exponent below 1 at v -> 0).
+    fn force_gradient(&self, v: f64, z: &[f64], normal: f64, dfdz: &mut [f64]) -> f64 {
+        let (s, ds) = self.s_and_slope(v, normal);
+        let mut df_dv = self.viscous;
+        for ((e, &zi), d) in self.elements.iter().zip(z).zip(dfdz.iter_mut()) {
+            *d = e.stiffness;
+            if e.damping != 0.0 {
+                let (d_dz, d_dv) = self.element_partials(e, v, zi, s, ds);
+                *d += e.damping * d_dz;
+                df_dv += e.damping * d_dv;
+            }
+        }
+        if df_dv.is_finite() && dfdz.iter().all(|d| d.is_finite()) {
+            df_dv
+        } else {
+            finite_difference_force_gradient(self, v, z, normal, dfdz)
+        }
+    }
+    /// Each element's d(dz_i/dt)/dv from `Gms::element_partials` (finite differences where
+    /// that is not finite).
+    fn state_velocity_derivative(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) {
+        let (s, ds) = self.s_and_slope(v, normal);
+        for ((e, &zi), o) in self.elements.iter().zip(z).zip(out.iter_mut()) {
+            *o = self.element_partials(e, v, zi, s, ds).1;
+        }
+        if !out.iter().all(|o| o.is_finite()) {
+            finite_difference_velocity_derivative(self, v, z, normal, out);
         }
     }
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
