@@ -119,39 +119,44 @@ fn dahl_jacobian_matches_finite_differences() {
     }
 }
 
+/// Three GMS elements, two damped, with this sharpness and Stribeck exponent.
+fn three_element_gms(sharpness: f64, delta: f64) -> Gms {
+    let element = |stiffness, weight, damping| GmsElement {
+        stiffness,
+        weight,
+        damping,
+    };
+    Gms {
+        elements: vec![
+            element(4e5, 0.5, 2.0),
+            element(1e5, 0.3, 0.0),
+            element(2.5e4, 0.2, 0.7),
+        ],
+        sharpness,
+        delta,
+        ..Gms::default()
+    }
+}
+
+/// A random (v, z, N) for `m`: each element loaded to within 1.5 times its sliding force.
+fn gms_probe(m: &Gms, rng: &mut Uniform) -> (f64, Vec<f64>, f64) {
+    let (v, normal) = (rng.velocity(), rng.between(1.0, 30.0));
+    let s = m.s(v, normal);
+    let z = m
+        .elements
+        .iter()
+        .map(|e| rng.between(-1.5, 1.5) * e.weight * s / e.stiffness)
+        .collect();
+    (v, z, normal)
+}
+
 #[test]
 fn gms_jacobian_matches_finite_differences() {
     let mut rng = Uniform(0x5555_aaaa_3333_cccc);
     for sharpness in [1.0, 2.0, 3.5, 20.0] {
-        let m = Gms {
-            elements: vec![
-                GmsElement {
-                    stiffness: 4e5,
-                    weight: 0.5,
-                    damping: 2.0,
-                },
-                GmsElement {
-                    stiffness: 1e5,
-                    weight: 0.3,
-                    damping: 0.0,
-                },
-                GmsElement {
-                    stiffness: 2.5e4,
-                    weight: 0.2,
-                    damping: 0.7,
-                },
-            ],
-            sharpness,
-            ..Gms::default()
-        };
+        let m = three_element_gms(sharpness, 2.0);
         for _ in 0..2000 {
-            let (v, normal) = (rng.velocity(), rng.between(1.0, 30.0));
-            let s = m.s(v, normal);
-            let z: Vec<f64> = m
-                .elements
-                .iter()
-                .map(|e| rng.between(-1.5, 1.5) * e.weight * s / e.stiffness)
-                .collect();
+            let (v, z, normal) = gms_probe(&m, &mut rng);
             assert_jacobian_matches(&m, v, &z, normal);
         }
     }
@@ -205,36 +210,9 @@ fn assert_gradients_match(m: &dyn FrictionModel, v: f64, z: &[f64], normal: f64)
 fn closed_form_force_gradients_match_finite_differences() {
     let mut rng = Uniform(0x1234_5678_9abc_def0);
     for (sharpness, delta) in [(1.0, 2.0), (2.0, 0.7), (3.5, 2.0), (20.0, 3.0)] {
-        let m = Gms {
-            elements: vec![
-                GmsElement {
-                    stiffness: 4e5,
-                    weight: 0.5,
-                    damping: 2.0,
-                },
-                GmsElement {
-                    stiffness: 1e5,
-                    weight: 0.3,
-                    damping: 0.0,
-                },
-                GmsElement {
-                    stiffness: 2.5e4,
-                    weight: 0.2,
-                    damping: 0.7,
-                },
-            ],
-            sharpness,
-            delta,
-            ..Gms::default()
-        };
+        let m = three_element_gms(sharpness, delta);
         for _ in 0..2000 {
-            let (v, normal) = (rng.velocity(), rng.between(1.0, 30.0));
-            let s = m.s(v, normal);
-            let z: Vec<f64> = m
-                .elements
-                .iter()
-                .map(|e| rng.between(-1.5, 1.5) * e.weight * s / e.stiffness)
-                .collect();
+            let (v, z, normal) = gms_probe(&m, &mut rng);
             assert_gradients_match(&m, v, &z, normal);
         }
     }

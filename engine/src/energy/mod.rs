@@ -275,6 +275,19 @@ pub struct RecordMotion {
     pub displacement: SeriesSource,
 }
 
+impl RecordMotion {
+    /// Its displacement and velocity at `time`, without acceleration, linearly interpolated.
+    fn samples<'a>(&'a self, time: &'a [f64]) -> Samples<'a> {
+        Samples {
+            time,
+            x: &self.x,
+            v: &self.v,
+            a: &[],
+            interp: Interp::Linear,
+        }
+    }
+}
+
 /// The energy analysis of a measured record, from its measured displacement, velocity and
 /// acceleration where it has them (the paper's proposal of separate sensors); `sources` says
 /// which were used. A measured displacement must be relative to the spring's equilibrium
@@ -290,30 +303,21 @@ pub fn analyze_record(
     opts: &EnergyOptions,
 ) -> Result<EnergyAnalysis, EngineError> {
     let (measured, motion) = measured_motion(record, osc, opts)?;
-    let RecordMotion {
-        v,
-        x,
-        velocity,
-        displacement,
-    } = measured;
     let time = record.time();
     let (a, acceleration) = match record.channel(Channel::Acceleration) {
-        Some(measured) => (measured.to_vec(), SeriesSource::Measured),
+        Some(channel) => (channel.to_vec(), SeriesSource::Measured),
         None => (
-            differentiate_velocity(time, &v, opts, &motion)?,
+            differentiate_velocity(time, &measured.v, opts, &motion)?,
             SeriesSource::Differentiated,
         ),
     };
     let samples = Samples {
-        time,
-        x: &x,
-        v: &v,
         a: &a,
-        interp: Interp::Linear,
+        ..measured.samples(time)
     };
     let sources = SeriesSources {
-        displacement,
-        velocity,
+        displacement: measured.displacement,
+        velocity: measured.velocity,
         acceleration,
     };
     Ok(assemble(osc, &samples, &motion, opts, sources))
@@ -329,14 +333,7 @@ pub fn half_cycle_force(
     opts: &EnergyOptions,
 ) -> Result<Option<f64>, EngineError> {
     let (measured, motion) = measured_motion(record, osc, opts)?;
-    let samples = Samples {
-        time: record.time(),
-        x: &measured.x,
-        v: &measured.v,
-        a: &[],
-        interp: Interp::Linear,
-    };
-    let (_, mean, _) = half_cycles(&samples, &motion, osc);
+    let (_, mean, _) = half_cycles(&measured.samples(record.time()), &motion, osc);
     Ok(mean.is_finite().then_some(mean))
 }
 
@@ -358,13 +355,7 @@ fn measured_motion(
             record.name
         )));
     };
-    let samples = Samples {
-        time: record.time(),
-        x: &measured.x,
-        v: &measured.v,
-        a: &[],
-        interp: Interp::Linear,
-    };
+    let samples = measured.samples(record.time());
     let motion = detect_motion(&samples, opts.velocity_threshold, record.v0, &record.name)?;
     Ok((measured, motion))
 }
