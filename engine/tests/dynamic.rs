@@ -190,7 +190,9 @@ fn dahl_is_recovered_from_its_own_records() {
 /// standard errors of the truth (the undamped elements' sigma_i are flagged, not determined).
 /// It failed with finite-difference force gradients in the Rodas4 Jacobian (k_1 18 standard
 /// errors off at rms/noise 1.006); with GMS's closed-form gradients the fit reaches 0.998 and
-/// k_1 lies 1.6 standard errors from the truth.
+/// k_1 lies 1.6 standard errors from the truth. It is sensitive to the path: writing the state
+/// Jacobian's d/dz in the gradients' algebraically equal form (m p / load for m load^(m-1))
+/// made it fail again.
 #[test]
 fn gms_with_two_elements_is_recovered_from_its_own_records() {
     let osc = Oscillator::fmm();

@@ -67,48 +67,7 @@ impl Mode {
             PI
         }
     }
-}
 
-/// The last sample evaluated and the rotation of the last sample spacing.
-#[derive(Debug, Clone, Copy)]
-struct Recurrence {
-    t: f64,
-    p: f64,
-    q: f64,
-    dt: f64,
-    rot_c: f64,
-    rot_s: f64,
-}
-
-/// The exact propagator as a [`Stepper`] over `[x, v]`.
-#[derive(Debug, Clone, Default)]
-pub struct ClosedForm {
-    mode: Mode,
-    t: f64,
-    t_prev: f64,
-    t_end: f64,
-    /// Phase w_d tau of the next candidate zero of v.
-    next_phase: f64,
-    y: [f64; 2],
-    cache: Cell<Option<Recurrence>>,
-    counts: StepCounts,
-}
-
-impl ClosedForm {
-    /// A closed-form propagator (the motion comes from the system at each reset).
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Whether the segment `motion` is solved in closed form (underdamped).
-    pub fn supports(motion: &AffineMotion) -> bool {
-        let w0_sq = motion.stiffness / motion.mass;
-        let sigma = 0.5 * (motion.damping) / motion.mass;
-        motion.mass > 0.0 && motion.stiffness > 0.0 && sigma >= 0.0 && sigma * sigma < w0_sq
-    }
-}
-
-impl Mode {
     /// The recurrence moved from `last` to `t`: one rotation when `t` is one sample spacing
     /// after `last`, a direct evaluation (and the rotation of the new spacing) otherwise.
     #[inline]
@@ -144,6 +103,46 @@ impl Mode {
             rot_c: decay * c,
             rot_s: decay * s,
         }
+    }
+}
+
+/// The last sample evaluated and the rotation of the last sample spacing.
+#[derive(Debug, Clone, Copy)]
+struct Recurrence {
+    t: f64,
+    p: f64,
+    q: f64,
+    dt: f64,
+    rot_c: f64,
+    rot_s: f64,
+}
+
+/// The exact propagator as a [`Stepper`] over `[x, v]`.
+#[derive(Debug, Clone, Default)]
+pub struct ClosedForm {
+    mode: Mode,
+    t: f64,
+    t_prev: f64,
+    t_end: f64,
+    /// Phase w_d tau of the next candidate zero of v.
+    next_phase: f64,
+    y: [f64; 2],
+    /// The sample recurrence where the last sweep over a grid left it (reset per segment).
+    cache: Cell<Option<Recurrence>>,
+    counts: StepCounts,
+}
+
+impl ClosedForm {
+    /// A closed-form propagator (the motion comes from the system at each reset).
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Whether the segment `motion` is solved in closed form (underdamped).
+    pub fn supports(motion: &AffineMotion) -> bool {
+        let w0_sq = motion.stiffness / motion.mass;
+        let sigma = 0.5 * (motion.damping) / motion.mass;
+        motion.mass > 0.0 && motion.stiffness > 0.0 && sigma >= 0.0 && sigma * sigma < w0_sq
     }
 }
 

@@ -227,8 +227,7 @@ impl Gms {
 
     /// The Stribeck curve s(v) \[N\] (the total sliding force for weights summing to 1).
     pub fn s(&self, v: f64, normal: f64) -> f64 {
-        normal
-            * (self.mu_c + (self.mu_s - self.mu_c) * decay((v / self.v_s).abs().powf(self.delta)))
+        self.s_and_slope(v, normal).0
     }
 
     /// The Stribeck curve s(v) and its slope ds/dv from one power: with u = |v / v_s|,
@@ -259,6 +258,23 @@ impl Gms {
                 (d_dz, 1.0 - p + v * m * p * ds / s)
             }
             Some(_) => (0.0, 1.0),
+        }
+    }
+
+    /// d(dz/dt)/dz of the element law: -|v| m load^(m-1) k / (w s) while loading
+    /// (load > 0), 0 while unloading and for a frozen element (the state Jacobian's form;
+    /// `Gms::element_partials` gives the same derivative as m p / load for the gradients).
+    fn z_dot_slope(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
+        match Self::element_load(e, v, z, s) {
+            Some((limit, load)) if load > 0.0 => {
+                let power = if self.sharpness == 1.0 {
+                    1.0
+                } else {
+                    self.sharpness * load.powf(self.sharpness - 1.0)
+                };
+                -v.abs() * power * e.stiffness / limit
+            }
+            _ => 0.0,
         }
     }
 
@@ -298,22 +314,6 @@ impl Gms {
                 v * (1.0 - p)
             }
             Some(_) => v,
-        }
-    }
-
-    /// d(dz/dt)/dz of the element law: -|v| m load^(m-1) k / (w s) while loading
-    /// (load > 0), 0 while unloading and for a frozen element.
-    fn z_dot_slope(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
-        match Self::element_load(e, v, z, s) {
-            Some((limit, load)) if load > 0.0 => {
-                let power = if self.sharpness == 1.0 {
-                    1.0
-                } else {
-                    self.sharpness * load.powf(self.sharpness - 1.0)
-                };
-                -v.abs() * power * e.stiffness / limit
-            }
-            _ => 0.0,
         }
     }
 }
