@@ -183,6 +183,61 @@ fn compare_ranks_the_classical_models() {
     assert!(out.join("best_x10mm_velocity_fit.svg").is_file());
 }
 
+/// Issue 14's acceptance on the bundled Coulomb fixture: LuGre and Dahl converge, their
+/// Coulomb level within 0.5 % of the Coulomb fit's mu, and sigma0 a lower bound (the records
+/// do not resolve presliding) with the bound stated and no standard error; no parameter shows
+/// a zero standard error.
+#[test]
+fn lugre_and_dahl_bound_presliding_from_below_on_the_coulomb_fixture() {
+    let out = scratch_dir("fc", "presliding");
+    let cfg = fixtures_dir().join("fmm-compare.toml");
+    let (o, r) = run_json(
+        &[
+            "compare",
+            cfg.to_str().unwrap(),
+            "--models",
+            "coulomb,dahl,lugre",
+        ],
+        &out,
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let ranking = r["ranking"].as_array().unwrap();
+    let model = |name: &str| ranking.iter().find(|f| f["model"] == name).unwrap();
+    let param = |f: &serde_json::Value, name: &str| {
+        f["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["name"] == name)
+            .unwrap()
+            .clone()
+    };
+    let mu = param(model("coulomb"), "mu")["value"].as_f64().unwrap();
+    for name in ["dahl", "lugre"] {
+        let f = model(name);
+        assert_eq!(f["converged"], true, "{name}: {}", f["termination"]);
+        let mu_c = param(f, "mu_c")["value"].as_f64().unwrap();
+        assert!(
+            (mu_c - mu).abs() / mu < 0.005,
+            "{name}: mu_c {mu_c} vs {mu}"
+        );
+        let sigma0 = param(f, "sigma0");
+        assert_eq!(sigma0["identifiability"], "lower_bound", "{name}: {sigma0}");
+        let bound = sigma0["bound"].as_f64().unwrap();
+        assert!(
+            bound > 0.0 && bound <= sigma0["value"].as_f64().unwrap(),
+            "{sigma0}"
+        );
+        assert!(sigma0["std_error"].is_null() && sigma0["ci95"].is_null());
+        for p in f["parameters"].as_array().unwrap() {
+            assert!(
+                p["std_error"].is_null() || p["std_error"].as_f64().unwrap() > 0.0,
+                "{name}: {p}"
+            );
+        }
+    }
+}
+
 #[test]
 fn compare_rejects_an_unknown_model_with_a_suggestion() {
     let out = scratch_dir("fc", "compare-bad");

@@ -120,8 +120,8 @@ fn the_prefit_start_brings_a_local_lugre_fit_to_the_noise_level() {
     );
 }
 
-/// LuGre or Dahl on Coulomb records: converged, the Coulomb level within 0.5 %, and sigma0 a
-/// lower bound without a standard error.
+/// LuGre or Dahl on Coulomb records: converged, the sliding level within 0.5 % (and mu_c
+/// within its statistics), and sigma0 a lower bound without a standard error.
 fn presliding_is_a_lower_bound_on_coulomb_records(model: &(dyn FrictionModel + 'static)) {
     let osc = Oscillator::fmm();
     let mu = 0.24;
@@ -129,17 +129,34 @@ fn presliding_is_a_lower_bound_on_coulomb_records(model: &(dyn FrictionModel + '
     let r = fit(&osc, model, &recs, &FitOptions::default()).unwrap();
     let sigma0 = r.param("sigma0").unwrap();
     eprintln!(
-        "{} on coulomb: {}, mu_c {}, sigma0 {:e} {:?} bound {:?}, rms/noise {:.4}",
+        "{} on coulomb: {}, mu_c {:?}, mu_s {:?}, v_s {:?}, sigma0 {:e} {:?} bound {:?}, rms/noise {:.4}",
         r.model,
         r.termination,
-        r.value("mu_c").unwrap(),
+        r.param("mu_c"),
+        r.param("mu_s"),
+        r.param("v_s"),
         sigma0.value,
         sigma0.identifiability,
         sigma0.bound,
         noise_ratio(&r)
     );
     assert!(r.converged, "{}", r.termination);
-    assert!(rel(r.value("mu_c").unwrap(), mu) < 0.005);
+    // The Coulomb level the records see: the fitted sliding force at 1 to 10 cm/s within
+    // 0.5 % of mu N. mu_c itself is LuGre's level far above its Stribeck velocity; when the
+    // records leave v_s free (not identifiable) it trades against mu_s and sigma2 and is held
+    // to its own statistics: within 3 standard errors of the truth. (On the bundled fixture
+    // cli/tests/fit_compare.rs holds mu_c itself to 0.5 %.)
+    for v in [0.01, 0.03, 0.1] {
+        let level = r.fitted_model.steady_state(v, osc.normal_force) / osc.normal_force;
+        assert!(rel(level, mu) < 0.005, "sliding level {level} at {v} m/s");
+    }
+    let mu_c = r.param("mu_c").unwrap();
+    match mu_c.std_error {
+        Some(se) if mu_c.identifiability == Some(Identifiability::Determined) => {
+            assert!((mu_c.value - mu).abs() <= 3.0 * se, "{mu_c:?}")
+        }
+        _ => assert!(mu_c.identifiability != Some(Identifiability::Determined)),
+    }
     assert_eq!(sigma0.identifiability, Some(Identifiability::LowerBound));
     let bound = sigma0.bound.expect("a lower bound states its value");
     assert!(bound > 0.0 && bound <= sigma0.value);

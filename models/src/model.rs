@@ -109,6 +109,20 @@ pub struct GuessHint {
     pub mass: f64,
 }
 
+/// The rigid-contact limit of a model with a presliding stiffness (see
+/// [`FrictionModel::rigid_limit`]). On records that do not resolve presliding (Coulomb-like
+/// data), the cost falls towards the limit law's as the stiffness grows, so the stiffness has
+/// a lower bound but no value; an optimiser that stops at a large finite stiffness, or a cost
+/// curvature taken there, would otherwise call it determined.
+#[derive(Debug)]
+pub struct RigidLimit {
+    /// The limit law at its default values (the identifier fits it; its `start_from` maps a
+    /// fitted instance of the model onto it).
+    pub law: Box<dyn FrictionModel>,
+    /// Index of the stiffness parameter that runs to infinity.
+    pub stiffness: usize,
+}
+
 /// A friction law: a pure function of sliding velocity, internal states and normal force.
 ///
 /// Implementors derive `Clone`, `Serialize` and `Deserialize` (with `#[serde(default,
@@ -251,6 +265,15 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
         _ctx: &crate::start::StartContext,
     ) -> bool {
         false
+    }
+
+    /// The static law this model tends to as its contact stiffness grows without bound (rigid
+    /// bristles), with the index of that stiffness among `params()`: LuGre tends to stribeck
+    /// (its bristle damping kept near critical), Dahl to coulomb. The identifier fits the limit
+    /// law to the same records and calls the stiffness determined only when the records
+    /// exclude the limit (a likelihood-ratio test, [`RigidLimit`]). Default: `None`.
+    fn rigid_limit(&self) -> Option<RigidLimit> {
+        None
     }
 
     /// Checks every parameter against its physical bounds; returns warnings for values that

@@ -101,10 +101,14 @@ fn static_laws_from_simpler_static_laws() {
     same_steady_state(&s, &vc);
     assert!(s.start_from(&fitted_stribeck(), &ctx));
     assert_eq!(s, fitted_stribeck());
-    // Models without a start mapping, and fits without a Coulomb level, change nothing.
+    // Coulomb takes the Coulomb level (the Stribeck curve far from its dip).
     let mut c = Coulomb::default();
-    assert!(!c.start_from(&fitted_stribeck(), &ctx));
-    assert_eq!(c, Coulomb::default());
+    assert!(c.start_from(&fitted_stribeck(), &ctx));
+    assert_eq!(c.mu, fitted_stribeck().mu_c);
+    // Models without a start mapping, and fits without a Coulomb level, change nothing.
+    let mut m = Makkar::default();
+    assert!(!m.start_from(&fitted_stribeck(), &ctx));
+    assert_eq!(m, Makkar::default());
     let mut l = LuGre::default();
     assert!(!l.start_from(&NoFriction {}, &ctx));
     assert_eq!(l, LuGre::default());
@@ -121,4 +125,46 @@ fn levels_keep_what_was_fitted() {
     let levels = StribeckLevels::from_model(&odd).unwrap();
     assert_eq!(levels.mu_s, 0.1);
     assert_eq!(levels.mu_s_at_least_mu_c(), 0.22);
+}
+
+/// The rigid-contact limit of each model that declares one: the limit law, started from a
+/// fitted instance of the model, has the model's steady-state curve (the curve the model
+/// slides at once its bristles are rigid), and the declared stiffness is the model's sigma0.
+#[test]
+fn rigid_limits_slide_at_the_models_steady_state_curve() {
+    let lugre = LuGre {
+        sigma0: 3e6,
+        sigma1: 900.0,
+        sigma2: 1.3,
+        mu_c: 0.21,
+        mu_s: 0.29,
+        v_s: 0.007,
+    };
+    let dahl = Dahl {
+        sigma0: 4e5,
+        mu_c: 0.23,
+        alpha: 1.4,
+    };
+    let ctx = StartContext::new(N, MASS);
+    for model in [&lugre as &dyn FrictionModel, &dahl] {
+        let limit = model
+            .rigid_limit()
+            .expect("a bristle model has a rigid limit");
+        let mut law = limit.law;
+        assert_eq!(
+            law.n_states(),
+            0,
+            "{}: the limit is a static law",
+            model.name()
+        );
+        assert!(law.start_from(model, &ctx));
+        same_steady_state(law.as_ref(), model);
+        assert_eq!(model.param_info()[limit.stiffness].name, "sigma0");
+    }
+    for model in [
+        &fitted_stribeck() as &dyn FrictionModel,
+        &Coulomb { mu: 0.2 },
+    ] {
+        assert!(model.rigid_limit().is_none(), "{}", model.name());
+    }
 }

@@ -280,14 +280,7 @@ fn structure_finding(stats: &[Statistic]) -> Finding {
 pub fn parameters_at_bounds(layout: &[FreeParam], values: &[f64]) -> Vec<Finding> {
     let mut out = Vec::new();
     for (f, &p) in layout.iter().zip(values) {
-        let u = f.to_internal(p);
-        let (lo, hi) = f.internal_bounds();
-        let near = |b: f64| b.is_finite() && (u - b).abs() <= 1e-6 * b.abs().max(1.0);
-        let which = if near(lo) {
-            ("lower", f.lower)
-        } else if near(hi) {
-            ("upper", f.upper)
-        } else {
+        let Some(side) = f.bound_side(p) else {
             continue;
         };
         out.push(Finding::warn(
@@ -295,7 +288,9 @@ pub fn parameters_at_bounds(layout: &[FreeParam], values: &[f64]) -> Vec<Finding
             Some(p),
             format!(
                 "`{}` = {p:e} {} is at its {} bound: the data push it further (check the units, the model and the bounds)",
-                f.name, f.unit, which.0
+                f.name,
+                f.unit,
+                side.name()
             ),
         ));
     }

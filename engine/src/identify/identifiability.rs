@@ -20,9 +20,11 @@ use super::outcome::{Check, Finding, TerminationReason};
 use super::problem::{FitProblem, ProblemParts};
 use super::residuals::Residuals;
 use super::starts::{run_start, MultiStart, RunSlot, StartRun};
-use super::stats::{covariance, Covariance};
+use super::stats::{chi_square_95, covariance, Covariance};
+use super::strategy::{fit_simpler, stage_options, FitTarget};
 use crate::error::EngineError;
-use frictionid_models::FrictionModel;
+use frictionid_models::start::TYPICAL_PRESLIDING_DISPLACEMENT;
+use frictionid_models::{clone_model, FrictionModel, StartContext, StribeckLevels};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
@@ -41,6 +43,12 @@ pub const PROFILE_HALVINGS: usize = 3;
 
 /// Iterations of the re-optimisation of the other parameters at each profile step.
 pub const PROFILE_ITERATIONS: u64 = 12;
+
+/// Iterations of the re-optimisation at each step of the profile of a rigid limit's
+/// stiffness: the other parameters move far along it (LuGre's Stribeck levels and bristle
+/// damping change by factors between decades of sigma0), and a profile that stops short of
+/// their optimum overstates the lower bound.
+pub const LIMIT_PROFILE_ITERATIONS: u64 = 40;
 
 /// What the records say about a fitted parameter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -106,9 +114,10 @@ pub fn settle<R: Residuals + 'static>(
         progress: None,
         ..opts.clone()
     };
+    let limit = rigid_limit(reference, &runs.best, &quiet);
     let mut restarts = PROFILE_RESTARTS;
     loop {
-        match profile_all(reference, &runs.best, &quiet, restarts > 0)? {
+        match profile_all(reference, &runs.best, &quiet, limit.as_ref(), restarts > 0)? {
             Profiled::Standings(standings) => {
                 return Ok(finish(reference, runs, standings, &quiet))
             }
@@ -160,31 +169,200 @@ fn flat_and_delta<R: Residuals>(
     Ok(Some((slots, PROFILE_DELTA * variance)))
 }
 
-/// Profiles every flat parameter at `best`; with `restart`, stops at the first profile point
-/// a `delta` below the best cost.
+/// Profiles every flat parameter at `best`, and the stiffness of a rigid `limit` the records
+/// do not exclude (its upper side open, only the lower side profiled); with `restart`, stops
+/// at the first profile point a `delta` below the best cost, or at the limit when it lies
+/// that far below.
 fn profile_all<R: Residuals + 'static>(
     reference: &FitProblem<R>,
     best: &StartRun,
     opts: &FitOptions,
+    limit: Option<&Limit>,
     restart: bool,
 ) -> Result<Profiled, EngineError> {
     let mut standings = vec![Standing::DETERMINED; reference.layout.len()];
-    let Some((slots, delta)) = flat_and_delta(reference, best)? else {
+    let Some((mut slots, delta)) = flat_and_delta(reference, best)? else {
         return Ok(Profiled::Standings(standings));
     };
+    let open_limit = limit.filter(|l| l.cost <= best.cost + delta * l.rise_factor());
+    if let Some(l) = open_limit {
+        if l.cost < best.cost - delta && restart {
+            if let Some(u) = l.approach(reference, best, delta) {
+                return Ok(Profiled::Lower(u));
+            }
+        }
+        if !slots.contains(&l.slot) {
+            slots.push(l.slot);
+        }
+    }
     let profile = Profile {
         reference,
         best,
         opts,
+        limit,
     };
     for j in slots {
-        let (standing, lower) = profile.standing(j, delta);
+        let open_above = open_limit.filter(|l| l.slot == j).map(|l| l.cost);
+        let (standing, lower) = profile.standing(j, delta, open_above);
         if let Some(u) = lower.filter(|_| restart) {
             return Ok(Profiled::Lower(u));
         }
         standings[j] = standing;
     }
     Ok(Profiled::Standings(standings))
+}
+
+/// The rigid-contact limit of the fitted model (`FrictionModel::rigid_limit`) fitted to the
+/// same records. The records resolve the contact's stiffness only when they reject the limit:
+/// a likelihood-ratio test of the nested limit law, whose cost must lie more than
+/// chi²(d, 95 %) / 2 residual variances above the best, d the parameters the limit removes.
+/// Otherwise the stiffness's upper side is open (it is at most a lower bound).
+struct Limit {
+    /// The stiffness's slot in the layout.
+    slot: usize,
+    /// The limit law's best cost.
+    cost: f64,
+    /// The free parameters the limit removes (at least 1).
+    removed: usize,
+    /// The fitted limit law.
+    law: Box<dyn FrictionModel>,
+}
+
+/// Decades of contact stiffness the target steps through on its way to a rigid limit that
+/// fits clearly better than the fit's optimum (from a tenth of the typical presliding
+/// displacement down; a step clipped at the stiffness's bound ends it).
+pub const LIMIT_APPROACH_DECADES: i32 = 10;
+
+impl Limit {
+    /// The cost rise that rejects the limit, in units of the one-parameter rise
+    /// [`PROFILE_DELTA`]: chi²(d) / chi²(1).
+    fn rise_factor(&self) -> f64 {
+        chi_square_95(self.removed) / chi_square_95(1)
+    }
+
+    /// The target started from the fitted limit law at the presliding displacement of `ctx`
+    /// (internal coordinates; the parameters that are not the model's where `best` has them).
+    fn start_of_target<R: Residuals>(
+        &self,
+        reference: &FitProblem<R>,
+        best: &StartRun,
+        ctx: &StartContext,
+    ) -> Option<DVector<f64>> {
+        let mut started = clone_model(reference.model.as_ref());
+        if !started.start_from(self.law.as_ref(), ctx) {
+            return None;
+        }
+        let values = started.params();
+        let at_best = reference.physical(&best.u);
+        let p: Vec<f64> = reference
+            .layout
+            .iter()
+            .zip(at_best)
+            .map(|(f, x)| match f.kind {
+                ParamKind::Model(i) => f.clip(values[i]),
+                _ => x,
+            })
+            .collect();
+        Some(reference.internal(&p))
+    }
+
+    /// The target mapped from the limit law with its stiffness at the internal value `u`
+    /// (internal coordinates); `None` when the law has no Coulomb level or the mapping fails.
+    fn target_at_stiffness<R: Residuals>(
+        &self,
+        reference: &FitProblem<R>,
+        best: &StartRun,
+        u: f64,
+    ) -> Option<DVector<f64>> {
+        let osc = &reference.oscillator;
+        let level = StribeckLevels::from_model(self.law.as_ref())?.mu_c * osc.normal_force;
+        let stiffness = reference.layout[self.slot].to_physical(u);
+        let ctx = StartContext {
+            presliding_displacement: level / stiffness,
+            ..StartContext::new(osc.normal_force, osc.mass)
+        };
+        let mut at = self.start_of_target(reference, best, &ctx)?;
+        at[self.slot] = u;
+        Some(at)
+    }
+
+    /// The way from the fit's optimum to a limit that fits better by more than `delta`: the
+    /// target mapped from the limit law at stiffnesses a decade apart; the first point whose
+    /// cost is within `delta` of the limit's, else the lowest one.
+    fn approach<R: Residuals>(
+        &self,
+        reference: &FitProblem<R>,
+        best: &StartRun,
+        delta: f64,
+    ) -> Option<DVector<f64>> {
+        let osc = &reference.oscillator;
+        let mut lowest: Option<(f64, DVector<f64>)> = None;
+        let mut previous: Option<DVector<f64>> = None;
+        for k in 1..=LIMIT_APPROACH_DECADES {
+            let ctx = StartContext {
+                presliding_displacement: TYPICAL_PRESLIDING_DISPLACEMENT * 10f64.powi(-k),
+                ..StartContext::new(osc.normal_force, osc.mass)
+            };
+            let u = self.start_of_target(reference, best, &ctx)?;
+            if previous.as_ref() == Some(&u) {
+                break;
+            }
+            let cost = reference
+                .residuals_at(&reference.physical(&u))
+                .ok()
+                .map(|r| 0.5 * r.norm_squared())
+                .filter(|c| c.is_finite());
+            if let Some(c) = cost {
+                if c <= self.cost + delta {
+                    return Some(u);
+                }
+                if lowest.as_ref().is_none_or(|(l, _)| c < *l) {
+                    lowest = Some((c, u.clone()));
+                }
+            }
+            previous = Some(u);
+        }
+        lowest.map(|(_, u)| u)
+    }
+}
+
+/// The model's rigid limit fitted to the records (from its own guess and from the fit's best
+/// mapped onto it), when the model declares one and its stiffness is free; `None` otherwise
+/// or when the limit cannot be fitted.
+fn rigid_limit<R: Residuals + 'static>(
+    reference: &FitProblem<R>,
+    best: &StartRun,
+    opts: &FitOptions,
+) -> Option<Limit> {
+    let declared = reference.model.rigid_limit()?;
+    let slot = reference
+        .layout
+        .iter()
+        .position(|f| f.kind == ParamKind::Model(declared.stiffness))?;
+    let fitted = reference.realise(&reference.physical(&best.u)).ok()?.model;
+    let osc = &reference.oscillator;
+    let ctx = StartContext::new(osc.normal_force, osc.mass);
+    let on = FitTarget {
+        residuals: &reference.residuals,
+        osc,
+        records: &reference.records,
+    };
+    let limit_opts = FitOptions {
+        oscillator: opts.oscillator.clone(),
+        ..stage_options(opts)
+    };
+    let fit = fit_simpler(
+        &on,
+        declared.law.as_ref(),
+        &limit_opts,
+        &[(fitted.as_ref(), ctx)],
+    )?;
+    Some(Limit {
+        slot,
+        cost: fit.cost,
+        removed: reference.layout.len().saturating_sub(fit.free).max(1),
+        law: fit.model,
+    })
 }
 
 /// Runs the solver from `u` and makes it the best run when it ends lower; whether it did.
@@ -240,7 +418,7 @@ fn flat_slots<R: Residuals>(
         .filter(|&j| {
             let se = cov.std_errors[j] * layout[j].internal_derivative(p[j]).abs();
             let fine = !cov.singular && se.is_finite() && se > 0.0 && se <= FLAT_INTERNAL_SE;
-            let at_bound = p[j] <= layout[j].lower || p[j] >= layout[j].upper;
+            let at_bound = layout[j].bound_side(p[j]).is_some();
             !fine || at_bound || (dynamic && noise_dominated(reference, jac, p, r, j))
         })
         .collect()
@@ -374,6 +552,9 @@ struct Profile<'a, R: Residuals> {
     reference: &'a FitProblem<R>,
     best: &'a StartRun,
     opts: &'a FitOptions,
+    /// The model's rigid limit: a profile of its stiffness also tries the others mapped from
+    /// the limit law at each stiffness (levels and a critically damped contact).
+    limit: Option<&'a Limit>,
 }
 
 impl<R: Residuals + 'static> Profile<'_, R> {
@@ -399,13 +580,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
                 break;
             }
             let pins = [(j, u)];
-            match pinned_fit(
-                self.reference,
-                &pins,
-                &others,
-                self.opts,
-                PROFILE_ITERATIONS,
-            ) {
+            match self.step_fit(&pins, &others) {
                 None if out.is_empty() && halvings < PROFILE_HALVINGS => {
                     step /= 2.0;
                     halvings += 1;
@@ -427,12 +602,62 @@ impl<R: Residuals + 'static> Profile<'_, R> {
         out
     }
 
+    /// The others re-optimised at a profile step `pins` from where the previous step left
+    /// them (`previous`); a step of the rigid limit's stiffness also from the others mapped
+    /// from the limit law at that stiffness (with more iterations), keeping the lower end: the
+    /// cost near a rigid limit has several minima in the levels.
+    fn step_fit(&self, pins: &[(usize, f64)], previous: &DVector<f64>) -> Option<StartRun> {
+        let &[(j, u)] = pins else {
+            return None;
+        };
+        let Some(limit) = self.limit.filter(|l| l.slot == j) else {
+            return pinned_fit(
+                self.reference,
+                pins,
+                previous,
+                self.opts,
+                PROFILE_ITERATIONS,
+            );
+        };
+        let run = |start: &DVector<f64>| {
+            pinned_fit(
+                self.reference,
+                pins,
+                start,
+                self.opts,
+                LIMIT_PROFILE_ITERATIONS,
+            )
+        };
+        let Some(mapped) = limit.target_at_stiffness(self.reference, self.best, u) else {
+            return run(previous);
+        };
+        let mapped = without(&mapped, pins);
+        let (a, b) = if self.opts.parallel {
+            rayon::join(|| run(previous), || run(&mapped))
+        } else {
+            (run(previous), run(&mapped))
+        };
+        [a, b]
+            .into_iter()
+            .flatten()
+            .min_by(|x, y| x.cost.total_cmp(&y.cost))
+    }
+
     /// The standing of slot `j` for a cost rise `delta` (absolute), and the lowest profile
     /// point (internal coordinates) when its cost lies more than `delta` below the best.
-    fn standing(&self, j: usize, delta: f64) -> (Standing, Option<DVector<f64>>) {
+    /// `open_above`: the cost the parameter's upper side runs to (a rigid limit the records
+    /// do not exclude): that side is open and not profiled.
+    fn standing(
+        &self,
+        j: usize,
+        delta: f64,
+        open_above: Option<f64>,
+    ) -> (Standing, Option<DVector<f64>>) {
         let best = self.best.cost;
         // The two sides are independent refits: side by side on two threads.
-        let (below, above) = if self.opts.parallel {
+        let (below, above) = if open_above.is_some() {
+            (self.side(j, -1.0, best + delta), Vec::new())
+        } else if self.opts.parallel {
             rayon::join(
                 || self.side(j, -1.0, best + delta),
                 || self.side(j, 1.0, best + delta),
@@ -454,6 +679,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
             .iter()
             .chain(&above)
             .map(|p| p.cost)
+            .chain(open_above)
             .fold(best, f64::min);
         let pairs = |side: &[ProfilePoint]| -> Vec<(f64, f64)> {
             side.iter().map(|p| (p.u, p.cost)).collect()

@@ -129,6 +129,41 @@ impl FreeParam {
             (self.lower / self.scale, self.upper / self.scale)
         }
     }
+
+    /// The bound the physical value `p` sits at: within 1e-6 (relative, at least absolute)
+    /// of it in internal coordinates, so that a value a rounding short of its bound (1e12
+    /// read back as 999999999999.999) counts as at the bound.
+    pub fn bound_side(&self, p: f64) -> Option<BoundSide> {
+        let u = self.to_internal(p);
+        let (lo, hi) = self.internal_bounds();
+        let near = |b: f64| b.is_finite() && (u - b).abs() <= 1e-6 * b.abs().max(1.0);
+        if near(lo) {
+            Some(BoundSide::Lower)
+        } else if near(hi) {
+            Some(BoundSide::Upper)
+        } else {
+            None
+        }
+    }
+}
+
+/// Which bound a parameter sits at.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BoundSide {
+    /// Its lower bound.
+    Lower,
+    /// Its upper bound.
+    Upper,
+}
+
+impl BoundSide {
+    /// `lower` or `upper`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Lower => "lower",
+            Self::Upper => "upper",
+        }
+    }
 }
 
 #[cfg(test)]
@@ -152,5 +187,27 @@ mod tests {
             assert!((log.internal_derivative(p) * p - 1.0).abs() < 1e-15);
         }
         assert_eq!(log.internal_bounds().0, f64::NEG_INFINITY);
+    }
+
+    #[test]
+    fn a_value_a_rounding_short_of_its_bound_is_at_it() {
+        let stiffness = FreeParam {
+            log: true,
+            ..FreeParam::linear(
+                "s".into(),
+                "N/m",
+                ParamKind::Model(0),
+                (0.0, 1e12),
+                1e5,
+                1.0,
+            )
+        };
+        let read_back = (1e12f64.ln()).exp();
+        assert!(read_back < 1e12);
+        assert_eq!(stiffness.bound_side(read_back), Some(BoundSide::Upper));
+        assert_eq!(stiffness.bound_side(0.99e12), None);
+        let mu = FreeParam::linear("mu".into(), "1", ParamKind::Model(0), (0.0, 10.0), 0.3, 1.0);
+        assert_eq!(mu.bound_side(0.0), Some(BoundSide::Lower));
+        assert_eq!(mu.bound_side(1e-3), None);
     }
 }

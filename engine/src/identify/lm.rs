@@ -78,6 +78,10 @@ pub struct LevenbergMarquardt {
     /// Largest change of any parameter in one step (a trust-region cap: a step that would
     /// move further is shortened along its direction).
     pub max_step: f64,
+    /// Coordinates whose step cap grows with their magnitude: `max_step` times
+    /// max(1, |p_i|) (linear coordinates, whose scale is fixed at the start: a parameter that
+    /// has moved to many times its scale may still move by a multiple of itself).
+    pub relative_step: Vec<bool>,
     mu: f64,
     nu: f64,
     residuals: DVector<f64>,
@@ -100,6 +104,7 @@ impl LevenbergMarquardt {
             ftol: 1e-9,
             tau: 1e-3,
             max_step: f64::INFINITY,
+            relative_step: Vec::new(),
             stall_tol: 1e-6,
             stall_window: 10,
             history: Vec::new(),
@@ -312,6 +317,15 @@ impl LevenbergMarquardt {
         then - self.cost <= self.stall_tol * self.cost
     }
 
+    /// The largest change of coordinate `i` (at `p_i`) in one step.
+    fn step_cap(&self, i: usize, p_i: f64) -> f64 {
+        if self.relative_step.get(i).copied().unwrap_or(false) {
+            self.max_step * p_i.abs().max(1.0)
+        } else {
+            self.max_step
+        }
+    }
+
     /// The damped, length-capped step; `None` when the damped system is not positive definite.
     /// Parameters held at a bound by a gradient pointing outwards stay put; the damped normal
     /// equations are solved for the others only.
@@ -338,9 +352,11 @@ impl LevenbergMarquardt {
         for (r, &i) in free.iter().enumerate() {
             delta[i] = reduced[r];
         }
-        let longest = delta.amax();
-        if longest > self.max_step {
-            delta *= self.max_step / longest;
+        let over = (0..n)
+            .map(|i| delta[i].abs() / self.step_cap(i, p[i]))
+            .fold(0.0, f64::max);
+        if over > 1.0 {
+            delta /= over;
         }
         Some(delta)
     }

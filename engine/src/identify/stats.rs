@@ -153,9 +153,53 @@ pub fn bic(n: usize, ssr: f64, p: usize) -> f64 {
     nf * (ssr / nf).ln() + p as f64 * nf.ln()
 }
 
+/// The 95 % quantile of the chi-square distribution with `dof` degrees of freedom: exact for
+/// 1 (the squared normal quantile) and 2 (-2 ln 0.05), tabulated to 4 decimals up to 20,
+/// beyond by the Wilson-Hilferty cube (relative error below 5e-4).
+pub fn chi_square_95(dof: usize) -> f64 {
+    const TABLE: [f64; 18] = [
+        7.8147, 9.4877, 11.0705, 12.5916, 14.0671, 15.5073, 16.9190, 18.3070, 19.6751, 21.0261,
+        22.3620, 23.6848, 24.9958, 26.2962, 27.5871, 28.8693, 30.1435, 31.4104,
+    ];
+    match dof {
+        0 => 0.0,
+        1 => 3.841_458_820_694_124,
+        2 => -2.0 * 0.05f64.ln(),
+        3..=20 => TABLE[dof - 3],
+        _ => {
+            let z = 1.644_853_626_951_472_7;
+            let k = dof as f64;
+            let a = 2.0 / (9.0 * k);
+            k * (1.0 - a + z * a.sqrt()).powi(3)
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn chi_square_quantiles_match_tables() {
+        // Tabulated 95 % values (e.g. NIST/SEMATECH e-Handbook, table 1.3.6.7.4).
+        for (dof, q) in [
+            (1, 3.841),
+            (2, 5.991),
+            (3, 7.815),
+            (6, 12.592),
+            (10, 18.307),
+            (11, 19.675),
+            (20, 31.410),
+            (21, 32.671),
+            (50, 67.505),
+            (100, 124.342),
+        ] {
+            let got = chi_square_95(dof);
+            assert!((got - q).abs() < 5e-4 * q, "dof {dof}: {got} vs {q}");
+        }
+        // One degree of freedom: the square of the two-sided normal quantile.
+        assert!((chi_square_95(1) - 1.959_963_984_540_054f64.powi(2)).abs() < 1e-12);
+    }
 
     #[test]
     fn t_quantiles_match_tables() {

@@ -170,7 +170,7 @@ fn stages<R: Residuals + 'static>(plan: &StartPlan<'_, R>) -> Vec<Box<dyn Fricti
 
 /// The options of a stage: one start, one local run, the model's own parameters and
 /// bounds, the oscillator fixed, no uncertainty budget, no progress.
-fn stage_options(opts: &FitOptions) -> FitOptions {
+pub fn stage_options(opts: &FitOptions) -> FitOptions {
     let keys = non_model_bound_keys();
     FitOptions {
         free: None,
@@ -197,37 +197,72 @@ fn stage_fit<R: Residuals + 'static>(
     plan: &StartPlan<'_, R>,
     stage: &(dyn FrictionModel + 'static),
 ) -> Option<Box<dyn FrictionModel>> {
-    let opts = stage_options(plan.opts);
-    let residuals = plan.residuals.as_ref();
-    let layout = build_layout(plan.osc, stage, plan.records, residuals, &opts).ok()?;
+    let on = FitTarget {
+        residuals: plan.residuals,
+        osc: plan.osc,
+        records: &plan.records.into(),
+    };
+    fit_simpler(&on, stage, &stage_options(plan.opts), &[]).map(|f| f.model)
+}
+
+/// The records a simpler law is fitted to, with the fit's residuals and oscillator.
+pub struct FitTarget<'a, R: Residuals> {
+    /// The residuals of the fit.
+    pub residuals: &'a Arc<R>,
+    /// The oscillator.
+    pub osc: &'a Oscillator,
+    /// The records.
+    pub records: &'a Arc<[Record]>,
+}
+
+/// A simpler law fitted to the records of a fit.
+pub struct SimplerFit {
+    /// The fitted law.
+    pub model: Box<dyn FrictionModel>,
+    /// Its cost (half the sum of squared residuals, as the fit's).
+    pub cost: f64,
+    /// Its free parameters (the model's and the others alike).
+    pub free: usize,
+}
+
+/// Fits `law` with `opts` (local runs: one from its data-driven guess and one from each model
+/// of `also_from` mapped onto it by `start_from`, the best kept); `None` when it fails.
+pub fn fit_simpler<R: Residuals + 'static>(
+    on: &FitTarget<'_, R>,
+    law: &(dyn FrictionModel + 'static),
+    opts: &FitOptions,
+    also_from: &[(&dyn FrictionModel, StartContext)],
+) -> Option<SimplerFit> {
+    let layout = build_layout(on.osc, law, on.records, on.residuals.as_ref(), opts).ok()?;
     if layout.params.is_empty() {
         return None;
     }
-    let shared: Arc<[Record]> = plan.records.into();
     let make = || {
         FitProblem::new(
-            plan.residuals.clone(),
+            on.residuals.clone(),
             ProblemParts {
-                oscillator: *plan.osc,
+                oscillator: *on.osc,
                 model: layout.start_model.clone(),
-                records: shared.clone(),
+                records: on.records.clone(),
                 layout: layout.params.clone(),
                 sim: opts.sim,
                 parallel: opts.parallel,
             },
         )
     };
+    let mut points = vec![layout.start.clone()];
+    for (fitted, ctx) in also_from {
+        points.extend(mapped_point(&layout, *fitted, ctx, opts).filter(|p| !points.contains(p)));
+    }
     let reference = make();
-    let runs = run_starts(
-        make,
-        &reference,
-        std::slice::from_ref(&layout.start),
-        &opts,
-        1,
-    )
-    .ok()?;
+    let runs = run_starts(make, &reference, &points, opts, points.len()).ok()?;
     let p = reference.physical(&runs.best.u);
-    reference.realise(&p).ok().map(|w| w.model)
+    let model = reference.realise(&p).ok()?.model;
+    Some(SimplerFit {
+        model,
+        cost: runs.best.cost,
+        free: layout.params.len(),
+    })
 }
 
 /// The staged starting points: each stage mapped onto the target (the last, most refined

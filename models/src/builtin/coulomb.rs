@@ -10,6 +10,7 @@
 //! Coulomb friction is the paper's Eq. (1).
 
 use crate::model::{sgn, FrictionModel, GuessHint};
+use crate::start::{StartContext, StribeckLevels};
 
 crate::declare_params! {
     /// Coulomb friction: a constant force mu N opposing the sliding direction.
@@ -42,5 +43,13 @@ impl FrictionModel for Coulomb {
     }
     fn apply_guess(&mut self, hint: &GuessHint) {
         self.mu = hint.mu;
+    }
+    /// The Coulomb level of the fitted model (its sliding force far from any Stribeck dip).
+    fn start_from(&mut self, fitted: &dyn FrictionModel, _ctx: &StartContext) -> bool {
+        let Some(levels) = StribeckLevels::from_model(fitted) else {
+            return false;
+        };
+        self.mu = levels.mu_c;
+        true
     }
 }

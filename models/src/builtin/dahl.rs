@@ -21,7 +21,8 @@
 //! Reference: P. R. Dahl, "A solid friction model", Technical Report TOR-0158(3107-18)-1,
 //! The Aerospace Corporation, 1968.
 
-use crate::model::{sgn, FrictionModel, GuessHint};
+use crate::builtin::coulomb::Coulomb;
+use crate::model::{sgn, FrictionModel, GuessHint, RigidLimit};
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
 crate::declare_params! {
@@ -129,5 +130,12 @@ impl FrictionModel for Dahl {
         self.mu_c = levels.mu_c;
         self.sigma0 = ctx.stiffness_for(levels.mu_c * ctx.normal_force);
         true
+    }
+    /// Rigid bristles: the force jumps between +-mu_c N at each reversal, Coulomb's law.
+    fn rigid_limit(&self) -> Option<RigidLimit> {
+        Some(RigidLimit {
+            law: Box::new(Coulomb::default()),
+            stiffness: 0,
+        })
     }
 }

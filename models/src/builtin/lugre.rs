@@ -17,9 +17,9 @@
 //! Reference: C. Canudas de Wit, H. Olsson, K. J. Åström, P. Lischinsky, "A new model for
 //! control of systems with friction", IEEE Trans. Automatic Control 40(3), 419-425, 1995.
 
-use crate::builtin::stribeck::mu_s_warning;
+use crate::builtin::stribeck::{mu_s_warning, Stribeck};
 use crate::error::ModelError;
-use crate::model::{check_bounds, decay, sgn, FrictionModel, GuessHint};
+use crate::model::{check_bounds, decay, sgn, FrictionModel, GuessHint, RigidLimit};
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
 crate::declare_params! {
@@ -159,6 +159,14 @@ impl FrictionModel for LuGre {
         self.sigma0 = ctx.stiffness_for(levels.mu_c * ctx.normal_force);
         self.sigma1 = ctx.critical_damping(self.sigma0);
         true
+    }
+    /// Rigid, critically damped bristles: the force follows the steady-state curve, a
+    /// Stribeck law with delta = 2 and sigma2 as its viscous term.
+    fn rigid_limit(&self) -> Option<RigidLimit> {
+        Some(RigidLimit {
+            law: Box::new(Stribeck::default()),
+            stiffness: 0,
+        })
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(self.name(), &self.param_info(), &self.params())?;
