@@ -292,3 +292,44 @@ fn only_the_stribeck_exponent_is_fixed_by_default() {
         }
     }
 }
+
+/// Dahl's rate against its equation written with libm's `powf`: dF/dt = sigma0 v |r|^alpha
+/// sgn(r), r = 1 - F sgn(v) / (mu_c N), over shapes and loads on both sides of r = 0 (the
+/// model takes |r|^alpha as exp(alpha ln |r|), and exactly |r| at alpha = 1).
+#[test]
+fn dahl_rate_matches_its_equation() {
+    for alpha in [0.3, 0.5, 1.0, 1.7, 4.0] {
+        let m = Dahl {
+            sigma0: 2e5,
+            mu_c: 0.21,
+            alpha,
+        };
+        let fc = m.mu_c * N;
+        for f in [
+            -1.9 * fc,
+            -fc,
+            -0.4 * fc,
+            0.0,
+            0.3 * fc,
+            0.999 * fc,
+            fc,
+            1.5 * fc,
+        ] {
+            for v in [-0.2f64, -1e-4, 3e-3, 0.4] {
+                let r = 1.0 - f * v.signum() / fc;
+                let expected =
+                    m.sigma0 * v * r.abs().powf(alpha) * r.signum() * (r != 0.0) as i32 as f64;
+                let mut dz = [0.0];
+                m.state_derivative(v, &[f], N, &mut dz);
+                assert!(
+                    close(dz[0], expected, 1e-13),
+                    "alpha {alpha}, F {f}, v {v}: {} vs {expected}",
+                    dz[0]
+                );
+                if alpha == 1.0 {
+                    assert_eq!(dz[0], m.sigma0 * v * r.abs() * sgn(r));
+                }
+            }
+        }
+    }
+}

@@ -559,9 +559,16 @@ struct Profile<'a, R: Residuals> {
 
 impl<R: Residuals + 'static> Profile<'_, R> {
     /// Profile points (internal value, cost) on one side (`side` = ±1), stepping outward
-    /// until the cost exceeds `limit`, a bound is reached or a step fails; a first step that
-    /// fails is retried at half the distance (at most [`PROFILE_HALVINGS`] times).
+    /// until the cost exceeds `limit` (for the rigid limit's stiffness: at two steps in a
+    /// row, since a re-optimisation near the limit can end in a poorer local minimum), a
+    /// bound is reached or a step fails; a first step that fails is retried at half the
+    /// distance (at most [`PROFILE_HALVINGS`] times).
     fn side(&self, j: usize, side: f64, limit: f64) -> Vec<ProfilePoint> {
+        let confirmations = if self.limit.is_some_and(|l| l.slot == j) {
+            2
+        } else {
+            1
+        };
         let f = &self.reference.layout[j];
         let (lo, hi) = f.internal_bounds();
         let centre = self.best.u[j];
@@ -593,7 +600,8 @@ impl<R: Residuals + 'static> Profile<'_, R> {
                         cost: run.cost,
                         at: merged(&others, &pins, self.best.u.len()),
                     });
-                    if run.cost > limit {
+                    let above = out.iter().rev().take_while(|p| p.cost > limit).count();
+                    if above >= confirmations {
                         break;
                     }
                 }
@@ -688,8 +696,8 @@ impl<R: Residuals + 'static> Profile<'_, R> {
         let centre = (self.best.u[j], best);
         let f = &self.reference.layout[j];
         // A side that cannot be evaluated at all (too stiff to simulate) counts as open.
-        let low = crossing(centre, &below, floor + delta).map(|u| f.to_physical(u));
-        let high = crossing(centre, &above, floor + delta).map(|u| f.to_physical(u));
+        let low = outer_crossing(centre, &below, floor + delta).map(|u| f.to_physical(u));
+        let high = outer_crossing(centre, &above, floor + delta).map(|u| f.to_physical(u));
         let (class, bound) = match (low, high) {
             (Some(_), Some(_)) => (Identifiability::Determined, None),
             (Some(b), None) => (Identifiability::LowerBound, Some(b)),
@@ -697,6 +705,16 @@ impl<R: Residuals + 'static> Profile<'_, R> {
             (None, None) => (Identifiability::NotIdentifiable, None),
         };
         (Standing { class, bound }, lowest)
+    }
+}
+
+/// Where the profile rises above `limit` for good: [`crossing`] from its last point within
+/// the limit (a point above it followed by one within is a re-optimisation that stopped in a
+/// poorer local minimum, not the edge of the interval).
+fn outer_crossing(centre: (f64, f64), points: &[(f64, f64)], limit: f64) -> Option<f64> {
+    match points.iter().rposition(|&(_, c)| c <= limit) {
+        Some(k) => crossing(points[k], &points[k + 1..], limit),
+        None => crossing(centre, points, limit),
     }
 }
 
@@ -758,27 +776,44 @@ fn settle_convergence<R: Residuals + 'static>(
     };
 }
 
-/// The covariance of the determined parameters alone (the others held where they are): the
-/// columns of the rest are dropped, and their rows and columns come back as NaN.
+/// The covariance of the determined parameters, marginal over every undetermined parameter
+/// whose column keeps JᵀJ invertible (a Stribeck velocity the records leave flat trades with
+/// the levels: holding it fixed would understate their errors) and conditional on the rest
+/// (a stiffness run to its rigid limit has a vanishing column). The undetermined parameters'
+/// rows and columns come back as NaN.
 pub fn covariance_of_determined(
     jac: &DMatrix<f64>,
     ssr: f64,
     standings: &[Standing],
 ) -> Covariance {
-    let keep: Vec<usize> = (0..jac.ncols())
-        .filter(|&j| standings.get(j).is_none_or(Standing::determined))
-        .collect();
+    let determined = |j: usize| standings.get(j).is_none_or(Standing::determined);
+    let mut keep: Vec<usize> = (0..jac.ncols()).filter(|&j| determined(j)).collect();
     if keep.len() == jac.ncols() {
         return covariance(jac, ssr);
+    }
+    for j in (0..jac.ncols()).filter(|&j| !determined(j)) {
+        let mut with = keep.clone();
+        with.push(j);
+        with.sort_unstable();
+        let cov = covariance(&jac.select_columns(&with), ssr);
+        if !cov.singular && cov.std_errors.iter().all(|s| s.is_finite()) {
+            keep = with;
+        }
     }
     let reduced = covariance(&jac.select_columns(&keep), ssr);
     let p = jac.ncols();
     let mut matrix = DMatrix::from_element(p, p, f64::NAN);
     let mut correlation = DMatrix::from_element(p, p, f64::NAN);
     let mut std_errors = vec![f64::NAN; p];
-    for (a, &ja) in keep.iter().enumerate() {
+    let shown: Vec<(usize, usize)> = keep
+        .iter()
+        .enumerate()
+        .filter(|(_, &j)| determined(j))
+        .map(|(a, &j)| (a, j))
+        .collect();
+    for &(a, ja) in &shown {
         std_errors[ja] = reduced.std_errors[a];
-        for (b, &jb) in keep.iter().enumerate() {
+        for &(b, jb) in &shown {
             matrix[(ja, jb)] = reduced.matrix[(a, b)];
             correlation[(ja, jb)] = reduced.correlation[(a, b)];
         }
@@ -842,6 +877,20 @@ mod tests {
     }
 
     #[test]
+    fn the_outer_crossing_skips_a_point_above_the_limit_that_a_later_one_undercuts() {
+        // -1 rose to 3 (a poor local minimum), -2 fits again at 1, -3 rises to 5: the
+        // interval ends between -2 and -3, at -2.25.
+        let points = [(-1.0, 3.0), (-2.0, 1.0), (-3.0, 5.0)];
+        let u = outer_crossing((0.0, 0.0), &points, 2.0).unwrap();
+        assert!((u + 2.25).abs() < 1e-12);
+        assert_eq!(outer_crossing((0.0, 0.0), &points[..2], 2.0), None);
+        assert_eq!(
+            outer_crossing((0.0, 0.0), &points[..1], 2.0),
+            crossing((0.0, 0.0), &points[..1], 2.0)
+        );
+    }
+
+    #[test]
     fn pins_are_removed_and_merged_back() {
         let u = DVector::from_vec(vec![1.0, 2.0, 3.0]);
         let pins = [(1, 9.0)];
@@ -851,15 +900,23 @@ mod tests {
     }
 
     #[test]
-    fn dropped_parameters_have_no_standard_error_and_the_rest_keep_theirs() {
-        let jac = DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 0.0, 1.0, 1.0, 1.0]);
+    fn undetermined_parameters_have_no_standard_error_and_widen_the_rest_where_they_can() {
         let flat = Standing {
-            class: Identifiability::LowerBound,
-            bound: Some(1.0),
+            class: Identifiability::NotIdentifiable,
+            bound: None,
         };
-        let cov = covariance_of_determined(&jac, 1.0, &[Standing::DETERMINED, flat]);
+        let standings = [Standing::DETERMINED, flat];
+        // A flat parameter with a column of its own: the determined one's error is marginal
+        // over it. JᵀJ = [[2, 1], [1, 2]], its inverse's first entry 2/3, s² = 1 / (3 - 2).
+        let traded = DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 0.0, 1.0, 1.0, 1.0]);
+        let cov = covariance_of_determined(&traded, 1.0, &standings);
+        assert!(cov.std_errors[1].is_nan() && cov.matrix[(0, 1)].is_nan());
+        assert!((cov.std_errors[0] - (2.0f64 / 3.0).sqrt()).abs() < 1e-12);
+        // A flat parameter whose column vanishes (run to a limit): held where it is. One
+        // column [1, 0, 1]: (JᵀJ)^-1 = 1/2, s² = 1 / (3 - 1).
+        let vanished = DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+        let cov = covariance_of_determined(&vanished, 1.0, &standings);
         assert!(cov.std_errors[1].is_nan());
-        // One column [1, 0, 1]: (JᵀJ)^-1 = 1/2, s² = 1 / (3 - 1).
         assert!((cov.std_errors[0] - 0.5).abs() < 1e-12);
     }
 }
