@@ -17,7 +17,7 @@ use super::residuals::{NuisanceValues, Residuals, Segment, VelocityResponse};
 use super::setup::{build_layout, Layout};
 use super::starts::{run_starts, start_count, MultiStart, StartRun};
 use super::stats::{self, aic, bic, t_quantile_975, Covariance};
-use super::strategy::{self, plan_starts, Search, Seeded, StartPlan};
+use super::strategy::{self, plan_starts, Planned, Search, Seeded, StartPlan};
 use crate::energy::{analyze_record, forces_from_states, states_along};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
@@ -120,7 +120,10 @@ fn fit_seeded<R: Residuals + 'static>(
             layout: &layout,
             opts,
         };
-        let mut seeded = plan_starts(&plan, search, n_starts);
+        let Planned {
+            mut seeded,
+            reachable,
+        } = plan_starts(&plan, search, n_starts);
         if let Some(prefit) = seed_model {
             // Last, where the prefit finding looks for it.
             seeded.push(Seeded {
@@ -129,7 +132,14 @@ fn fit_seeded<R: Residuals + 'static>(
             });
         }
         let points: Vec<Vec<f64>> = seeded.iter().map(|s| s.point.clone()).collect();
-        let runs = run_starts(make_problem, &reference, &points, opts, search.promoted())?;
+        let runs = run_starts(
+            make_problem,
+            &reference,
+            &points,
+            opts,
+            search.promoted(),
+            reachable,
+        )?;
         (runs, seeded.into_iter().map(|s: Seeded| s.origin).collect())
     };
     if let Some((jac, r)) = &runs.best.linearisation {

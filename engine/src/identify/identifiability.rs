@@ -199,7 +199,7 @@ fn profile_all<R: Residuals + 'static>(
         reference,
         best,
         opts,
-        limit,
+        limit: open_limit,
     };
     for j in slots {
         let open_above = open_limit.filter(|l| l.slot == j).map(|l| l.cost);
@@ -552,8 +552,10 @@ struct Profile<'a, R: Residuals> {
     reference: &'a FitProblem<R>,
     best: &'a StartRun,
     opts: &'a FitOptions,
-    /// The model's rigid limit: a profile of its stiffness also tries the others mapped from
-    /// the limit law at each stiffness (levels and a critically damped contact).
+    /// The model's rigid limit when the records do not reject it: the profile of its
+    /// stiffness (the lower side) also tries the others mapped from the limit law at each
+    /// stiffness (levels and a critically damped contact). A rejected limit leaves the
+    /// stiffness an ordinary parameter.
     limit: Option<&'a Limit>,
 }
 

@@ -30,27 +30,39 @@ pub type LmState = IterState<DVector<f64>, (), DMatrix<f64>, (), DVector<f64>, f
 pub const OUTPACE_FACTOR: f64 = 2.0;
 
 /// The lowest cost any of a group of concurrent runs has converged to, shared between them
-/// (+inf until one converges).
+/// (+inf until one converges), or a cost the fitted model is known to reach (a nested law's
+/// fit); a run is held to it only after `grace` iterations of its own.
 #[derive(Debug)]
-pub struct Pace(AtomicU64);
+pub struct Pace {
+    best: AtomicU64,
+    grace: u64,
+}
 
 impl Default for Pace {
     fn default() -> Self {
-        Self(AtomicU64::new(f64::INFINITY.to_bits()))
+        Self::with_grace(0)
     }
 }
 
 impl Pace {
-    /// A run converged at `cost` (finite, >= 0: their bit patterns order as the values do).
+    /// A pace that holds each run to it after `grace` iterations.
+    pub fn with_grace(grace: u64) -> Self {
+        Self {
+            best: AtomicU64::new(f64::INFINITY.to_bits()),
+            grace,
+        }
+    }
+
+    /// Records a converged (or reachable) cost.
     pub fn converged_at(&self, cost: f64) {
         if cost.is_finite() && cost >= 0.0 {
-            self.0.fetch_min(cost.to_bits(), Ordering::Relaxed);
+            self.best.fetch_min(cost.to_bits(), Ordering::Relaxed);
         }
     }
 
     /// The lowest converged cost so far.
     pub fn best(&self) -> f64 {
-        f64::from_bits(self.0.load(Ordering::Relaxed))
+        f64::from_bits(self.best.load(Ordering::Relaxed))
     }
 }
 
@@ -201,7 +213,7 @@ where
         let p = state
             .take_param()
             .ok_or_else(|| Error::msg("Levenberg-Marquardt lost its parameter vector"))?;
-        if let Some(best) = self.outpaced_by() {
+        if let Some(best) = self.outpaced_by(state.get_iter()) {
             self.converged = Some(TerminationReason::Outpaced {
                 best,
                 cost: self.cost,
@@ -301,10 +313,12 @@ impl LevenbergMarquardt {
         self.converged.as_ref()
     }
 
-    /// The converged cost of another run that this run is [`OUTPACE_FACTOR`] times above.
-    fn outpaced_by(&self) -> Option<f64> {
-        let best = self.pace.as_ref()?.best();
-        (self.cost > OUTPACE_FACTOR * best).then_some(best)
+    /// The converged cost of another run that this run, at iteration `iteration`, is
+    /// [`OUTPACE_FACTOR`] times above (after the pace's grace).
+    fn outpaced_by(&self, iteration: u64) -> Option<f64> {
+        let pace = self.pace.as_ref()?;
+        let best = pace.best();
+        (iteration >= pace.grace && self.cost > OUTPACE_FACTOR * best).then_some(best)
     }
 
     /// Whether the cost fell by less than `stall_tol` relative over the last `stall_window`
@@ -458,7 +472,12 @@ mod tests {
 
     /// Rosenbrock from (-1.2, 1) (cost 12.1) racing runs that converged at `best`.
     fn race_rosenbrock(best: f64) -> (u64, TerminationReason) {
-        let pace = Arc::new(Pace::default());
+        race_rosenbrock_after(best, 0)
+    }
+
+    /// The same, held to the pace only after `grace` iterations.
+    fn race_rosenbrock_after(best: f64, grace: u64) -> (u64, TerminationReason) {
+        let pace = Arc::new(Pace::with_grace(grace));
         pace.converged_at(best);
         let inf = f64::INFINITY;
         let mut solver = LevenbergMarquardt::new(
@@ -484,6 +503,17 @@ mod tests {
         // The starting cost, 0.5 ((10 (1 - 1.44))^2 + 2.2^2).
         assert!((cost - 12.1).abs() < 1e-12 && best == 1.0, "{cost} {best}");
         assert!(!reason.is_converged());
+    }
+
+    #[test]
+    fn a_pace_with_grace_lets_a_run_take_its_first_iterations() {
+        let (iterations, reason) = race_rosenbrock_after(1e-30, 3);
+        assert_eq!(iterations, 4, "{reason:?}");
+        let TerminationReason::Outpaced { cost, .. } = reason else {
+            panic!("not outpaced: {reason:?}");
+        };
+        // Three iterations took it below its starting cost.
+        assert!(cost < 12.1, "{cost}");
     }
 
     #[test]

@@ -41,7 +41,8 @@ pub enum TerminationReason {
         parameters: Vec<String>,
     },
     /// Abandoned: another start of the same fit had converged to a cost `factor` times lower
-    /// or more ([`super::lm::Pace`]); this one could not have become the best within reach.
+    /// or more, or (screening) the nested static law the model contains reached it
+    /// ([`super::lm::Pace`]); this one could not have become the best within reach.
     Outpaced {
         /// The cost the other start converged to.
         best: f64,
@@ -89,7 +90,7 @@ impl fmt::Display for TerminationReason {
             ),
             Self::Outpaced { best, cost } => write!(
                 f,
-                "abandoned at cost {cost:.6e}: another start converged to {best:.6e}"
+                "abandoned at cost {cost:.6e}: another start, or the nested law it contains, reached {best:.6e}"
             ),
             Self::Other { text } => f.write_str(text),
         }

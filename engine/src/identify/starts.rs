@@ -24,6 +24,11 @@ pub const MAX_STARTS: usize = 1000;
 /// Iterations every start of a multi-start fit runs before the most promising is continued.
 pub const SCREEN_ITERATIONS: u64 = 15;
 
+/// Iterations a screened start runs before it is held to a cost the model is known to reach
+/// (the fit of the nested law it contains): one still [`super::lm::OUTPACE_FACTOR`] times
+/// above it is abandoned.
+pub const SCREEN_GRACE: u64 = 5;
+
 /// Starts continued to convergence after the screening phase by a local search (the best
 /// one; see `Search::promoted`).
 pub const PROMOTED_STARTS: usize = 1;
@@ -296,7 +301,8 @@ fn classify(runs: Vec<Result<StartRun, EngineError>>) -> Screened {
     screened
 }
 
-/// Runs every start from `points` (phase 1: each for a few iterations when there are several;
+/// Runs every start from `points` (phase 1: each for a few iterations when there are several,
+/// abandoning those left far behind a `reachable` cost after [`SCREEN_GRACE`] iterations;
 /// phase 2: the `promote` most promising to the iteration limit) and picks the best.
 /// `make_problem` builds a fresh problem per run; `reference` explains a total failure.
 pub fn run_starts<R, F>(
@@ -305,6 +311,7 @@ pub fn run_starts<R, F>(
     points: &[Vec<f64>],
     opts: &FitOptions,
     promote: usize,
+    reachable: Option<f64>,
 ) -> Result<MultiStart, EngineError>
 where
     R: Residuals + 'static,
@@ -316,6 +323,11 @@ where
     } else {
         opts.max_iterations
     };
+    let screen_pace = reachable.filter(|_| n_starts > 1).map(|cost| {
+        let pace = Pace::with_grace(SCREEN_GRACE);
+        pace.converged_at(cost);
+        Arc::new(pace)
+    });
     let run = |(s, p): (usize, &Vec<f64>)| {
         let problem = make_problem();
         let u0 = problem.internal(p);
@@ -323,7 +335,7 @@ where
             start: s,
             starts: n_starts,
             max_iterations: screen,
-            pace: None,
+            pace: screen_pace.clone(),
         };
         run_start(problem, u0, opts, slot)
     };

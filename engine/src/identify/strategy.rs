@@ -107,15 +107,19 @@ pub struct StartPlan<'a, R: Residuals> {
 }
 
 /// Every starting point of `search`: staged ones first, then the local ones, then (global)
-/// the Latin hypercube; duplicates dropped.
+/// the Latin hypercube; duplicates dropped; with the cost of the target's nested limit law
+/// when a stage fitted it.
 pub fn plan_starts<R: Residuals + 'static>(
     plan: &StartPlan<'_, R>,
     search: Search,
     n_local: usize,
-) -> Vec<Seeded> {
+) -> Planned {
     let mut out = Vec::new();
+    let mut reachable = None;
     if search != Search::Local {
-        out.extend(staged_points(plan));
+        let fitted = stages(plan);
+        out.extend(staged_points(plan, &fitted));
+        reachable = nested_limit_cost(plan.model, &fitted);
     }
     let local = fit_starting_points(
         &plan.layout.params,
@@ -144,7 +148,29 @@ pub fn plan_starts<R: Residuals + 'static>(
             unique.push(s);
         }
     }
-    unique
+    Planned {
+        seeded: unique,
+        reachable,
+    }
+}
+
+/// The starts of a fit and what the stages found.
+pub struct Planned {
+    /// Every starting point, staged ones first.
+    pub seeded: Vec<Seeded>,
+    /// The cost of the stage that is the target's rigid limit (`FrictionModel::rigid_limit`):
+    /// the target reaches it as its stiffness grows, so a screened start left far above it
+    /// is abandoned.
+    pub reachable: Option<f64>,
+}
+
+/// The cost of the fitted stage that is `model`'s rigid-limit law, if any.
+fn nested_limit_cost(model: &dyn FrictionModel, fitted: &[SimplerFit]) -> Option<f64> {
+    let law = model.rigid_limit()?.law;
+    fitted
+        .iter()
+        .find(|f| f.model.name() == law.name())
+        .map(|f| f.cost)
 }
 
 /// Whether a model has Stribeck levels (a static and a Coulomb level and a Stribeck
@@ -156,7 +182,7 @@ fn has_stribeck_levels(model: &dyn FrictionModel) -> bool {
 
 /// The stages below the target: coulomb, then stribeck (each only when it is not the target
 /// itself), each fitted from its data-driven guess; most refined last.
-fn stages<R: Residuals + 'static>(plan: &StartPlan<'_, R>) -> Vec<Box<dyn FrictionModel>> {
+fn stages<R: Residuals + 'static>(plan: &StartPlan<'_, R>) -> Vec<SimplerFit> {
     let target = plan.layout.start_model.name();
     let mut out = Vec::new();
     if target != "coulomb" {
@@ -191,18 +217,18 @@ pub fn stage_options(opts: &FitOptions) -> FitOptions {
     }
 }
 
-/// Fits `stage` (one start, one run) and returns the fitted model; `None` when it fails
-/// (the target then starts from its other starts).
+/// Fits `stage` (one start, one run); `None` when it fails (the target then starts from its
+/// other starts).
 fn stage_fit<R: Residuals + 'static>(
     plan: &StartPlan<'_, R>,
     stage: &(dyn FrictionModel + 'static),
-) -> Option<Box<dyn FrictionModel>> {
+) -> Option<SimplerFit> {
     let on = FitTarget {
         residuals: plan.residuals,
         osc: plan.osc,
         records: &plan.records.into(),
     };
-    fit_simpler(&on, stage, &stage_options(plan.opts), &[]).map(|f| f.model)
+    fit_simpler(&on, stage, &stage_options(plan.opts), &[])
 }
 
 /// The records a simpler law is fitted to, with the fit's residuals and oscillator.
@@ -255,7 +281,7 @@ pub fn fit_simpler<R: Residuals + 'static>(
         points.extend(mapped_point(&layout, *fitted, ctx, opts).filter(|p| !points.contains(p)));
     }
     let reference = make();
-    let runs = run_starts(make, &reference, &points, opts, points.len()).ok()?;
+    let runs = run_starts(make, &reference, &points, opts, points.len(), None).ok()?;
     let p = reference.physical(&runs.best.u);
     let model = reference.realise(&p).ok()?.model;
     Some(SimplerFit {
@@ -267,8 +293,10 @@ pub fn fit_simpler<R: Residuals + 'static>(
 
 /// The staged starting points: each stage mapped onto the target (the last, most refined
 /// stage at every presliding scale of [`STAGED_PRESLIDING`]).
-fn staged_points<R: Residuals + 'static>(plan: &StartPlan<'_, R>) -> Vec<Seeded> {
-    let fitted = stages(plan);
+fn staged_points<R: Residuals + 'static>(
+    plan: &StartPlan<'_, R>,
+    fitted: &[SimplerFit],
+) -> Vec<Seeded> {
     let base = StartContext::new(plan.osc.normal_force, plan.osc.mass);
     let mut out = Vec::new();
     for (k, stage) in fitted.iter().enumerate().rev() {
@@ -282,10 +310,10 @@ fn staged_points<R: Residuals + 'static>(plan: &StartPlan<'_, R>) -> Vec<Seeded>
                 presliding_displacement: s * TYPICAL_PRESLIDING_DISPLACEMENT,
                 ..base
             };
-            if let Some(point) = mapped_point(plan.layout, stage.as_ref(), &ctx, plan.opts) {
+            if let Some(point) = mapped_point(plan.layout, stage.model.as_ref(), &ctx, plan.opts) {
                 out.push(Seeded {
                     point,
-                    origin: format!("staged from {}", stage.name()),
+                    origin: format!("staged from {}", stage.model.name()),
                 });
             }
         }
