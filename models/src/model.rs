@@ -119,8 +119,13 @@ pub struct RigidLimit {
     /// The limit law at its default values (the identifier fits it; its `start_from` maps a
     /// fitted instance of the model onto it).
     pub law: Box<dyn FrictionModel>,
-    /// Index of the stiffness parameter that runs to infinity.
+    /// Index of the stiffness parameter that runs to infinity (for several elements, the
+    /// first: the limit needs them all stiff).
     pub stiffness: usize,
+    /// Parameters of the limit law, fixed by default, that the model's limit leaves free
+    /// (GMS fits its Stribeck shape exponent: the limit's Stribeck law must fit it too, or
+    /// the limit's cost would be too high and the stiffness called determined too readily).
+    pub also_free: Vec<&'static str>,
 }
 
 /// A friction law: a pure function of sliding velocity, internal states and normal force.

@@ -129,7 +129,8 @@ fn levels_keep_what_was_fitted() {
 
 /// The rigid-contact limit of each model that declares one: the limit law, started from a
 /// fitted instance of the model, has the model's steady-state curve (the curve the model
-/// slides at once its bristles are rigid), and the declared stiffness is the model's sigma0.
+/// slides at once its bristles are rigid), the declared stiffness is a stiffness, and the
+/// parameters it frees are the law's.
 #[test]
 fn rigid_limits_slide_at_the_models_steady_state_curve() {
     let lugre = LuGre {
@@ -145,8 +146,11 @@ fn rigid_limits_slide_at_the_models_steady_state_curve() {
         mu_c: 0.23,
         alpha: 1.4,
     };
+    let mut gms = Gms::with_elements(2);
+    gms.delta = 1.3;
+    gms.viscous = 0.7;
     let ctx = StartContext::new(N, MASS);
-    for model in [&lugre as &dyn FrictionModel, &dahl] {
+    for model in [&lugre as &dyn FrictionModel, &dahl, &gms] {
         let limit = model
             .rigid_limit()
             .expect("a bristle model has a rigid limit");
@@ -159,7 +163,9 @@ fn rigid_limits_slide_at_the_models_steady_state_curve() {
         );
         assert!(law.start_from(model, &ctx));
         same_steady_state(law.as_ref(), model);
-        assert_eq!(model.param_info()[limit.stiffness].name, "sigma0");
+        assert_eq!(model.param_info()[limit.stiffness].unit, "N/m");
+        let names: Vec<String> = law.param_info().into_iter().map(|p| p.name).collect();
+        assert!(limit.also_free.iter().all(|n| names.iter().any(|m| m == n)));
     }
     for model in [
         &fitted_stribeck() as &dyn FrictionModel,

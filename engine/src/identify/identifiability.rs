@@ -349,6 +349,7 @@ fn rigid_limit<R: Residuals + 'static>(
     };
     let limit_opts = FitOptions {
         oscillator: opts.oscillator.clone(),
+        free: limit_free(declared.law.as_ref(), &declared.also_free),
         ..stage_options(opts)
     };
     let fit = fit_simpler(
@@ -363,6 +364,21 @@ fn rigid_limit<R: Residuals + 'static>(
         removed: reference.layout.len().saturating_sub(fit.free).max(1),
         law: fit.model,
     })
+}
+
+/// The free parameters of a limit law: its defaults and `also_free`; `None` (the defaults)
+/// when there is nothing to add.
+fn limit_free(law: &dyn FrictionModel, also_free: &[&str]) -> Option<Vec<String>> {
+    if also_free.is_empty() {
+        return None;
+    }
+    let free = law
+        .param_info()
+        .into_iter()
+        .filter(|p| !p.fixed_by_default || also_free.contains(&p.name.as_str()))
+        .map(|p| p.name)
+        .collect();
+    Some(free)
 }
 
 /// Runs the solver from `u` and makes it the best run when it ends lower; whether it did.

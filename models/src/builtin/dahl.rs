@@ -152,6 +152,7 @@ impl FrictionModel for Dahl {
         Some(RigidLimit {
             law: Box::new(Coulomb::default()),
             stiffness: 0,
+            also_free: Vec::new(),
         })
     }
 }

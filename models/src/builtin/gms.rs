@@ -85,11 +85,11 @@
 //! novel model for friction simulation and compensation", IEEE Trans. Automatic Control
 //! 50(11), 1883-1887, 2005.
 
-use crate::builtin::stribeck::mu_s_warning;
+use crate::builtin::stribeck::{mu_s_warning, Stribeck};
 use crate::error::ModelError;
 use crate::model::{
     check_bounds, check_len, decay, finite_difference_force_gradient,
-    finite_difference_velocity_derivative, sgn, FrictionModel, GuessHint, ParamInfo,
+    finite_difference_velocity_derivative, sgn, FrictionModel, GuessHint, ParamInfo, RigidLimit,
 };
 use crate::params::ParamSpec;
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
@@ -752,6 +752,16 @@ impl FrictionModel for Gms {
         }
         self.scale_stiffness(ctx.stiffness_for(levels.mu_c * ctx.normal_force));
         true
+    }
+    /// Rigid elements: each saturates at once at its share of the Stribeck curve, and the
+    /// model slides at s(v) + viscous v, a Stribeck law with GMS's shape exponent (free, as
+    /// in GMS) and no dynamics (the elements' damping acts only while they deflect).
+    fn rigid_limit(&self) -> Option<RigidLimit> {
+        Some(RigidLimit {
+            law: Box::new(Stribeck::default()),
+            stiffness: 0,
+            also_free: vec!["delta"],
+        })
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         if self.elements.is_empty() {

@@ -166,6 +166,7 @@ impl FrictionModel for LuGre {
         Some(RigidLimit {
             law: Box::new(Stribeck::default()),
             stiffness: 0,
+            also_free: Vec::new(),
         })
     }
     fn validate(&self) -> Result<Vec<String>, ModelError> {
