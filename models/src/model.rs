@@ -119,9 +119,13 @@ pub struct RigidLimit {
     /// The limit law at its default values (the identifier fits it; its `start_from` maps a
     /// fitted instance of the model onto it).
     pub law: Box<dyn FrictionModel>,
-    /// Index of the stiffness parameter that runs to infinity (for several elements, the
-    /// first: the limit needs them all stiff).
-    pub stiffness: usize,
+    /// Indices of the stiffness parameters that run to infinity (one per element).
+    pub stiffnesses: Vec<usize>,
+    /// Indices of the parameters that act only through presliding and vanish from the limit
+    /// (Dahl's shape exponent; GMS's element weights, dampings and sharpness): when the
+    /// records do not reject the limit, their cost profiles are flat and they are not
+    /// identifiable.
+    pub presliding: Vec<usize>,
     /// Parameters of the limit law, fixed by default, that the model's limit leaves free
     /// (GMS fits its Stribeck shape exponent: the limit's Stribeck law must fit it too, or
     /// the limit's cost would be too high and the stiffness called determined too readily).

@@ -163,7 +163,15 @@ fn rigid_limits_slide_at_the_models_steady_state_curve() {
         );
         assert!(law.start_from(model, &ctx));
         same_steady_state(law.as_ref(), model);
-        assert_eq!(model.param_info()[limit.stiffness].unit, "N/m");
+        let info = model.param_info();
+        assert!(!limit.stiffnesses.is_empty());
+        assert!(limit.stiffnesses.iter().all(|&i| info[i].unit == "N/m"));
+        // The presliding-only parameters are not among the limit law's own.
+        let law_names: Vec<String> = law.param_info().into_iter().map(|p| p.name).collect();
+        for &i in &limit.presliding {
+            assert!(!law_names.contains(&info[i].name), "{}", info[i].name);
+            assert!(!limit.stiffnesses.contains(&i));
+        }
         let names: Vec<String> = law.param_info().into_iter().map(|p| p.name).collect();
         assert!(limit.also_free.iter().all(|n| names.iter().any(|m| m == n)));
     }

@@ -191,9 +191,7 @@ fn profile_all<R: Residuals + 'static>(
                 return Ok(Profiled::Lower(u));
             }
         }
-        if !slots.contains(&l.slot) {
-            slots.push(l.slot);
-        }
+        l.plan_profiles(best.cost + delta, &mut slots, &mut standings);
     }
     let profile = Profile {
         reference,
@@ -202,7 +200,7 @@ fn profile_all<R: Residuals + 'static>(
         limit: open_limit,
     };
     for j in slots {
-        let open_above = open_limit.filter(|l| l.slot == j).map(|l| l.cost);
+        let open_above = open_limit.filter(|l| l.is_stiffness(j)).map(|l| l.cost);
         let (standing, lower) = profile.standing(j, delta, open_above);
         if let Some(u) = lower.filter(|_| restart) {
             return Ok(Profiled::Lower(u));
@@ -218,8 +216,10 @@ fn profile_all<R: Residuals + 'static>(
 /// chi²(d, 95 %) / 2 residual variances above the best, d the parameters the limit removes.
 /// Otherwise the stiffness's upper side is open (it is at most a lower bound).
 struct Limit {
-    /// The stiffness's slot in the layout.
-    slot: usize,
+    /// The slots of the stiffnesses in the layout (the first drives the approach).
+    slots: Vec<usize>,
+    /// The slots of the parameters that act only through presliding.
+    presliding: Vec<usize>,
     /// The limit law's best cost.
     cost: f64,
     /// The free parameters the limit removes (at least 1).
@@ -234,6 +234,39 @@ struct Limit {
 pub const LIMIT_APPROACH_DECADES: i32 = 10;
 
 impl Limit {
+    /// The profiles of a limit the records do not reject: every stiffness (its lower side);
+    /// and, when the limit's cost is within `within` (the best cost plus one parameter's 95 %
+    /// rise), none of the presliding-only parameters, which are not identifiable: every value
+    /// of one reaches the limit's cost as the stiffnesses grow.
+    fn plan_profiles(&self, within: f64, slots: &mut Vec<usize>, standings: &mut [Standing]) {
+        for &j in &self.slots {
+            if !slots.contains(&j) {
+                slots.push(j);
+            }
+        }
+        if self.cost <= within {
+            for &j in &self.presliding {
+                standings[j] = Standing {
+                    class: Identifiability::NotIdentifiable,
+                    bound: None,
+                };
+            }
+            slots.retain(|j| !self.presliding.contains(j));
+        }
+    }
+
+    /// Whether slot `j` is one of the limit's stiffnesses.
+    fn is_stiffness(&self, j: usize) -> bool {
+        self.slots.contains(&j)
+    }
+
+    /// Whether slot `j` is the limit's first stiffness, whose profile steps are re-optimised
+    /// from two starts with more iterations (the others, e.g. GMS's further elements, are
+    /// profiled as ordinary parameters with their upper side open).
+    fn is_first_stiffness(&self, j: usize) -> bool {
+        self.slots.first() == Some(&j)
+    }
+
     /// The cost rise that rejects the limit, in units of the one-parameter rise
     /// [`PROFILE_DELTA`]: chi²(d) / chi²(1).
     fn rise_factor(&self) -> f64 {
@@ -266,23 +299,24 @@ impl Limit {
         Some(reference.internal(&p))
     }
 
-    /// The target mapped from the limit law with its stiffness at the internal value `u`
-    /// (internal coordinates); `None` when the law has no Coulomb level or the mapping fails.
+    /// The target mapped from the limit law with the stiffness in `slot` at the internal
+    /// value `u` (the others at the same physical stiffness; internal coordinates); `None`
+    /// when the law has no Coulomb level or the mapping fails.
     fn target_at_stiffness<R: Residuals>(
         &self,
         reference: &FitProblem<R>,
         best: &StartRun,
-        u: f64,
+        (slot, u): (usize, f64),
     ) -> Option<DVector<f64>> {
         let osc = &reference.oscillator;
         let level = StribeckLevels::from_model(self.law.as_ref())?.mu_c * osc.normal_force;
-        let stiffness = reference.layout[self.slot].to_physical(u);
+        let stiffness = reference.layout[slot].to_physical(u);
         let ctx = StartContext {
             presliding_displacement: level / stiffness,
             ..StartContext::new(osc.normal_force, osc.mass)
         };
         let mut at = self.start_of_target(reference, best, &ctx)?;
-        at[self.slot] = u;
+        at[slot] = u;
         Some(at)
     }
 
@@ -327,18 +361,23 @@ impl Limit {
 }
 
 /// The model's rigid limit fitted to the records (from its own guess and from the fit's best
-/// mapped onto it), when the model declares one and its stiffness is free; `None` otherwise
-/// or when the limit cannot be fitted.
+/// mapped onto it), when the model declares one and a stiffness of it is free; `None`
+/// otherwise or when the limit cannot be fitted.
 fn rigid_limit<R: Residuals + 'static>(
     reference: &FitProblem<R>,
     best: &StartRun,
     opts: &FitOptions,
 ) -> Option<Limit> {
     let declared = reference.model.rigid_limit()?;
-    let slot = reference
-        .layout
-        .iter()
-        .position(|f| f.kind == ParamKind::Model(declared.stiffness))?;
+    let slots_of = |indices: &[usize]| -> Vec<usize> {
+        (0..reference.layout.len())
+            .filter(|&j| matches!(reference.layout[j].kind, ParamKind::Model(i) if indices.contains(&i)))
+            .collect()
+    };
+    let slots = slots_of(&declared.stiffnesses);
+    if slots.is_empty() {
+        return None;
+    }
     let fitted = reference.realise(&reference.physical(&best.u)).ok()?.model;
     let osc = &reference.oscillator;
     let ctx = StartContext::new(osc.normal_force, osc.mass);
@@ -359,7 +398,8 @@ fn rigid_limit<R: Residuals + 'static>(
         &[(fitted.as_ref(), ctx)],
     )?;
     Some(Limit {
-        slot,
+        slots,
+        presliding: slots_of(&declared.presliding),
         cost: fit.cost,
         removed: reference.layout.len().saturating_sub(fit.free).max(1),
         law: fit.model,
@@ -582,7 +622,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
     /// bound is reached or a step fails; a first step that fails is retried at half the
     /// distance (at most [`PROFILE_HALVINGS`] times).
     fn side(&self, j: usize, side: f64, limit: f64) -> Vec<ProfilePoint> {
-        let confirmations = if self.limit.is_some_and(|l| l.slot == j) {
+        let confirmations = if self.limit.is_some_and(|l| l.is_first_stiffness(j)) {
             2
         } else {
             1
@@ -636,7 +676,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
         let &[(j, u)] = pins else {
             return None;
         };
-        let Some(limit) = self.limit.filter(|l| l.slot == j) else {
+        let Some(limit) = self.limit.filter(|l| l.is_first_stiffness(j)) else {
             return pinned_fit(
                 self.reference,
                 pins,
@@ -654,7 +694,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
                 LIMIT_PROFILE_ITERATIONS,
             )
         };
-        let Some(mapped) = limit.target_at_stiffness(self.reference, self.best, u) else {
+        let Some(mapped) = limit.target_at_stiffness(self.reference, self.best, (j, u)) else {
             return run(previous);
         };
         let mapped = without(&mapped, pins);

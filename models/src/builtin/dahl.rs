@@ -151,7 +151,8 @@ impl FrictionModel for Dahl {
     fn rigid_limit(&self) -> Option<RigidLimit> {
         Some(RigidLimit {
             law: Box::new(Coulomb::default()),
-            stiffness: 0,
+            stiffnesses: vec![0],
+            presliding: vec![2],
             also_free: Vec::new(),
         })
     }

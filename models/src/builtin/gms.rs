@@ -755,11 +755,15 @@ impl FrictionModel for Gms {
     }
     /// Rigid elements: each saturates at once at its share of the Stribeck curve, and the
     /// model slides at s(v) + viscous v, a Stribeck law with GMS's shape exponent (free, as
-    /// in GMS) and no dynamics (the elements' damping acts only while they deflect).
+    /// in GMS) and no dynamics: the elements' weights (only their sum scales the curve), their
+    /// damping (it acts only while they deflect) and the sharpness of their saturation vanish.
     fn rigid_limit(&self) -> Option<RigidLimit> {
+        let n = self.elements.len();
+        let sharpness = 3 * n + 4;
         Some(RigidLimit {
             law: Box::new(Stribeck::default()),
-            stiffness: 0,
+            stiffnesses: (0..n).collect(),
+            presliding: (n..3 * n).chain([sharpness]).collect(),
             also_free: vec!["delta"],
         })
     }

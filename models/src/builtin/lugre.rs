@@ -165,7 +165,8 @@ impl FrictionModel for LuGre {
     fn rigid_limit(&self) -> Option<RigidLimit> {
         Some(RigidLimit {
             law: Box::new(Stribeck::default()),
-            stiffness: 0,
+            stiffnesses: vec![0],
+            presliding: Vec::new(),
             also_free: Vec::new(),
         })
     }
