@@ -24,6 +24,19 @@ fn run_json(args: &[&str], out: &Path) -> (std::process::Output, serde_json::Val
     (o, read_report(out))
 }
 
+/// `compare` of `models` on the FMM fixture into a scratch directory named `tag`: it must
+/// succeed; the directory and the JSON report.
+fn compare_fixture(tag: &str, models: &str) -> (std::path::PathBuf, serde_json::Value) {
+    let out = scratch_dir("fc", tag);
+    let cfg = fixtures_dir().join("fmm-compare.toml");
+    let (o, r) = run_json(
+        &["compare", cfg.to_str().unwrap(), "--models", models],
+        &out,
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    (out, r)
+}
+
 const TRUTH_MU: f64 = 0.24;
 const MU_N: f64 = TRUTH_MU * 14.5;
 
@@ -135,18 +148,7 @@ fn a_normal_force_uncertainty_in_the_config_reaches_every_fitted_parameter() {
 
 #[test]
 fn compare_ranks_the_classical_models() {
-    let out = scratch_dir("fc", "compare");
-    let cfg = fixtures_dir().join("fmm-compare.toml");
-    let (o, r) = run_json(
-        &[
-            "compare",
-            cfg.to_str().unwrap(),
-            "--models",
-            "coulomb,viscous_coulomb,none",
-        ],
-        &out,
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (out, r) = compare_fixture("compare", "coulomb,viscous_coulomb,none");
     assert_eq!(r["command"], "compare");
     let ranking = r["ranking"].as_array().unwrap();
     let names: Vec<&str> = ranking
@@ -189,18 +191,7 @@ fn compare_ranks_the_classical_models() {
 /// a zero standard error.
 #[test]
 fn lugre_and_dahl_bound_presliding_from_below_on_the_coulomb_fixture() {
-    let out = scratch_dir("fc", "presliding");
-    let cfg = fixtures_dir().join("fmm-compare.toml");
-    let (o, r) = run_json(
-        &[
-            "compare",
-            cfg.to_str().unwrap(),
-            "--models",
-            "coulomb,dahl,lugre",
-        ],
-        &out,
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (_, r) = compare_fixture("presliding", "coulomb,dahl,lugre");
     let ranking = r["ranking"].as_array().unwrap();
     let model = |name: &str| ranking.iter().find(|f| f["model"] == name).unwrap();
     let param = |f: &serde_json::Value, name: &str| {
