@@ -333,3 +333,26 @@ fn dahl_rate_matches_its_equation() {
         }
     }
 }
+
+/// Stribeck's curve against its equation written with libm's `powf`, for the shapes it
+/// computes without it (delta = 1, 2) and others.
+#[test]
+fn stribeck_curve_matches_its_equation_for_any_shape() {
+    for delta in [0.5, 1.0, 1.5, 2.0, 3.0] {
+        let m = Stribeck {
+            mu_c: 0.2,
+            mu_s: 0.28,
+            v_s: 0.02,
+            delta,
+            viscous: 0.0,
+        };
+        for v in [1e-6, 0.003, 0.02, 0.05, 0.3] {
+            let expected = 0.2 + 0.08 * (-(v / 0.02f64).powf(delta)).exp();
+            let got = m.coefficient(v);
+            assert!(
+                close(got, expected, 1e-15),
+                "delta {delta}, v {v}: {got} vs {expected}"
+            );
+        }
+    }
+}
