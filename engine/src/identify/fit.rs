@@ -91,7 +91,7 @@ fn fit_seeded<R: Residuals + 'static>(
     let clock = Instant::now();
     check_inputs(osc, model, records, residuals.as_ref())?;
     let layout = build_layout(osc, model, records, residuals.as_ref(), opts)?;
-    let seed_model = seed.and_then(|s| s.as_ref().ok()).map(|p| &p.model);
+    let seed_model = seed.and_then(|s| s.as_ref().ok()).map(|p| p.model.as_ref());
     let n_starts = start_count(opts, layout.n_model_free())?;
     let shared: Arc<[Record]> = records.into();
     let make_problem = || {
@@ -120,17 +120,7 @@ fn fit_seeded<R: Residuals + 'static>(
             layout: &layout,
             opts,
         };
-        let Planned {
-            mut seeded,
-            reachable,
-        } = plan_starts(&plan, search, n_starts);
-        if let Some(prefit) = seed_model {
-            // Last, where the prefit finding looks for it.
-            seeded.push(Seeded {
-                point: seeded_point(&layout, prefit.as_ref()),
-                origin: PREFIT_ORIGIN.into(),
-            });
-        }
+        let Planned { seeded, reachable } = starts_with_prefit(&plan, search, n_starts, seed_model);
         let points: Vec<Vec<f64>> = seeded.iter().map(|s| s.point.clone()).collect();
         let runs = run_starts(
             make_problem,
@@ -168,6 +158,24 @@ fn fit_seeded<R: Residuals + 'static>(
         result.wall_time_s = clock.elapsed().as_secs_f64();
     }
     Ok(result)
+}
+
+/// The starts of `search` (see [`plan_starts`]) and, last (where the prefit finding looks
+/// for it), the prefit's optimum when there is one.
+fn starts_with_prefit<R: Residuals + 'static>(
+    plan: &StartPlan<'_, R>,
+    search: Search,
+    n_starts: usize,
+    prefit: Option<&dyn FrictionModel>,
+) -> Planned {
+    let mut planned = plan_starts(plan, search, n_starts);
+    if let Some(prefit) = prefit {
+        planned.seeded.push(Seeded {
+            point: seeded_point(plan.layout, prefit),
+            origin: PREFIT_ORIGIN.into(),
+        });
+    }
+    planned
 }
 
 /// The layout's starting point with the free model parameters at `seeded`'s values (clipped
