@@ -21,10 +21,10 @@ use super::problem::{FitProblem, ProblemParts};
 use super::residuals::Residuals;
 use super::starts::{run_start, MultiStart, RunSlot, StartRun};
 use super::stats::{chi_square_95, covariance, Covariance};
-use super::strategy::{fit_simpler, stage_options, FitTarget};
+use super::strategy::{fit_simpler, stage_options, FitTarget, Onto};
 use crate::error::EngineError;
 use frictionid_models::start::TYPICAL_PRESLIDING_DISPLACEMENT;
-use frictionid_models::{clone_model, FrictionModel, StartContext, StribeckLevels};
+use frictionid_models::{FrictionModel, StartContext, StribeckLevels};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
@@ -281,21 +281,14 @@ impl Limit {
         best: &StartRun,
         ctx: &StartContext,
     ) -> Option<DVector<f64>> {
-        let mut started = clone_model(reference.model.as_ref());
-        if !started.start_from(self.law.as_ref(), ctx) {
-            return None;
-        }
-        let values = started.params();
         let at_best = reference.physical(&best.u);
-        let p: Vec<f64> = reference
-            .layout
-            .iter()
-            .zip(at_best)
-            .map(|(f, x)| match f.kind {
-                ParamKind::Model(i) => f.clip(values[i]),
-                _ => x,
-            })
-            .collect();
+        let onto = Onto {
+            model: reference.model.as_ref(),
+            params: &reference.layout,
+            base: &at_best,
+            keep: &[],
+        };
+        let p = onto.started_from(self.law.as_ref(), ctx)?;
         Some(reference.internal(&p))
     }
 

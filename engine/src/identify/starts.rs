@@ -172,8 +172,8 @@ fn solver_for<R: Residuals>(problem: &FitProblem<R>, opts: &FitOptions) -> Leven
     let upper = DVector::from_iterator(bounds.len(), bounds.iter().map(|b| b.1));
     let mut solver = LevenbergMarquardt::new(lower, upper);
     // One step changes a log-scaled parameter by at most a factor e^2 and a linear one by at
-    // most twice its scale or its magnitude, whichever is larger, so a poor linearisation cannot throw a trial point into a region
-    // where the simulation is stiff or degenerate.
+    // most twice its scale or its magnitude, whichever is larger, so a poor linearisation
+    // cannot throw a trial point into a region where the simulation is stiff or degenerate.
     solver.max_step = 2.0;
     solver.relative_step = problem.layout.iter().map(|f| !f.log).collect();
     if let Some(t) = opts.tolerance {

@@ -330,25 +330,53 @@ fn mapped_point(
     ctx: &StartContext,
     opts: &FitOptions,
 ) -> Option<Vec<f64>> {
-    let mut started = clone_model(layout.start_model.as_ref());
-    if !started.start_from(fitted, ctx) {
-        return None;
+    let onto = Onto {
+        model: layout.start_model.as_ref(),
+        params: &layout.params,
+        base: &layout.start,
+        keep: &opts.keep_initial,
+    };
+    onto.started_from(fitted, ctx)
+}
+
+/// A model and the free parameters of a fit, onto which a fitted model is mapped.
+pub struct Onto<'a> {
+    /// The model whose `start_from` maps.
+    pub model: &'a (dyn FrictionModel + 'static),
+    /// The free parameters (the layout).
+    pub params: &'a [FreeParam],
+    /// Physical values of every free parameter where the mapping gives none.
+    pub base: &'a [f64],
+    /// Free model parameters that keep their `base` value.
+    pub keep: &'a [String],
+}
+
+impl Onto<'_> {
+    /// The physical point of the model started from `fitted` at `ctx`: free model parameters
+    /// take the mapped values (clipped to their bounds; a non-finite one, or one in `keep`,
+    /// its base value), the others their base values. `None` when the model cannot start
+    /// from `fitted`.
+    pub fn started_from(&self, fitted: &dyn FrictionModel, ctx: &StartContext) -> Option<Vec<f64>> {
+        let mut started = clone_model(self.model);
+        if !started.start_from(fitted, ctx) {
+            return None;
+        }
+        let values = started.params();
+        let point = self
+            .params
+            .iter()
+            .zip(self.base)
+            .map(|(f, &x)| match f.kind {
+                ParamKind::Model(i) if !self.keep.contains(&f.name) => values
+                    .get(i)
+                    .copied()
+                    .filter(|v| v.is_finite())
+                    .map_or(x, |v| f.clip(v)),
+                _ => x,
+            })
+            .collect();
+        Some(point)
     }
-    let values = started.params();
-    let point = layout
-        .params
-        .iter()
-        .zip(&layout.start)
-        .map(|(f, &x)| match f.kind {
-            ParamKind::Model(i) if !opts.keep_initial.contains(&f.name) => values
-                .get(i)
-                .copied()
-                .filter(|v| v.is_finite())
-                .map_or(x, |v| f.clip(v)),
-            _ => x,
-        })
-        .collect();
-    Some(point)
 }
 
 /// A small seeded generator (SplitMix64) for the Latin hypercube.

@@ -758,12 +758,20 @@ impl FrictionModel for Gms {
     /// in GMS) and no dynamics: the elements' weights (only their sum scales the curve), their
     /// damping (it acts only while they deflect) and the sharpness of their saturation vanish.
     fn rigid_limit(&self) -> Option<RigidLimit> {
+        // The vector order of `params`: ELEMENT_PARAMS kind by kind (stiffnesses, weights,
+        // dampings), one entry per element, then SHARED_PARAMS.
         let n = self.elements.len();
-        let sharpness = 3 * n + 4;
+        let kind = |k: usize| k * n..(k + 1) * n;
+        let shared = |name: &str| {
+            SHARED_PARAMS
+                .iter()
+                .position(|p| p.name == name)
+                .map(|i| ELEMENT_PARAMS.len() * n + i)
+        };
         Some(RigidLimit {
             law: Box::new(Stribeck::default()),
-            stiffnesses: (0..n).collect(),
-            presliding: (n..3 * n).chain([sharpness]).collect(),
+            stiffnesses: kind(0).collect(),
+            presliding: kind(1).chain(kind(2)).chain(shared("sharpness")).collect(),
             also_free: vec!["delta"],
         })
     }
