@@ -6,9 +6,9 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use common::{lugre_truth, records, stiff_lugre_truth, NOISE};
+use common::{lugre_truth, records, stiff_lugre_truth, stribeck_truth, NOISE};
 use criterion::{criterion_group, criterion_main, Criterion};
-use frictionid_engine::identify::{compare, fit, FitOptions, Search};
+use frictionid_engine::identify::{compare, fit, FitDomain, FitOptions, Search};
 use frictionid_engine::Oscillator;
 use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre};
 use std::hint::black_box;
@@ -67,5 +67,31 @@ fn lugre(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, coulomb_and_compare, lugre);
+/// Issue 14's force route (`domain = "force"`, the energy-based force of Eq. 7) against the
+/// velocity fit of the same law on the same noisy records.
+fn force_route(c: &mut Criterion) {
+    let osc = Oscillator::fmm();
+    let force = FitOptions {
+        domain: FitDomain::Force,
+        ..FitOptions::default()
+    };
+    let velocity = FitOptions::default();
+    let coulomb = Coulomb { mu: 0.24 };
+    let stribeck = stribeck_truth();
+    let laws: [(&str, &dyn FrictionModel); 2] = [("coulomb", &coulomb), ("stribeck", &stribeck)];
+    let mut group = c.benchmark_group("force route");
+    group.sample_size(20);
+    for (name, truth) in laws {
+        let recs = records(&osc, truth, NOISE, 100);
+        let start = default_model(name).expect("a registered law");
+        for (domain, opts) in [("force", &force), ("velocity", &velocity)] {
+            group.bench_function(format!("{name}, {domain} domain, 3 FMM records"), |b| {
+                b.iter(|| fit(&osc, black_box(start.as_ref()), &recs, opts).expect("fit"))
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, coulomb_and_compare, lugre, force_route);
 criterion_main!(benches);

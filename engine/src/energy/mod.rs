@@ -78,8 +78,8 @@ pub use differentiate::{
 pub use halfcycle::{HalfCycle, MIN_RUN};
 pub use mechanical::MechanicalEnergy;
 pub use model_force::{
-    force_residuals, forces_from_states, model_force_along, model_force_with_normal, states_along,
-    ForceResiduals,
+    force_residuals, forces_at, forces_from_states, model_force_along, model_force_with_normal,
+    states_along, ForceResiduals,
 };
 
 use crate::error::EngineError;

@@ -89,6 +89,18 @@ pub fn states_along(
     max_substeps: u64,
 ) -> Result<Vec<f64>, EngineError> {
     check_motion(time, v, normal)?;
+    states_along_checked(model, time, v, normal, max_substeps)
+}
+
+/// [`states_along`] of a motion already checked by [`check_motion`] (a fit checks it once,
+/// not at every evaluation).
+pub(crate) fn states_along_checked(
+    model: &dyn FrictionModel,
+    time: &[f64],
+    v: &[f64],
+    normal: &NormalForce,
+    max_substeps: u64,
+) -> Result<Vec<f64>, EngineError> {
     let ns = model.n_states();
     let mut z = vec![0.0; ns];
     let mut out = Vec::with_capacity(v.len() * ns);
@@ -131,14 +143,30 @@ pub fn forces_from_states(
     normal: &NormalForce,
     states: &[f64],
 ) -> Vec<f64> {
+    forces_at(model, v, normal, states, 0..v.len())
+}
+
+/// The model's force at the samples `indices` from its states at every sample
+/// ([`states_along`]; empty for a static law).
+pub fn forces_at(
+    model: &dyn FrictionModel,
+    v: &[f64],
+    normal: &NormalForce,
+    states: &[f64],
+    indices: impl Iterator<Item = usize>,
+) -> Vec<f64> {
     let ns = model.n_states();
-    (0..v.len())
+    indices
         .map(|i| model.force(v[i], &states[i * ns..(i + 1) * ns], normal.at(i)))
         .collect()
 }
 
 /// Equal lengths, finite samples, strictly increasing time, a finite non-negative normal force.
-fn check_motion(time: &[f64], v: &[f64], normal: &NormalForce) -> Result<(), EngineError> {
+pub(crate) fn check_motion(
+    time: &[f64],
+    v: &[f64],
+    normal: &NormalForce,
+) -> Result<(), EngineError> {
     if time.len() != v.len() {
         return Err(EngineError::InvalidInput(format!(
             "{} time stamps but {} velocities",

@@ -92,7 +92,9 @@ fn fit_seeded<R: Residuals + 'static>(
     check_inputs(osc, model, records, residuals.as_ref())?;
     let layout = build_layout(osc, model, records, residuals.as_ref(), opts)?;
     let seed_model = seed.and_then(|s| s.as_ref().ok()).map(|p| p.model.as_ref());
-    let n_starts = start_count(opts, layout.n_model_free())?;
+    let simulated = residuals.simulates_response();
+    let direct = strategy::fits_directly(model, simulated);
+    let n_starts = start_count(opts, layout.n_model_free(), direct)?;
     let shared: Arc<[Record]> = records.into();
     let make_problem = || {
         FitProblem::new(
@@ -108,7 +110,7 @@ fn fit_seeded<R: Residuals + 'static>(
         )
     };
     let reference = make_problem();
-    let search = Search::resolve(opts.search, model, layout.n_model_free());
+    let search = Search::resolve(opts.search, model, layout.n_model_free(), simulated);
     let (runs, origins) = if layout.params.is_empty() {
         (evaluate_as_is(&reference)?, vec!["as given".to_string()])
     } else {

@@ -23,8 +23,9 @@ use super::options::{FitDomain, FitOptions, ForceTarget};
 use super::residuals::STEPS_PER_SAMPLE;
 use super::residuals::{Evaluation, NuisanceKind, RecordCase, Residuals, SampleAxes, Segment};
 use super::state_cache::StateCache;
+use crate::energy::forces_at;
+use crate::energy::model_force::{check_motion, states_along_checked};
 use crate::energy::{analyze_record, record_motion};
-use crate::energy::{forces_from_states, states_along};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::noise::noise_floor_level;
@@ -163,6 +164,27 @@ impl ForceAlongMotion {
         sum / self.tracks.len().max(1) as f64
     }
 
+    /// The model's states along track `index` (a dynamic model), from the cache when the
+    /// model's parameters were evaluated last time.
+    fn states_of(
+        &self,
+        index: usize,
+        at: &Evaluation<'_>,
+        track: &ForceTrack,
+    ) -> Result<Arc<Vec<f64>>, EngineError> {
+        let budget = STEPS_PER_SAMPLE * (track.time.len() as u64).max(100);
+        self.states.states(index, at.model, || {
+            at.count_simulation();
+            states_along_checked(
+                at.model,
+                &track.time,
+                &track.velocity,
+                &track.normal,
+                budget,
+            )
+        })
+    }
+
     fn track_of(&self, index: usize, record: &Record) -> Result<&ForceTrack, EngineError> {
         self.tracks.get(index).ok_or_else(|| EngineError::Record {
             record: record.name.clone(),
@@ -202,6 +224,7 @@ impl ForceTrack {
                 energy_target(record, osc, opts)?
             }
         };
+        check_motion(record.time(), &motion.v, &normal).map_err(|e| err(e.to_string()))?;
         if target.len() < 2 {
             return Err(err(format!(
                 "{} samples to compare the model force with (Eq. 7 is masked where |v| <= \
@@ -305,29 +328,27 @@ impl Residuals for ForceAlongMotion {
     fn predict(&self, at: &Evaluation<'_>, case: RecordCase<'_>) -> Result<Vec<f64>, EngineError> {
         let (index, record, nuisance) = (case.index, case.record, case.nuisance);
         let track = self.track_of(index, record)?;
-        let budget = STEPS_PER_SAMPLE * (track.time.len() as u64).max(100);
-        let states = self
-            .states
-            .states(index, at.model, || {
-                at.count_simulation();
-                states_along(
-                    at.model,
-                    &track.time,
-                    &track.velocity,
-                    &track.normal,
-                    budget,
-                )
-            })
-            .map_err(|e| EngineError::Record {
-                record: record.name.clone(),
-                reason: e.to_string(),
-            })?;
-        let force = forces_from_states(at.model, &track.velocity, &track.normal, &states);
-        Ok(track
-            .used
-            .iter()
-            .map(|&i| force[i] + nuisance.force_offset)
-            .collect())
+        let states = if at.model.n_states() == 0 {
+            at.count_simulation();
+            Arc::new(Vec::new())
+        } else {
+            self.states_of(index, at, track)
+                .map_err(|e| EngineError::Record {
+                    record: record.name.clone(),
+                    reason: e.to_string(),
+                })?
+        };
+        let mut force = forces_at(
+            at.model,
+            &track.velocity,
+            &track.normal,
+            &states,
+            track.used.iter().copied(),
+        );
+        if nuisance.force_offset != 0.0 {
+            force.iter_mut().for_each(|f| *f += nuisance.force_offset);
+        }
+        Ok(force)
     }
 
     /// One segment, weighted by the target's noise level: records of different noise weigh

@@ -77,7 +77,11 @@ pub struct LevenbergMarquardt {
     pub xtol: f64,
     /// Stop when an accepted step reduces the cost by less than ftol relative.
     pub ftol: f64,
-    /// Initial damping relative to the largest diagonal entry of JᵀJ.
+    /// Initial damping: the step solves (JᵀJ + mu diag(JᵀJ)) d = -Jᵀr (Marquardt's scaling),
+    /// so mu is a pure number and the path does not depend on the residuals' unit (a
+    /// force-domain fit weighted by 1/noise started ten thousand times too damped when mu
+    /// was scaled by the largest diagonal entry). Small: the starts are seeded near an
+    /// optimum (staged, prefit, data-driven guess).
     pub tau: f64,
     /// Stop when the cost fell by less than this fraction over the last `stall_window`
     /// accepted steps. For noisy data a relative change of 1e-6 is far below the statistical
@@ -114,7 +118,7 @@ impl LevenbergMarquardt {
             gtol: 1e-10,
             xtol: 1e-8,
             ftol: 1e-9,
-            tau: 1e-3,
+            tau: 1e-5,
             max_step: f64::INFINITY,
             relative_step: Vec::new(),
             stall_tol: 1e-6,
@@ -193,9 +197,8 @@ where
             ));
         }
         let j = problem.jacobian(&p0)?;
-        let a = j.transpose() * &j;
-        let max_diag = a.diagonal().iter().cloned().fold(0.0, f64::max);
-        self.mu = self.tau * max_diag.max(1e-300);
+        // The damping scales diag(JᵀJ) (Marquardt), so it is a pure number.
+        self.mu = self.tau;
         self.nu = 2.0;
         self.residuals = r;
         self.jacobian = j;
@@ -530,6 +533,43 @@ mod tests {
             pace.converged_at(cost);
         }
         assert_eq!(pace.best(), 1.0);
+    }
+
+    /// Rosenbrock with its residuals (and Jacobian) in another unit: times `0`.
+    struct Scaled(f64);
+    impl Operator for Scaled {
+        type Param = DVector<f64>;
+        type Output = DVector<f64>;
+        fn apply(&self, p: &DVector<f64>) -> Result<DVector<f64>, Error> {
+            Ok(Rosenbrock.apply(p)? * self.0)
+        }
+    }
+    impl Jacobian for Scaled {
+        type Param = DVector<f64>;
+        type Jacobian = DMatrix<f64>;
+        fn jacobian(&self, p: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+            Ok(Rosenbrock.jacobian(p)? * self.0)
+        }
+    }
+
+    /// The damping is a pure number: the path does not depend on the residuals' unit (a
+    /// force fit weighted by 1/noise once started with 1e4 times the damping of the same fit
+    /// in other units).
+    #[test]
+    fn the_path_does_not_depend_on_the_unit_of_the_residuals() {
+        let inf = f64::INFINITY;
+        let path = |scale: f64| {
+            let (s, reason) = run(Scaled(scale), vec![-1.2, 1.0], vec![-inf; 2], vec![inf; 2]);
+            let p = best(&s).unwrap().0;
+            (s.get_iter(), p, reason)
+        };
+        let (iterations, p, reason) = path(1.0);
+        assert!(reason.is_converged(), "{reason:?}");
+        for scale in [1e-3, 1e4] {
+            let (n, q, _) = path(scale);
+            assert_eq!(n, iterations, "scale {scale}");
+            assert!((&q - &p).amax() < 1e-12, "scale {scale}: {q} against {p}");
+        }
     }
 
     #[test]

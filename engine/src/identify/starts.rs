@@ -56,11 +56,21 @@ impl StartRun {
     }
 }
 
-/// The number of starts: as asked, else one when at most two model parameters are free.
-pub fn start_count(opts: &FitOptions, n_model_free: usize) -> Result<usize, EngineError> {
+/// The number of starts: as asked, else one when at most two model parameters are free or
+/// the fit is `direct` (a static law along the measured motion, see
+/// [`super::strategy::fits_directly`]).
+pub fn start_count(
+    opts: &FitOptions,
+    n_model_free: usize,
+    direct: bool,
+) -> Result<usize, EngineError> {
     let n = opts
         .multistart
-        .unwrap_or(if n_model_free > 2 { DEFAULT_STARTS } else { 1 })
+        .unwrap_or(if n_model_free > 2 && !direct {
+            DEFAULT_STARTS
+        } else {
+            1
+        })
         .max(1);
     if n > MAX_STARTS {
         return Err(EngineError::InvalidInput(format!(

@@ -115,6 +115,11 @@ pub fn covariance(j: &DMatrix<f64>, ssr: f64) -> Covariance {
 /// residuals: B S B n / (n - p) with the bread B = (JᵀJ)^-1 (`bread`) and the meat
 /// S = sum over lags |l| <= `lags` of (1 - |l| / (lags + 1)) sum_t g_t g_(t-l)ᵀ,
 /// g_t = J_t r_t, with pairs taken within each segment (record) of `segments` lengths only.
+///
+/// The Bartlett-weighted meat is computed as (1 / (L + 1)) sum_t u_t u_tᵀ with u_t the sum of
+/// the scores over the window t - L ..= t (clipped to the segment, t running L past its
+/// end): each pair of scores l <= L apart shares L + 1 - l windows, so this is the lag sum
+/// exactly, in O(n p²) instead of O(n L p²).
 pub fn newey_west(
     j: &DMatrix<f64>,
     r: &[f64],
@@ -123,22 +128,43 @@ pub fn newey_west(
     bread: &DMatrix<f64>,
 ) -> DMatrix<f64> {
     let (n, p) = j.shape();
-    let scores = DMatrix::from_fn(n, p, |t, c| j[(t, c)] * r[t]);
-    let mut meat = scores.tr_mul(&scores);
+    let mut meat = DMatrix::zeros(p, p);
     let mut start = 0;
     for &len in segments {
         let end = (start + len).min(n);
-        for l in 1..=lags.min(len.saturating_sub(1)) {
-            let w = 1.0 - l as f64 / (lags as f64 + 1.0);
-            let lead = scores.rows(start + l, end - start - l);
-            let lag = scores.rows(start, end - start - l);
-            let cross = lead.tr_mul(&lag);
-            meat += (&cross + cross.transpose()) * w;
-        }
+        add_bartlett_meat(&mut meat, j, r, start..end, lags);
         start = end;
     }
     let dof = n.saturating_sub(p).max(1) as f64;
     bread * meat * bread * (n as f64 / dof)
+}
+
+/// Adds one segment's Bartlett-weighted score products (see [`newey_west`]) to `meat`.
+fn add_bartlett_meat(
+    meat: &mut DMatrix<f64>,
+    j: &DMatrix<f64>,
+    r: &[f64],
+    rows: std::ops::Range<usize>,
+    lags: usize,
+) {
+    let p = j.ncols();
+    let score = |t: usize, c: usize| j[(t, c)] * r[t];
+    let mut u = vec![0.0; p];
+    for t in rows.start..rows.end + lags {
+        for (c, uc) in u.iter_mut().enumerate() {
+            if t < rows.end {
+                *uc += score(t, c);
+            }
+            if t > rows.start + lags {
+                *uc -= score(t - lags - 1, c);
+            }
+        }
+        for a in 0..p {
+            for b in 0..p {
+                meat[(a, b)] += u[a] * u[b] / (lags + 1) as f64;
+            }
+        }
+    }
 }
 
 /// Akaike's information criterion for Gaussian least squares: n ln(SSR/n) + 2 p.
@@ -276,5 +302,44 @@ mod tests {
         // Alternating residuals are negatively correlated at lag 1: lags shrink the variance.
         let with_lags = newey_west(&j, &r, &[n], 5, &bread);
         assert!(with_lags[(0, 0)] < hac[(0, 0)]);
+    }
+
+    use nalgebra::DVector;
+
+    /// The textbook lag sum of the meat, pair by pair within each segment.
+    fn lag_sum_meat(j: &DMatrix<f64>, r: &[f64], segments: &[usize], lags: usize) -> DMatrix<f64> {
+        let p = j.ncols();
+        let g = |t: usize| DVector::from_fn(p, |c, _| j[(t, c)] * r[t]);
+        let mut meat = DMatrix::zeros(p, p);
+        let mut start = 0;
+        for &len in segments {
+            for t in start..start + len {
+                for s in start..start + len {
+                    let l = t.abs_diff(s);
+                    if l <= lags {
+                        let w = 1.0 - l as f64 / (lags as f64 + 1.0);
+                        meat += g(t) * g(s).transpose() * w;
+                    }
+                }
+            }
+            start += len;
+        }
+        meat
+    }
+
+    #[test]
+    fn newey_west_equals_the_bartlett_weighted_lag_sum_within_segments() {
+        let segments = [37, 5, 58];
+        let n: usize = segments.iter().sum();
+        let j = DMatrix::from_fn(n, 3, |t, c| ((t * (c + 2)) as f64 * 0.37).sin() + c as f64);
+        let r: Vec<f64> = (0..n).map(|t| (t as f64 * 0.11).cos() + 0.3).collect();
+        let bread = DMatrix::from_fn(3, 3, |a, b| if a == b { 1.0 + a as f64 } else { 0.1 });
+        let dof_factor = n as f64 / (n - 3) as f64;
+        for lags in [0, 1, 4, 9, 80] {
+            let want = &bread * lag_sum_meat(&j, &r, &segments, lags) * &bread * dof_factor;
+            let got = newey_west(&j, &r, &segments, lags, &bread);
+            let scale = want.abs().max();
+            assert!((got - &want).abs().max() < 1e-12 * scale, "lags {lags}");
+        }
     }
 }

@@ -62,9 +62,17 @@ impl Search {
     }
 
     /// The strategy asked for, else `staged` for a model with internal states or more than
-    /// two free parameters and `local` otherwise (a Coulomb fit stays one start, one run).
-    pub fn resolve(asked: Option<Self>, model: &dyn FrictionModel, n_model_free: usize) -> Self {
-        asked.unwrap_or(if model.n_states() > 0 || n_model_free > 2 {
+    /// two free parameters and `local` otherwise (a Coulomb fit stays one start, one run),
+    /// and `local` for a static law fitted along the measured motion
+    /// ([`fits_directly`]).
+    pub fn resolve(
+        asked: Option<Self>,
+        model: &dyn FrictionModel,
+        n_model_free: usize,
+        simulated: bool,
+    ) -> Self {
+        let wide = model.n_states() > 0 || n_model_free > 2;
+        asked.unwrap_or(if wide && !fits_directly(model, simulated) {
             Self::Staged
         } else {
             Self::Local
@@ -79,6 +87,15 @@ impl Search {
             Self::Global => 3,
         }
     }
+}
+
+/// Whether `model` is a static law fitted without simulating the response (`simulated`
+/// false: the force domain). Its residuals are the law itself at the measured velocities:
+/// no phase error traps the solver and the data-driven guess puts the levels at the target
+/// force's, so the default is one start from the guess (the force route's speed; `search`
+/// and `multistart` still ask for more).
+pub fn fits_directly(model: &dyn FrictionModel, simulated: bool) -> bool {
+    !simulated && model.n_states() == 0
 }
 
 /// A starting point and where it came from.
@@ -502,17 +519,18 @@ mod tests {
     #[test]
     fn dynamic_or_wide_models_search_staged_and_coulomb_locally() {
         let lugre = LuGre::default();
-        assert_eq!(Search::resolve(None, &lugre, 6), Search::Staged);
-        assert_eq!(Search::resolve(None, &Coulomb::default(), 1), Search::Local);
-        assert_eq!(
-            Search::resolve(None, &Stribeck::default(), 4),
-            Search::Staged
-        );
-        let asked = Some(Search::Global);
-        assert_eq!(
-            Search::resolve(asked, &Coulomb::default(), 1),
-            Search::Global
-        );
+        let stribeck = Stribeck::default();
+        for simulated in [true, false] {
+            assert_eq!(Search::resolve(None, &lugre, 6, simulated), Search::Staged);
+            let coulomb = Search::resolve(None, &Coulomb::default(), 1, simulated);
+            assert_eq!(coulomb, Search::Local);
+            let asked = Some(Search::Global);
+            let global = Search::resolve(asked, &Coulomb::default(), 1, simulated);
+            assert_eq!(global, Search::Global);
+        }
+        assert_eq!(Search::resolve(None, &stribeck, 4, true), Search::Staged);
+        // Along the measured motion a static law has no phase to trap the solver.
+        assert_eq!(Search::resolve(None, &stribeck, 4, false), Search::Local);
     }
 
     #[test]
