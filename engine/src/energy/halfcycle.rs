@@ -242,18 +242,23 @@ fn gauss3(lo: f64, hi: f64, f: impl Fn(f64) -> (f64, f64)) -> (f64, f64) {
     (acc.0 * r, acc.1 * r)
 }
 
+/// The white-noise level of a velocity that the turning-point detector's hysteresis scales
+/// with: [`crate::record::noise::difference_noise`] of its second differences.
+pub(crate) const VELOCITY_NOISE_ORDER: usize = 2;
+
 /// Finds the turning points. `release` is the release velocity: when |release| <= the
-/// hysteresis level the first sample is the first turning point. `record` names the data in
-/// errors.
+/// hysteresis level the first sample is the first turning point. `velocity_noise` is the
+/// velocity's noise from its differences of [`VELOCITY_NOISE_ORDER`]. `record` names the data
+/// in errors.
 pub(crate) fn detect_motion(
     s: &Samples,
     velocity_threshold: f64,
+    velocity_noise: f64,
     release: f64,
     record: &str,
 ) -> Result<Motion, EngineError> {
     let n = s.n();
-    let level =
-        velocity_threshold.max(NOISE_FACTOR * crate::record::noise::difference_noise(s.v, 2));
+    let level = velocity_threshold.max(NOISE_FACTOR * velocity_noise);
     // Excursions: (first, last, sign) runs of |v| > level, at least MIN_RUN long.
     let mut runs: Vec<(usize, usize, f64)> = Vec::new();
     let mut i = 0;

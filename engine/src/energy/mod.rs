@@ -84,8 +84,9 @@ pub use model_force::{
 
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
+use crate::record::noise::difference_noise;
 use crate::record::{Channel, Record};
-use halfcycle::{detect_motion, half_cycles, Interp, Motion, Samples};
+use halfcycle::{detect_motion, half_cycles, Interp, Motion, Samples, VELOCITY_NOISE_ORDER};
 use serde::{Deserialize, Serialize};
 
 /// Options of the energy analysis.
@@ -356,7 +357,18 @@ fn measured_motion(
         )));
     };
     let samples = measured.samples(record.time());
-    let motion = detect_motion(&samples, opts.velocity_threshold, record.v0, &record.name)?;
+    let noise = match measured.velocity {
+        SeriesSource::Measured => record.difference_noise(Channel::Velocity, VELOCITY_NOISE_ORDER),
+        _ => None,
+    }
+    .unwrap_or_else(|| difference_noise(&measured.v, VELOCITY_NOISE_ORDER));
+    let motion = detect_motion(
+        &samples,
+        opts.velocity_threshold,
+        noise,
+        record.v0,
+        &record.name,
+    )?;
     Ok((measured, motion))
 }
 
@@ -425,7 +437,8 @@ pub fn analyze_states(
         a,
         interp: Interp::Hermite,
     };
-    let motion = detect_motion(&samples, opts.velocity_threshold, v[0], "states")?;
+    let noise = difference_noise(v, VELOCITY_NOISE_ORDER);
+    let motion = detect_motion(&samples, opts.velocity_threshold, noise, v[0], "states")?;
     let exact = SeriesSources {
         displacement: SeriesSource::Exact,
         velocity: SeriesSource::Exact,

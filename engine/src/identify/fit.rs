@@ -693,8 +693,11 @@ fn energy_check(
     // The energy analysis sees the measured velocity corrected by the fitted offset, from the
     // fitted release displacement.
     let mut corrected = rec.clone();
-    for v in corrected.velocity_mut() {
-        *v -= nuisance.offset;
+    if nuisance.offset != 0.0 {
+        // (Leaves the record's cached noise levels alone when there is nothing to correct.)
+        for v in corrected.velocity_mut() {
+            *v -= nuisance.offset;
+        }
     }
     corrected.x0 = nuisance.x0_of(rec);
     let osc = &world.oscillator;

@@ -50,6 +50,9 @@ pub struct Record {
     /// before it. `None`: the record starts at release.
     #[serde(default)]
     pub release_time: Option<f64>,
+    /// Noise levels estimated from the samples, each computed once.
+    #[serde(skip)]
+    estimated_noise: noise::NoiseCache,
 }
 
 impl Record {
@@ -74,12 +77,14 @@ impl Record {
             v0: 0.0,
             weight: 1.0,
             release_time: None,
+            estimated_noise: noise::NoiseCache::default(),
         }
     }
 
     /// The record with `values` as its `channel` (replacing one already there). A
     /// [`Channel::NormalForce`] becomes the sampled [`NormalForce`].
     pub fn with_channel(mut self, channel: Channel, values: Vec<f64>) -> Self {
+        self.estimated_noise.clear();
         match channel {
             Channel::NormalForce => self.normal_force = Some(NormalForce::Sampled(values)),
             other => {
@@ -128,6 +133,7 @@ impl Record {
 
     /// The samples of `channel`, mutable, if the record has it.
     pub fn channel_mut(&mut self, channel: Channel) -> Option<&mut [f64]> {
+        self.estimated_noise.clear();
         match channel {
             Channel::NormalForce => match &mut self.normal_force {
                 Some(NormalForce::Sampled(values)) => Some(values),
@@ -160,6 +166,7 @@ impl Record {
 
     /// Sets (or with `None` removes) the record's own normal force.
     pub fn set_normal_force(&mut self, normal_force: Option<NormalForce>) {
+        self.estimated_noise.clear();
         self.normal_force = normal_force;
     }
 
@@ -179,6 +186,7 @@ impl Record {
             v0: self.v0,
             weight: self.weight,
             release_time: self.release_time,
+            estimated_noise: noise::NoiseCache::default(),
         }
     }
 
@@ -198,9 +206,19 @@ impl Record {
     /// `None` when the record lacks the channel.
     pub fn noise_level(&self, channel: Channel) -> Option<f64> {
         let values = self.channel(channel)?;
+        Some(self.given_noise(channel).unwrap_or_else(|| {
+            let estimated = self.difference_noise(channel, channel.noise_order());
+            estimated.unwrap_or(0.0).max(noise::noise_floor(values))
+        }))
+    }
+
+    /// [`noise::difference_noise`] of `channel`'s differences of `order`, computed once per
+    /// record; `None` when the record lacks the channel.
+    pub fn difference_noise(&self, channel: Channel, order: usize) -> Option<f64> {
+        let values = self.channel(channel)?;
         Some(
-            self.given_noise(channel)
-                .unwrap_or_else(|| noise::noise_floor_level(values, channel.noise_order())),
+            self.estimated_noise
+                .get_or(channel, order, || noise::difference_noise(values, order)),
         )
     }
 
@@ -312,6 +330,34 @@ pub(crate) fn channel_list(channels: &[Channel]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The cached noise level follows every change of the samples and never makes records
+    /// differ.
+    #[test]
+    fn the_estimated_noise_is_cached_until_the_samples_change() {
+        let n = 2000;
+        let time: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
+        let mut v: Vec<f64> = time.iter().map(|t| 0.1 * (13.8 * t).sin()).collect();
+        crate::synthetic::add_gaussian_noise(&mut v, 2e-4, 5);
+        let mut rec = Record::new("r", time, v.clone(), 0.0);
+        let level = rec.noise_level(Channel::Velocity).unwrap();
+        assert_eq!(
+            level,
+            noise::noise_floor_level(&v, Channel::Velocity.noise_order())
+        );
+        let twin = rec.clone();
+        assert_eq!(twin.noise_level(Channel::Velocity), Some(level));
+        rec.velocity_mut().iter_mut().for_each(|x| *x *= 10.0);
+        let scaled = rec.noise_level(Channel::Velocity).unwrap();
+        assert!(
+            (scaled / level - 10.0).abs() < 1e-9,
+            "{scaled} against {level}"
+        );
+        let rebuilt = Record::new("r", twin.time().to_vec(), rec.velocity().to_vec(), 0.0);
+        assert_eq!(rec, rebuilt);
+        let replaced = rec.with_channel(Channel::Velocity, v);
+        assert_eq!(replaced.noise_level(Channel::Velocity), Some(level));
+    }
 
     fn record() -> Record {
         Record::new(

@@ -8,6 +8,9 @@
 //! stops. The one estimator of the workspace: the energy analysis, the force domain and the
 //! response channels use it with the order their signals need.
 
+use super::Channel;
+use std::collections::BTreeMap;
+
 /// Difference order for response channels (velocity, displacement, acceleration): third
 /// differences of the FMM motion (1 kHz, 2.2 Hz) are 1e-6 of the signal, far below any
 /// instrument's noise.
@@ -31,9 +34,17 @@ pub fn difference_noise(values: &[f64], order: usize) -> f64 {
 /// [`difference_noise`], never below 1e-6 of the values' RMS (noise-free records) nor zero:
 /// a level to divide residuals by.
 pub fn noise_floor_level(values: &[f64], order: usize) -> f64 {
+    difference_noise(values, order).max(noise_floor(values))
+}
+
+/// The smallest level [`noise_floor_level`] returns: 1e-6 of the values' RMS, 1 for zeros.
+pub fn noise_floor(values: &[f64]) -> f64 {
     let rms = (values.iter().map(|f| f * f).sum::<f64>() / values.len().max(1) as f64).sqrt();
-    let floor = if rms > 0.0 { 1e-6 * rms } else { 1.0 };
-    difference_noise(values, order).max(floor)
+    if rms > 0.0 {
+        1e-6 * rms
+    } else {
+        1.0
+    }
 }
 
 /// C(2k, k): the variance gain of the k-th difference of white noise.
@@ -48,6 +59,55 @@ fn median(values: &mut [f64]) -> f64 {
     }
     let mid = values.len() / 2;
     *values.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// The [`difference_noise`] of a record's channels, each order computed once (a fit asks
+/// for a record's velocity noise a dozen times: weights, the guess, the turning points, the
+/// energy check). Part of the record's cached state, not of its value: clones carry it,
+/// comparisons and serialisation ignore it, and every change of the samples clears it.
+#[derive(Debug, Default)]
+pub struct NoiseCache(std::sync::Mutex<BTreeMap<(Channel, usize), f64>>);
+
+impl NoiseCache {
+    /// The cached noise of `channel`'s differences of `order`, else `estimate()` (then
+    /// cached).
+    pub fn get_or(&self, channel: Channel, order: usize, estimate: impl FnOnce() -> f64) -> f64 {
+        let key = (channel, order);
+        if let Some(level) = self.levels().and_then(|l| l.get(&key).copied()) {
+            return level;
+        }
+        let level = estimate();
+        if let Some(mut levels) = self.levels() {
+            levels.insert(key, level);
+        }
+        level
+    }
+
+    /// Forgets every level (the samples changed).
+    pub fn clear(&mut self) {
+        if let Ok(levels) = self.0.get_mut() {
+            levels.clear();
+        }
+    }
+
+    fn levels(&self) -> Option<std::sync::MutexGuard<'_, BTreeMap<(Channel, usize), f64>>> {
+        self.0.lock().ok()
+    }
+}
+
+impl Clone for NoiseCache {
+    fn clone(&self) -> Self {
+        Self(std::sync::Mutex::new(
+            self.levels().map(|l| l.clone()).unwrap_or_default(),
+        ))
+    }
+}
+
+impl PartialEq for NoiseCache {
+    /// A cache never makes two records differ.
+    fn eq(&self, _other: &Self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]
