@@ -26,6 +26,7 @@ use crate::error::EngineError;
 use frictionid_models::start::TYPICAL_PRESLIDING_DISPLACEMENT;
 use frictionid_models::{FrictionModel, StartContext, StribeckLevels};
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// chi²(1 dof, 95 %) / 2 = 3.8415 / 2: the rise of the cost (half the sum of squares), in
@@ -199,9 +200,18 @@ fn profile_all<R: Residuals + 'static>(
         opts,
         limit: open_limit,
     };
-    for j in slots {
+    let profile_of = |j: usize| {
         let open_above = open_limit.filter(|l| l.is_stiffness(j)).map(|l| l.cost);
-        let (standing, lower) = profile.standing(j, delta, open_above);
+        (j, profile.standing(j, delta, open_above))
+    };
+    // The profiles are independent: in parallel, read in slot order (the first lower point
+    // restarts the fit, whichever thread found it first).
+    let profiled: Vec<_> = if opts.parallel {
+        slots.par_iter().map(|&j| profile_of(j)).collect()
+    } else {
+        slots.iter().map(|&j| profile_of(j)).collect()
+    };
+    for (j, (standing, lower)) in profiled {
         if let Some(u) = lower.filter(|_| restart) {
             return Ok(Profiled::Lower(u));
         }

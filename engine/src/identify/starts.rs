@@ -361,7 +361,7 @@ where
             n_starts,
             promote,
         };
-        continue_best(&make_problem, &mut screened, opts, phase);
+        continue_best(&make_problem, &mut screened, opts, phase, reachable);
     }
     let first_error = screened.first_error.take();
     pick_best(screened).ok_or_else(|| total_failure(first_error, reference, points))
@@ -378,8 +378,13 @@ struct Phase {
 /// Phase 2: continues the best screened starts (unless converged) to the iteration limit, in
 /// the order of their screened costs; a continued start still [`super::lm::OUTPACE_FACTOR`]
 /// times above the cost an earlier start converged to is abandoned.
-fn continue_best<R, F>(make_problem: &F, screened: &mut Screened, opts: &FitOptions, phase: Phase)
-where
+fn continue_best<R, F>(
+    make_problem: &F,
+    screened: &mut Screened,
+    opts: &FitOptions,
+    phase: Phase,
+    reachable: Option<f64>,
+) where
     R: Residuals + 'static,
     F: Fn() -> FitProblem<R> + Sync,
 {
@@ -399,6 +404,9 @@ where
     let pace = Arc::new(Pace::default());
     for (_, o) in screened.ok.iter().filter(|(_, o)| o.converged()) {
         pace.converged_at(o.cost);
+    }
+    if let Some(cost) = reachable {
+        pace.converged_at(cost);
     }
     let slot = |start| RunSlot {
         start,
