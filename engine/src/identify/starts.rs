@@ -2,11 +2,12 @@
 //! screening of every start and the continuation of the most promising one.
 
 use super::layout::{FreeParam, ParamKind};
-use super::lm::{termination_reason, LevenbergMarquardt, LmState, Pace};
+use super::lm::{termination_reason, DampingStart, LevenbergMarquardt, LmState, Pace};
 use super::options::{FitOptions, Progress, ProgressFn};
 use super::outcome::{StartOutcome, TerminationReason};
 use super::problem::FitProblem;
 use super::residuals::Residuals;
+use super::strategy::fits_directly;
 use crate::error::EngineError;
 use argmin::core::observers::{Observe, ObserverMode};
 use argmin::core::{Executor, State, KV};
@@ -14,6 +15,24 @@ use frictionid_models::FrictionModel;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use std::sync::Arc;
+
+/// The relative damping start of the fits that take one (see [`damping_start_for`]).
+pub const RELATIVE_DAMPING: f64 = 1e-5;
+
+/// How the solver's damping starts for `model` fitted with residuals that do (`simulated`)
+/// or do not simulate the response. Relative ([`RELATIVE_DAMPING`], a pure number) for
+/// velocity fits and for static laws along the measured motion: a Stribeck force fit
+/// converges in 4 iterations (17 with the largest-diagonal rule at its 1/noise weights),
+/// GMS fitted to the FMM fixture in 6.3 s (14.9 s). The largest-diagonal rule for a model
+/// with internal states fitted along the measured motion, whose rugged landscapes it was
+/// measured on (see [`DampingStart::LargestDiagonal`]).
+pub fn damping_start_for(model: &dyn FrictionModel, simulated: bool) -> DampingStart {
+    if simulated || fits_directly(model, simulated) {
+        DampingStart::Relative(RELATIVE_DAMPING)
+    } else {
+        DampingStart::LargestDiagonal(1e-3)
+    }
+}
 
 /// Starts of a multi-start fit when more than two model parameters are free.
 pub const DEFAULT_STARTS: usize = 4;
@@ -186,6 +205,10 @@ fn solver_for<R: Residuals>(problem: &FitProblem<R>, opts: &FitOptions) -> Leven
     // cannot throw a trial point into a region where the simulation is stiff or degenerate.
     solver.max_step = 2.0;
     solver.relative_step = problem.layout.iter().map(|f| !f.log).collect();
+    solver.damping_start = damping_start_for(
+        problem.model.as_ref(),
+        problem.residuals.simulates_response(),
+    );
     if let Some(t) = opts.tolerance {
         solver.ftol = t;
     }
