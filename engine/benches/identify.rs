@@ -9,9 +9,11 @@ mod common;
 use common::{lugre_truth, records, stiff_lugre_truth, stribeck_truth, NOISE};
 use criterion::{criterion_group, criterion_main, Criterion};
 use frictionid_engine::identify::{compare, fit, FitDomain, FitOptions, Search};
-use frictionid_engine::Oscillator;
+use frictionid_engine::record::RecordSource;
+use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre};
 use std::hint::black_box;
+use std::path::Path;
 
 fn coulomb_and_compare(c: &mut Criterion) {
     let osc = Oscillator::fmm();
@@ -39,7 +41,43 @@ fn coulomb_and_compare(c: &mut Criterion) {
             compare(&osc, black_box(&models), &recs, &FitOptions::default()).expect("compare")
         })
     });
+    let every: Vec<Box<dyn FrictionModel>> = frictionid_models::registry::names()
+        .iter()
+        .filter_map(|n| default_model(n).ok())
+        .collect();
+    let fixture = fixture_records();
+    group.bench_function("five models, the FMM fixture", |b| {
+        b.iter(|| {
+            compare(&osc, black_box(&models), &fixture, &FitOptions::default()).expect("compare")
+        })
+    });
+    group.bench_function("every registered model, the FMM fixture", |b| {
+        b.iter(|| {
+            compare(&osc, black_box(&every), &fixture, &FitOptions::default()).expect("compare")
+        })
+    });
     group.finish();
+}
+
+/// The bundled FMM fixture's three records (`fixtures/x10mm.csv`, ...), as
+/// `fixtures/fmm-compare.toml` reads them.
+fn fixture_records() -> Vec<Record> {
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures");
+    [
+        ("x10mm.csv", 0.010),
+        ("x14mm.csv", 0.014),
+        ("x22mm.csv", 0.022),
+    ]
+    .into_iter()
+    .map(|(file, x0)| {
+        let entry = RecordSource {
+            file: Some(file.into()),
+            x0: Some(x0),
+            ..RecordSource::default()
+        };
+        entry.load(&base).expect("the bundled fixture")
+    })
+    .collect()
 }
 
 fn lugre(c: &mut Criterion) {

@@ -536,3 +536,23 @@ fn pick_best(screened: Screened) -> Option<MultiStart> {
         outcomes: outcomes.into_iter().map(|(_, o)| o).collect(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use frictionid_models::{Coulomb, LuGre, Stribeck};
+
+    #[test]
+    fn the_damping_starts_relative_except_for_dynamic_models_along_the_motion() {
+        let relative = DampingStart::Relative(RELATIVE_DAMPING);
+        for simulated in [true, false] {
+            assert_eq!(damping_start_for(&Coulomb::default(), simulated), relative);
+            assert_eq!(damping_start_for(&Stribeck::default(), simulated), relative);
+        }
+        assert_eq!(damping_start_for(&LuGre::default(), true), relative);
+        assert_eq!(
+            damping_start_for(&LuGre::default(), false),
+            DampingStart::LargestDiagonal(1e-3)
+        );
+    }
+}
