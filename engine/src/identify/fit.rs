@@ -619,7 +619,7 @@ fn record_fit<R: Residuals>(
     let sum_sq = channels.first().map_or(0.0, |c| c.rms_residual.powi(2)) * first as f64;
     let nuisance = &world.nuisance[ri];
     let (energy_force, ebf, mf, finding) = if problem.residuals.simulates_response() {
-        match energy_check(rec, nuisance, world, opts) {
+        match energy_check(problem.residuals.as_ref(), ri, rec, nuisance, world, opts) {
             Ok((ef, ebf, mf)) => {
                 let finding = diagnostics::energy_balance(&rec.name, &ef);
                 (Some(ef), ebf, mf, Some(finding))
@@ -683,8 +683,11 @@ fn channel_fits(segments: &[Segment], predicted: &[f64], measured: &[f64]) -> Ve
         .collect()
 }
 
-/// The energy check of one record, its energy-based force and the model force along it.
-fn energy_check(
+/// The energy check of record `index` (`rec`), its energy-based force and the model force
+/// along it.
+fn energy_check<R: Residuals + ?Sized>(
+    residuals: &R,
+    index: usize,
     rec: &Record,
     nuisance: &NuisanceValues,
     world: &Realised,
@@ -693,15 +696,18 @@ fn energy_check(
     // The energy analysis sees the measured velocity corrected by the fitted offset, from the
     // fitted release displacement.
     let mut corrected = rec.clone();
-    if nuisance.offset != 0.0 {
-        // (Leaves the record's cached noise levels alone when there is nothing to correct.)
+    corrected.x0 = nuisance.x0_of(rec);
+    let osc = &world.oscillator;
+    let analysis = if nuisance.offset == 0.0 {
+        // The velocity as measured: the analysis the guess made, when m, c, k and x0 are
+        // those it was made with.
+        residuals.energy_analysis(index, &corrected, osc, &opts.energy)?
+    } else {
         for v in corrected.velocity_mut() {
             *v -= nuisance.offset;
         }
-    }
-    corrected.x0 = nuisance.x0_of(rec);
-    let osc = &world.oscillator;
-    let analysis = analyze_record(&corrected, osc, &opts.energy)?;
+        Arc::new(analyze_record(&corrected, osc, &opts.energy)?)
+    };
     // The fit's step budget: bristles too stiff to replay cheaply (sigma0 far inside a
     // one-sided bound) leave the check out, with a warning, instead of taking seconds.
     let budget = STEPS_PER_SAMPLE * (analysis.time.len() as u64).max(100);
@@ -710,7 +716,7 @@ fn energy_check(
     let states = states_along(model, &analysis.time, &analysis.v, &normal, budget)?;
     let model_force = forces_from_states(model, &analysis.v, &normal, &states);
     let ef = energy_force_check(&analysis, ForceReference::ModelForce(&model_force))?;
-    Ok((ef, analysis.friction, model_force))
+    Ok((ef, analysis.friction.clone(), model_force))
 }
 
 /// k/m and c/m (the combinations velocity data fix) with delta-method standard errors.

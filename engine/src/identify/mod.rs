@@ -20,6 +20,7 @@
 //! - [`energy_check::energy_force_check`]: the energy-balance check, shared with the
 //!   `energy` command.
 
+pub mod analysis_cache;
 pub mod budget;
 pub mod compare;
 pub mod diagnostics;

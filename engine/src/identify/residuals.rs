@@ -11,6 +11,7 @@
 
 use super::options::FitOptions;
 use super::work::WorkBudget;
+use crate::energy::{analyze_record, EnergyAnalysis, EnergyOptions};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -18,6 +19,7 @@ use crate::simulate::{SimOptions, SimStats};
 use frictionid_models::{FrictionModel, GuessHint};
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 pub use super::response::VelocityResponse;
 
@@ -258,6 +260,19 @@ pub trait Residuals: Send + Sync {
     /// velocity, [`super::setup::guess_hint`]).
     fn hint(&self, osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
         super::setup::guess_hint(osc, records, opts)
+    }
+
+    /// The energy analysis (Eq. 7) of the fit's record `index`, its velocity as measured,
+    /// under `osc` (default: computed at every call; a producer may keep it for the energy
+    /// check, see [`super::analysis_cache`]).
+    fn energy_analysis(
+        &self,
+        _index: usize,
+        record: &Record,
+        osc: &Oscillator,
+        options: &EnergyOptions,
+    ) -> Result<Arc<EnergyAnalysis>, EngineError> {
+        Ok(Arc::new(analyze_record(record, osc, options)?))
     }
 
     /// Whether the prediction is the oscillator's simulated response: then the energy-balance

@@ -14,16 +14,18 @@
 //! the fitted x0 and release shift feeds all of them; the velocity offset applies to the
 //! velocity channel (and needs one in every record).
 
+use super::analysis_cache::AnalysisCache;
 use super::options::FitOptions;
 use super::residuals::{
     Evaluation, NuisanceKind, NuisanceValues, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
 };
-use crate::energy::record_motion;
+use crate::energy::{record_motion, EnergyAnalysis, EnergyOptions};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::{channel_list, Channel, Record};
 use crate::simulate::{simulate, simulate_velocity, Initial, SimOptions};
 use frictionid_models::GuessHint;
+use std::sync::Arc;
 
 /// The response channels, in the order they are stacked.
 const RESPONSE: [Channel; 3] = [
@@ -55,6 +57,8 @@ pub struct VelocityResponse {
     nuisance: Vec<NuisanceKind>,
     tracks: Vec<ResponseTrack>,
     primary: Channel,
+    /// The records' energy analyses: the guess's, kept for the energy check.
+    analyses: AnalysisCache,
 }
 
 impl VelocityResponse {
@@ -74,6 +78,7 @@ impl VelocityResponse {
             nuisance,
             tracks: Vec::new(),
             primary: Channel::Velocity,
+            analyses: AnalysisCache::default(),
         }
     }
 
@@ -329,7 +334,28 @@ impl Residuals for VelocityResponse {
                 _ => r.clone(),
             })
             .collect();
-        super::setup::guess_hint(osc, &with_velocity, opts)
+        // A record measured as velocity is analysed once, for the guess and the energy check
+        // (the same level as the half-cycle analysis alone gives).
+        let level = |index: usize, rec: &Record| {
+            let analysed = records[index]
+                .channel(Channel::Velocity)
+                .and_then(|_| self.energy_analysis(index, rec, osc, &opts.energy).ok());
+            match analysed {
+                Some(analysis) => super::setup::level_of_analysis(&analysis),
+                None => super::setup::friction_level(rec, osc, opts),
+            }
+        };
+        super::setup::guess_hint_with(osc, &with_velocity, level)
+    }
+
+    fn energy_analysis(
+        &self,
+        index: usize,
+        record: &Record,
+        osc: &Oscillator,
+        options: &EnergyOptions,
+    ) -> Result<Arc<EnergyAnalysis>, EngineError> {
+        self.analyses.analysis(index, record, osc, options)
     }
 
     /// Prepared records need a response channel (not necessarily velocity); an unprepared

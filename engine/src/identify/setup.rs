@@ -5,7 +5,7 @@
 use super::layout::{FreeParam, ParamKind};
 use super::options::{FitOptions, OscillatorParam};
 use super::residuals::{NuisanceKind, Residuals};
-use crate::energy::{analyze_record, half_cycle_force};
+use crate::energy::{analyze_record, half_cycle_force, EnergyAnalysis};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -21,10 +21,19 @@ pub fn non_model_bound_keys() -> Vec<&'static str> {
 
 /// Data-driven hints: the friction level from the half-cycle energy estimate, a typical speed.
 pub fn guess_hint(osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
+    guess_hint_with(osc, records, |_, rec| friction_level(rec, osc, opts))
+}
+
+/// [`guess_hint`] with each record's friction level from `level` (of its index and itself).
+pub fn guess_hint_with(
+    osc: &Oscillator,
+    records: &[Record],
+    level: impl Fn(usize, &Record) -> Option<f64>,
+) -> GuessHint {
     let mut levels = Vec::new();
     let mut speeds = Vec::new();
-    for rec in records {
-        if let Some(level) = friction_level(rec, osc, opts) {
+    for (index, rec) in records.iter().enumerate() {
+        if let Some(level) = level(index, rec) {
             levels.push(level);
         }
         let peak = rec.velocity().iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -54,13 +63,23 @@ pub fn guess_hint(osc: &Oscillator, records: &[Record], opts: &FitOptions) -> Gu
 
 /// A record's friction level: its half-cycle energy estimate, else (no complete half-cycle
 /// with a positive loss) the mean |F| of Eq. 7 along it.
-fn friction_level(record: &Record, osc: &Oscillator, opts: &FitOptions) -> Option<f64> {
-    let usable = |f: f64| (f.is_finite() && f > 0.0).then_some(f);
+pub(crate) fn friction_level(record: &Record, osc: &Oscillator, opts: &FitOptions) -> Option<f64> {
     let half_cycles = half_cycle_force(record, osc, &opts.energy).ok()?;
-    half_cycles.and_then(usable).or_else(|| {
+    half_cycles.and_then(usable_level).or_else(|| {
         let analysis = analyze_record(record, osc, &opts.energy).ok()?;
-        usable(analysis.mean_abs_force)
+        usable_level(analysis.mean_abs_force)
     })
+}
+
+/// [`friction_level`] read off a record's energy analysis: the mean of its half-cycle
+/// forces, else the mean |F| of Eq. 7.
+pub(crate) fn level_of_analysis(analysis: &EnergyAnalysis) -> Option<f64> {
+    usable_level(analysis.half_cycle_mean).or_else(|| usable_level(analysis.mean_abs_force))
+}
+
+/// A friction level that can start a fit: finite and positive.
+fn usable_level(f: f64) -> Option<f64> {
+    (f.is_finite() && f > 0.0).then_some(f)
 }
 
 fn unknown_name(kind: &str, name: &str, valid: &[String]) -> EngineError {

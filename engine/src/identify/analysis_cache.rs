@@ -1,0 +1,122 @@
+//! The Eq. 7 energy analyses of a fit's records, each computed once: the data-driven guess
+//! reads its friction level from the analysis the energy check needs at the end, when nothing
+//! that analysis depends on (the oscillator's m, c and k, the release displacement, the
+//! velocity offset) was fitted.
+
+use crate::energy::{analyze_record, EnergyAnalysis, EnergyOptions};
+use crate::error::EngineError;
+use crate::oscillator::Oscillator;
+use crate::record::Record;
+use std::sync::{Arc, Mutex};
+
+/// What an analysis of a record depends on besides its samples.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Key {
+    index: usize,
+    mass: f64,
+    damping: f64,
+    stiffness: f64,
+    x0: f64,
+    options: EnergyOptions,
+}
+
+/// The analyses of the records of one fit, by record index (the fit's records never change
+/// their samples; a velocity corrected by a fitted offset is not asked for here).
+#[derive(Debug, Default)]
+pub struct AnalysisCache(Mutex<Vec<(Key, Arc<EnergyAnalysis>)>>);
+
+impl AnalysisCache {
+    /// The energy analysis of `record` (the fit's record `index`, its velocity as measured)
+    /// under `osc` and `options`: kept from an earlier call with the same oscillator, release
+    /// displacement and options, else computed ([`analyze_record`]).
+    pub fn analysis(
+        &self,
+        index: usize,
+        record: &Record,
+        osc: &Oscillator,
+        options: &EnergyOptions,
+    ) -> Result<Arc<EnergyAnalysis>, EngineError> {
+        let key = Key {
+            index,
+            mass: osc.mass,
+            damping: osc.damping,
+            stiffness: osc.stiffness,
+            x0: record.x0,
+            options: *options,
+        };
+        if let Some(kept) = self.find(&key) {
+            return Ok(kept);
+        }
+        let analysis = Arc::new(analyze_record(record, osc, options)?);
+        if let Ok(mut entries) = self.0.lock() {
+            entries.push((key, analysis.clone()));
+        }
+        Ok(analysis)
+    }
+
+    fn find(&self, key: &Key) -> Option<Arc<EnergyAnalysis>> {
+        let entries = self.0.lock().ok()?;
+        entries
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, a)| a.clone())
+    }
+}
+
+impl Clone for AnalysisCache {
+    /// A clone starts empty (it may serve other records).
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+impl PartialEq for AnalysisCache {
+    /// A cache never makes two producers differ.
+    fn eq(&self, _other: &Self) -> bool {
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synthetic::release_records;
+    use frictionid_models::Coulomb;
+
+    /// The same analysis value (its masked samples are NaN, so compared as written out).
+    fn same(a: &EnergyAnalysis, b: &EnergyAnalysis) -> bool {
+        serde_json::to_string(a).ok() == serde_json::to_string(b).ok()
+    }
+
+    #[test]
+    fn an_analysis_is_kept_for_the_same_inputs_only() {
+        let osc = Oscillator::fmm();
+        let records =
+            release_records(&osc, &Coulomb { mu: 0.24 }, &[0.014], 2.0, 1000.0, 2e-4, 3).unwrap();
+        let rec = &records[0];
+        let options = EnergyOptions::default();
+        let cache = AnalysisCache::default();
+        let first = cache.analysis(0, rec, &osc, &options).unwrap();
+        assert!(same(&first, &analyze_record(rec, &osc, &options).unwrap()));
+        let again = cache.analysis(0, rec, &osc, &options).unwrap();
+        assert!(Arc::ptr_eq(&first, &again));
+        let heavier = Oscillator {
+            mass: osc.mass * 1.01,
+            ..osc
+        };
+        let other = cache.analysis(0, rec, &heavier, &options).unwrap();
+        assert!(!Arc::ptr_eq(&first, &other));
+        assert!(same(
+            &other,
+            &analyze_record(rec, &heavier, &options).unwrap()
+        ));
+        let mut moved = rec.clone();
+        moved.x0 += 1e-3;
+        let shifted = cache.analysis(0, &moved, &osc, &options).unwrap();
+        assert!(same(
+            &shifted,
+            &analyze_record(&moved, &osc, &options).unwrap()
+        ));
+        assert!(!Arc::ptr_eq(&first, &shifted));
+    }
+}
