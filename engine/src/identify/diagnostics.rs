@@ -76,9 +76,9 @@ pub fn energy_balance(record: &str, ef: &EnergyForce) -> Finding {
 }
 
 /// Lag-`lag` autocorrelation of the residual segments (pairs within a segment only).
-fn autocorrelation(segments: &[Vec<f64>], lag: usize) -> f64 {
+fn autocorrelation<S: AsRef<[f64]>>(segments: &[S], lag: usize) -> f64 {
     let (mut num, mut den) = (0.0, 0.0);
-    for s in segments {
+    for s in segments.iter().map(AsRef::as_ref) {
         den += s.iter().map(|r| r * r).sum::<f64>();
         num += s
             .iter()
@@ -97,19 +97,28 @@ fn autocorrelation(segments: &[Vec<f64>], lag: usize) -> f64 {
 /// residuals' first differences (for AR(1), their lag-1 autocorrelation is -(1 - phi) / 2).
 /// Differencing removes the slow, motion-locked part, which would otherwise pass for
 /// strongly coloured noise and hide itself.
-pub(crate) fn noise_correlation(segments: &[Vec<f64>]) -> f64 {
+pub(crate) fn noise_correlation<S: AsRef<[f64]>>(segments: &[S]) -> f64 {
     let differences: Vec<Vec<f64>> = segments
         .iter()
-        .map(|s| s.windows(2).map(|w| w[1] - w[0]).collect())
+        .map(|s| s.as_ref().windows(2).map(|w| w[1] - w[0]).collect())
         .collect();
     (1.0 + 2.0 * autocorrelation(&differences, 1)).clamp(0.0, 0.999)
 }
 
-/// Pearson correlation of pooled, already demeaned series.
-fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let sab: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
-    let saa: f64 = a.iter().map(|x| x * x).sum();
-    let sbb: f64 = b.iter().map(|y| y * y).sum();
+/// Pearson correlation of already demeaned series `a` and `b` of the moving parts, pooled
+/// (from the sums over the parts: nothing is copied).
+fn pooled_correlation(
+    moving: &[Moving],
+    a: fn(&Moving) -> &[f64],
+    b: fn(&Moving) -> &[f64],
+) -> f64 {
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for m in moving {
+        let (a, b) = (a(m), b(m));
+        sab += a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        saa += a.iter().map(|x| x * x).sum::<f64>();
+        sbb += b.iter().map(|y| y * y).sum::<f64>();
+    }
     if saa > 0.0 && sbb > 0.0 {
         sab / (saa * sbb).sqrt()
     } else {
@@ -179,8 +188,8 @@ pub fn residual_structure(records: &[RecordFit], osc: &Oscillator, threshold: f6
         .iter()
         .filter_map(|r| moving_part(r, osc, threshold))
         .collect();
-    let residuals: Vec<Vec<f64>> = moving.iter().map(|m| m.residual.clone()).collect();
-    let n = residuals.iter().map(Vec::len).sum::<usize>() as f64;
+    let residuals: Vec<&[f64]> = moving.iter().map(|m| m.residual.as_slice()).collect();
+    let n = residuals.iter().map(|r| r.len()).sum::<usize>() as f64;
     if n < 10.0 {
         return Finding::new(
             Check::ResidualStructure,
@@ -194,13 +203,11 @@ pub fn residual_structure(records: &[RecordFit], osc: &Oscillator, threshold: f6
     let phi = noise_correlation(&residuals);
     let n_eff = (n * (1.0 - phi) / (1.0 + phi)).max(3.0);
     let n_eff_acf = (n * (1.0 - phi * phi) / (1.0 + phi * phi)).max(3.0);
-    let pooled = |f: fn(&Moving) -> &Vec<f64>| -> Vec<f64> {
-        moving.iter().flat_map(|m| f(m).iter().copied()).collect()
-    };
-    let all_residuals = pooled(|m| &m.residual);
     let mut stats = Vec::new();
-    for (name, series) in [("sgn(v)", pooled(|m| &m.sign)), ("x", pooled(|m| &m.x))] {
-        let rho = correlation(&all_residuals, &series);
+    let sign: fn(&Moving) -> &[f64] = |m| &m.sign;
+    let x: fn(&Moving) -> &[f64] = |m| &m.x;
+    for (name, series) in [("sgn(v)", sign), ("x", x)] {
+        let rho = pooled_correlation(&moving, |m| &m.residual, series);
         stats.push(Statistic {
             name,
             effect: rho.abs(),
@@ -226,19 +233,18 @@ pub fn residual_structure(records: &[RecordFit], osc: &Oscillator, threshold: f6
 
 /// The residual mean over whole records, relative to the residual RMS.
 fn mean_statistic(records: &[RecordFit], phi: f64) -> Statistic {
-    let residual: Vec<f64> = records
-        .iter()
-        .flat_map(|r| {
-            r.series
-                .fitted
-                .iter()
-                .zip(&r.series.measured)
-                .map(|(f, m)| f - m)
-        })
-        .collect();
-    let n = residual.len().max(1) as f64;
-    let mean = residual.iter().sum::<f64>() / n;
-    let rms = (residual.iter().map(|r| r * r).sum::<f64>() / n).sqrt();
+    let (mut count, mut sum, mut sum_sq) = (0usize, 0.0, 0.0);
+    for r in records {
+        for (f, m) in r.series.fitted.iter().zip(&r.series.measured) {
+            let residual = f - m;
+            count += 1;
+            sum += residual;
+            sum_sq += residual * residual;
+        }
+    }
+    let n = count.max(1) as f64;
+    let mean = sum / n;
+    let rms = (sum_sq / n).sqrt();
     let n_eff = (n * (1.0 - phi) / (1.0 + phi)).max(3.0);
     let effect = if rms > 0.0 { mean.abs() / rms } else { 0.0 };
     Statistic {

@@ -695,14 +695,15 @@ fn energy_check<R: Residuals + ?Sized>(
 ) -> Result<(EnergyForce, Vec<f64>, Vec<f64>), EngineError> {
     // The energy analysis sees the measured velocity corrected by the fitted offset, from the
     // fitted release displacement.
-    let mut corrected = rec.clone();
-    corrected.x0 = nuisance.x0_of(rec);
     let osc = &world.oscillator;
-    let analysis = if nuisance.offset == 0.0 {
-        // The velocity as measured: the analysis the guess made, when m, c, k and x0 are
-        // those it was made with.
-        residuals.energy_analysis(index, &corrected, osc, &opts.energy)?
+    let x0 = nuisance.x0_of(rec);
+    let analysis = if nuisance.offset == 0.0 && x0 == rec.x0 {
+        // The record as measured: the analysis the guess made, when m, c and k are those it
+        // was made with.
+        residuals.energy_analysis(index, rec, osc, &opts.energy)?
     } else {
+        let mut corrected = rec.clone();
+        corrected.x0 = x0;
         for v in corrected.velocity_mut() {
             *v -= nuisance.offset;
         }

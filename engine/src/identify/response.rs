@@ -25,6 +25,7 @@ use crate::oscillator::Oscillator;
 use crate::record::{channel_list, Channel, Record};
 use crate::simulate::{simulate, simulate_velocity, Initial, SimOptions};
 use frictionid_models::GuessHint;
+use std::borrow::Cow;
 use std::sync::Arc;
 
 /// The response channels, in the order they are stacked.
@@ -327,11 +328,13 @@ impl Residuals for VelocityResponse {
     /// Hints from the energy analysis of the velocity; a record without one lends it the
     /// differentiated displacement ([`record_motion`]).
     fn hint(&self, osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
-        let with_velocity: Vec<Record> = records
+        let with_velocity: Vec<Cow<'_, Record>> = records
             .iter()
             .map(|r| match (r.channel(Channel::Velocity), record_motion(r)) {
-                (None, Some(motion)) => r.clone().with_channel(Channel::Velocity, motion.v),
-                _ => r.clone(),
+                (None, Some(motion)) => {
+                    Cow::Owned(r.clone().with_channel(Channel::Velocity, motion.v))
+                }
+                _ => Cow::Borrowed(r),
             })
             .collect();
         // A record measured as velocity is analysed once, for the guess and the energy check

@@ -10,6 +10,7 @@ use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use frictionid_models::{FrictionModel, GuessHint, ParamInfo};
+use std::borrow::Borrow;
 
 /// Bound keys that are not model parameters: the oscillator properties, then every nuisance
 /// parameter's key.
@@ -25,14 +26,14 @@ pub fn guess_hint(osc: &Oscillator, records: &[Record], opts: &FitOptions) -> Gu
 }
 
 /// [`guess_hint`] with each record's friction level from `level` (of its index and itself).
-pub fn guess_hint_with(
+pub fn guess_hint_with<B: Borrow<Record>>(
     osc: &Oscillator,
-    records: &[Record],
+    records: &[B],
     level: impl Fn(usize, &Record) -> Option<f64>,
 ) -> GuessHint {
     let mut levels = Vec::new();
     let mut speeds = Vec::new();
-    for (index, rec) in records.iter().enumerate() {
+    for (index, rec) in records.iter().map(Borrow::borrow).enumerate() {
         if let Some(level) = level(index, rec) {
             levels.push(level);
         }
