@@ -231,7 +231,16 @@ pub fn savitzky_golay_derivative(
             Some(_) => Some(unit_weights(w, p)?),
             None => None,
         };
-        for i in seg[0]..seg[1] {
+        // Where the window is centred, every sample has the centre row: one sweep per tap.
+        let centred = (s + w / 2)..(e + w / 2 + 1 - w).max(s + w / 2);
+        let centred = match (&table, uniform_dt) {
+            (Some(table), Some(dt)) if seg[0] <= centred.start && centred.end <= seg[1] => {
+                centred_slopes(&table[w / 2], v, centred.clone(), dt, &mut out);
+                centred
+            }
+            _ => 0..0,
+        };
+        for i in (seg[0]..seg[1]).filter(|i| !centred.contains(i)) {
             let lo = i.saturating_sub(w / 2).clamp(s, e - w);
             let hi = lo + w;
             let slope = match (&table, uniform_dt) {
@@ -245,6 +254,29 @@ pub fn savitzky_golay_derivative(
         }
     }
     Ok(out)
+}
+
+/// The slopes at the samples `at` of a window centred on each, from the centre row `weights`
+/// of the unit-spacing table: out\[i\] = sum_k weights\[k\] v\[i - h + k\] / dt (h = half the
+/// window), summed tap after tap over all samples at once (contiguous sweeps the compiler
+/// vectorises; a dot product per sample took seven instructions per tap).
+fn centred_slopes(
+    weights: &[f64],
+    v: &[f64],
+    at: std::ops::Range<usize>,
+    dt: f64,
+    out: &mut [f64],
+) {
+    let h = weights.len() / 2;
+    let slopes = &mut out[at.clone()];
+    slopes.iter_mut().for_each(|x| *x = 0.0);
+    for (k, &c) in weights.iter().enumerate() {
+        let shifted = &v[at.start + k - h..at.end + k - h];
+        for (x, &vk) in slopes.iter_mut().zip(shifted) {
+            *x += c * vk;
+        }
+    }
+    slopes.iter_mut().for_each(|x| *x /= dt);
 }
 
 /// sum a_j b_j in four interleaved partial sums (independent chains the CPU overlaps; a
