@@ -7,7 +7,7 @@
 mod common;
 
 use common::{lugre_truth, records, stiff_lugre_truth, stribeck_truth, NOISE};
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use frictionid_engine::identify::{compare, fit, FitDomain, FitOptions, Search};
 use frictionid_engine::record::RecordSource;
 use frictionid_engine::{Oscillator, Record};
@@ -28,6 +28,35 @@ fn coulomb_and_compare(c: &mut Criterion) {
             )
             .expect("fit")
         })
+    });
+    // The same fit of records never fitted before: their noise levels are estimated again
+    // (a record keeps them once estimated; the setup, not timed, rebuilds the records).
+    let fresh = || -> Vec<Record> {
+        recs.iter()
+            .map(|r| {
+                Record::new(
+                    r.name.clone(),
+                    r.time().to_vec(),
+                    r.velocity().to_vec(),
+                    r.x0,
+                )
+            })
+            .collect()
+    };
+    c.bench_function("fit coulomb mu, 3 fresh FMM records", |b| {
+        b.iter_batched(
+            fresh,
+            |records| {
+                fit(
+                    &osc,
+                    black_box(&Coulomb::default()),
+                    &records,
+                    &FitOptions::default(),
+                )
+                .expect("fit")
+            },
+            BatchSize::SmallInput,
+        )
     });
     let models: Vec<Box<dyn FrictionModel>> =
         ["coulomb", "viscous_coulomb", "stribeck", "dahl", "lugre"]
