@@ -18,16 +18,17 @@ use std::path::Path;
 fn coulomb_and_compare(c: &mut Criterion) {
     let osc = Oscillator::fmm();
     let recs = records(&osc, &Coulomb { mu: 0.24 }, NOISE, 100);
+    let fit_mu = |records: &[Record]| {
+        fit(
+            &osc,
+            black_box(&Coulomb::default()),
+            records,
+            &FitOptions::default(),
+        )
+        .expect("fit")
+    };
     c.bench_function("fit coulomb mu, 3 FMM records", |b| {
-        b.iter(|| {
-            fit(
-                &osc,
-                black_box(&Coulomb::default()),
-                &recs,
-                &FitOptions::default(),
-            )
-            .expect("fit")
-        })
+        b.iter(|| fit_mu(&recs))
     });
     // The same fit of records never fitted before: their noise levels are estimated again
     // (a record keeps them once estimated; the setup, not timed, rebuilds the records).
@@ -44,19 +45,7 @@ fn coulomb_and_compare(c: &mut Criterion) {
             .collect()
     };
     c.bench_function("fit coulomb mu, 3 fresh FMM records", |b| {
-        b.iter_batched(
-            fresh,
-            |records| {
-                fit(
-                    &osc,
-                    black_box(&Coulomb::default()),
-                    &records,
-                    &FitOptions::default(),
-                )
-                .expect("fit")
-            },
-            BatchSize::SmallInput,
-        )
+        b.iter_batched(fresh, |records| fit_mu(&records), BatchSize::SmallInput)
     });
     let models: Vec<Box<dyn FrictionModel>> =
         ["coulomb", "viscous_coulomb", "stribeck", "dahl", "lugre"]

@@ -66,6 +66,9 @@ impl Pace {
     }
 }
 
+/// Nielsen's tau of the largest-diagonal damping start ([`DampingStart::LargestDiagonal`]).
+pub const LARGEST_DIAGONAL_TAU: f64 = 1e-3;
+
 /// The damping of the first iteration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum DampingStart {
@@ -145,7 +148,7 @@ impl LevenbergMarquardt {
             gtol: 1e-10,
             xtol: 1e-8,
             ftol: 1e-9,
-            damping_start: DampingStart::LargestDiagonal(1e-3),
+            damping_start: DampingStart::LargestDiagonal(LARGEST_DIAGONAL_TAU),
             max_step: f64::INFINITY,
             relative_step: Vec::new(),
             stall_tol: 1e-6,
@@ -581,7 +584,7 @@ mod tests {
         assert_eq!(pace.best(), 1.0);
     }
 
-    /// Rosenbrock with its residuals (and Jacobian) in another unit: times `0`.
+    /// Rosenbrock with its residuals (and Jacobian) in another unit: times the factor held.
     struct Scaled(f64);
     impl Operator for Scaled {
         type Param = DVector<f64>;

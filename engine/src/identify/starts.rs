@@ -2,7 +2,9 @@
 //! screening of every start and the continuation of the most promising one.
 
 use super::layout::{FreeParam, ParamKind};
-use super::lm::{termination_reason, DampingStart, LevenbergMarquardt, LmState, Pace};
+use super::lm::{
+    termination_reason, DampingStart, LevenbergMarquardt, LmState, Pace, LARGEST_DIAGONAL_TAU,
+};
 use super::options::{FitOptions, Progress, ProgressFn};
 use super::outcome::{StartOutcome, TerminationReason};
 use super::problem::FitProblem;
@@ -30,7 +32,7 @@ pub fn damping_start_for(model: &dyn FrictionModel, simulated: bool) -> DampingS
     if simulated || fits_directly(model, simulated) {
         DampingStart::Relative(RELATIVE_DAMPING)
     } else {
-        DampingStart::LargestDiagonal(1e-3)
+        DampingStart::LargestDiagonal(LARGEST_DIAGONAL_TAU)
     }
 }
 
@@ -552,7 +554,7 @@ mod tests {
         assert_eq!(damping_start_for(&LuGre::default(), true), relative);
         assert_eq!(
             damping_start_for(&LuGre::default(), false),
-            DampingStart::LargestDiagonal(1e-3)
+            DampingStart::LargestDiagonal(LARGEST_DIAGONAL_TAU)
         );
     }
 }
