@@ -8,7 +8,9 @@
 //! variances (chi²(1 dof) at 95 %, halved because the cost is half the sum of squares). A side
 //! where it rises is bounded there; the parameter is `determined` (both sides), a
 //! `lower_bound` (only values below are excluded, e.g. sigma0 on Coulomb-like records), an
-//! `upper_bound`, or `not_identifiable`.
+//! `upper_bound`, or `not_identifiable`. Each step's re-optimisation is wanted only to a
+//! twentieth of that rise ([`PROFILE_RESOLUTION`]): it stops when the Gauss-Newton step
+//! promises less.
 //!
 //! A fit that hit the iteration limit only because such a parameter kept running on is
 //! settled: the unbounded parameters are pinned where they are and the others re-optimised;
@@ -44,6 +46,11 @@ pub const PROFILE_HALVINGS: usize = 3;
 
 /// Iterations of the re-optimisation of the other parameters at each profile step.
 pub const PROFILE_ITERATIONS: u64 = 12;
+
+/// The precision a profile step's re-optimisation needs, as a fraction of the profile's
+/// cost rise: it stops when the Gauss-Newton step promises less decrease (a standing turns
+/// on the cost against the rise; the solver's own tests ask about a thousandth of it).
+pub const PROFILE_RESOLUTION: f64 = 0.05;
 
 /// Iterations of the re-optimisation at each step of the profile of a rigid limit's
 /// stiffness: the other parameters move far along it (LuGre's Stribeck levels and bristle
@@ -199,6 +206,7 @@ fn profile_all<R: Residuals + 'static>(
         best,
         opts,
         limit: open_limit,
+        resolution: PROFILE_RESOLUTION * delta,
     };
     let profile_of = |j: usize| {
         let open_above = open_limit.filter(|l| l.is_stiffness(j)).map(|l| l.cost);
@@ -439,6 +447,7 @@ fn restart_from<R: Residuals + 'static>(
         starts: 1,
         max_iterations: opts.max_iterations,
         pace: None,
+        cost_resolution: None,
     };
     let Ok(run) = run_start(problem, u, opts, slot) else {
         return false;
@@ -573,7 +582,7 @@ fn pinned_fit<R: Residuals + 'static>(
     pins: &[(usize, f64)],
     others: &DVector<f64>,
     opts: &FitOptions,
-    iterations: u64,
+    (iterations, cost_resolution): (u64, Option<f64>),
 ) -> Option<StartRun> {
     let sub = pinned_problem(reference, pins)?;
     let run = if sub.layout.is_empty() {
@@ -592,6 +601,7 @@ fn pinned_fit<R: Residuals + 'static>(
             starts: 1,
             max_iterations: iterations,
             pace: None,
+            cost_resolution,
         };
         run_start(sub, others.clone(), opts, slot).ok()?
     };
@@ -616,6 +626,8 @@ struct Profile<'a, R: Residuals> {
     /// stiffness (levels and a critically damped contact). A rejected limit leaves the
     /// stiffness an ordinary parameter.
     limit: Option<&'a Limit>,
+    /// The precision of a step's cost ([`PROFILE_RESOLUTION`] of the rise).
+    resolution: f64,
 }
 
 impl<R: Residuals + 'static> Profile<'_, R> {
@@ -685,7 +697,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
                 pins,
                 previous,
                 self.opts,
-                PROFILE_ITERATIONS,
+                (PROFILE_ITERATIONS, Some(self.resolution)),
             );
         };
         let run = |start: &DVector<f64>| {
@@ -694,7 +706,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
                 pins,
                 start,
                 self.opts,
-                LIMIT_PROFILE_ITERATIONS,
+                (LIMIT_PROFILE_ITERATIONS, Some(self.resolution)),
             )
         };
         let Some(mapped) = limit.target_at_stiffness(self.reference, self.best, (j, u)) else {
@@ -815,7 +827,7 @@ fn settle_convergence<R: Residuals + 'static>(
         return;
     }
     let others = without(&runs.best.u, &pins);
-    let Some(run) = pinned_fit(reference, &pins, &others, opts, opts.max_iterations) else {
+    let Some(run) = pinned_fit(reference, &pins, &others, opts, (opts.max_iterations, None)) else {
         return;
     };
     if !run.converged() || run.cost > runs.best.cost {

@@ -27,6 +27,12 @@ pub enum TerminationReason {
         /// Accepted steps judged.
         window: usize,
     },
+    /// The Gauss-Newton step promised less than `resolution` decrease of the cost (a run
+    /// that needs its cost only to that precision).
+    WithinResolution {
+        /// The absolute cost resolution.
+        resolution: f64,
+    },
     /// The damping grew past its limit without a decrease of the cost.
     DampingLimit,
     /// The iteration limit was reached before any convergence criterion.
@@ -78,6 +84,10 @@ impl fmt::Display for TerminationReason {
             Self::Stagnation { tolerance, window } => write!(
                 f,
                 "converged: cost changed by less than {tolerance:e} relative over {window} steps"
+            ),
+            Self::WithinResolution { resolution } => write!(
+                f,
+                "converged: the linear model promises less than {resolution:e} further decrease of the cost"
             ),
             Self::DampingLimit => {
                 f.write_str("converged: no further decrease possible (damping limit)")

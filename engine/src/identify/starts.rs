@@ -229,6 +229,10 @@ pub struct RunSlot {
     /// The costs the concurrent runs of the fit converged to (the run is abandoned when it
     /// falls behind them, and reports its own when it converges); `None`: a run on its own.
     pub pace: Option<Arc<Pace>>,
+    /// The precision its cost is wanted to (absolute; a profile step's, a fraction of the
+    /// profile's rise): it stops when the Gauss-Newton step promises less. `None`: the
+    /// solver's own convergence tests only.
+    pub cost_resolution: Option<f64>,
 }
 
 /// Runs the solver on `problem` from `u0`.
@@ -240,6 +244,7 @@ pub fn run_start<R: Residuals + 'static>(
 ) -> Result<StartRun, EngineError> {
     let mut solver = solver_for(&problem, opts);
     solver.pace = slot.pace.clone();
+    solver.cost_resolution = slot.cost_resolution;
     let model_name = problem.model.name().to_string();
     let mut exec = Executor::new(problem, solver)
         .configure(|s| s.param(u0).max_iters(slot.max_iterations))
@@ -371,6 +376,7 @@ where
             starts: n_starts,
             max_iterations: screen,
             pace: screen_pace.clone(),
+            cost_resolution: None,
         };
         run_start(problem, u0, opts, slot)
     };
@@ -438,6 +444,7 @@ fn continue_best<R, F>(
         starts: n_starts,
         max_iterations: opts.max_iterations - screen,
         pace: Some(pace.clone()),
+        cost_resolution: None,
     };
     let finish =
         |(s, u): &(usize, DVector<f64>)| (*s, run_start(make_problem(), u.clone(), opts, slot(*s)));

@@ -212,18 +212,14 @@ impl Rodas4 {
     /// Factors E = I / (gamma h) - J and sets the coupling coefficients c_ij / h; false when
     /// E is singular.
     fn factor(&mut self, h: f64) -> bool {
-        let n = self.y.len();
         let diag = 1.0 / (GAMMA * h);
-        for (ch, c) in self.c_h.iter_mut().zip(&C) {
-            for (x, &cij) in ch.iter_mut().zip(c) {
+        // Row i couples stage i + 2 to the i + 1 stages before it; the rest stay unused.
+        for (i, (ch, c)) in self.c_h.iter_mut().zip(&C).enumerate() {
+            for (x, &cij) in ch.iter_mut().zip(c).take(i + 1) {
                 *x = cij / h;
             }
         }
-        let jac = &self.jac;
-        self.lu.factor(|i, j| {
-            let d = if i == j { diag } else { 0.0 };
-            d - jac[i * n + j]
-        })
+        self.lu.factor_shifted(diag, &self.jac)
     }
 
     /// Solves E k = f(arg) + sum_j (c_sj / h) k_j for stage `s` (1-based, 2..=6) into

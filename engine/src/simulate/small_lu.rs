@@ -31,15 +31,30 @@ impl SmallLu {
         }
     }
 
-    /// Factors the matrix with entries `entry(i, j)`; whether it is invertible (no zero
-    /// pivot).
-    pub fn factor(&mut self, entry: impl Fn(usize, usize) -> f64) -> bool {
+    /// Factors E = diag I - M (`m` row-major, n x n); whether E is invertible (no zero
+    /// pivot). Off the diagonal the entries are 0 - m_ij, as a caller forming E would.
+    pub fn factor_shifted(&mut self, diag: f64, m: &[f64]) -> bool {
         let n = self.n;
-        for (idx, a) in self.lu.iter_mut().enumerate() {
-            *a = entry(idx / n, idx % n);
+        for (i, (row, m_row)) in self.lu.chunks_mut(n).zip(m.chunks(n)).enumerate() {
+            for (j, (e, &mij)) in row.iter_mut().zip(m_row).enumerate() {
+                *e = if i == j { diag } else { 0.0 } - mij;
+            }
         }
         self.swaps.clear();
-        for i in 0..n {
+        match n {
+            2 => self.eliminate_fixed::<2>(),
+            3 => self.eliminate_fixed::<3>(),
+            4 => self.eliminate_fixed::<4>(),
+            5 => self.eliminate_fixed::<5>(),
+            _ => self.eliminate(),
+        }
+        self.invertible = (0..n).all(|i| self.at(i, i) != 0.0);
+        self.invertible
+    }
+
+    /// Gaussian elimination with partial pivoting of the matrix in `lu`, in place.
+    fn eliminate(&mut self) {
+        for i in 0..self.n {
             let piv = self.pivot_row(i);
             let diag = self.at(piv, i);
             if diag == 0.0 {
@@ -52,8 +67,44 @@ impl SmallLu {
             }
             self.eliminate_below(i, diag);
         }
-        self.invertible = (0..n).all(|i| self.at(i, i) != 0.0);
-        self.invertible
+    }
+
+    /// [`SmallLu::eliminate`] for a size known when compiling: the same operations in the
+    /// same order, the loops unrolled and free of bounds checks (a stiff LuGre fit spent a
+    /// tenth of its time in the general loops).
+    fn eliminate_fixed<const N: usize>(&mut self) {
+        let lu = &mut self.lu[..N * N];
+        for i in 0..N {
+            let mut piv = i;
+            let mut largest = lu[i * N + i].abs();
+            for r in i + 1..N {
+                let size = lu[r * N + i].abs();
+                if size > largest {
+                    largest = size;
+                    piv = r;
+                }
+            }
+            let diag = lu[piv * N + i];
+            if diag == 0.0 {
+                continue;
+            }
+            if piv != i {
+                self.swaps.push((i, piv));
+                for j in 0..N {
+                    lu.swap(i * N + j, piv * N + j);
+                }
+            }
+            let inv_diag = 1.0 / diag;
+            for r in i + 1..N {
+                lu[r * N + i] *= inv_diag;
+            }
+            for k in i + 1..N {
+                let pivot_row_k = lu[i * N + k];
+                for r in i + 1..N {
+                    lu[r * N + k] -= pivot_row_k * lu[r * N + i];
+                }
+            }
+        }
     }
 
     /// Solves A x = b in place (b holds x on return); leaves b unchanged when A is singular.
@@ -64,8 +115,16 @@ impl SmallLu {
         for &(i, piv) in &self.swaps {
             b.swap(i, piv);
         }
-        self.forward_substitute(b);
-        self.back_substitute(b);
+        match self.n {
+            2 => substitute::<2>(&self.lu, b),
+            3 => substitute::<3>(&self.lu, b),
+            4 => substitute::<4>(&self.lu, b),
+            5 => substitute::<5>(&self.lu, b),
+            _ => {
+                self.forward_substitute(b);
+                self.back_substitute(b);
+            }
+        }
     }
 
     fn at(&self, i: usize, j: usize) -> f64 {
@@ -130,6 +189,26 @@ impl SmallLu {
     }
 }
 
+/// [`SmallLu::forward_substitute`] then [`SmallLu::back_substitute`] for a size known when
+/// compiling (the same operations in the same order).
+fn substitute<const N: usize>(lu: &[f64], b: &mut [f64]) {
+    let lu = &lu[..N * N];
+    let b = &mut b[..N];
+    for i in 0..N - 1 {
+        let coeff = b[i];
+        for r in i + 1..N {
+            b[r] -= coeff * lu[r * N + i];
+        }
+    }
+    for i in (0..N).rev() {
+        let coeff = b[i] / lu[i * N + i];
+        b[i] = coeff;
+        for r in 0..i {
+            b[r] -= coeff * lu[r * N + i];
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -143,6 +222,7 @@ mod tests {
     fn matches_nalgebra_lu_bit_for_bit() {
         let mut rng = StdRng::seed_from_u64(7);
         for n in 1..=12 {
+            // 2..=5 take the unrolled paths, the others the general loops.
             for trial in 0..20 {
                 let mut a: Vec<f64> = (0..n * n).map(|_| rng.random_range(-1.0..1.0)).collect();
                 if trial % 2 == 0 {
@@ -150,7 +230,9 @@ mod tests {
                 }
                 let b: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
                 let mut small = SmallLu::new(n);
-                assert!(small.factor(|i, j| a[i * n + j]));
+                // E = 0 I - M with M = -A: the matrix A itself.
+                let m: Vec<f64> = a.iter().map(|x| -x).collect();
+                assert!(small.factor_shifted(0.0, &m));
                 let mut x = b.clone();
                 small.solve(&mut x);
                 let reference = DMatrix::from_row_slice(n, n, &a).lu();
@@ -162,6 +244,6 @@ mod tests {
             }
         }
         let mut singular = SmallLu::new(2);
-        assert!(!singular.factor(|i, _| i as f64));
+        assert!(!singular.factor_shifted(0.0, &[0.0, 0.0, -1.0, -1.0]));
     }
 }
