@@ -50,7 +50,7 @@ pub const SCREEN_ITERATIONS: u64 = 15;
 /// above it is abandoned. Three (five until session 10): on the FMM fixture every start so
 /// abandoned was as far above after three iterations as after five (Dahl's from a compliant
 /// contact simulate its presliding oscillation at up to 16 ms a simulation): Dahl 1.29 ->
-/// 0.91 s, the five-model `compare` 1.91-1.93 -> 1.66-1.75 s, every result the same.
+/// 0.91 s, the five-model `compare` 1.91-1.93 -> 1.66-1.75 s, the optima the same to six digits.
 pub const SCREEN_GRACE: u64 = 3;
 
 /// Starts continued to convergence after the screening phase by a local search (the best
