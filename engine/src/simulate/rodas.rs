@@ -6,8 +6,8 @@
 //! coefficients of their code RODAS, in its transformed variables k_i = sum_j gamma_ij h f_j,
 //! which avoid multiplying by the Jacobian), with its third-order dense output. Each step
 //! factors E = I / (gamma h) - J once (LU with partial pivoting in buffers kept by the
-//! stepper, `small_lu.rs`: nalgebra's factorisation without its allocation and views per step,
-//! solves by reciprocal pivots; LuGre at sigma0 = 1e7 went from 1.02 to 0.86 ms) and
+//! stepper, `small_lu.rs`: nalgebra's operations in nalgebra's order, so the same bits, without
+//! its allocation and views per step; LuGre at sigma0 = 1e7 went from 1.02 to 0.86 ms) and
 //! solves six linear systems; the embedded error estimate is the last stage. The Jacobian comes from
 //! [`OdeSystem::jacobian`] (the model's analytic state Jacobian for the friction laws) and is
 //! evaluated once per accepted point: a rejected step reuses it.
