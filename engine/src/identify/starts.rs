@@ -47,11 +47,8 @@ pub const SCREEN_ITERATIONS: u64 = 15;
 
 /// Iterations a screened start runs before it is held to a cost the model is known to reach
 /// (the fit of the nested law it contains): one still [`super::lm::OUTPACE_FACTOR`] times
-/// above it is abandoned. Three (five until session 10): on the FMM fixture every start so
-/// abandoned was as far above after three iterations as after five (Dahl's from a compliant
-/// contact simulate its presliding oscillation at up to 16 ms a simulation): Dahl 1.29 ->
-/// 0.91 s, the five-model `compare` 1.91-1.93 -> 1.66-1.75 s, the optima the same to six digits.
-pub const SCREEN_GRACE: u64 = 3;
+/// above it is abandoned.
+pub const SCREEN_GRACE: u64 = 5;
 
 /// Starts continued to convergence after the screening phase by a local search (the best
 /// one; see `Search::promoted`).
