@@ -312,16 +312,41 @@ pub fn analyze_record(
             SeriesSource::Differentiated,
         ),
     };
-    let samples = Samples {
-        a: &a,
-        ..measured.samples(time)
-    };
     let sources = SeriesSources {
         displacement: measured.displacement,
         velocity: measured.velocity,
         acceleration,
     };
-    Ok(assemble(osc, &samples, &motion, opts, sources))
+    let series = Series {
+        time: time.to_vec(),
+        x: measured.x,
+        v: measured.v,
+        a,
+        interp: Interp::Linear,
+    };
+    Ok(assemble(osc, series, &motion, opts, sources))
+}
+
+/// The samples an analysis keeps (owned: the measured motion and the derivative are moved
+/// in, not copied) and how to interpolate between them.
+struct Series {
+    time: Vec<f64>,
+    x: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+    interp: Interp,
+}
+
+impl Series {
+    fn samples(&self) -> Samples<'_> {
+        Samples {
+            time: &self.time,
+            x: &self.x,
+            v: &self.v,
+            a: &self.a,
+            interp: self.interp,
+        }
+    }
 }
 
 /// The half-cycle energy estimate of the friction force of a measured record (the mean of
@@ -444,17 +469,25 @@ pub fn analyze_states(
         velocity: SeriesSource::Exact,
         acceleration: SeriesSource::Exact,
     };
-    Ok(assemble(osc, &samples, &motion, opts, exact))
+    let series = Series {
+        time: time.to_vec(),
+        x: x.to_vec(),
+        v: v.to_vec(),
+        a: a.to_vec(),
+        interp: Interp::Hermite,
+    };
+    Ok(assemble(osc, series, &motion, opts, exact))
 }
 
 /// Energies, Eq. 7 and the half-cycles from complete samples.
 fn assemble(
     osc: &Oscillator,
-    s: &Samples,
+    series: Series,
     motion: &Motion,
     opts: &EnergyOptions,
     sources: SeriesSources,
 ) -> EnergyAnalysis {
+    let s = &series.samples();
     let (m, c, k) = (osc.mass, osc.damping, osc.stiffness);
     let n = s.time.len();
     let mechanical = MechanicalEnergy::of(m, k, s.x, s.v);
@@ -479,11 +512,12 @@ fn assemble(
         f64::NAN
     };
     let (cycles, half_cycle_mean, half_cycle_std) = half_cycles(s, motion, osc);
+    let Series { time, x, v, a, .. } = series;
     EnergyAnalysis {
-        time: s.time.to_vec(),
-        x: s.x.to_vec(),
-        v: s.v.to_vec(),
-        a: s.a.to_vec(),
+        time,
+        x,
+        v,
+        a,
         mechanical,
         de_dt,
         friction,

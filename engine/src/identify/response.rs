@@ -134,6 +134,9 @@ impl VelocityResponse {
                 &mut sim,
             )?;
             at.record_work(index, &stats, clock.times.len());
+            if v.is_empty() {
+                return Ok(sim);
+            }
             v.extend_from_slice(&sim);
         }
         Ok(v)
@@ -190,20 +193,23 @@ impl VelocityResponse {
 
 /// Sample times of a record on the simulation clock (from the shifted release), and how
 /// many samples lie before the release.
-struct ReleaseClock {
+struct ReleaseClock<'a> {
     before: usize,
-    times: Vec<f64>,
+    times: Cow<'a, [f64]>,
 }
 
-impl ReleaseClock {
-    fn new(record: &Record, nuisance: &NuisanceValues) -> Self {
+impl<'a> ReleaseClock<'a> {
+    fn new(record: &'a Record, nuisance: &NuisanceValues) -> Self {
         let t0 = record.time().first().copied().unwrap_or(0.0);
         let release = record.release_time.unwrap_or(t0) + nuisance.shift;
         let before = record.time().partition_point(|&t| t < release);
-        let times = record.time()[before..]
-            .iter()
-            .map(|&t| t - release)
-            .collect();
+        let after = &record.time()[before..];
+        // Released at t = 0 (the common case): the record's own stamps, t - 0 = t.
+        let times = if release == 0.0 {
+            Cow::Borrowed(after)
+        } else {
+            Cow::Owned(after.iter().map(|&t| t - release).collect())
+        };
         Self { before, times }
     }
 }
@@ -330,11 +336,12 @@ impl Residuals for VelocityResponse {
     fn hint(&self, osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
         let with_velocity: Vec<Cow<'_, Record>> = records
             .iter()
-            .map(|r| match (r.channel(Channel::Velocity), record_motion(r)) {
-                (None, Some(motion)) => {
-                    Cow::Owned(r.clone().with_channel(Channel::Velocity, motion.v))
-                }
-                _ => Cow::Borrowed(r),
+            .map(|r| match r.channel(Channel::Velocity) {
+                Some(_) => Cow::Borrowed(r),
+                None => match record_motion(r) {
+                    Some(motion) => Cow::Owned(r.clone().with_channel(Channel::Velocity, motion.v)),
+                    None => Cow::Borrowed(r),
+                },
             })
             .collect();
         // A record measured as velocity is analysed once, for the guess and the energy check

@@ -9,6 +9,7 @@
 //! - [`sanity`]: units checked against the oscillator (mm/s, milliseconds, x0 in mm).
 
 pub mod channel;
+pub mod checked;
 pub mod noise;
 pub mod release;
 pub mod sanity;
@@ -53,6 +54,9 @@ pub struct Record {
     /// Noise levels estimated from the samples, each computed once.
     #[serde(skip)]
     estimated_noise: noise::NoiseCache,
+    /// The sample checks passed so far.
+    #[serde(skip)]
+    checked: checked::SampleCheck,
 }
 
 impl Record {
@@ -78,13 +82,14 @@ impl Record {
             weight: 1.0,
             release_time: None,
             estimated_noise: noise::NoiseCache::default(),
+            checked: checked::SampleCheck::default(),
         }
     }
 
     /// The record with `values` as its `channel` (replacing one already there). A
     /// [`Channel::NormalForce`] becomes the sampled [`NormalForce`].
     pub fn with_channel(mut self, channel: Channel, values: Vec<f64>) -> Self {
-        self.estimated_noise.clear();
+        self.samples_changed();
         match channel {
             Channel::NormalForce => self.normal_force = Some(NormalForce::Sampled(values)),
             other => {
@@ -131,9 +136,15 @@ impl Record {
         }
     }
 
+    /// Forgets what was worked out from the samples (noise levels, checks): they change.
+    fn samples_changed(&mut self) {
+        self.estimated_noise.clear();
+        self.checked.clear();
+    }
+
     /// The samples of `channel`, mutable, if the record has it.
     pub fn channel_mut(&mut self, channel: Channel) -> Option<&mut [f64]> {
-        self.estimated_noise.clear();
+        self.samples_changed();
         match channel {
             Channel::NormalForce => match &mut self.normal_force {
                 Some(NormalForce::Sampled(values)) => Some(values),
@@ -166,7 +177,7 @@ impl Record {
 
     /// Sets (or with `None` removes) the record's own normal force.
     pub fn set_normal_force(&mut self, normal_force: Option<NormalForce>) {
-        self.estimated_noise.clear();
+        self.samples_changed();
         self.normal_force = normal_force;
     }
 
@@ -187,6 +198,7 @@ impl Record {
             weight: self.weight,
             release_time: self.release_time,
             estimated_noise: noise::NoiseCache::default(),
+            checked: checked::SampleCheck::default(),
         }
     }
 
@@ -255,11 +267,18 @@ impl Record {
             record: self.name.clone(),
             reason,
         };
-        self.check_lengths().map_err(err)?;
-        self.check_finite().map_err(err)?;
-        self.time
-            .check(min_samples)
-            .map_err(|e| err(e.to_string()))?;
+        if self.checked.passed() {
+            self.time
+                .check_count(min_samples)
+                .map_err(|e| err(e.to_string()))?;
+        } else {
+            self.check_lengths().map_err(err)?;
+            self.check_finite().map_err(err)?;
+            self.time
+                .check(min_samples)
+                .map_err(|e| err(e.to_string()))?;
+            self.checked.pass();
+        }
         if !self.x0.is_finite() || !self.v0.is_finite() {
             return Err(err("x0 and v0 must be finite".into()));
         }
@@ -362,6 +381,27 @@ mod tests {
         assert_eq!(rec, rebuilt);
         let replaced = rec.with_channel(Channel::Velocity, v);
         assert_eq!(replaced.noise_level(Channel::Velocity), Some(level));
+    }
+
+    /// A check that passed is remembered only while the samples stay: a sample made
+    /// non-finite afterwards, or a record too short for a larger count, still fails.
+    #[test]
+    fn passed_checks_are_forgotten_when_the_samples_change() {
+        let mut rec = record();
+        assert!(rec.validate(2).is_ok());
+        assert!(rec.validate(4).is_ok());
+        assert!(rec.validate(5).is_err(), "four samples are fewer than five");
+        let twin = rec.clone();
+        rec.velocity_mut()[2] = f64::NAN;
+        let err = rec.validate(2).unwrap_err().to_string();
+        assert!(err.contains("sample 2 is not finite"), "{err}");
+        assert!(twin.validate(4).is_ok());
+        let bad_time = Record::new("r", vec![0.0, 0.2, 0.1, 0.3], vec![0.0; 4], 0.0);
+        assert!(bad_time.validate(2).is_err());
+        assert!(
+            bad_time.validate(2).is_err(),
+            "a failed check is not remembered"
+        );
     }
 
     fn record() -> Record {

@@ -19,9 +19,13 @@ pub const RESPONSE_ORDER: usize = 3;
 /// Robust white-noise standard deviation of `values` from their `order`-th differences (see
 /// the module docs); 0 when there are too few samples.
 pub fn difference_noise(values: &[f64], order: usize) -> f64 {
+    // The k-th differences in place, one order after the other.
     let mut d = values.to_vec();
-    for _ in 0..order {
-        d = d.windows(2).map(|w| w[1] - w[0]).collect();
+    for _ in 0..order.min(d.len()) {
+        for i in 0..d.len() - 1 {
+            d[i] = d[i + 1] - d[i];
+        }
+        d.pop();
     }
     if d.is_empty() {
         return 0.0;

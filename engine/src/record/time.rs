@@ -56,13 +56,19 @@ fn check_order(time: &[f64], strict: bool) -> Result<(), TimeError> {
 
 /// Checks [`check_time`] and that there are at least `min_samples` samples.
 pub fn check_time_base(time: &[f64], min_samples: usize) -> Result<(), TimeError> {
+    check_count(time, min_samples)?;
+    check_time(time)
+}
+
+/// Checks that there are at least `min_samples` time stamps.
+pub fn check_count(time: &[f64], min_samples: usize) -> Result<(), TimeError> {
     if time.len() < min_samples {
         return Err(TimeError::TooFew {
             found: time.len(),
             needed: min_samples,
         });
     }
-    check_time(time)
+    Ok(())
 }
 
 /// The time stamps of a record \[s\]: finite and strictly increasing (see [`TimeBase::new`]).
@@ -103,6 +109,11 @@ impl TimeBase {
     /// Checks the stamps and that there are at least `min_samples` of them.
     pub fn check(&self, min_samples: usize) -> Result<(), TimeError> {
         check_time_base(&self.samples, min_samples)
+    }
+
+    /// Checks only that there are at least `min_samples` stamps (see [`check_count`]).
+    pub fn check_count(&self, min_samples: usize) -> Result<(), TimeError> {
+        check_count(&self.samples, min_samples)
     }
 
     /// The samples from index `first` on (none if `first` is past the end).
