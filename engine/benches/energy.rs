@@ -2,6 +2,11 @@
 //! turning points and half-cycles) of a 2000-sample FMM record with vibrometer-like noise,
 //! and the model force along it.
 
+/// mimalloc, as the `frictionid` binary and the Python module use (see the README's performance
+/// section: glibc's malloc returned and refaulted the fits' buffers, a sixth of a Coulomb fit).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};

@@ -3,6 +3,11 @@
 //! (sigma0 = 1e7) records. Records: the acceptance set-up of the tests (releases of 10, 14
 //! and 22 mm, 2 s at 1 kHz, 0.2 mm/s noise).
 
+/// mimalloc, as the `frictionid` binary and the Python module use (see the README's performance
+/// section: glibc's malloc returned and refaulted the fits' buffers, a sixth of a Coulomb fit).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 #[path = "../tests/common/mod.rs"]
 mod common;
 

@@ -4,6 +4,11 @@
 //! (sigma0 = 1e7 N/m). The RHS counts are printed once per case (stderr) for the README's
 //! performance table.
 
+/// mimalloc, as the `frictionid` binary and the Python module use (see the README's performance
+/// section: glibc's malloc returned and refaulted the fits' buffers, a sixth of a Coulomb fit).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use frictionid_engine::synthetic::uniform_times;
 use frictionid_engine::{simulate, Initial, Integrator, Oscillator, SimOptions};

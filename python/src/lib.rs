@@ -11,6 +11,11 @@
 //! - [`errors`]: `ValueError` for bad input, `frictionid.FitError` for a failed fit.
 //! - [`api`]: the module's functions.
 
+/// mimalloc, as the `frictionid` binary uses: glibc's malloc gave the fits' buffers back to
+/// the system and faulted them in again at every evaluation (a sixth of a Coulomb fit).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 pub mod api;
 pub mod convert;
 pub mod errors;
