@@ -577,18 +577,26 @@ mod tests {
     fn race_rosenbrock_after(best: f64, grace: u64) -> (u64, TerminationReason) {
         let pace = Arc::new(Pace::with_grace(grace));
         pace.converged_at(best);
+        let (state, reason) = rosenbrock_with(|solver| solver.pace = Some(pace));
+        (state.get_iter(), reason)
+    }
+
+    /// Rosenbrock from (-1.2, 1), unbounded, by a default solver that `configure` adjusts.
+    fn rosenbrock_with(
+        configure: impl FnOnce(&mut LevenbergMarquardt),
+    ) -> (LmState, TerminationReason) {
         let inf = f64::INFINITY;
         let mut solver = LevenbergMarquardt::new(
             DVector::from_vec(vec![-inf; 2]),
             DVector::from_vec(vec![inf; 2]),
         );
-        solver.pace = Some(pace);
+        configure(&mut solver);
         let res = Executor::new(Rosenbrock, solver)
             .configure(|s| s.param(DVector::from_vec(vec![-1.2, 1.0])).max_iters(500))
             .run()
             .unwrap();
         let reason = termination_reason(&res.solver, &res.state().termination_status, 500);
-        (res.state().get_iter(), reason)
+        (res.state().clone(), reason)
     }
 
     #[test]
@@ -681,24 +689,15 @@ mod tests {
         let inf = f64::INFINITY;
         let (full, _) = run(Rosenbrock, vec![-1.2, 1.0], vec![-inf; 2], vec![inf; 2]);
         let resolution = 1e-4;
-        let mut solver = LevenbergMarquardt::new(
-            DVector::from_vec(vec![-inf; 2]),
-            DVector::from_vec(vec![inf; 2]),
-        );
-        solver.cost_resolution = Some(resolution);
-        let res = Executor::new(Rosenbrock, solver)
-            .configure(|s| s.param(DVector::from_vec(vec![-1.2, 1.0])).max_iters(500))
-            .run()
-            .unwrap();
-        let reason = termination_reason(&res.solver, &res.state().termination_status, 500);
+        let (state, reason) = rosenbrock_with(|solver| solver.cost_resolution = Some(resolution));
         assert_eq!(reason, TerminationReason::WithinResolution { resolution });
         assert!(reason.is_converged());
-        let cost = res.state().get_best_cost();
+        let cost = state.get_best_cost();
         assert!(cost < 2.0 * resolution, "{cost}");
         assert!(
-            res.state().get_iter() < full.get_iter(),
+            state.get_iter() < full.get_iter(),
             "{} vs {}",
-            res.state().get_iter(),
+            state.get_iter(),
             full.get_iter()
         );
     }
