@@ -274,14 +274,9 @@ where
             self.converged = Some(TerminationReason::GradientBelowTolerance);
             return Ok((state.param(p).cost(self.cost), None));
         }
-        if let Some(resolution) = self.cost_resolution {
-            if self
-                .gauss_newton_gain(&p, &normal)
-                .is_some_and(|gain| gain < resolution)
-            {
-                self.converged = Some(TerminationReason::WithinResolution { resolution });
-                return Ok((state.param(p).cost(self.cost), None));
-            }
+        if let Some(resolution) = self.resolved(&p, &normal) {
+            self.converged = Some(TerminationReason::WithinResolution { resolution });
+            return Ok((state.param(p).cost(self.cost), None));
         }
         let Some(delta) = self.damped_step(&p, &normal) else {
             self.raise_damping();
@@ -412,6 +407,13 @@ impl LevenbergMarquardt {
             delta /= over;
         }
         Some(delta)
+    }
+
+    /// The cost resolution, when the Gauss-Newton step at `p` promises less decrease.
+    fn resolved(&self, p: &DVector<f64>, normal: &NormalEquations) -> Option<f64> {
+        let resolution = self.cost_resolution?;
+        let gain = self.gauss_newton_gain(p, normal)?;
+        (gain < resolution).then_some(resolution)
     }
 
     /// The decrease of the cost the linear model predicts for the Gauss-Newton step (damping
