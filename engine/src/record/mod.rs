@@ -51,12 +51,34 @@ pub struct Record {
     /// before it. `None`: the record starts at release.
     #[serde(default)]
     pub release_time: Option<f64>,
+    /// What was worked out from the samples (noise levels, checks), kept until they change.
+    #[serde(skip)]
+    derived: SampleFacts,
+}
+
+/// What is worked out from a record's samples and kept until they change: clones carry it
+/// (they have the same samples), equality and serialisation ignore it (bookkeeping, not
+/// data), and every change of the samples forgets it ([`Record::samples_changed`]).
+#[derive(Debug, Default, Clone)]
+struct SampleFacts {
     /// Noise levels estimated from the samples, each computed once.
-    #[serde(skip)]
-    estimated_noise: noise::NoiseCache,
-    /// The sample checks passed so far.
-    #[serde(skip)]
+    noise: noise::NoiseCache,
+    /// Whether the samples passed their checks.
     checked: checked::SampleCheck,
+}
+
+impl SampleFacts {
+    fn clear(&mut self) {
+        self.noise.clear();
+        self.checked.clear();
+    }
+}
+
+impl PartialEq for SampleFacts {
+    /// Records are equal whatever they remember.
+    fn eq(&self, _other: &Self) -> bool {
+        true
+    }
 }
 
 impl Record {
@@ -81,8 +103,7 @@ impl Record {
             v0: 0.0,
             weight: 1.0,
             release_time: None,
-            estimated_noise: noise::NoiseCache::default(),
-            checked: checked::SampleCheck::default(),
+            derived: SampleFacts::default(),
         }
     }
 
@@ -138,8 +159,7 @@ impl Record {
 
     /// Forgets what was worked out from the samples (noise levels, checks): they change.
     fn samples_changed(&mut self) {
-        self.estimated_noise.clear();
-        self.checked.clear();
+        self.derived.clear();
     }
 
     /// The samples of `channel`, mutable, if the record has it.
@@ -197,8 +217,7 @@ impl Record {
             v0: self.v0,
             weight: self.weight,
             release_time: self.release_time,
-            estimated_noise: noise::NoiseCache::default(),
-            checked: checked::SampleCheck::default(),
+            derived: SampleFacts::default(),
         }
     }
 
@@ -229,7 +248,8 @@ impl Record {
     pub fn difference_noise(&self, channel: Channel, order: usize) -> Option<f64> {
         let values = self.channel(channel)?;
         Some(
-            self.estimated_noise
+            self.derived
+                .noise
                 .get_or(channel, order, || noise::difference_noise(values, order)),
         )
     }
@@ -267,7 +287,7 @@ impl Record {
             record: self.name.clone(),
             reason,
         };
-        if self.checked.passed() {
+        if self.derived.checked.passed() {
             self.time
                 .check_count(min_samples)
                 .map_err(|e| err(e.to_string()))?;
@@ -277,7 +297,7 @@ impl Record {
             self.time
                 .check(min_samples)
                 .map_err(|e| err(e.to_string()))?;
-            self.checked.pass();
+            self.derived.checked.pass();
         }
         if !self.x0.is_finite() || !self.v0.is_finite() {
             return Err(err("x0 and v0 must be finite".into()));
@@ -315,12 +335,11 @@ impl Record {
         let time = self.time();
         let v = self.velocity();
         let finite = |i: usize| time[i].is_finite() && v.get(i).is_none_or(|x| x.is_finite());
-        // The common case first, in one pass the compiler can vectorise.
+        // The common case first, in one pass the compiler can vectorise; the search for the
+        // offending sample only when there is one.
         let all_finite = time.iter().chain(v).all(|x| x.is_finite());
-        if let Some(i) = (!all_finite)
-            .then(|| (0..time.len()).find(|&i| !finite(i)))
-            .flatten()
-        {
+        let offending = || (0..time.len()).find(|&i| !finite(i));
+        if let Some(i) = if all_finite { None } else { offending() } {
             return Err(match v.get(i) {
                 Some(vi) => format!("sample {i} is not finite (t = {}, v = {vi})", time[i]),
                 None => format!("time stamp {i} is not finite (t = {})", time[i]),

@@ -87,6 +87,10 @@ fn from_order_key(key: u64) -> f64 {
     })
 }
 
+/// The [`difference_noise`] of a record's channels, each order computed once (a fit asks
+/// for a record's velocity noise a dozen times: weights, the guess, the turning points, the
+/// energy check). One of the facts a record derives from its samples (`SampleFacts`), not
+/// part of its value.
 #[derive(Debug, Default)]
 pub struct NoiseCache(std::sync::Mutex<BTreeMap<(Channel, usize), f64>>);
 
@@ -122,13 +126,6 @@ impl Clone for NoiseCache {
         Self(std::sync::Mutex::new(
             self.levels().map(|l| l.clone()).unwrap_or_default(),
         ))
-    }
-}
-
-impl PartialEq for NoiseCache {
-    /// A cache never makes two records differ.
-    fn eq(&self, _other: &Self) -> bool {
-        true
     }
 }
 

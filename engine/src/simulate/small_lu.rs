@@ -41,70 +41,19 @@ impl SmallLu {
             }
         }
         self.swaps.clear();
+        let (lu, swaps) = (&mut self.lu, &mut self.swaps);
+        // A size known when compiling unrolls the loops and drops the bounds checks (a stiff
+        // LuGre fit spent a tenth of its time in the general loops); the operations and their
+        // order are the same for every size.
         match n {
-            2 => self.eliminate_fixed::<2>(),
-            3 => self.eliminate_fixed::<3>(),
-            4 => self.eliminate_fixed::<4>(),
-            5 => self.eliminate_fixed::<5>(),
-            _ => self.eliminate(),
+            2 => eliminate(lu, 2, swaps),
+            3 => eliminate(lu, 3, swaps),
+            4 => eliminate(lu, 4, swaps),
+            5 => eliminate(lu, 5, swaps),
+            _ => eliminate(lu, n, swaps),
         }
-        self.invertible = (0..n).all(|i| self.at(i, i) != 0.0);
+        self.invertible = (0..n).all(|i| self.lu[i * n + i] != 0.0);
         self.invertible
-    }
-
-    /// Gaussian elimination with partial pivoting of the matrix in `lu`, in place.
-    fn eliminate(&mut self) {
-        for i in 0..self.n {
-            let piv = self.pivot_row(i);
-            let diag = self.at(piv, i);
-            if diag == 0.0 {
-                // A zero column below the diagonal: nothing to eliminate.
-                continue;
-            }
-            if piv != i {
-                self.swaps.push((i, piv));
-                self.swap_rows(i, piv);
-            }
-            self.eliminate_below(i, diag);
-        }
-    }
-
-    /// [`SmallLu::eliminate`] for a size known when compiling: the same operations in the
-    /// same order, the loops unrolled and free of bounds checks (a stiff LuGre fit spent a
-    /// tenth of its time in the general loops).
-    fn eliminate_fixed<const N: usize>(&mut self) {
-        let lu = &mut self.lu[..N * N];
-        for i in 0..N {
-            let mut piv = i;
-            let mut largest = lu[i * N + i].abs();
-            for r in i + 1..N {
-                let size = lu[r * N + i].abs();
-                if size > largest {
-                    largest = size;
-                    piv = r;
-                }
-            }
-            let diag = lu[piv * N + i];
-            if diag == 0.0 {
-                continue;
-            }
-            if piv != i {
-                self.swaps.push((i, piv));
-                for j in 0..N {
-                    lu.swap(i * N + j, piv * N + j);
-                }
-            }
-            let inv_diag = 1.0 / diag;
-            for r in i + 1..N {
-                lu[r * N + i] *= inv_diag;
-            }
-            for k in i + 1..N {
-                let pivot_row_k = lu[i * N + k];
-                for r in i + 1..N {
-                    lu[r * N + k] -= pivot_row_k * lu[r * N + i];
-                }
-            }
-        }
     }
 
     /// Solves A x = b in place (b holds x on return); leaves b unchanged when A is singular.
@@ -116,95 +65,73 @@ impl SmallLu {
             b.swap(i, piv);
         }
         match self.n {
-            2 => substitute::<2>(&self.lu, b),
-            3 => substitute::<3>(&self.lu, b),
-            4 => substitute::<4>(&self.lu, b),
-            5 => substitute::<5>(&self.lu, b),
-            _ => {
-                self.forward_substitute(b);
-                self.back_substitute(b);
-            }
+            2 => substitute(&self.lu, 2, b),
+            3 => substitute(&self.lu, 3, b),
+            4 => substitute(&self.lu, 4, b),
+            5 => substitute(&self.lu, 5, b),
+            n => substitute(&self.lu, n, b),
         }
     }
+}
 
-    fn at(&self, i: usize, j: usize) -> f64 {
-        self.lu[i * self.n + j]
-    }
-
-    /// The first row at or below `i` with the largest |a| in column `i`.
-    fn pivot_row(&self, i: usize) -> usize {
-        let mut best = i;
-        let mut largest = self.at(i, i).abs();
-        for r in i + 1..self.n {
-            let size = self.at(r, i).abs();
+/// Gaussian elimination with partial pivoting of the n x n matrix `lu` (row-major), in
+/// place, recording the row swaps: for each column the first row with the largest |a| at or
+/// below the diagonal, the column below scaled by the pivot's reciprocal, then the rank-one
+/// update column by column.
+#[inline(always)]
+fn eliminate(lu: &mut [f64], n: usize, swaps: &mut Vec<(usize, usize)>) {
+    let lu = &mut lu[..n * n];
+    for i in 0..n {
+        let mut piv = i;
+        let mut largest = lu[i * n + i].abs();
+        for r in i + 1..n {
+            let size = lu[r * n + i].abs();
             if size > largest {
                 largest = size;
-                best = r;
+                piv = r;
             }
         }
-        best
-    }
-
-    fn swap_rows(&mut self, i: usize, piv: usize) {
-        let n = self.n;
-        for j in 0..n {
-            self.lu.swap(i * n + j, piv * n + j);
+        let diag = lu[piv * n + i];
+        if diag == 0.0 {
+            // A zero column below the diagonal: nothing to eliminate.
+            continue;
         }
-    }
-
-    /// One step of Gaussian elimination below the pivot `diag` at (i, i).
-    fn eliminate_below(&mut self, i: usize, diag: f64) {
-        let n = self.n;
+        if piv != i {
+            swaps.push((i, piv));
+            for j in 0..n {
+                lu.swap(i * n + j, piv * n + j);
+            }
+        }
         let inv_diag = 1.0 / diag;
         for r in i + 1..n {
-            self.lu[r * n + i] *= inv_diag;
+            lu[r * n + i] *= inv_diag;
         }
         for k in i + 1..n {
-            let pivot_row_k = self.lu[i * n + k];
+            let pivot_row_k = lu[i * n + k];
             for r in i + 1..n {
-                self.lu[r * n + k] -= pivot_row_k * self.lu[r * n + i];
-            }
-        }
-    }
-
-    /// Solves L y = b (unit lower triangle) in place.
-    fn forward_substitute(&self, b: &mut [f64]) {
-        for i in 0..self.n.saturating_sub(1) {
-            let coeff = b[i];
-            for (r, br) in b.iter_mut().enumerate().skip(i + 1) {
-                *br -= coeff * self.at(r, i);
-            }
-        }
-    }
-
-    /// Solves U x = y in place.
-    fn back_substitute(&self, b: &mut [f64]) {
-        for i in (0..self.n).rev() {
-            let coeff = b[i] / self.at(i, i);
-            b[i] = coeff;
-            for (r, br) in b.iter_mut().enumerate().take(i) {
-                *br -= coeff * self.at(r, i);
+                lu[r * n + k] -= pivot_row_k * lu[r * n + i];
             }
         }
     }
 }
 
-/// [`SmallLu::forward_substitute`] then [`SmallLu::back_substitute`] for a size known when
-/// compiling (the same operations in the same order).
-fn substitute<const N: usize>(lu: &[f64], b: &mut [f64]) {
-    let lu = &lu[..N * N];
-    let b = &mut b[..N];
-    for i in 0..N - 1 {
+/// Solves L y = b (unit lower triangle) and then U x = y, in place, with the n x n factors
+/// `lu`.
+#[inline(always)]
+fn substitute(lu: &[f64], n: usize, b: &mut [f64]) {
+    let lu = &lu[..n * n];
+    let b = &mut b[..n];
+    for i in 0..n.saturating_sub(1) {
         let coeff = b[i];
-        for r in i + 1..N {
-            b[r] -= coeff * lu[r * N + i];
+        for r in i + 1..n {
+            b[r] -= coeff * lu[r * n + i];
         }
     }
-    for i in (0..N).rev() {
-        let coeff = b[i] / lu[i * N + i];
+    for i in (0..n).rev() {
+        let coeff = b[i] / lu[i * n + i];
         b[i] = coeff;
         for r in 0..i {
-            b[r] -= coeff * lu[r * N + i];
+            b[r] -= coeff * lu[r * n + i];
         }
     }
 }
