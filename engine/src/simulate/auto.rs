@@ -181,6 +181,21 @@ mod tests {
         assert!(ratio(makkar(4.5e5).as_ref()) > STIFF_RATIO);
     }
 
+    /// Dahl's force reaches its Coulomb level in finite time when alpha < 1 (|r|^alpha is not
+    /// Lipschitz at r = 0), and an explicit method chatters about it there: the estimate at
+    /// the sliding state picks Rodas4 for such a law at a rest stiffness where the linear
+    /// hysteresis (alpha = 1, the same slope at every state) stays with Dopri5.
+    #[test]
+    fn a_dahl_law_that_saturates_in_finite_time_is_stiff_where_it_slides() {
+        let dahl =
+            |alpha: f64| model(serde_json::json!({"type": "dahl", "sigma0": 3e4, "alpha": alpha}));
+        assert!(ratio(dahl(1.0).as_ref()) < STIFF_RATIO);
+        for alpha in [0.5, 0.8, 0.95] {
+            let r = ratio(dahl(alpha).as_ref());
+            assert!(r > STIFF_RATIO, "alpha {alpha}: {r}");
+        }
+    }
+
     /// GMS elements have no stiffness while relaxed (the rate's slope vanishes at z = 0 for a
     /// sharpness above 1) and much when loaded: the estimate at the steady sliding states
     /// picks Rodas4 for the default law (Dopri5 took 66 000 RHS on the FMM release, Rodas4

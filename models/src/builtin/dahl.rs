@@ -128,6 +128,17 @@ impl FrictionModel for Dahl {
     fn steady_state(&self, v: f64, normal: f64) -> f64 {
         self.mu_c * normal * sgn(v)
     }
+    /// Steady sliding: the force at its Coulomb level, F = mu_c N sgn(v) (r = 0). For alpha < 1
+    /// the rate's slope is unbounded there and the force reaches the level in finite time: an
+    /// explicit method chatters about it (Dopri5 took 26 000 steps for the FMM release at
+    /// sigma0 1e5, alpha 0.8, against Rodas4's 1 000), so the stiffness estimate looks here.
+    fn sliding_states(&self, v: f64, normal: f64, out: &mut [f64]) -> bool {
+        let Some(f) = out.first_mut() else {
+            return false;
+        };
+        *f = self.mu_c * normal * sgn(v);
+        true
+    }
     fn stored_energy(&self, z: &[f64], _normal: f64) -> f64 {
         let f = z.first().copied().unwrap_or(0.0);
         f * f / (2.0 * self.sigma0)
