@@ -60,6 +60,9 @@ impl Comparison {
     }
 }
 
+/// A model's name and its fit.
+type ModelFit = (String, Result<FitResult, EngineError>);
+
 /// Fits every model in `models` to `records` (in parallel when `opts.parallel`) and ranks
 /// them by AIC. Each model is fitted with `opts` (its free list, bounds and initial values
 /// apply only to parameters the model has; others are ignored).
@@ -73,7 +76,7 @@ pub fn compare(
     if models.is_empty() {
         return Err(EngineError::InvalidInput("no models to compare".into()));
     }
-    let run = |m: &(dyn FrictionModel + 'static)| -> (String, Result<FitResult, EngineError>) {
+    let run = |m: &(dyn FrictionModel + 'static)| -> ModelFit {
         let names: Vec<String> = m.param_info().into_iter().map(|p| p.name).collect();
         let mut o = opts.clone();
         o.free = opts
@@ -86,8 +89,14 @@ pub fn compare(
         o.keep_initial.retain(|k| names.contains(k));
         (m.name().to_string(), fit(osc, m, records, &o))
     };
-    let results: Vec<(String, Result<FitResult, EngineError>)> = if opts.parallel {
-        models.par_iter().map(|m| run(m.as_ref())).collect()
+    let results: Vec<ModelFit> = if opts.parallel {
+        let order = heaviest_first(models);
+        let mut done: Vec<(usize, ModelFit)> = order
+            .par_iter()
+            .map(|&i| (i, run(models[i].as_ref())))
+            .collect();
+        done.sort_by_key(|(i, _)| *i);
+        done.into_iter().map(|(_, r)| r).collect()
     } else {
         models.iter().map(|m| run(m.as_ref())).collect()
     };
@@ -112,6 +121,18 @@ pub fn compare(
         warnings,
         wall_time_s: clock.elapsed().as_secs_f64(),
     })
+}
+
+/// The models' indices, the likely longest fit first (more internal states, then more
+/// parameters): rayon starts the first items first, so the long dynamic fits do not wait
+/// behind the short static ones and the short ones fill the cores at the end.
+fn heaviest_first(models: &[Box<dyn FrictionModel>]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..models.len()).collect();
+    order.sort_by_key(|&i| {
+        let m = &models[i];
+        std::cmp::Reverse((m.n_states(), m.params().len()))
+    });
+    order
 }
 
 /// Sets every fit's delta AIC, Akaike weight and whether it is indistinguishable from the
@@ -185,4 +206,27 @@ fn comparison_warnings(ranking: &[FitResult], failed: &[FailedFit]) -> Vec<Strin
         .iter()
         .map(|f| format!("model `{}` could not be fitted: {}", f.model, f.error));
     unconverged.chain(failures).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use frictionid_models::default_model;
+
+    #[test]
+    fn the_dynamic_fits_start_first_and_the_single_parameter_laws_last() {
+        let names = ["coulomb", "viscous_coulomb", "stribeck", "dahl", "lugre"];
+        let models: Vec<Box<dyn FrictionModel>> = names
+            .iter()
+            .map(|n| default_model(n).expect("a registered model"))
+            .collect();
+        let order: Vec<&str> = heaviest_first(&models)
+            .into_iter()
+            .map(|i| names[i])
+            .collect();
+        assert_eq!(
+            order,
+            ["lugre", "dahl", "stribeck", "viscous_coulomb", "coulomb"]
+        );
+    }
 }
