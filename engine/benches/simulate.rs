@@ -147,5 +147,38 @@ fn paper_140mm(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, fmm_models, fmm_stiff, paper_140mm);
+/// Dahl with alpha < 1, whose force reaches its Coulomb level in finite time (session 11):
+/// the explicit method chatters there, and `auto` (the fits' choice) now takes Rodas4.
+fn fmm_saturating_dahl(c: &mut Criterion) {
+    let osc = Oscillator::fmm();
+    let times = uniform_times(2.0, 1000.0);
+    let mut group = c.benchmark_group("fmm_22mm_2s_1kHz_dahl_alpha_0.8");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(3));
+    let json = serde_json::json!({ "type": "dahl", "sigma0": 1e5, "mu_c": 0.35, "alpha": 0.8 });
+    let Ok(built) = frictionid_models::build_json(&json) else {
+        return;
+    };
+    let model = built.model;
+    for (label, integrator) in [("auto", Integrator::Auto), ("dopri5", Integrator::Dopri5)] {
+        let opts = SimOptions {
+            integrator,
+            ..SimOptions::default()
+        };
+        let rhs = run(&osc, model.as_ref(), 0.022, 2.0, &times, &opts);
+        eprintln!("fmm_22mm_2s_1kHz_dahl_alpha_0.8/{label}: {rhs} RHS evaluations");
+        group.bench_function(label, |b| {
+            b.iter(|| run(&osc, model.as_ref(), black_box(0.022), 2.0, &times, &opts))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    fmm_models,
+    fmm_stiff,
+    fmm_saturating_dahl,
+    paper_140mm
+);
 criterion_main!(benches);
