@@ -250,8 +250,8 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
     /// The internal states of steady sliding at velocity `v` (written into `out`, length
     /// `n_states`), where the law states them; `false` (the default) when it does not. The
     /// engine's `auto` integrator choice looks for stiffness there as well as at the initial
-    /// states: a law whose states are soft when relaxed and stiff when loaded (GMS) would
-    /// otherwise be given the explicit method. The harness (`testing::check_sliding_states`)
+    /// states: a law whose states are soft when relaxed and stiff when loaded (GMS, Dahl with
+    /// alpha < 1) would otherwise be given the explicit method. The harness (`testing::check_sliding_states`)
     /// requires dz/dt = 0 and the steady-state force there.
     fn sliding_states(&self, _v: f64, _normal: f64, _out: &mut [f64]) -> bool {
         false

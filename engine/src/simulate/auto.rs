@@ -6,7 +6,8 @@
 //! representative sliding state (x = 0, v = the larger of |v0| and omega_n |x0|, the initial
 //! internal states, and the law's steady sliding states where it states them:
 //! `FrictionModel::sliding_states`; GMS elements are soft when relaxed and stiff when
-//! loaded), times the step Dopri5 takes for accuracy on a free vibration at the
+//! loaded, and Dahl's rate with alpha < 1 has an unbounded slope where its force reaches its
+//! level), times the step Dopri5 takes for accuracy on a free vibration at the
 //! default tolerances (about T_n / 100). Dopri5's stability region reaches about 3.3 along
 //! the negative real axis: beyond that its steps are set by stability, not accuracy, and its
 //! cost grows with the ratio, while Rodas4 (a few times the cost per step, no stability
