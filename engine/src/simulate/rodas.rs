@@ -211,7 +211,8 @@ impl Rodas4 {
 
     /// Factors E = I / (gamma h) - J and sets the coupling coefficients c_ij / h; false when
     /// E is singular.
-    fn factor(&mut self, h: f64) -> bool {
+    #[inline(always)]
+    fn factor(&mut self, h: f64, n: usize) -> bool {
         let diag = 1.0 / (GAMMA * h);
         // Row i couples stage i + 2 to the i + 1 stages before it; the rest stay unused.
         for (i, (ch, c)) in self.c_h.iter_mut().zip(&C).enumerate() {
@@ -219,21 +220,22 @@ impl Rodas4 {
                 *x = cij / h;
             }
         }
-        self.lu.factor_shifted(diag, &self.jac)
+        self.lu.factor_shifted(diag, &self.jac[..n * n])
     }
 
     /// Solves E k = f(arg) + sum_j (c_sj / h) k_j for stage `s` (1-based, 2..=6) into
     /// k[s-1], where `arg` is in `y_new` (f at the step's start time: the system is
-    /// autonomous).
-    fn stage<S: OdeSystem>(&mut self, system: &S, s: usize) {
-        system.rhs(self.ctrl.t, &self.y_new, &mut self.dy);
+    /// autonomous). `n` is the dimension (see [`Rodas4::step`]).
+    #[inline(always)]
+    fn stage<S: OdeSystem>(&mut self, system: &S, s: usize, n: usize) {
+        system.rhs(self.ctrl.t, &self.y_new[..n], &mut self.dy[..n]);
         self.counts.rhs_evaluations += 1;
         let coupling = &self.c_h[s - 2][..s - 1];
         let (done, todo) = self.k.split_at_mut(s - 1);
-        let out = &mut todo[0];
-        out.copy_from_slice(&self.dy);
+        let out = &mut todo[0][..n];
+        out.copy_from_slice(&self.dy[..n]);
         for (kj, &c) in done.iter().zip(coupling) {
-            for (o, &kv) in out.iter_mut().zip(kj) {
+            for (o, &kv) in out.iter_mut().zip(&kj[..n]) {
                 *o += c * kv;
             }
         }
@@ -241,10 +243,12 @@ impl Rodas4 {
     }
 
     /// Writes y + sum_j a_j k_j (stage argument from row `row` of A) into `y_new`.
-    fn stage_argument(&mut self, row: usize) {
-        self.y_new.copy_from_slice(&self.y);
+    #[inline(always)]
+    fn stage_argument(&mut self, row: usize, n: usize) {
+        let y_new = &mut self.y_new[..n];
+        y_new.copy_from_slice(&self.y[..n]);
         for (kj, &aj) in self.k.iter().zip(&A[row]).take(row + 1) {
-            for (yn, &kv) in self.y_new.iter_mut().zip(kj) {
+            for (yn, &kv) in y_new.iter_mut().zip(&kj[..n]) {
                 *yn += aj * kv;
             }
         }
@@ -252,30 +256,35 @@ impl Rodas4 {
 
     /// The six stages; leaves the solution in `y_new` and the error estimate in k[5].
     /// Returns false when E is singular.
-    fn stages<S: OdeSystem>(&mut self, system: &S, h: f64) -> bool {
-        if !self.factor(h) {
+    #[inline(always)]
+    fn stages<S: OdeSystem>(&mut self, system: &S, h: f64, n: usize) -> bool {
+        if !self.factor(h, n) {
             return false;
         }
-        self.k[0].copy_from_slice(&self.fx);
-        self.lu.solve(&mut self.k[0]);
+        let k0 = &mut self.k[0][..n];
+        k0.copy_from_slice(&self.fx[..n]);
+        self.lu.solve(k0);
         for s in 2..=5 {
-            self.stage_argument(s - 2);
-            self.stage(system, s);
+            self.stage_argument(s - 2, n);
+            self.stage(system, s, n);
         }
         // Stiffly accurate: stage 6 is evaluated at the 5th stage's solution.
-        for (yn, &k5) in self.y_new.iter_mut().zip(&self.k[4]) {
+        for (yn, &k5) in self.y_new[..n].iter_mut().zip(&self.k[4][..n]) {
             *yn += k5;
         }
-        self.stage(system, 6);
-        for (yn, &k6) in self.y_new.iter_mut().zip(&self.k[5]) {
+        self.stage(system, 6, n);
+        for (yn, &k6) in self.y_new[..n].iter_mut().zip(&self.k[5][..n]) {
             *yn += k6;
         }
         true
     }
 
     /// The RMS norm of the error estimate k_6.
-    fn error_norm(&self) -> f64 {
-        self.ctrl.tol.rms_norm(&self.y, &self.y_new, &self.k[5])
+    #[inline(always)]
+    fn error_norm(&self, n: usize) -> f64 {
+        self.ctrl
+            .tol
+            .rms_norm(&self.y[..n], &self.y_new[..n], &self.k[5][..n])
     }
 
     /// The step-size factor h / h_new for error `err`, growing at most `max_growth` times.
@@ -318,14 +327,16 @@ impl Rodas4 {
     }
 
     /// Stores the dense output of the accepted step of size `h` and moves to its end.
-    fn accept(&mut self, h: f64) {
+    #[inline(always)]
+    fn accept(&mut self, h: f64, n: usize) {
         let [c0, c1, c2, c3] = &mut self.cont;
-        for i in 0..self.y.len() {
+        let (c2, c3) = (&mut c2[..n], &mut c3[..n]);
+        for i in 0..n {
             c2[i] = D[0].iter().zip(&self.k).map(|(&d, k)| d * k[i]).sum();
             c3[i] = D[1].iter().zip(&self.k).map(|(&d, k)| d * k[i]).sum();
         }
-        c0.copy_from_slice(&self.y);
-        c1.copy_from_slice(&self.y_new);
+        c0[..n].copy_from_slice(&self.y[..n]);
+        c1[..n].copy_from_slice(&self.y_new[..n]);
         std::mem::swap(&mut self.y, &mut self.y_new);
         self.ctrl.advance(h);
         if self.ctrl.reached {
@@ -364,15 +375,41 @@ impl Stepper for Rodas4 {
         Ok(())
     }
 
+    /// One attempt. The common sizes (a bristle or Dahl model: 3 components; a few GMS
+    /// elements: 4, 5) get a copy of the step with the size known when compiling: the loops
+    /// over components unroll and the copies of 24-byte states stop calling `memcpy` (a
+    /// stiff LuGre fit spent a fifth of its time in that overhead). The operations and their
+    /// order are those of every size, so the results are the same to the bit.
     fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome> {
+        match self.y.len() {
+            2 => self.step_sized(system, 2),
+            3 => self.step_sized(system, 3),
+            4 => self.step_sized(system, 4),
+            5 => self.step_sized(system, 5),
+            n => self.step_sized(system, n),
+        }
+    }
+
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        match self.y.len().min(out.len()) {
+            3 => self.interpolate_sized(t, out, 3),
+            n => self.interpolate_sized(t, out, n),
+        }
+    }
+}
+
+impl Rodas4 {
+    /// One attempt of a step of the system of dimension `n` (see [`Rodas4::step`]).
+    #[inline(always)]
+    fn step_sized<S: OdeSystem>(&mut self, system: &S, n: usize) -> StepResult<StepOutcome> {
         let h = self.ctrl.next_attempt()?;
         if self.stale {
             self.refresh(system);
         }
-        if !self.stages(system, h) {
+        if !self.stages(system, h, n) {
             return Ok(self.reject(h, 0.5 * h));
         }
-        let err = self.error_norm();
+        let err = self.error_norm(n);
         let within = err <= 1.0;
         if !within {
             return Ok(self.reject(h, h / Self::shrink(err, MAX_GROWTH)));
@@ -380,15 +417,18 @@ impl Stepper for Rodas4 {
         self.ctrl.h = self.next_after_accept(h, err);
         self.ctrl.after_reject = false;
         self.counts.accepted += 1;
-        self.accept(h);
+        self.accept(h, n);
         Ok(StepOutcome::Accepted)
     }
 
-    fn interpolate(&self, t: f64, out: &mut [f64]) {
+    /// The dense output at `t` into the first `n` components of `out`.
+    #[inline(always)]
+    fn interpolate_sized(&self, t: f64, out: &mut [f64], n: usize) {
         let s = self.ctrl.fraction_of_last_step(t);
         let s1 = 1.0 - s;
         let [c0, c1, c2, c3] = &self.cont;
-        for (i, o) in out.iter_mut().enumerate() {
+        let (c0, c1, c2, c3) = (&c0[..n], &c1[..n], &c2[..n], &c3[..n]);
+        for (i, o) in out[..n].iter_mut().enumerate() {
             *o = c0[i] * s1 + s * (c1[i] + s1 * (c2[i] + s * c3[i]));
         }
     }

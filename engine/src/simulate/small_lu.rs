@@ -33,30 +33,45 @@ impl SmallLu {
 
     /// Factors E = diag I - M (`m` row-major, n x n); whether E is invertible (no zero
     /// pivot). Off the diagonal the entries are 0 - m_ij, as a caller forming E would.
+    /// Inlined, dispatching on `m`'s length: a caller whose slice has a size known when
+    /// compiling gets the unrolled elimination of that size (a stiff LuGre fit spent a tenth
+    /// of its time in the general loops); the operations and their order are the same for
+    /// every size.
+    #[inline(always)]
     pub fn factor_shifted(&mut self, diag: f64, m: &[f64]) -> bool {
-        let n = self.n;
-        for (i, (row, m_row)) in self.lu.chunks_mut(n).zip(m.chunks(n)).enumerate() {
+        match m.len() {
+            4 => self.factor_sized(diag, m, 2),
+            9 => self.factor_sized(diag, m, 3),
+            16 => self.factor_sized(diag, m, 4),
+            25 => self.factor_sized(diag, m, 5),
+            _ => self.factor_sized(diag, m, self.n),
+        }
+    }
+
+    /// [`SmallLu::factor_shifted`] for an `n` x `n` matrix (not invertible when the sizes of
+    /// `m` and the factors differ from it).
+    #[inline(always)]
+    fn factor_sized(&mut self, diag: f64, m: &[f64], n: usize) -> bool {
+        self.swaps.clear();
+        self.invertible = false;
+        if n == 0 || n != self.n || m.len() != n * n {
+            return false;
+        }
+        let lu = &mut self.lu[..n * n];
+        for (i, (row, m_row)) in lu.chunks_exact_mut(n).zip(m.chunks_exact(n)).enumerate() {
             for (j, (e, &mij)) in row.iter_mut().zip(m_row).enumerate() {
                 *e = if i == j { diag } else { 0.0 } - mij;
             }
         }
-        self.swaps.clear();
-        let (lu, swaps) = (&mut self.lu, &mut self.swaps);
-        // A size known when compiling unrolls the loops and drops the bounds checks (a stiff
-        // LuGre fit spent a tenth of its time in the general loops); the operations and their
-        // order are the same for every size.
-        match n {
-            2 => eliminate(lu, 2, swaps),
-            3 => eliminate(lu, 3, swaps),
-            4 => eliminate(lu, 4, swaps),
-            5 => eliminate(lu, 5, swaps),
-            _ => eliminate(lu, n, swaps),
-        }
-        self.invertible = (0..n).all(|i| self.lu[i * n + i] != 0.0);
+        eliminate(lu, n, &mut self.swaps);
+        self.invertible = (0..n).all(|i| lu[i * n + i] != 0.0);
         self.invertible
     }
 
     /// Solves A x = b in place (b holds x on return); leaves b unchanged when A is singular.
+    /// Inlined, dispatching on `b`'s length: a caller whose slice has a size known when
+    /// compiling gets the unrolled substitution of that size.
+    #[inline(always)]
     pub fn solve(&self, b: &mut [f64]) {
         if !self.invertible || b.len() != self.n {
             return;
@@ -64,7 +79,7 @@ impl SmallLu {
         for &(i, piv) in &self.swaps {
             b.swap(i, piv);
         }
-        match self.n {
+        match b.len() {
             2 => substitute(&self.lu, 2, b),
             3 => substitute(&self.lu, 3, b),
             4 => substitute(&self.lu, 4, b),
