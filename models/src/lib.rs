@@ -18,8 +18,8 @@ pub mod testing;
 pub use builtin::*;
 pub use error::ModelError;
 pub use model::{
-    check_bounds, check_len, clone_model, decay, sgn, FrictionModel, GuessHint, ParamInfo,
-    RigidLimit,
+    check_bounds, check_len, clone_model, decay, sgn, FrictionModel, GuessHint, Linearisation,
+    ParamInfo, RigidLimit,
 };
 pub use params::{DeclaredParams, ParamSpec};
 pub use registry::{build_json, build_toml, default_model, listings, names, Built, ModelListing};

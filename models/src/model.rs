@@ -236,6 +236,19 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
         finite_difference_velocity_derivative(self, v, z, normal, out);
     }
 
+    /// The three partial derivatives a stiff step needs at (v, z), in one call:
+    /// [`state_jacobian`](FrictionModel::state_jacobian) into `out.dz_dz`,
+    /// [`state_velocity_derivative`](FrictionModel::state_velocity_derivative) into
+    /// `out.dz_dv`, [`force_gradient`](FrictionModel::force_gradient)'s dF/dz into `out.df_dz`
+    /// and its dF/dv returned. A law whose derivatives share terms (LuGre's Stribeck
+    /// exponential) computes them once; the results must equal the three calls bit for bit
+    /// (checked by `testing::check_combined_linearisation`).
+    fn linearisation(&self, v: f64, z: &[f64], normal: f64, out: Linearisation<'_>) -> f64 {
+        self.state_jacobian(v, z, normal, out.dz_dz);
+        self.state_velocity_derivative(v, z, normal, out.dz_dv);
+        self.force_gradient(v, z, normal, out.df_dz)
+    }
+
     /// For static laws that are affine in the velocity within a sliding mode: `(a, b)` such
     /// that `slip_force(v, direction, N) = a + b v` for every v in that mode (e.g. coulomb:
     /// (direction mu N, 0); viscous_coulomb: (direction mu N, c_v)). The engine may then solve
@@ -416,6 +429,17 @@ pub fn check_len(model: &str, expected: usize, got: usize) -> Result<(), ModelEr
             got,
         })
     }
+}
+
+/// Where [`FrictionModel::linearisation`] writes (n_states x n_states row-major, then
+/// n_states and n_states entries).
+pub struct Linearisation<'a> {
+    /// d(dz_i)/dz_j, row-major.
+    pub dz_dz: &'a mut [f64],
+    /// d(dz_i)/dv.
+    pub dz_dv: &'a mut [f64],
+    /// dF/dz_j.
+    pub df_dz: &'a mut [f64],
 }
 
 /// exp(-x) for x >= 0, without calling `exp` where the result is 0 anyway (x > 745.2: below

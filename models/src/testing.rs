@@ -22,7 +22,7 @@
 pub mod motion;
 
 use crate::error::ModelError;
-use crate::model::FrictionModel;
+use crate::model::{FrictionModel, Linearisation};
 use crate::registry::{build_json, build_toml, default_model, names};
 use crate::ParamInfo;
 use thiserror::Error;
@@ -70,6 +70,9 @@ pub enum Check {
     ForceOnlyParams,
     /// `state_derivative_and_force` equals `state_derivative` and `force`, bit for bit.
     CombinedRhs,
+    /// `linearisation` equals `state_jacobian`, `state_velocity_derivative` and
+    /// `force_gradient`, bit for bit.
+    CombinedLinearisation,
     /// Stated sliding states are a fixed point of the states with the steady-state force.
     SlidingStates,
     /// (motion) The simulator completes every release.
@@ -131,6 +134,7 @@ pub fn check_model(model: &Model) -> Outcome {
     check_stored_energy(model)?;
     check_force_only_params(model)?;
     check_combined_rhs(model)?;
+    check_combined_linearisation(model)?;
     check_sliding_states(model)
 }
 
@@ -488,6 +492,41 @@ pub fn check_combined_rhs(model: &Model) -> Outcome {
     })
 }
 
+/// [`Check::CombinedLinearisation`]: at every probe point the one-call derivatives equal the
+/// three separate calls, bit for bit (a stiff step's Jacobian, and so every trajectory, must
+/// not depend on which the engine calls).
+pub fn check_combined_linearisation(model: &Model) -> Outcome {
+    let n = model.n_states();
+    for_each_probe(model, |v, z, normal| {
+        let (mut dz_dz, mut dz_dv, mut df_dz) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
+        model.state_jacobian(v, z, normal, &mut dz_dz);
+        model.state_velocity_derivative(v, z, normal, &mut dz_dv);
+        let df_dv = model.force_gradient(v, z, normal, &mut df_dz);
+        let separate = [dz_dz, dz_dv, df_dz, vec![df_dv]];
+        let (mut dz_dz, mut dz_dv, mut df_dz) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
+        let out = Linearisation {
+            dz_dz: &mut dz_dz,
+            dz_dv: &mut dz_dv,
+            df_dz: &mut df_dz,
+        };
+        let df_dv = model.linearisation(v, z, normal, out);
+        let combined = [dz_dz, dz_dv, df_dz, vec![df_dv]];
+        let bits = |parts: &[Vec<f64>; 4]| -> Vec<u64> {
+            parts.iter().flatten().map(|x| x.to_bits()).collect()
+        };
+        ensure(
+            model,
+            Check::CombinedLinearisation,
+            bits(&combined) == bits(&separate),
+            || {
+                format!(
+                "at v = {v}, z = {z:?}, N = {normal}: one call gives [dz/dz, dz/dv, dF/dz, dF/dv] {combined:?}; separate {separate:?}"
+            )
+            },
+        )
+    })
+}
+
 /// [`Check::SlidingStates`]: where the law states its steady sliding states, at sliding
 /// speeds of both signs dz/dt vanishes (to 1e-9 of |v| per state) and the force is the
 /// steady-state force (to 1e-9 relative).
@@ -688,6 +727,10 @@ mod tests {
             self.0.state_derivative(v, z, normal, dz);
             self.0.sigma0 * z[0] + self.0.sigma2 * v
         }
+        fn linearisation(&self, v: f64, z: &[f64], normal: f64, out: Linearisation<'_>) -> f64 {
+            self.0.linearisation(v, z, normal, out);
+            self.0.sigma2
+        }
         crate::declared_param_methods!(
             name: "testing_rs_forgetful_lugre",
             equation: "",
@@ -712,6 +755,22 @@ mod tests {
         assert_eq!(check_combined_rhs(&LuGre::default()), Ok(()));
         let e = check_combined_rhs(&ForgetfulLuGre::default()).unwrap_err();
         assert_eq!(e.check, Check::CombinedRhs);
+        assert!(e.message.contains("one call gives"), "{e}");
+    }
+
+    /// LuGre's one-call derivatives share the Stribeck exponential and give the three calls'
+    /// bits; a one-call dF/dv that forgets the bristle damping is caught.
+    #[test]
+    fn one_call_derivatives_that_differ_from_the_three_calls_are_caught() {
+        for sigma0 in [1e5, 1e7, 1e9] {
+            let lugre = LuGre {
+                sigma0,
+                ..LuGre::default()
+            };
+            assert_eq!(check_combined_linearisation(&lugre), Ok(()));
+        }
+        let e = check_combined_linearisation(&ForgetfulLuGre::default()).unwrap_err();
+        assert_eq!(e.check, Check::CombinedLinearisation);
         assert!(e.message.contains("one call gives"), "{e}");
     }
 

@@ -10,16 +10,17 @@
 //!
 //! dh/dz is the model's `state_jacobian`, dF/dv and dF/dz its `force_gradient` and dh/dv its
 //! `state_velocity_derivative` (analytic for the built-in dynamic models, finite differences
-//! by default). For static laws only the 2 x 2 mechanics remain, with d(slip_force)/dv taken
+//! by default), all three from one call of its `linearisation`. For static laws only the 2 x 2 mechanics remain, with d(slip_force)/dv taken
 //! by finite differences.
 
 use super::{Dynamics, Law};
 use frictionid_models::model::velocity_step;
+use frictionid_models::Linearisation;
 
 impl Dynamics<'_> {
     /// Writes the Jacobian of [`Dynamics::rhs`] at `y` in slip direction `dir`, row-major,
     /// into `jac` (len(y)^2 entries). Allocates nothing beyond what the model's derivative
-    /// methods do.
+    /// methods do, up to [`STACK_STATES`] internal states.
     pub fn jacobian(&self, y: &[f64], dir: f64, jac: &mut [f64]) {
         let n = y.len();
         let ([_, v, z @ ..], true) = (y, jac.len() == n * n) else {
@@ -54,33 +55,49 @@ impl Dynamics<'_> {
     /// Fills rows 1 (dF/dz, scaled by -1/m) and 2.. (dh/dv, dh/dz) of a dynamic model; rows
     /// 0 and the first two entries of row 1 are left for the caller. Returns dF/dv.
     ///
-    /// Scratch-free: the model's dense n_z x n_z state Jacobian is written into the head of
-    /// `jac` and moved into its block from the last entry backwards (each entry moves to a
-    /// higher index, so nothing unread is overwritten); dh/dv goes through row 0's tail.
+    /// One call of the model's `linearisation` (LuGre shares its Stribeck exponential between
+    /// the three derivatives) into scratch on the stack for up to [`STACK_STATES`] states (a
+    /// heap buffer beyond), then each entry into its block.
     fn state_blocks(&self, v: f64, z: &[f64], jac: &mut [f64]) -> f64 {
         let nz = z.len();
         let n = nz + 2;
-        self.model
-            .state_jacobian(v, z, self.normal, &mut jac[..nz * nz]);
-        for idx in (0..nz * nz).rev() {
-            let (i, j) = (idx / nz, idx % nz);
-            jac[(2 + i) * n + 2 + j] = jac[idx];
-        }
-        self.model
-            .state_velocity_derivative(v, z, self.normal, &mut jac[2..n]);
+        let need = nz * nz + 2 * nz;
+        let mut stack = [0.0; STACK_SCRATCH];
+        let mut heap = Vec::new();
+        let scratch = if need <= STACK_SCRATCH {
+            &mut stack[..need]
+        } else {
+            heap.resize(need, 0.0);
+            &mut heap[..]
+        };
+        let (dz_dz, rest) = scratch.split_at_mut(nz * nz);
+        let (dz_dv, df_dz) = rest.split_at_mut(nz);
+        let out = Linearisation {
+            dz_dz,
+            dz_dv,
+            df_dz,
+        };
+        let df_dv = self.model.linearisation(v, z, self.normal, out);
+        let (dz_dz, rest) = scratch.split_at(nz * nz);
+        let (dz_dv, df_dz) = rest.split_at(nz);
         for i in 0..nz {
-            jac[(2 + i) * n + 1] = jac[2 + i];
-            jac[(2 + i) * n] = 0.0;
+            let row = &mut jac[(2 + i) * n..(3 + i) * n];
+            row[0] = 0.0;
+            row[1] = dz_dv[i];
+            row[2..].copy_from_slice(&dz_dz[i * nz..(i + 1) * nz]);
         }
-        let df_dv = self
-            .model
-            .force_gradient(v, z, self.normal, &mut jac[n + 2..2 * n]);
-        for d in &mut jac[n + 2..2 * n] {
-            *d /= -self.mass;
+        for (d, &f) in jac[n + 2..2 * n].iter_mut().zip(df_dz) {
+            *d = f / -self.mass;
         }
         df_dv
     }
 }
+
+/// States whose derivatives fit the stack scratch of [`Dynamics::jacobian`] (7: 49 + 14 entries).
+const STACK_STATES: usize = 7;
+
+/// Entries of that scratch.
+const STACK_SCRATCH: usize = STACK_STATES * STACK_STATES + 2 * STACK_STATES;
 
 #[cfg(test)]
 mod tests {

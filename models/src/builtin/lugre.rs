@@ -19,7 +19,7 @@
 
 use crate::builtin::stribeck::{mu_s_warning, Stribeck};
 use crate::error::ModelError;
-use crate::model::{check_bounds, decay, sgn, FrictionModel, GuessHint, RigidLimit};
+use crate::model::{check_bounds, decay, sgn, FrictionModel, GuessHint, Linearisation, RigidLimit};
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
 crate::declare_params! {
@@ -43,12 +43,18 @@ impl LuGre {
 
     /// The partial derivatives (d/dz, d/dv) of dz/dt; (0, 0) without normal load.
     fn z_dot_partials(&self, v: f64, z: f64, normal: f64) -> (f64, f64) {
-        let g = self.g(v, normal);
+        let r = v / self.v_s;
+        self.z_dot_partials_with(v, z, normal, decay(r * r))
+    }
+
+    /// [`LuGre::z_dot_partials`] with the Stribeck exponential exp(-(v/v_s)^2) given.
+    fn z_dot_partials_with(&self, v: f64, z: f64, normal: f64, stribeck: f64) -> (f64, f64) {
+        let g = normal * (self.mu_c + (self.mu_s - self.mu_c) * stribeck);
         if g <= 0.0 {
             return (0.0, 0.0);
         }
         let r = v / self.v_s;
-        let dg = normal * (self.mu_s - self.mu_c) * decay(r * r) * (-2.0 * r / self.v_s);
+        let dg = normal * (self.mu_s - self.mu_c) * stribeck * (-2.0 * r / self.v_s);
         let d_ratio = (sgn(v) * g - v.abs() * dg) / (g * g);
         (-self.sigma0 * v.abs() / g, 1.0 - self.sigma0 * z * d_ratio)
     }
@@ -117,6 +123,29 @@ impl FrictionModel for LuGre {
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
         let z0 = z.first().copied().unwrap_or(0.0);
         self.force_at(v, z0, self.z_dot(v, z0, normal))
+    }
+    /// The Stribeck exponential once for the three derivatives (it was five of the eleven
+    /// exponentials of a Rodas4 step).
+    fn linearisation(&self, v: f64, z: &[f64], normal: f64, out: Linearisation<'_>) -> f64 {
+        let z0 = z.first().copied().unwrap_or(0.0);
+        let r = v / self.v_s;
+        let stribeck = decay(r * r);
+        let (dz_dz, dz_dv) = self.z_dot_partials_with(v, z0, normal, stribeck);
+        if let Some(j) = out.dz_dz.first_mut() {
+            let g = normal * (self.mu_c + (self.mu_s - self.mu_c) * stribeck);
+            *j = if g > 0.0 {
+                -self.sigma0 * v.abs() / g
+            } else {
+                0.0
+            };
+        }
+        if let Some(o) = out.dz_dv.first_mut() {
+            *o = dz_dv;
+        }
+        if let Some(d) = out.df_dz.first_mut() {
+            *d = self.sigma0 + self.sigma1 * dz_dz;
+        }
+        self.sigma1 * dz_dv + self.sigma2
     }
     /// dz/dt once for both (it holds the Stribeck level's exponential).
     fn state_derivative_and_force(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) -> f64 {
