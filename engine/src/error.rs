@@ -56,6 +56,13 @@ pub enum IntegrationFailure {
         /// Start of the step holding the event [s].
         time: f64,
     },
+    /// The caller's watch of the samples stopped the run (a record of a fit's evaluation
+    /// whose outcome no longer matters: a record before it failed).
+    #[error("stopped by the caller's watch of the samples")]
+    Halted {
+        /// Time reached [s].
+        time: f64,
+    },
 }
 
 impl IntegrationFailure {
@@ -67,7 +74,8 @@ impl IntegrationFailure {
             | Self::NonFiniteState { time, .. }
             | Self::EventBudgetExceeded { time, .. }
             | Self::ClosedFormUnavailable { time }
-            | Self::EventNotLocated { time } => *time,
+            | Self::EventNotLocated { time }
+            | Self::Halted { time } => *time,
         }
     }
 }

@@ -3,7 +3,9 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use frictionid_engine::error::IntegrationFailure;
 use frictionid_engine::exact::coulomb_free_vibration;
+use frictionid_engine::simulate::{simulate_velocity_watched, VelocityRun};
 use frictionid_engine::synthetic::uniform_times;
 use frictionid_engine::{
     simulate, simulate_velocity, EngineError, EventKind, Initial, Integrator, Oscillator,
@@ -401,6 +403,49 @@ fn velocity_only_variant_matches_the_full_trajectory() {
         assert_eq!(buf, full.v, "{name}");
         assert_eq!(stats, full.stats, "{name}");
     }
+}
+
+/// A watch that stops a run halts it after the step where it said so, with the samples
+/// written so far those of the unwatched run; a watch that never stops changes nothing.
+#[test]
+fn a_watched_run_stops_when_its_watch_says_so() {
+    let times = uniform_times(2.0, 1000.0);
+    let osc = Oscillator::fmm();
+    let model = default_model("lugre").unwrap();
+    let init = Initial::at_rest(0.022);
+    let opts = SimOptions::default();
+    let mut full = Vec::new();
+    let stats =
+        simulate_velocity(&osc, model.as_ref(), &init, 2.0, &times, &opts, &mut full).unwrap();
+    let run_watched = |stop_after: usize, v_out: &mut Vec<f64>| {
+        let mut seen = 0;
+        let mut watch = |fresh: &[f64]| {
+            seen += fresh.len();
+            seen >= stop_after
+        };
+        let run = VelocityRun {
+            sample_times: &times,
+            v_out,
+            watch: &mut watch,
+        };
+        simulate_velocity_watched(&osc, model.as_ref(), &init, 2.0, &opts, run)
+    };
+    let mut unstopped = Vec::new();
+    assert_eq!(run_watched(usize::MAX, &mut unstopped).unwrap(), stats);
+    assert_eq!(unstopped, full);
+    let mut stopped = Vec::new();
+    let err = run_watched(500, &mut stopped).unwrap_err();
+    let EngineError::Integration(IntegrationFailure::Halted { time }) = err else {
+        panic!("expected a halted run, got {err}");
+    };
+    // Stopped within a step of the 500th sample (t = 0.499 s).
+    assert!((0.49..0.6).contains(&time), "halted at t = {time}");
+    assert!(
+        stopped.len() >= 500 && stopped.len() < 600,
+        "{}",
+        stopped.len()
+    );
+    assert_eq!(stopped[..], full[..stopped.len()]);
 }
 
 fn integration_time(e: EngineError) -> f64 {

@@ -9,7 +9,7 @@
 use super::layout::{FreeParam, ParamKind};
 use super::residuals::{Evaluation, NuisanceValues, RecordCase, Residuals, VelocityResponse};
 use super::work::WorkBudget;
-use crate::error::EngineError;
+use crate::error::{EngineError, IntegrationFailure};
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use crate::simulate::SimOptions;
@@ -17,7 +17,7 @@ use argmin::core::{Error, Jacobian, Operator};
 use frictionid_models::FrictionModel;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 pub use super::residuals::STEPS_PER_SAMPLE;
@@ -199,14 +199,26 @@ impl<R: Residuals> FitProblem<R> {
     /// Weighted residuals of every record at physical parameters `p`, concatenated.
     pub fn residuals_at(&self, p: &[f64]) -> Result<DVector<f64>, EngineError> {
         let world = self.realise(p)?;
-        let at = self.evaluation(&world);
+        // The lowest index of a record that failed: the evaluation reports the first error
+        // in record order, so a later record's simulation is stopped (or not started) once
+        // an earlier one failed (a trial point too stiff for the work budget costs one
+        // record's failure instead of three); the outcome is the same.
+        let failed = AtomicUsize::new(usize::MAX);
+        let at = self.evaluation(&world).with_failures(&failed);
         let run = |r: usize| -> Result<Vec<f64>, EngineError> {
+            if at.superseded(r) {
+                return Err(IntegrationFailure::Halted { time: 0.0 }.into());
+            }
             let case = RecordCase {
                 index: r,
                 record: &self.records[r],
                 nuisance: &world.nuisance[r],
             };
-            self.residuals.residuals(&at, case)
+            let residuals = self.residuals.residuals(&at, case);
+            if residuals.is_err() {
+                failed.fetch_min(r, Ordering::Relaxed);
+            }
+            residuals
         };
         let parts: Vec<Result<Vec<f64>, EngineError>> =
             if self.worth_threads() && self.records.len() > 1 {
@@ -357,5 +369,90 @@ impl<R: Residuals> Jacobian for FitProblem<R> {
             .and_then(|c| c.as_ref().filter(|(cu, _)| cu == u).map(|(_, r)| r.clone()));
         let r0 = cached.unwrap_or_else(|| self.residuals_or_nan(u));
         Ok(self.jacobian_internal(u, &r0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exact::coulomb_free_vibration;
+    use crate::record::{Channel, TimeBase};
+    use crate::simulate::Integrator;
+    use frictionid_models::LuGre;
+
+    /// Three velocity records of the exact Coulomb motion (mu 0.24) released from 10, 14 and
+    /// 22 mm, 1 s at 1 kHz.
+    fn coulomb_records(osc: &Oscillator) -> Vec<Record> {
+        let time: Vec<f64> = (0..1000).map(|i| i as f64 * 1e-3).collect();
+        [0.010, 0.014, 0.022]
+            .iter()
+            .map(|&x0| {
+                let exact =
+                    coulomb_free_vibration(osc, 0.24 * osc.normal_force, x0, &time).unwrap();
+                let mut r = Record::from_time_base(
+                    format!("{} mm", x0 * 1e3),
+                    TimeBase::new(time.clone()).unwrap(),
+                )
+                .with_channel(Channel::Velocity, exact.v);
+                r.x0 = x0;
+                r
+            })
+            .collect()
+    }
+
+    /// LuGre's sigma0 free (log), Dopri5 forced, records evaluated one after the other.
+    fn stiffness_problem(records: Arc<[Record]>) -> FitProblem {
+        let model = LuGre {
+            sigma0: 1e5,
+            mu_c: 0.24,
+            mu_s: 0.24,
+            ..LuGre::default()
+        };
+        let residuals =
+            Arc::new(VelocityResponse::for_records(&records, false, false, false).unwrap());
+        let sigma0 = FreeParam {
+            log: true,
+            ..FreeParam::linear(
+                "sigma0".into(),
+                "N/m",
+                ParamKind::Model(0),
+                (1.0, 1e12),
+                1e5,
+                1e5,
+            )
+        };
+        FitProblem::new(
+            residuals,
+            ProblemParts {
+                oscillator: Oscillator::fmm(),
+                model: Box::new(model),
+                records,
+                layout: vec![sigma0],
+                sim: SimOptions {
+                    integrator: Integrator::Dopri5,
+                    ..SimOptions::default()
+                },
+                parallel: false,
+            },
+        )
+    }
+
+    /// Once a record's simulation fails, the records after it in the same evaluation are not
+    /// simulated (their outcome no longer matters): the first evaluation, at a soft contact,
+    /// sets each record's work budget, and a trial at a contact a thousand times stiffer
+    /// (stability-bound for Dopri5, far over the budget) fails on the first record and costs
+    /// that one simulation, not three. The error is the one the first record alone gives.
+    #[test]
+    fn an_evaluation_stops_at_the_first_record_that_fails() {
+        let records = coulomb_records(&Oscillator::fmm());
+        let problem = stiffness_problem(records.clone().into());
+        let soft = problem.residuals_at(&[1e5]).unwrap();
+        assert!(soft.iter().all(|r| r.is_finite()));
+        assert_eq!(problem.simulations(), 3);
+        let err = problem.residuals_at(&[1e8]).unwrap_err().to_string();
+        assert_eq!(problem.simulations(), 4, "{err}");
+        let alone = stiffness_problem(records[..1].to_vec().into());
+        alone.residuals_at(&[1e5]).unwrap();
+        assert_eq!(err, alone.residuals_at(&[1e8]).unwrap_err().to_string());
     }
 }

@@ -18,7 +18,7 @@ use crate::record::Record;
 use crate::simulate::{SimOptions, SimStats};
 use frictionid_models::{FrictionModel, GuessHint};
 use serde::{Deserialize, Serialize};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::Arc;
 
 pub use super::response::VelocityResponse;
@@ -167,6 +167,7 @@ pub struct Evaluation<'a> {
     pub sim: &'a SimOptions,
     simulations: &'a AtomicU64,
     work: Option<&'a WorkBudget>,
+    failed: Option<&'a AtomicUsize>,
 }
 
 impl<'a> Evaluation<'a> {
@@ -183,7 +184,27 @@ impl<'a> Evaluation<'a> {
             sim,
             simulations,
             work: None,
+            failed: None,
         }
+    }
+
+    /// The same, within an evaluation of several records that notes the lowest index of a
+    /// record that failed in `failed` (`usize::MAX`: none).
+    pub fn with_failures(self, failed: &'a AtomicUsize) -> Self {
+        Self {
+            failed: Some(failed),
+            ..self
+        }
+    }
+
+    /// Whether record `index` no longer matters to the evaluation: a record before it failed
+    /// (whose error the evaluation reports whatever the later records do), and its work
+    /// budget is set (a record's first simulation, which sets it, always runs in full).
+    pub fn superseded(&self, index: usize) -> bool {
+        let failed_before = self
+            .failed
+            .is_some_and(|f| f.load(Ordering::Relaxed) < index);
+        failed_before && self.work.is_some_and(|w| w.cap(index, 1).is_some())
     }
 
     /// The same, with simulations held to `work` ([`super::work`]).

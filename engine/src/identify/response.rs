@@ -23,7 +23,7 @@ use crate::energy::{record_motion, EnergyAnalysis, EnergyOptions};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::{channel_list, Channel, Record};
-use crate::simulate::{simulate, simulate_velocity, Initial, SimOptions};
+use crate::simulate::{simulate, simulate_velocity_watched, Initial, SimOptions, VelocityRun};
 use frictionid_models::GuessHint;
 use std::borrow::Cow;
 use std::sync::Arc;
@@ -124,15 +124,14 @@ impl VelocityResponse {
             let mut sim = Vec::with_capacity(clock.times.len());
             let init = initial(record, nuisance);
             let opts = budgeted(at, index, record, clock.times.len());
-            let stats = simulate_velocity(
-                at.oscillator,
-                at.model,
-                &init,
-                t_end,
-                &clock.times,
-                &opts,
-                &mut sim,
-            )?;
+            let mut superseded = |_: &[f64]| at.superseded(index);
+            let run = VelocityRun {
+                sample_times: &clock.times,
+                v_out: &mut sim,
+                watch: &mut superseded,
+            };
+            let stats =
+                simulate_velocity_watched(at.oscillator, at.model, &init, t_end, &opts, run)?;
             at.record_work(index, &stats, clock.times.len());
             if v.is_empty() {
                 return Ok(sim);

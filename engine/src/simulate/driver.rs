@@ -134,6 +134,12 @@ impl<R: Recorder> Driver<'_, R> {
             if stepper.step(segment)? == StepOutcome::Rejected {
                 continue;
             }
+            if self.rec.halted() {
+                return Err(IntegrationFailure::Halted {
+                    time: stepper.previous_time(),
+                }
+                .into());
+            }
             if stepper.state().iter().any(|v| !v.is_finite()) {
                 return Err(IntegrationFailure::NonFiniteState {
                     time: stepper.time(),

@@ -306,9 +306,48 @@ pub fn simulate_velocity(
     opts: &SimOptions,
     v_out: &mut Vec<f64>,
 ) -> Result<SimStats, EngineError> {
+    let mut no_watch = |_: &[f64]| false;
+    let velocity = VelocityRun {
+        sample_times,
+        v_out,
+        watch: &mut no_watch,
+    };
+    simulate_velocity_watched(osc, model, init, t_end, opts, velocity)
+}
+
+/// Where [`simulate_velocity_watched`] writes, and who watches.
+pub struct VelocityRun<'a> {
+    /// The sample times.
+    pub sample_times: &'a [f64],
+    /// The velocities at them (cleared first).
+    pub v_out: &'a mut Vec<f64>,
+    /// Called after each step with the samples it wrote (possibly none); `true` stops the
+    /// run with [`IntegrationFailure::Halted`].
+    pub watch: &'a mut dyn FnMut(&[f64]) -> bool,
+}
+
+/// [`simulate_velocity`] with a watch asked after every step: a fit stops the simulation of a
+/// record once another record of the same evaluation has failed.
+pub fn simulate_velocity_watched(
+    osc: &Oscillator,
+    model: &dyn FrictionModel,
+    init: &Initial,
+    t_end: f64,
+    opts: &SimOptions,
+    run_to: VelocityRun<'_>,
+) -> Result<SimStats, EngineError> {
+    let VelocityRun {
+        sample_times,
+        v_out,
+        watch,
+    } = run_to;
     v_out.clear();
     v_out.reserve(sample_times.len());
-    let mut rec = VelocityRecorder { v: v_out };
+    let mut rec = VelocityRecorder {
+        v: v_out,
+        watch,
+        watched: 0,
+    };
     Ok(run(osc, model, init, t_end, sample_times, opts, &mut rec)?.stats)
 }
 
@@ -328,6 +367,12 @@ pub(crate) trait Recorder {
     /// driver may skip computing them: the values it passes are then meaningless).
     fn wants_forces(&self) -> bool {
         true
+    }
+
+    /// Whether the run should stop here (asked after every step; the samples written so far
+    /// stay). Never, by default.
+    fn halted(&mut self) -> bool {
+        false
     }
 
     /// Consecutive samples of a law without internal states, as columns of equal length;
@@ -423,6 +468,9 @@ impl FullRecorder<'_> {
 
 struct VelocityRecorder<'a> {
     v: &'a mut Vec<f64>,
+    watch: &'a mut dyn FnMut(&[f64]) -> bool,
+    /// Samples the watch has seen.
+    watched: usize,
 }
 
 impl Recorder for VelocityRecorder<'_> {
@@ -436,6 +484,12 @@ impl Recorder for VelocityRecorder<'_> {
 
     fn sample_block(&mut self, block: &SampleBlock<'_>) {
         self.v.extend_from_slice(block.v);
+    }
+
+    fn halted(&mut self) -> bool {
+        let fresh = self.v.get(self.watched..).unwrap_or_default();
+        self.watched = self.v.len();
+        (self.watch)(fresh)
     }
 }
 
