@@ -143,6 +143,9 @@ pub struct LevenbergMarquardt {
     jacobian: DMatrix<f64>,
     cost: f64,
     converged: Option<TerminationReason>,
+    /// Whether the last trial point could not be evaluated (non-finite residuals: a
+    /// simulation that failed or ran into its work budget).
+    trial_failed: bool,
     /// Converged costs of the other runs of the fit: the run stops when it falls behind
     /// them by [`OUTPACE_FACTOR`].
     pub pace: Option<Arc<Pace>>,
@@ -170,6 +173,7 @@ impl LevenbergMarquardt {
             jacobian: DMatrix::zeros(0, 0),
             cost: f64::INFINITY,
             converged: None,
+            trial_failed: false,
             pace: None,
         }
     }
@@ -243,6 +247,7 @@ where
         self.jacobian = j;
         self.cost = cost;
         self.converged = None;
+        self.trial_failed = false;
         self.history.clear();
         Ok((state.param(p0).cost(cost), None))
     }
@@ -294,6 +299,7 @@ where
         }
         let r_new = problem.apply(&trial)?;
         let cost_new = half_sq(&r_new);
+        self.trial_failed = !cost_new.is_finite();
         // Predicted reduction of the linear model for the projected step.
         let predicted = normal.predicted_reduction(&step);
         let actual = self.cost - cost_new;
@@ -369,11 +375,17 @@ impl LevenbergMarquardt {
     }
 
     /// The converged cost of another run that this run, at iteration `iteration`, is
-    /// [`OUTPACE_FACTOR`] times above (after the pace's grace).
+    /// [`OUTPACE_FACTOR`] times above: after the pace's grace, or at once when its last
+    /// trial point could not be evaluated. The grace is for a run that is descending; one
+    /// whose trial failed stands still, and with its step at the solver's cap
+    /// ([`LevenbergMarquardt::max_step`]) more damping tries the same point again until the
+    /// damped step falls below the cap, each try a simulation run into its work budget (on
+    /// the FMM fixture, four of Dahl's five screened starts spent their whole grace so).
     fn outpaced_by(&self, iteration: u64) -> Option<f64> {
         let pace = self.pace.as_ref()?;
         let best = pace.best();
-        (iteration >= pace.grace && self.cost > OUTPACE_FACTOR * best).then_some(best)
+        let held = iteration >= pace.grace || self.trial_failed;
+        (held && self.cost > OUTPACE_FACTOR * best).then_some(best)
     }
 
     /// Whether the cost fell by less than `stall_tol` relative over the last `stall_window`
@@ -622,6 +634,49 @@ mod tests {
         };
         // Three iterations took it below its starting cost.
         assert!(cost < 12.1, "{cost}");
+    }
+
+    /// r = p - 10, which cannot be evaluated beyond p = 1 (a trial point whose simulation
+    /// fails).
+    struct Walled;
+    impl Operator for Walled {
+        type Param = DVector<f64>;
+        type Output = DVector<f64>;
+        fn apply(&self, p: &DVector<f64>) -> Result<DVector<f64>, Error> {
+            let r = if p[0] > 1.0 { f64::NAN } else { p[0] - 10.0 };
+            Ok(DVector::from_vec(vec![r]))
+        }
+    }
+    impl Jacobian for Walled {
+        type Param = DVector<f64>;
+        type Jacobian = DMatrix<f64>;
+        fn jacobian(&self, _p: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+            Ok(DMatrix::from_element(1, 1, 1.0))
+        }
+    }
+
+    /// Within its grace a run that descends goes on (above), but one whose trial point cannot
+    /// be evaluated is held to the pace at once: from p = 0 (cost 50) the Gauss-Newton step
+    /// to 10 fails (iteration 0), and the run is abandoned at its next iteration instead of
+    /// retrying with more damping for the rest of its grace.
+    #[test]
+    fn a_run_whose_trial_fails_is_held_to_the_pace_within_its_grace() {
+        let pace = Arc::new(Pace::with_grace(5));
+        pace.converged_at(1.0);
+        let inf = f64::INFINITY;
+        let mut solver =
+            LevenbergMarquardt::new(DVector::from_vec(vec![-inf]), DVector::from_vec(vec![inf]));
+        solver.pace = Some(pace);
+        let res = Executor::new(Walled, solver)
+            .configure(|s| s.param(DVector::from_vec(vec![0.0])).max_iters(50))
+            .run()
+            .unwrap();
+        let reason = termination_reason(&res.solver, &res.state().termination_status, 50);
+        assert_eq!(res.state().get_iter(), 2, "{reason:?}");
+        let TerminationReason::Outpaced { cost, best } = reason else {
+            panic!("not outpaced: {reason:?}");
+        };
+        assert_eq!((cost, best), (50.0, 1.0));
     }
 
     #[test]
