@@ -418,11 +418,7 @@ fn a_watched_run_stops_when_its_watch_says_so() {
     let stats =
         simulate_velocity(&osc, model.as_ref(), &init, 2.0, &times, &opts, &mut full).unwrap();
     let run_watched = |stop_after: usize, v_out: &mut Vec<f64>| {
-        let mut seen = 0;
-        let mut watch = |fresh: &[f64]| {
-            seen += fresh.len();
-            seen >= stop_after
-        };
+        let mut watch = |written: usize| written >= stop_after;
         let run = VelocityRun {
             sample_times: &times,
             v_out,

@@ -124,7 +124,7 @@ impl VelocityResponse {
             let mut sim = Vec::with_capacity(clock.times.len());
             let init = initial(record, nuisance);
             let opts = budgeted(at, index, record, clock.times.len());
-            let mut superseded = |_: &[f64]| at.superseded(index);
+            let mut superseded = |_: usize| at.superseded(index);
             let run = VelocityRun {
                 sample_times: &clock.times,
                 v_out: &mut sim,

@@ -10,8 +10,8 @@
 //!
 //! dh/dz is the model's `state_jacobian`, dF/dv and dF/dz its `force_gradient` and dh/dv its
 //! `state_velocity_derivative` (analytic for the built-in dynamic models, finite differences
-//! by default), all three from one call of its `linearisation`. For static laws only the 2 x 2 mechanics remain, with d(slip_force)/dv taken
-//! by finite differences.
+//! by default), all three from one call of its `linearisation`. For static laws only the
+//! 2 x 2 mechanics remain, with d(slip_force)/dv taken by finite differences.
 
 use super::{Dynamics, Law};
 use frictionid_models::model::velocity_step;

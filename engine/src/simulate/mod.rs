@@ -306,7 +306,7 @@ pub fn simulate_velocity(
     opts: &SimOptions,
     v_out: &mut Vec<f64>,
 ) -> Result<SimStats, EngineError> {
-    let mut no_watch = |_: &[f64]| false;
+    let mut no_watch = |_: usize| false;
     let velocity = VelocityRun {
         sample_times,
         v_out,
@@ -321,9 +321,9 @@ pub struct VelocityRun<'a> {
     pub sample_times: &'a [f64],
     /// The velocities at them (cleared first).
     pub v_out: &'a mut Vec<f64>,
-    /// Called after each step with the samples it wrote (possibly none); `true` stops the
+    /// Called after each step with the number of samples written so far; `true` stops the
     /// run with [`IntegrationFailure::Halted`].
-    pub watch: &'a mut dyn FnMut(&[f64]) -> bool,
+    pub watch: &'a mut dyn FnMut(usize) -> bool,
 }
 
 /// [`simulate_velocity`] with a watch asked after every step: a fit stops the simulation of a
@@ -343,11 +343,7 @@ pub fn simulate_velocity_watched(
     } = run_to;
     v_out.clear();
     v_out.reserve(sample_times.len());
-    let mut rec = VelocityRecorder {
-        v: v_out,
-        watch,
-        watched: 0,
-    };
+    let mut rec = VelocityRecorder { v: v_out, watch };
     Ok(run(osc, model, init, t_end, sample_times, opts, &mut rec)?.stats)
 }
 
@@ -468,9 +464,7 @@ impl FullRecorder<'_> {
 
 struct VelocityRecorder<'a> {
     v: &'a mut Vec<f64>,
-    watch: &'a mut dyn FnMut(&[f64]) -> bool,
-    /// Samples the watch has seen.
-    watched: usize,
+    watch: &'a mut dyn FnMut(usize) -> bool,
 }
 
 impl Recorder for VelocityRecorder<'_> {
@@ -487,9 +481,7 @@ impl Recorder for VelocityRecorder<'_> {
     }
 
     fn halted(&mut self) -> bool {
-        let fresh = self.v.get(self.watched..).unwrap_or_default();
-        self.watched = self.v.len();
-        (self.watch)(fresh)
+        (self.watch)(self.v.len())
     }
 }
 

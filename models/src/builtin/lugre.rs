@@ -41,22 +41,27 @@ impl LuGre {
         normal * (self.mu_c + (self.mu_s - self.mu_c) * decay(r * r))
     }
 
-    /// The partial derivatives (d/dz, d/dv) of dz/dt; (0, 0) without normal load.
+    /// The partial derivatives (d/dz, d/dv) of dz/dt, from one Stribeck exponential; (0, 0)
+    /// without normal load. d/dz does not depend on z.
     fn z_dot_partials(&self, v: f64, z: f64, normal: f64) -> (f64, f64) {
         let r = v / self.v_s;
-        self.z_dot_partials_with(v, z, normal, decay(r * r))
-    }
-
-    /// [`LuGre::z_dot_partials`] with the Stribeck exponential exp(-(v/v_s)^2) given.
-    fn z_dot_partials_with(&self, v: f64, z: f64, normal: f64, stribeck: f64) -> (f64, f64) {
+        let stribeck = decay(r * r);
         let g = normal * (self.mu_c + (self.mu_s - self.mu_c) * stribeck);
         if g <= 0.0 {
             return (0.0, 0.0);
         }
-        let r = v / self.v_s;
         let dg = normal * (self.mu_s - self.mu_c) * stribeck * (-2.0 * r / self.v_s);
         let d_ratio = (sgn(v) * g - v.abs() * dg) / (g * g);
         (-self.sigma0 * v.abs() / g, 1.0 - self.sigma0 * z * d_ratio)
+    }
+
+    /// dF/dz into `dfdz` and dF/dv returned, from the partials (d/dz, d/dv) of dz/dt:
+    /// dF/dz = sigma0 + sigma1 d(dz/dt)/dz, dF/dv = sigma1 d(dz/dt)/dv + sigma2.
+    fn force_partials(&self, (dz_dz, dz_dv): (f64, f64), dfdz: &mut [f64]) -> f64 {
+        if let Some(d) = dfdz.first_mut() {
+            *d = self.sigma0 + self.sigma1 * dz_dz;
+        }
+        self.sigma1 * dz_dv + self.sigma2
     }
 
     /// F = sigma0 z + sigma1 dz/dt + sigma2 v.
@@ -97,22 +102,13 @@ impl FrictionModel for LuGre {
     /// d(dz/dt)/dz = -sigma0 |v| / g(v) (0 without normal load).
     fn state_jacobian(&self, v: f64, _z: &[f64], normal: f64, jac: &mut [f64]) {
         if let Some(j) = jac.first_mut() {
-            let g = self.g(v, normal);
-            *j = if g > 0.0 {
-                -self.sigma0 * v.abs() / g
-            } else {
-                0.0
-            };
+            *j = self.z_dot_partials(v, 0.0, normal).0;
         }
     }
     /// dF/dz = sigma0 + sigma1 d(dz/dt)/dz, dF/dv = sigma1 d(dz/dt)/dv + sigma2.
     fn force_gradient(&self, v: f64, z: &[f64], normal: f64, dfdz: &mut [f64]) -> f64 {
         let z0 = z.first().copied().unwrap_or(0.0);
-        let (dz_dz, dz_dv) = self.z_dot_partials(v, z0, normal);
-        if let Some(d) = dfdz.first_mut() {
-            *d = self.sigma0 + self.sigma1 * dz_dz;
-        }
-        self.sigma1 * dz_dv + self.sigma2
+        self.force_partials(self.z_dot_partials(v, z0, normal), dfdz)
     }
     /// d(dz/dt)/dv = 1 - sigma0 z (sgn(v) g - |v| g') / g^2 (0 without normal load).
     fn state_velocity_derivative(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) {
@@ -124,28 +120,18 @@ impl FrictionModel for LuGre {
         let z0 = z.first().copied().unwrap_or(0.0);
         self.force_at(v, z0, self.z_dot(v, z0, normal))
     }
-    /// The Stribeck exponential once for the three derivatives (it was five of the eleven
-    /// exponentials of a Rodas4 step).
+    /// The Stribeck exponential once for the three derivatives (the three calls take it three
+    /// times).
     fn linearisation(&self, v: f64, z: &[f64], normal: f64, out: Linearisation<'_>) -> f64 {
         let z0 = z.first().copied().unwrap_or(0.0);
-        let r = v / self.v_s;
-        let stribeck = decay(r * r);
-        let (dz_dz, dz_dv) = self.z_dot_partials_with(v, z0, normal, stribeck);
+        let partials = self.z_dot_partials(v, z0, normal);
         if let Some(j) = out.dz_dz.first_mut() {
-            let g = normal * (self.mu_c + (self.mu_s - self.mu_c) * stribeck);
-            *j = if g > 0.0 {
-                -self.sigma0 * v.abs() / g
-            } else {
-                0.0
-            };
+            *j = partials.0;
         }
         if let Some(o) = out.dz_dv.first_mut() {
-            *o = dz_dv;
+            *o = partials.1;
         }
-        if let Some(d) = out.df_dz.first_mut() {
-            *d = self.sigma0 + self.sigma1 * dz_dz;
-        }
-        self.sigma1 * dz_dv + self.sigma2
+        self.force_partials(partials, out.df_dz)
     }
     /// dz/dt once for both (it holds the Stribeck level's exponential).
     fn state_derivative_and_force(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) -> f64 {
