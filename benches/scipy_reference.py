@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""SciPy's solve_ivp on the cases of frictionid's `simulate` benchmarks, for the README's
-performance table: what a user would otherwise write in Python.
+"""SciPy's solve_ivp on the cases of frictionid's `simulate` benchmarks, for the table in
+benches/README.md: what a user would otherwise write in Python.
 
 Usage: python3 benches/scipy_reference.py [--repeat N]
 

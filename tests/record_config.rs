@@ -1,5 +1,5 @@
 //! Realistic records through the configuration file: `[record_defaults]`, `release = "auto"`
-//! and unit mistakes caught before any fit (issue 12), on a synthetic record whose release is
+//! and unit mistakes caught before any fit, on a synthetic record whose release is
 //! known.
 
 use frictionid_cli::config::Config;

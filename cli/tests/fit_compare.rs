@@ -185,7 +185,7 @@ fn compare_ranks_the_classical_models() {
     assert!(out.join("best_x10mm_velocity_fit.svg").is_file());
 }
 
-/// Issue 14's acceptance on the bundled Coulomb fixture: LuGre and Dahl converge, their
+/// LuGre and Dahl on the bundled Coulomb fixture (truth: Coulomb, mu = 0.24): both converge, their
 /// Coulomb level within 0.5 % of the Coulomb fit's mu, and sigma0 a lower bound (the records
 /// do not resolve presliding) with the bound stated and no standard error; no parameter shows
 /// a zero standard error.

@@ -2,8 +2,8 @@
 //! turning points and half-cycles) of a 2000-sample FMM record with vibrometer-like noise,
 //! and the model force along it.
 
-/// mimalloc, as the `frictionid` binary and the Python module use (see the README's performance
-/// section: glibc's malloc returned and refaulted the fits' buffers, a sixth of a Coulomb fit).
+/// mimalloc, as the `frictionid` binary and the Python module use (glibc's malloc returned
+/// and refaulted the fits' buffers, a sixth of a Coulomb fit's time).
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

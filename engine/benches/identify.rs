@@ -1,10 +1,10 @@
-//! Identifier benchmarks (issues 13 and 14): the Coulomb mu fit on the three FMM records, the
+//! Identifier benchmarks: the Coulomb mu fit on the three FMM records, the
 //! five-model comparison, and LuGre fits from the default start and from the truth of stiff
 //! (sigma0 = 1e7) records. Records: the acceptance set-up of the tests (releases of 10, 14
 //! and 22 mm, 2 s at 1 kHz, 0.2 mm/s noise).
 
-/// mimalloc, as the `frictionid` binary and the Python module use (see the README's performance
-/// section: glibc's malloc returned and refaulted the fits' buffers, a sixth of a Coulomb fit).
+/// mimalloc, as the `frictionid` binary and the Python module use (glibc's malloc returned
+/// and refaulted the fits' buffers, a sixth of a Coulomb fit's time).
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
@@ -128,7 +128,7 @@ fn lugre(c: &mut Criterion) {
     group.finish();
 }
 
-/// Issue 14's force route (`domain = "force"`, the energy-based force of Eq. 7) against the
+/// The force route (`domain = "force"`, the energy-based force of Eq. 7) against the
 /// velocity fit of the same law on the same noisy records.
 fn force_route(c: &mut Criterion) {
     let osc = Oscillator::fmm();

@@ -1,11 +1,11 @@
 //! Criterion benchmarks of the simulation engine: one run per registered model for the FMM case
 //! (N = 14.5 N, x0 = 22 mm, 2 s sampled at 1 kHz, default Dopri5), the paper's 140 mm Coulomb case (N = m g, mu = 0.24)
 //! with Dopri5, the closed form and the paper's Euler (T_n / 1e6), and the stiff bristle models
-//! (sigma0 = 1e7 N/m). The RHS counts are printed once per case (stderr) for the README's
-//! performance table.
+//! (sigma0 = 1e7 N/m). The RHS counts are printed once per case (stderr) for the
+//! table in benches/README.md.
 
-/// mimalloc, as the `frictionid` binary and the Python module use (see the README's performance
-/// section: glibc's malloc returned and refaulted the fits' buffers, a sixth of a Coulomb fit).
+/// mimalloc, as the `frictionid` binary and the Python module use (glibc's malloc returned
+/// and refaulted the fits' buffers, a sixth of a Coulomb fit's time).
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
@@ -61,7 +61,7 @@ fn fmm_models(c: &mut Criterion) {
     group.finish();
 }
 
-/// The stiff end of the bristle models (issue 13: sigma0 = 1e7 N/m, LuGre with sigma1 =
+/// The stiff end of the bristle models (sigma0 = 1e7 N/m, LuGre with sigma1 =
 /// 5000 N s/m) with the explicit integrator and with Rodas4, and Rodas4 at 1e8 and 1e9;
 /// Rodas4 at the default 1e5 (against the `fmm_22mm_2s_1kHz` Dopri5 rows: where `auto`
 /// should switch); and Dahl saturating in finite time.
@@ -149,8 +149,9 @@ fn paper_140mm(c: &mut Criterion) {
     group.finish();
 }
 
-/// Dahl with alpha < 1, whose force reaches its Coulomb level in finite time (session 11):
-/// the explicit method chatters there, and `auto` (the fits' choice) now takes Rodas4.
+/// Dahl with alpha < 1, whose force reaches its Coulomb level in finite time: the explicit
+/// method chatters there, and `auto` (the fits' choice) takes Rodas4 (it looks at the sliding
+/// state).
 fn saturating_dahl(group: &mut BenchmarkGroup<'_, WallTime>, osc: &Oscillator, times: &[f64]) {
     let json = serde_json::json!({ "type": "dahl", "sigma0": 1e5, "mu_c": 0.35, "alpha": 0.8 });
     let Ok(built) = frictionid_models::build_json(&json) else {

@@ -1,4 +1,5 @@
-//! Dynamic friction models identified from their own synthetic FMM records (issue 14): the
+//! Dynamic friction models identified from their own synthetic FMM records (known truth and
+//! noise, the oracle): the
 //! default configuration names only the model; the truths are independent of the fit.
 
 mod common;
@@ -213,7 +214,7 @@ fn dahl_is_recovered_from_its_own_records() {
     assert_eq!(sigma0.identifiability, Some(Identifiability::Determined));
 }
 
-/// Issue 14's GMS acceptance: two elements from the default configuration (every parameter
+/// GMS recovered from its own records: two elements from the default configuration (every parameter
 /// free, delta and sharpness too), the noise level and each determined parameter within 3
 /// standard errors of the truth (the undamped elements' sigma_i are flagged, not determined).
 /// It failed with finite-difference force gradients in the Rodas4 Jacobian (k_1 18 standard
@@ -241,7 +242,7 @@ fn gms_with_two_elements_is_recovered_from_its_own_records() {
     assert!((noise_ratio(&r) - 1.0).abs() < 0.02);
 }
 
-/// Stiff bristles (sigma0 1e7, issue 14's second truth) from the default configuration (the
+/// Stiff bristles (sigma0 1e7, the stiff LuGre truth) from the default configuration (the
 /// fits' simulations on `integrator = "auto"`: Rodas4 for these bristles): the noise level,
 /// and sigma0 within a factor of 2 or a bound that contains the truth.
 #[test]

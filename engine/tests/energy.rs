@@ -1,4 +1,4 @@
-//! Energy analysis (issue 4) against known truth: the exact Coulomb solution of the FMM case,
+//! Energy analysis against known truth: the exact Coulomb solution of the FMM case,
 //! engine-simulated Coulomb motion, closed-form derivatives and closed-form state trajectories.
 
 use frictionid_engine::energy::{

@@ -88,7 +88,7 @@ fn stribeck_parameters_are_recovered_and_the_comparison_ranks_it_first() {
 
 #[test]
 fn a_fit_started_at_the_truth_of_stiff_bristles_runs_and_stays_there() {
-    // Issue 13: sigma0 = 1e7 N/m records; with Dopri5 under a step budget the start point
+    // sigma0 = 1e7 N/m records; with Dopri5 under a step budget the start point
     // itself was rejected. With `integrator = "auto"` the fit integrates them with Rodas4.
     let osc = Oscillator::fmm();
     let truth = LuGre {
@@ -229,7 +229,7 @@ fn a_right_fit_passes_every_diagnostic() {
     assert!(r.warnings.is_empty(), "{:?}", r.warnings);
 }
 
-/// The defects of issue 12 on the synthetic records: an unmodelled offset of 3 mm/s and a
+/// Defects of real measurements on the synthetic records: an unmodelled offset of 3 mm/s and a
 /// velocity exported in mm/s each fail a diagnostic. In mm/s the data-driven start is mu = 5,
 /// at which the mass cannot leave x0 (5 N > k x0): the Jacobian is zero, so mu has no
 /// standard error (null, never 0 and a zero-width interval).

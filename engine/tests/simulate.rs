@@ -1,4 +1,4 @@
-//! Acceptance tests of the event-detecting engine (issue 3). Oracles: the exact piecewise
+//! Tests of the event-detecting engine. Oracles: the exact piecewise
 //! Coulomb solution, the energy balance of a passive system, and mirror symmetry.
 
 #![allow(clippy::needless_range_loop)]
@@ -806,7 +806,7 @@ fn max_gap(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// A bristle model of the issue's stiff case: sigma0 as given (LuGre with sigma1 = 5000).
+/// A bristle model of the stiff benchmark case: sigma0 as given (LuGre with sigma1 = 5000).
 fn stiff(name: &str, sigma0: f64) -> Box<dyn FrictionModel> {
     let mut json = serde_json::json!({ "type": name, "sigma0": sigma0 });
     if name == "lugre" {
@@ -842,7 +842,7 @@ fn tight_run_at(model: &dyn FrictionModel, integrator: Integrator, atol: f64) ->
 
 #[test]
 fn rodas_agrees_with_a_tight_dopri5_reference_on_stiff_bristles() {
-    // Issue 13's case: FMM rig from 22 mm, 2 s at 1 kHz, sigma0 = 1e7 N/m. The reference is
+    // The stiff case: FMM rig from 22 mm, 2 s at 1 kHz, sigma0 = 1e7 N/m. The reference is
     // the explicit method at rtol 1e-14 (about a million RHS evaluations).
     for name in ["lugre", "dahl"] {
         let model = stiff(name, 1e7);
@@ -869,8 +869,8 @@ fn tightest_dopri5_run(model: &dyn FrictionModel) -> Trajectory {
 }
 
 #[test]
-fn auto_integrates_stiff_dahl_within_issue_13s_budget() {
-    // Issue 13's target: Dahl at sigma0 = 1e7 N/m (state: the force in newtons, elastic tail
+fn auto_integrates_stiff_dahl_within_10000_rhs_and_1e_8_m() {
+    // Dahl at sigma0 = 1e7 N/m (state: the force in newtons, elastic tail
     // of 72 restarts in the last 0.4 s) within 10 000 RHS evaluations, to 1e-8 m of x.
     let model = stiff("dahl", 1e7);
     let sim = fmm_run_with(model.as_ref(), 0.022, 2.0, Integrator::Auto);

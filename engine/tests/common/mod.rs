@@ -1,4 +1,5 @@
-//! Synthetic FMM records made by the engine (the identifier issue's acceptance set-up).
+//! Synthetic FMM records made by the engine with known truths and noise: the oracles of the
+//! identifier's recovery tests.
 #![allow(dead_code)]
 
 use frictionid_engine::synthetic::release_records;
@@ -17,7 +18,7 @@ pub fn records(osc: &Oscillator, model: &dyn FrictionModel, noise: f64, seed: u6
         .expect("simulation of the truth")
 }
 
-/// The LuGre law of the dynamic-identification issue's acceptance: sigma0 1e5 N/m, sigma1
+/// The LuGre truth of the dynamic-model recovery tests: sigma0 1e5 N/m, sigma1
 /// 500 N s/m, sigma2 1 N s/m, mu_c 0.22, mu_s 0.30, v_s 0.01 m/s.
 pub fn lugre_truth() -> LuGre {
     LuGre {
@@ -30,7 +31,7 @@ pub fn lugre_truth() -> LuGre {
     }
 }
 
-/// Issue 14's stiff LuGre truth: bristles of sigma0 1e7 N/m.
+/// The stiff LuGre truth of the recovery tests: bristles of sigma0 1e7 N/m.
 pub fn stiff_lugre_truth() -> LuGre {
     LuGre {
         sigma0: 1e7,
