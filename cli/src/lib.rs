@@ -9,8 +9,15 @@
 //! tables), [`terminal`] (the terminal writer of report values), [`plots`] (SVG charts),
 //! [`progress`] (progress bars), [`error`] (typed errors).
 //!
-//! Exit codes: 0 success, 1 error (one line on stderr), 2 a fit that did not converge (its
-//! report is written).
+//! Exit codes, decided in one place ([`main_with_args`], from the command's
+//! [`commands::Outcome`]):
+//! - 0: success, warnings allowed (also `--help` and `--version`);
+//! - 1 ([`EXIT_ERROR`]): an error, bad arguments included, printed as one line on stderr
+//!   (an internal panic too); no report is written;
+//! - 2 ([`EXIT_NOT_CONVERGED`]): a fit did not converge (`compare`: the best-ranked model's
+//!   fit); its report is written;
+//! - 3 ([`EXIT_DIAGNOSTIC_FAILED`]): a fit converged but one of its diagnostics failed
+//!   (`compare`: the best-ranked model's fit); its report is written.
 
 pub mod args;
 pub mod commands;
