@@ -12,9 +12,9 @@
 
 use crate::data::MAX_SAMPLES;
 use crate::energy::{Differentiator, EnergyOptions};
-use crate::identify::setup::non_model_bound_keys;
 use crate::identify::{
-    FitDomain, FitOptions, ForceTarget, OscillatorParam, ProgressFn, PropertyUncertainty, Search,
+    non_model_bound_keys, FitDomain, FitOptions, ForceTarget, OscillatorParam, ProgressFn,
+    PropertyUncertainty, Search,
 };
 use crate::oscillator::Oscillator;
 use crate::simulate::{Integrator, SimOptions};

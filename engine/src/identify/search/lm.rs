@@ -12,7 +12,7 @@
 //! through [`Jacobian`]. A residual vector with a non-finite entry (e.g. a simulation that
 //! failed for the trial parameters) is treated as an infinitely bad trial and rejected.
 
-use super::outcome::TerminationReason;
+use crate::identify::values::outcome::TerminationReason;
 use argmin::core::{
     Error, IterState, Jacobian, Operator, Problem, Solver, State,
     TerminationReason as ArgminReason, TerminationStatus, KV,
