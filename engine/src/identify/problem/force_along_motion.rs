@@ -1,4 +1,4 @@
-//! Fits in the force domain: the model's friction force along the measured motion against a
+//! The force domain's residuals: the model's friction force along the measured motion against a
 //! target force ([`ForceAlongMotion`]).
 //!
 //! The measured motion is replayed, not simulated: the velocity channel (or the differentiated
