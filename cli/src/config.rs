@@ -40,7 +40,7 @@
 //! syntax errors name the line and column.
 
 use crate::error::CliError;
-use frictionid_engine::record::RecordSource;
+use frictionid_engine::data::RecordSource;
 use frictionid_engine::spec::{
     EnergySpec, FitSpec, ModelSpec, OscillatorSpec, SimulationSpec, Spec, SpecError,
 };
@@ -69,7 +69,7 @@ pub struct Config {
 }
 
 /// One `[[records]]` entry, checked and resolved (the engine's shared record source).
-pub use frictionid_engine::record::source::ResolvedSource as RecordConfig;
+pub use frictionid_engine::data::source::ResolvedSource as RecordConfig;
 
 // ---------------------------------------------------------------------------------------------
 // Raw (as written) structures.

@@ -13,8 +13,8 @@ mod common;
 
 use common::{lugre_truth, records, stiff_lugre_truth, stribeck_truth, NOISE};
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use frictionid_engine::data::RecordSource;
 use frictionid_engine::identify::{compare, fit, FitDomain, FitOptions, Search};
-use frictionid_engine::record::RecordSource;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre};
 use std::hint::black_box;

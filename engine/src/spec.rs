@@ -12,9 +12,9 @@
 
 use crate::data::MAX_SAMPLES;
 use crate::energy::{Differentiator, EnergyOptions};
-use crate::identify::setup::non_model_bound_keys;
 use crate::identify::{
-    FitDomain, FitOptions, ForceTarget, OscillatorParam, ProgressFn, PropertyUncertainty, Search,
+    non_model_bound_keys, FitDomain, FitOptions, ForceTarget, OscillatorParam, ProgressFn,
+    PropertyUncertainty, Search,
 };
 use crate::oscillator::Oscillator;
 use crate::simulate::{Integrator, SimOptions};
@@ -330,7 +330,7 @@ impl Spec {
     /// `keep_initial` names parameters whose current values start the fit (see
     /// [`ModelSpec::given`]).
     pub fn fit_options(&self, keep_initial: &[String], hooks: &Hooks) -> FitOptions {
-        let extras = &self.fit.options;
+        let given = &self.fit.options;
         let defaults = FitOptions::default();
         FitOptions {
             free: self.fit.free.clone(),
@@ -340,27 +340,27 @@ impl Spec {
                 .iter()
                 .map(|(k, [lo, hi])| (k.clone(), (*lo, *hi)))
                 .collect(),
-            guess: extras.guess.unwrap_or(true),
+            guess: given.guess.unwrap_or(true),
             keep_initial: keep_initial.to_vec(),
-            oscillator: extras.oscillator.clone(),
-            velocity_offset: extras.velocity_offset,
-            time_shift: extras.time_shift,
-            x0: extras.x0,
+            oscillator: given.oscillator.clone(),
+            velocity_offset: given.velocity_offset,
+            time_shift: given.time_shift,
+            x0: given.x0,
             uncertainty: self.uncertainty,
-            domain: extras.domain,
-            force_target: extras.force_target,
-            force_offset: extras.force_offset,
-            prefit: extras.prefit.unwrap_or(defaults.prefit),
+            domain: given.domain,
+            force_target: given.force_target,
+            force_offset: given.force_offset,
+            prefit: given.prefit.unwrap_or(defaults.prefit),
             unknown_oscillator: self.unknown_oscillator.clone(),
-            multistart: extras.multistart,
-            search: extras.search,
+            multistart: given.multistart,
+            search: given.search,
             max_iterations: self.fit.max_iterations.unwrap_or(defaults.max_iterations),
             tolerance: self.fit.tolerance.or(defaults.tolerance),
             energy: self.energy.options(),
             parallel: hooks.parallel,
             progress: hooks.progress.clone(),
             sim: SimOptions {
-                integrator: extras
+                integrator: given
                     .integrator
                     .map_or(defaults.sim.integrator, IntegratorMethod::engine_integrator),
                 ..defaults.sim
@@ -421,13 +421,13 @@ pub struct FitSpec {
     /// Convergence tolerance of the solver (relative change of the cost).
     pub tolerance: Option<f64>,
     /// Further identifier options (`[fit.options]`).
-    pub options: FitExtras,
+    pub options: FitOptionsSpec,
 }
 
 /// `[fit.options]`: identifier options beyond `free` and `bounds`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct FitExtras {
+pub struct FitOptionsSpec {
     /// Oscillator properties to fit with the model: any of "mass", "damping", "stiffness".
     pub oscillator: Vec<OscillatorParam>,
     /// Fit a velocity offset per record.
@@ -451,7 +451,7 @@ pub struct FitExtras {
     pub force_target: ForceTarget,
     /// Force domain: fit a constant force offset per record (a load cell's zero).
     pub force_offset: bool,
-    /// Velocity fits of dynamic models start also from a force-domain prefit (default true).
+    /// Velocity fits of dynamic models start also from a force-domain prefit (default false).
     pub prefit: Option<bool>,
     /// The integrator of the fit's simulations (default `auto`: exact, rodas or dopri5 by the
     /// law and its stiffness, which stiff bristle records, sigma0 >= 1e6 N/m, need).

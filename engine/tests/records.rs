@@ -4,7 +4,8 @@
 //! unit mistakes caught before any fit.
 
 use frictionid_engine::data::DataError;
-use frictionid_engine::record::{Channel, NormalForce, RecordSource, Release, ScaleError};
+use frictionid_engine::data::RecordSource;
+use frictionid_engine::record::{Channel, NormalForce, Release, ScaleError};
 use frictionid_engine::synthetic::{defective_record, Defects};
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::Coulomb;

@@ -3,17 +3,20 @@
 //! software.
 //!
 //! Every reader returns an engine [`Record`] released from rest at x0 = 0 with unit weight; the
-//! caller sets `x0`, `v0` and `weight` from its configuration. Every error is a [`DataError`] whose
+//! caller sets `x0`, `v0` and `weight` from its configuration: [`RecordSource`] (one
+//! `[[records]]` entry, in `source.rs`) reads its file here and cuts it at the release. Every error is a [`DataError`] whose
 //! message is one line naming the file and, where there is one, the line and the reason.
 
 mod delimited;
+pub mod source;
 mod uff58;
 
 pub use delimited::read_delimited;
+pub use source::{RecordSource, RecordSourceError, ResolvedSource};
 pub use uff58::read_uff58;
 
 pub use crate::record::Channel;
-use crate::record::{Record, RecordSourceError, ScaleError, TimeBase, TimeError};
+use crate::record::{Record, ScaleError, TimeBase, TimeError};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -68,15 +68,14 @@
 
 pub mod differentiate;
 pub mod halfcycle;
-pub mod mechanical;
 pub mod model_force;
 
+pub use crate::simulate::MechanicalEnergy;
 pub use differentiate::{
     central_difference, derivative_weights, moving_average, paper_derivative,
     savitzky_golay_derivative, Differentiator, PAPER_SPAN,
 };
 pub use halfcycle::{HalfCycle, MIN_RUN};
-pub use mechanical::MechanicalEnergy;
 pub use model_force::{
     force_residuals, forces_at, forces_from_states, model_force_along, model_force_with_normal,
     states_along, ForceResiduals,

@@ -1,9 +1,10 @@
 //! Fitting several models to the same records and ranking them.
 
-use super::fit::{fit, FitResult};
-use super::options::FitOptions;
-use super::setup::non_model_bound_keys;
+use super::fit::fit;
 use crate::error::EngineError;
+use crate::identify::values::nuisance::non_model_bound_keys;
+use crate::identify::values::options::FitOptions;
+use crate::identify::values::result::FitResult;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use frictionid_models::FrictionModel;
@@ -26,7 +27,7 @@ pub const INDISTINGUISHABLE_DELTA_AIC: f64 = 2.0;
 /// Models ranked by AIC (best first), with BIC and RMS in each fit.
 #[derive(Debug, Clone, Serialize)]
 pub struct Comparison {
-    /// The fits, best (lowest AIC) first, each with its [`super::result::Rank`].
+    /// The fits, best (lowest AIC) first, each with its [`crate::identify::values::Rank`].
     pub ranking: Vec<FitResult>,
     /// Models whose fit failed.
     pub failed: Vec<FailedFit>,
@@ -55,7 +56,7 @@ pub struct ComparisonVerdict {
 impl Comparison {
     /// The verdict of the best fit (`None` when no model could be fitted): the CLI exits 2
     /// when it did not converge.
-    pub fn best_verdict(&self) -> Option<super::result::Verdict> {
+    pub fn best_verdict(&self) -> Option<crate::identify::values::Verdict> {
         self.ranking.first().map(FitResult::verdict)
     }
 }
@@ -148,7 +149,7 @@ fn rank(ranking: &mut [FitResult]) {
     let total: f64 = relative.iter().sum();
     for (fit, l) in ranking.iter_mut().zip(relative) {
         let delta_aic = fit.aic - best;
-        fit.rank = Some(super::result::Rank {
+        fit.rank = Some(crate::identify::values::Rank {
             delta_aic,
             akaike_weight: l / total,
             indistinguishable: delta_aic <= INDISTINGUISHABLE_DELTA_AIC,

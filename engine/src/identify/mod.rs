@@ -2,59 +2,37 @@
 //! parameters, optionally the oscillator and per-record nuisance parameters) to one or more
 //! measured records, and compares models on the same records.
 //!
-//! The seams:
-//! - [`residuals::Residuals`]: what a fit compares. [`residuals::VelocityResponse`] simulates
-//!   the free vibration and compares every response channel (velocity, displacement,
-//!   acceleration, each weighted by its noise); each producer declares the per-record
-//!   nuisance parameters ([`residuals::NuisanceKind`]) it adds.
-//!   [`force::ForceAlongMotion`] replays the measured motion and compares the model's force
-//!   with a measured or the energy-based force (fits in the force domain).
-//! - [`problem::FitProblem`]: generic over the producer; implements argmin's `Operator` and
-//!   `Jacobian`, so the solver, our bounded Levenberg-Marquardt ([`lm::LevenbergMarquardt`],
-//!   an argmin `Solver`), knows nothing of friction.
-//! - [`starts`]: the multi-start runs; [`strategy`]: where the starts come from (`local`,
-//!   `staged`, `global`); [`identifiability`]: which parameters the records determine;
-//!   [`setup`]: options to free parameters.
-//! - [`outcome`]: typed outcomes ([`outcome::TerminationReason`], [`outcome::StartOutcome`])
-//!   and the findings ([`outcome::Finding`]) every [`FitResult`] carries.
-//! - [`energy_check::energy_force_check`]: the energy-balance check, shared with the
-//!   `energy` command.
+//! Four floors, each importing only the ones below it:
+//! - [`values`]: options, the search asked for, the parameter layout, the nuisance kinds, the
+//!   property uncertainties, typed outcomes and findings, and the fit's result.
+//! - [`problem`]: what a fit compares ([`Residuals`]: [`SimulatedResponse`] simulates the free
+//!   vibration and compares every response channel, each weighted by its noise;
+//!   [`ForceAlongMotion`] replays the measured motion and compares a force), the data-driven
+//!   guess, the caches and the least-squares problem (argmin's `Operator` and `Jacobian`).
+//! - [`search`]: the free parameters, the bounded Levenberg-Marquardt solver, the multi-start
+//!   runs, the strategies (`local`, `staged`, `global`) and the prefit's options.
+//! - [`assessment`]: statistics, identifiability, diagnostics, the energy-balance check, the
+//!   sum-up into a [`FitResult`] and the property-uncertainty refits.
+//!
+//! On top, [`fit`] is the one place a fit runs (and re-runs: the prefit and the property
+//! refits are computed below and run here), and [`compare`] fits several models.
 
-pub mod analysis_cache;
-pub mod budget;
+pub mod assessment;
 pub mod compare;
-pub mod diagnostics;
-pub mod energy_check;
 pub mod fit;
-pub mod force;
-pub mod identifiability;
-pub mod layout;
-pub mod lm;
-pub mod options;
-pub mod outcome;
-pub mod prefit;
 pub mod problem;
-pub mod residuals;
-pub mod response;
-pub mod result;
-pub mod setup;
-pub mod starts;
-pub mod state_cache;
-pub mod stats;
-pub mod strategy;
-pub mod work;
+pub mod search;
+pub mod values;
 
-pub use budget::{PropertyUncertainty, StdErrorComponents};
+pub use assessment::{energy_force_check, ForceReference};
 pub use compare::{compare, Comparison, ComparisonVerdict, FailedFit};
-pub use energy_check::{energy_force_check, EnergyForce, ForceReference};
-pub use fit::{fit, fit_with, guess_hint, Derived, FitResult, FitSeries, FittedParam, RecordFit};
-pub use force::{fit_force, require_mechanics, require_oscillator, ForceAlongMotion};
-pub use identifiability::Identifiability;
-pub use lm::LevenbergMarquardt;
-pub use options::{FitDomain, FitOptions, ForceTarget, OscillatorParam, Progress, ProgressFn};
-pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
-pub use residuals::{
-    Evaluation, NuisanceKind, NuisanceValues, Residuals, Segment, VelocityResponse,
+pub use fit::{fit, fit_force, fit_with};
+pub use problem::{guess_hint, require_mechanics, require_oscillator, ForceAlongMotion};
+pub use problem::{Evaluation, Residuals, Segment, SimulatedResponse};
+pub use search::LevenbergMarquardt;
+pub use values::{
+    non_model_bound_keys, worst_status, Check, Derived, EnergyForce, Finding, FitDomain,
+    FitOptions, FitResult, FitSeries, FittedParam, ForceTarget, Identifiability, NuisanceKind,
+    NuisanceValues, OscillatorParam, Progress, ProgressFn, PropertyUncertainty, Rank, RecordFit,
+    Search, StartOutcome, Status, StdErrorComponents, TerminationReason, Verdict,
 };
-pub use result::{Rank, Verdict};
-pub use strategy::Search;

@@ -4,7 +4,6 @@
 //! - [`time`]: the [`TimeBase`] and the one check of time stamps used everywhere.
 //! - [`channel`]: the [`Channel`] names and the [`NormalForce`].
 //! - [`noise`]: a channel's white-noise level estimated from its samples.
-//! - [`source`]: one `[[records]]` entry of a configuration ([`RecordSource`]) and its loading.
 //! - [`release`]: the release instant, given or found in the pre-trigger rest.
 //! - [`sanity`]: units checked against the oscillator (mm/s, milliseconds, x0 in mm).
 
@@ -13,13 +12,11 @@ pub mod checked;
 pub mod noise;
 pub mod release;
 pub mod sanity;
-pub mod source;
 pub mod time;
 
 pub use channel::{Channel, NormalForce};
 pub use release::{detect_release, Release};
 pub use sanity::{check_scales, ScaleError};
-pub use source::{RecordSource, RecordSourceError, ResolvedSource};
 pub use time::{check_sorted, check_time, TimeBase, TimeError};
 
 use crate::error::EngineError;

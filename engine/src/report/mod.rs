@@ -87,7 +87,7 @@ pub trait Render {
     fn render(&self, sink: &mut dyn Sink);
 }
 
-pub use crate::identify::outcome::Status;
+pub use crate::identify::Status;
 /// Whether a command's result can be trusted as it stands (the fit's verdict; a command
 /// without a fit is `Ok`); decides the exit code of a front end.
 pub use crate::identify::Verdict;

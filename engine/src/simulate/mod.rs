@@ -44,6 +44,7 @@ mod dopri;
 mod driver;
 mod euler;
 mod jacobian;
+pub mod mechanical;
 mod rodas;
 mod root;
 mod small_lu;
@@ -52,13 +53,13 @@ mod stepper;
 pub use closed_form::ClosedForm;
 pub use dopri::Dopri5;
 pub use euler::Euler;
+pub use mechanical::MechanicalEnergy;
 pub use rodas::Rodas4;
 pub use stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper, Tolerance};
 
 use auto::resolve_method;
 use driver::Driver;
 
-use crate::energy::MechanicalEnergy;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use frictionid_models::{sgn, FrictionModel};

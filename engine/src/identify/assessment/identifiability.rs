@@ -16,20 +16,20 @@
 //! settled: the unbounded parameters are pinned where they are and the others re-optimised;
 //! when that converges the fit counts as converged for them.
 
-use super::layout::ParamKind;
-use super::options::FitOptions;
-use super::outcome::{Check, Finding, TerminationReason};
-use super::problem::{FitProblem, ProblemParts};
-use super::residuals::Residuals;
-use super::starts::{run_start, MultiStart, RunSlot, StartRun};
 use super::stats::{chi_square_95, covariance, Covariance};
-use super::strategy::{fit_simpler, stage_options, FitTarget, Onto};
 use crate::error::EngineError;
+use crate::identify::problem::least_squares::{FitProblem, ProblemParts};
+use crate::identify::problem::residuals::Residuals;
+use crate::identify::search::starts::{run_start, MultiStart, RunSlot, StartRun};
+use crate::identify::search::strategy::{fit_simpler, stage_options, FitTarget, Onto};
+use crate::identify::values::layout::ParamKind;
+use crate::identify::values::options::FitOptions;
+use crate::identify::values::outcome::{Check, Finding, TerminationReason};
+use crate::identify::values::result::Identifiability;
 use frictionid_models::start::TYPICAL_PRESLIDING_DISPLACEMENT;
 use frictionid_models::{FrictionModel, StartContext, StribeckLevels};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
-use serde::Serialize;
 
 /// chi²(1 dof, 95 %) / 2 = 3.8415 / 2: the rise of the cost (half the sum of squares), in
 /// residual variances, that excludes a parameter value at 95 %.
@@ -57,32 +57,6 @@ pub const PROFILE_RESOLUTION: f64 = 0.05;
 /// damping change by factors between decades of sigma0), and a profile that stops short of
 /// their optimum overstates the lower bound.
 pub const LIMIT_PROFILE_ITERATIONS: u64 = 40;
-
-/// What the records say about a fitted parameter.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Identifiability {
-    /// Bounded on both sides: the value and its standard error stand.
-    Determined,
-    /// Only smaller values are excluded (at 95 %): the parameter exceeds `bound`.
-    LowerBound,
-    /// Only larger values are excluded: the parameter is below `bound`.
-    UpperBound,
-    /// Neither side is bounded within the profile.
-    NotIdentifiable,
-}
-
-impl Identifiability {
-    /// Config-style name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Determined => "determined",
-            Self::LowerBound => "lower_bound",
-            Self::UpperBound => "upper_bound",
-            Self::NotIdentifiable => "not_identifiable",
-        }
-    }
-}
 
 /// One free parameter's standing.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,4 +1,4 @@
-//! Fits in the force domain: the model's friction force along the measured motion against a
+//! The force domain's residuals: the model's friction force along the measured motion against a
 //! target force ([`ForceAlongMotion`]).
 //!
 //! The measured motion is replayed, not simulated: the velocity channel (or the differentiated
@@ -16,21 +16,22 @@
 //! noise level estimated from the target ([`crate::record::noise::noise_floor_level`] of its first differences), so records of different noise
 //! weigh as they should in a joint fit. Nothing is simulated, so a force-domain fit costs a
 //! few milliseconds per evaluation and has no phase errors to trap the optimiser: it is also
-//! the prefit of velocity fits of dynamic models (see [`super::fit::fit`]).
+//! the prefit of velocity fits of dynamic models (run by [`crate::identify::fit::fit`]).
 
-use super::fit::{fit_with, FitResult};
-use super::options::{FitDomain, FitOptions, ForceTarget};
 use super::residuals::STEPS_PER_SAMPLE;
-use super::residuals::{Evaluation, NuisanceKind, RecordCase, Residuals, SampleAxes, Segment};
+use super::residuals::{Evaluation, RecordCase, Residuals, Segment};
 use super::state_cache::StateCache;
 use crate::energy::forces_at;
 use crate::energy::model_force::{check_motion, states_along_checked};
 use crate::energy::{analyze_record, record_motion};
 use crate::error::EngineError;
+use crate::identify::values::nuisance::NuisanceKind;
+use crate::identify::values::options::{FitDomain, FitOptions, ForceTarget};
+use crate::identify::values::result::SampleAxes;
 use crate::oscillator::Oscillator;
 use crate::record::noise::noise_floor_level;
 use crate::record::{channel_list, Channel, NormalForce, Record};
-use frictionid_models::{FrictionModel, GuessHint};
+use frictionid_models::GuessHint;
 use std::sync::Arc;
 
 /// Where a record's target force comes from.
@@ -433,14 +434,9 @@ fn velocity_only_options(opts: &FitOptions) -> Vec<&'static str> {
     keys
 }
 
-/// Fits `model`'s force along the measured motion of `records` to their target forces (see
-/// the module docs). The result's residuals are in N.
-pub fn fit_force(
-    osc: &Oscillator,
-    model: &(dyn FrictionModel + 'static),
-    records: &[Record],
-    opts: &FitOptions,
-) -> Result<FitResult, EngineError> {
+/// The options fit the force domain: `domain = "force"`, and none of the options only a
+/// velocity fit has.
+pub fn check_force_domain(opts: &FitOptions) -> Result<(), EngineError> {
     let velocity_keys = velocity_only_options(opts);
     if !velocity_keys.is_empty() {
         return Err(EngineError::InvalidInput(format!(
@@ -453,14 +449,7 @@ pub fn fit_force(
             "fit_force needs [fit.options] domain = \"force\"".into(),
         ));
     }
-    let producer = ForceAlongMotion::new(records, osc, opts)?;
-    let mean_normal = producer.mean_normal_force();
-    let mut result = fit_with(Arc::new(producer), osc, model, records, opts)?;
-    if opts.unknown_oscillator.iter().any(|k| k == "normal_force") {
-        // The records carry the normal force; the result's oscillator shows their mean.
-        result.oscillator.normal_force = mean_normal;
-    }
-    Ok(result)
+    Ok(())
 }
 
 #[cfg(test)]

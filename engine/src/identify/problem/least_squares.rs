@@ -4,12 +4,14 @@
 //! default); the problem maps the solver's coordinates to a model, an oscillator and the
 //! per-record nuisance values, and concatenates the producer's residuals over the records.
 //! It implements argmin's [`Operator`] (residuals) and [`Jacobian`] (forward differences), so
-//! any argmin least-squares solver can drive it; ours is [`super::lm::LevenbergMarquardt`].
+//! any argmin least-squares solver can drive it; ours is [`crate::identify::search::LevenbergMarquardt`].
 
-use super::layout::{FreeParam, ParamKind};
-use super::residuals::{Evaluation, NuisanceValues, RecordCase, Residuals, VelocityResponse};
-use super::work::WorkBudget;
+use super::residuals::{Evaluation, RecordCase, Residuals};
+use super::simulated_response::SimulatedResponse;
+use super::step_allowance::StepAllowance;
 use crate::error::{EngineError, IntegrationFailure};
+use crate::identify::values::layout::{FreeParam, ParamKind};
+use crate::identify::values::nuisance::NuisanceValues;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use crate::simulate::SimOptions;
@@ -20,15 +22,13 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
-pub use super::residuals::STEPS_PER_SAMPLE;
-
 /// Relative forward-difference step in internal coordinates. The ODE engine's default
 /// tolerances (rtol 1e-10) leave ~1e-10 relative noise in the residuals, so a step of 1e-6
 /// balances truncation against that noise (error ~ 1e-4 of the derivative).
 pub const FD_STEP: f64 = 1e-6;
 
 /// The residual function of a fit, generic over what produces the residuals.
-pub struct FitProblem<R: Residuals = VelocityResponse> {
+pub struct FitProblem<R: Residuals = SimulatedResponse> {
     /// The oscillator with its fixed values.
     pub oscillator: Oscillator,
     /// The model with its fixed values.
@@ -45,8 +45,8 @@ pub struct FitProblem<R: Residuals = VelocityResponse> {
     pub parallel: bool,
     simulations: AtomicU64,
     last_error: Mutex<Option<String>>,
-    /// The step budget of the simulations, per record ([`WorkBudget`]).
-    work: WorkBudget,
+    /// The step allowance of the simulations, per record ([`StepAllowance`]).
+    allowance: StepAllowance,
     /// The last point `apply` evaluated, reused by `jacobian` at the same point.
     cache: Mutex<Option<(DVector<f64>, DVector<f64>)>>,
     /// The last physical Jacobian and residuals, by point: the identifiability check and the
@@ -88,7 +88,7 @@ impl<R: Residuals> FitProblem<R> {
     /// oscillator carry the fixed values.
     pub fn new(residuals: Arc<R>, parts: ProblemParts) -> Self {
         Self {
-            work: WorkBudget::new(parts.records.len()),
+            allowance: StepAllowance::new(parts.records.len()),
             oscillator: parts.oscillator,
             model: parts.model,
             records: parts.records,
@@ -179,7 +179,7 @@ impl<R: Residuals> FitProblem<R> {
             &self.sim,
             &self.simulations,
         )
-        .with_work(&self.work)
+        .with_step_allowance(&self.allowance)
     }
 
     /// The prediction of record `r`'s measured series at `world`.
@@ -201,7 +201,7 @@ impl<R: Residuals> FitProblem<R> {
         let world = self.realise(p)?;
         // The lowest index of a record that failed: the evaluation reports the first error
         // in record order, so a later record's simulation is stopped (or not started) once
-        // an earlier one failed (a trial point too stiff for the work budget costs one
+        // an earlier one failed (a trial point too stiff for the step allowance costs one
         // record's failure instead of three); the outcome is the same.
         let failed = AtomicUsize::new(usize::MAX);
         let at = self.evaluation(&world).with_failures(&failed);
@@ -270,7 +270,7 @@ impl<R: Residuals> FitProblem<R> {
     fn worth_threads(&self) -> bool {
         self.parallel
             && !self
-                .work
+                .allowance
                 .is_light(self.records.iter().map(|r| r.time().len()))
     }
 
@@ -409,7 +409,7 @@ mod tests {
             ..LuGre::default()
         };
         let residuals =
-            Arc::new(VelocityResponse::for_records(&records, false, false, false).unwrap());
+            Arc::new(SimulatedResponse::for_records(&records, false, false, false).unwrap());
         let sigma0 = FreeParam {
             log: true,
             ..FreeParam::linear(
@@ -439,8 +439,8 @@ mod tests {
 
     /// Once a record's simulation fails, the records after it in the same evaluation are not
     /// simulated (their outcome no longer matters): the first evaluation, at a soft contact,
-    /// sets each record's work budget, and a trial at a contact a thousand times stiffer
-    /// (stability-bound for Dopri5, far over the budget) fails on the first record and costs
+    /// sets each record's step allowance, and a trial at a contact a thousand times stiffer
+    /// (stability-bound for Dopri5, far over the allowance) fails on the first record and costs
     /// that one simulation, not three. The error is the one the first record alone gives.
     #[test]
     fn an_evaluation_stops_at_the_first_record_that_fails() {

@@ -1,20 +1,17 @@
 //! The force-domain prefit of velocity fits of dynamic models (the paper's own route).
 //!
 //! Eq. 7 gives the friction force along the measured motion without any fit. Fitting a
-//! model's force along that motion to it ([`super::force::fit_force`] with the energy-based
-//! target) needs no simulation of the mechanics and has no phase errors to trap the
+//! model's force along that motion to it (a force-domain fit with the energy-based target,
+//! run by [`crate::identify::fit`] with the options [`prefit_options`] gives) needs no simulation of the mechanics and has no phase errors to trap the
 //! optimiser, so its optimum is a good start for the velocity fit of a model with internal
 //! states, whose default starts often end in a poor local minimum. The velocity fit runs its
 //! usual starts plus this one; the report says which start won. Static laws (no internal
 //! states) are not prefitted: their fit stays one start, one run.
 
-use super::force::fit_force;
-use super::options::{FitDomain, FitOptions, ForceTarget};
-use super::outcome::{Check, Finding, Status};
-use super::result::FitResult;
 use crate::error::EngineError;
-use crate::oscillator::Oscillator;
-use crate::record::Record;
+use crate::identify::values::options::{FitDomain, FitOptions, ForceTarget};
+use crate::identify::values::outcome::{Check, Finding, Status};
+use crate::identify::values::result::FitResult;
 use frictionid_models::FrictionModel;
 
 /// The prefit's optimum and what it cost.
@@ -27,18 +24,25 @@ pub struct Prefit {
     pub wall_time_s: f64,
 }
 
-/// The prefit of `model` on `records`, when `opts` asks for it and the model has internal
-/// states (`None` otherwise); an error when the prefit itself failed.
-pub fn prefit(
-    osc: &Oscillator,
-    model: &(dyn FrictionModel + 'static),
-    records: &[Record],
-    opts: &FitOptions,
-) -> Option<Result<Prefit, EngineError>> {
+impl Prefit {
+    /// The prefit's optimum and cost out of its force-domain fit.
+    pub fn of(result: FitResult) -> Self {
+        Self {
+            model: result.fitted_model,
+            rms_force: result.rms_residual,
+            wall_time_s: result.wall_time_s,
+        }
+    }
+}
+
+/// The options of the prefit of `model`, when `opts` asks for it and the model has internal
+/// states (`None` otherwise): the force domain against the energy-based force, nothing but
+/// the model's parameters free, no uncertainty refits, no progress.
+pub fn prefit_options(model: &dyn FrictionModel, opts: &FitOptions) -> Option<FitOptions> {
     if !opts.prefit || model.n_states() == 0 {
         return None;
     }
-    let force_opts = FitOptions {
+    Some(FitOptions {
         domain: FitDomain::Force,
         force_target: ForceTarget::Energy,
         force_offset: false,
@@ -49,14 +53,7 @@ pub fn prefit(
         uncertainty: Default::default(),
         progress: None,
         ..opts.clone()
-    };
-    Some(
-        fit_force(osc, model, records, &force_opts).map(|r: FitResult| Prefit {
-            model: r.fitted_model,
-            rms_force: r.rms_residual,
-            wall_time_s: r.wall_time_s,
-        }),
-    )
+    })
 }
 
 /// The origin a fit reports for the start the prefit gave.

@@ -1,7 +1,7 @@
 //! What a fit varies and how.
 
-use super::budget::PropertyUncertainty;
-use super::strategy::Search;
+use super::search::Search;
+use super::uncertainty::PropertyUncertainty;
 use crate::energy::EnergyOptions;
 use crate::simulate::{Integrator, SimOptions};
 use serde::{Deserialize, Serialize};
@@ -56,7 +56,7 @@ pub enum FitDomain {
     #[default]
     Velocity,
     /// The model's force along the measured motion against a target force
-    /// ([`super::force::ForceAlongMotion`]).
+    /// ([`crate::identify::problem::ForceAlongMotion`]).
     Force,
 }
 
@@ -121,7 +121,7 @@ pub struct FitOptions {
     /// Fit the release displacement x0 of each record, starting from its given value.
     pub x0: bool,
     /// One standard deviation of the oscillator's properties, propagated into every fitted
-    /// parameter's standard error (see [`super::budget`]).
+    /// parameter's standard error (see [`crate::identify::assessment::property_refits`]).
     pub uncertainty: PropertyUncertainty,
     /// What the fit compares.
     pub domain: FitDomain,
@@ -136,10 +136,10 @@ pub struct FitOptions {
     /// them fail with a message naming them.
     pub unknown_oscillator: Vec<String>,
     /// Number of starts; `None`: 1 when at most two model parameters are free, else
-    /// [`super::starts::DEFAULT_STARTS`].
+    /// [`crate::identify::search::starts::DEFAULT_STARTS`].
     pub multistart: Option<usize>,
     /// Search strategy; `None`: `staged` for models with internal states or more than two
-    /// free parameters, `local` otherwise (see [`super::strategy`]).
+    /// free parameters, `local` otherwise (see [`crate::identify::search::strategy`]).
     pub search: Option<Search>,
     /// Iteration limit of each start.
     pub max_iterations: u64,

@@ -1,8 +1,8 @@
-//! The work budget of a fit's simulations: a trial point may cost at most a multiple of what
+//! The step allowance of a fit's simulations: a trial point may cost at most a multiple of what
 //! the start point cost, so runaway trial points (a law that chatters, bristles stiffening
 //! without bound on records that cannot tell) are cut off by cost, not by stiffness. A
 //! physically valid stiff point is integrated by the stiff stepper in about as many steps as
-//! a soft one and stays well inside the budget.
+//! a soft one and stays well inside the allowance.
 //!
 //! Work is counted in integrator steps (accepted and rejected) per sample; the first
 //! simulation a problem runs (its start point) sets the baseline. A simulation over its cap
@@ -27,15 +27,15 @@ pub const PARALLEL_MIN_STEPS: f64 = 2000.0;
 /// Baseline steps per sample, in millionths (0: not measured yet).
 const SCALE: f64 = 1e6;
 
-/// The budget of one fit problem: per record, the start point's steps per sample, once
+/// The step allowance of one fit problem: per record, the start point's steps per sample, once
 /// measured (per record, so that the caps do not depend on which simulation ends first).
 #[derive(Debug, Default)]
-pub struct WorkBudget {
+pub struct StepAllowance {
     baseline: Vec<AtomicU64>,
 }
 
-impl WorkBudget {
-    /// A budget for `records` records whose baselines their first simulations set.
+impl StepAllowance {
+    /// An allowance for `records` records whose baselines their first simulations set.
     pub fn new(records: usize) -> Self {
         Self {
             baseline: (0..records).map(|_| AtomicU64::new(0)).collect(),
@@ -84,44 +84,44 @@ mod tests {
 
     #[test]
     fn the_first_simulation_sets_a_cap_of_a_multiple_of_its_steps_per_sample() {
-        let budget = WorkBudget::new(2);
-        assert_eq!(budget.cap(0, 1000), None);
+        let allowance = StepAllowance::new(2);
+        assert_eq!(allowance.cap(0, 1000), None);
         let start = SimStats {
             steps: 3000,
             rejected_steps: 1000,
             ..SimStats::default()
         };
-        budget.record(0, &start, 2000);
+        allowance.record(0, &start, 2000);
         // 2 steps per sample at the start: 16 per sample allowed.
-        assert_eq!(budget.cap(0, 1000), Some(16_000));
-        assert_eq!(budget.cap(1, 1000), None);
+        assert_eq!(allowance.cap(0, 1000), Some(16_000));
+        assert_eq!(allowance.cap(1, 1000), None);
         let later = SimStats {
             steps: 1,
             ..SimStats::default()
         };
-        budget.record(0, &later, 2000);
-        assert_eq!(budget.cap(0, 1000), Some(16_000));
-        budget.record(1, &later, 2000);
-        assert_eq!(budget.cap(1, 500), Some(500));
-        assert_eq!(budget.cap(2, 500), None);
+        allowance.record(0, &later, 2000);
+        assert_eq!(allowance.cap(0, 1000), Some(16_000));
+        allowance.record(1, &later, 2000);
+        assert_eq!(allowance.cap(1, 500), Some(500));
+        assert_eq!(allowance.cap(2, 500), None);
     }
 
     #[test]
     fn records_are_light_once_measured_below_the_parallel_threshold() {
-        let budget = WorkBudget::new(2);
+        let allowance = StepAllowance::new(2);
         let few = SimStats {
             steps: 10,
             ..SimStats::default()
         };
-        assert!(!budget.is_light([2000, 2000].into_iter()));
-        budget.record(0, &few, 2000);
+        assert!(!allowance.is_light([2000, 2000].into_iter()));
+        allowance.record(0, &few, 2000);
         assert!(
-            !budget.is_light([2000, 2000].into_iter()),
+            !allowance.is_light([2000, 2000].into_iter()),
             "record 1 unmeasured"
         );
-        budget.record(1, &few, 2000);
-        assert!(budget.is_light([2000, 2000].into_iter()));
-        let many = WorkBudget::new(1);
+        allowance.record(1, &few, 2000);
+        assert!(allowance.is_light([2000, 2000].into_iter()));
+        let many = StepAllowance::new(1);
         let dopri = SimStats {
             steps: 2500,
             ..SimStats::default()

@@ -1,4 +1,4 @@
-//! The oscillator's response as a fit compares it ([`VelocityResponse`]): simulate the free
+//! The oscillator's response as a fit compares it ([`SimulatedResponse`]): simulate the free
 //! vibration from each record's release state and compare every response channel the record
 //! holds (velocity, displacement, acceleration), stacked.
 //!
@@ -15,18 +15,16 @@
 //! velocity channel (and needs one in every record).
 
 use super::analysis_cache::AnalysisCache;
-use super::options::FitOptions;
-use super::residuals::{
-    Evaluation, NuisanceKind, NuisanceValues, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
-};
-use crate::energy::{record_motion, EnergyAnalysis, EnergyOptions};
+use super::residuals::{Evaluation, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE};
+use crate::energy::record_motion;
 use crate::error::EngineError;
+use crate::identify::values::nuisance::{NuisanceKind, NuisanceValues};
+use crate::identify::values::options::FitOptions;
 use crate::oscillator::Oscillator;
 use crate::record::{channel_list, Channel, Record};
 use crate::simulate::{simulate, simulate_velocity_watched, Initial, SimOptions, VelocityRun};
 use frictionid_models::GuessHint;
 use std::borrow::Cow;
-use std::sync::Arc;
 
 /// The response channels, in the order they are stacked.
 const RESPONSE: [Channel; 3] = [
@@ -50,11 +48,11 @@ struct ResponseTrack {
     measured: Vec<f64>,
 }
 
-/// The response producer. Built by [`VelocityResponse::for_records`] it compares every
-/// response channel; built by [`VelocityResponse::new`] (no records) it compares the velocity
+/// The response producer. Built by [`SimulatedResponse::for_records`] it compares every
+/// response channel; built by [`SimulatedResponse::new`] (no records) it compares the velocity
 /// channel alone, unweighted.
 #[derive(Debug, Clone, PartialEq)]
-pub struct VelocityResponse {
+pub struct SimulatedResponse {
     nuisance: Vec<NuisanceKind>,
     tracks: Vec<ResponseTrack>,
     primary: Channel,
@@ -62,7 +60,7 @@ pub struct VelocityResponse {
     analyses: AnalysisCache,
 }
 
-impl VelocityResponse {
+impl SimulatedResponse {
     /// A velocity-only response with a per-record velocity offset, release shift and/or
     /// release displacement.
     pub fn new(velocity_offset: bool, time_shift: bool, x0: bool) -> Self {
@@ -84,7 +82,7 @@ impl VelocityResponse {
     }
 
     /// The response of `records` over every response channel each holds, with the nuisance
-    /// parameters of [`VelocityResponse::new`]. Errors: a record without a response channel;
+    /// parameters of [`SimulatedResponse::new`]. Errors: a record without a response channel;
     /// a velocity offset asked for a record without velocity.
     pub fn for_records(
         records: &[Record],
@@ -110,7 +108,7 @@ impl VelocityResponse {
     /// values' x0 `shift` seconds after its release instant (the one found or given when the
     /// record was cut at its release, which may lie between samples; else its first time
     /// stamp). Samples before the release see the release velocity; no offset. `index` is the
-    /// record's place in the fit (for its work budget, [`super::work`]).
+    /// record's place in the fit (for its step allowance, [`super::step_allowance`]).
     pub fn simulate(
         &self,
         at: &Evaluation<'_>,
@@ -123,7 +121,7 @@ impl VelocityResponse {
             at.count_simulation();
             let mut sim = Vec::with_capacity(clock.times.len());
             let init = initial(record, nuisance);
-            let opts = budgeted(at, index, record, clock.times.len());
+            let opts = within_allowance(at, index, record, clock.times.len());
             let mut superseded = |_: usize| at.superseded(index);
             let run = VelocityRun {
                 sample_times: &clock.times,
@@ -141,7 +139,7 @@ impl VelocityResponse {
         Ok(v)
     }
 
-    /// The simulated `channels` of `record` (as [`VelocityResponse::simulate`]; before the
+    /// The simulated `channels` of `record` (as [`SimulatedResponse::simulate`]; before the
     /// release: x0, v0 and no acceleration), concatenated in the order given.
     fn simulate_channels(
         &self,
@@ -155,7 +153,7 @@ impl VelocityResponse {
         let trajectory = match clock.times.last() {
             Some(&t_end) => {
                 at.count_simulation();
-                let opts = budgeted(at, index, record, clock.times.len());
+                let opts = within_allowance(at, index, record, clock.times.len());
                 let init = initial(record, nuisance);
                 let trajectory =
                     simulate(at.oscillator, at.model, &init, t_end, &clock.times, &opts)?;
@@ -222,9 +220,15 @@ fn initial(record: &Record, nuisance: &NuisanceValues) -> Initial {
     }
 }
 
-/// The simulation options of record `index` with `simulated` samples: the step budget of
-/// the record ([`STEPS_PER_SAMPLE`]) and of the fit's work ([`super::work`]).
-fn budgeted(at: &Evaluation<'_>, index: usize, record: &Record, simulated: usize) -> SimOptions {
+/// The simulation options of record `index` with `simulated` samples: within the step limit
+/// of the record ([`STEPS_PER_SAMPLE`]) and the fit's step allowance
+/// ([`super::step_allowance`]).
+fn within_allowance(
+    at: &Evaluation<'_>,
+    index: usize,
+    record: &Record,
+    simulated: usize,
+) -> SimOptions {
     let base = STEPS_PER_SAMPLE * (record.len() as u64).max(100);
     at.capped(index, simulated, base)
 }
@@ -285,7 +289,7 @@ fn track(record: &Record, primary: Channel, reference: f64) -> ResponseTrack {
     ResponseTrack { stacked, measured }
 }
 
-impl Residuals for VelocityResponse {
+impl Residuals for SimulatedResponse {
     fn channel(&self) -> &'static str {
         self.primary.name()
     }
@@ -350,21 +354,15 @@ impl Residuals for VelocityResponse {
                 .channel(Channel::Velocity)
                 .and_then(|_| self.energy_analysis(index, rec, osc, &opts.energy).ok());
             match analysed {
-                Some(analysis) => super::setup::level_of_analysis(&analysis),
-                None => super::setup::friction_level(rec, osc, opts),
+                Some(analysis) => super::guess::level_of_analysis(&analysis),
+                None => super::guess::friction_level(rec, osc, opts),
             }
         };
-        super::setup::guess_hint_with(osc, &with_velocity, level)
+        super::guess::guess_hint_with(osc, &with_velocity, level)
     }
 
-    fn energy_analysis(
-        &self,
-        index: usize,
-        record: &Record,
-        osc: &Oscillator,
-        options: &EnergyOptions,
-    ) -> Result<Arc<EnergyAnalysis>, EngineError> {
-        self.analyses.analysis(index, record, osc, options)
+    fn analysis_cache(&self) -> Option<&AnalysisCache> {
+        Some(&self.analyses)
     }
 
     /// Prepared records need a response channel (not necessarily velocity); an unprepared
@@ -433,7 +431,7 @@ mod tests {
             .with_noise(Channel::Acceleration, 5e-3);
         record.x0 = 0.014;
         let producer =
-            VelocityResponse::for_records(std::slice::from_ref(&record), false, false, false)
+            SimulatedResponse::for_records(std::slice::from_ref(&record), false, false, false)
                 .unwrap();
         assert_eq!((producer.channel(), producer.unit()), ("displacement", "m"));
         let segments = producer.segments(0, &record);
@@ -461,9 +459,9 @@ mod tests {
         assert!(mismatched <= exact.half_cycles(), "{mismatched}");
         let bare = Record::from_time_base("f", TimeBase::new(vec![0.0, 1.0]).unwrap())
             .with_channel(Channel::Force, vec![0.0, 1.0]);
-        let e = VelocityResponse::for_records(&[bare], false, false, false).unwrap_err();
+        let e = SimulatedResponse::for_records(&[bare], false, false, false).unwrap_err();
         assert!(e.to_string().contains("no response channel to fit"), "{e}");
-        let e = VelocityResponse::for_records(&[record], true, false, false).unwrap_err();
+        let e = SimulatedResponse::for_records(&[record], true, false, false).unwrap_err();
         assert!(
             e.to_string()
                 .contains("velocity_offset = true needs a velocity channel"),
@@ -483,7 +481,7 @@ mod tests {
             .v;
         let mut record = Record::new("r", time, vec![0.0; 400], 0.014);
         record.weight = 4.0;
-        let producer = VelocityResponse::new(true, false, false);
+        let producer = SimulatedResponse::new(true, false, false);
         assert_eq!(producer.nuisance(), &[NuisanceKind::VelocityOffset]);
         let counter = AtomicU64::new(0);
         let sim = SimOptions::default();
@@ -512,7 +510,7 @@ mod tests {
             shift: 0.0305,
             ..NuisanceValues::default()
         };
-        let v = VelocityResponse::new(false, true, false)
+        let v = SimulatedResponse::new(false, true, false)
             .simulate(&at, case(&record, &shifted))
             .unwrap();
         assert!(v[..31].iter().all(|&x| x == 0.0));

@@ -10,33 +10,19 @@
 //! - `global`: the staged starts, plus a seeded Latin hypercube over the physical box in the
 //!   solver's (log) coordinates; all are screened and the best few refined.
 
-use super::identifiability::PROFILE_DELTA;
-use super::layout::{FreeParam, ParamKind};
-use super::options::FitOptions;
-use super::outcome::StartOutcome;
-use super::problem::{FitProblem, ProblemParts};
-use super::residuals::Residuals;
-use super::setup::{build_layout, non_model_bound_keys, Layout};
-use super::starts::{fit_starting_points, run_starts, PROMOTED_STARTS};
+use super::free_params::{build_layout, Layout};
+use super::starts::{fit_starting_points, run_starts};
+use crate::identify::problem::least_squares::{FitProblem, ProblemParts};
+use crate::identify::problem::residuals::Residuals;
+use crate::identify::values::layout::{FreeParam, ParamKind};
+use crate::identify::values::nuisance::non_model_bound_keys;
+use crate::identify::values::options::FitOptions;
+use crate::identify::values::search::Search;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use frictionid_models::start::TYPICAL_PRESLIDING_DISPLACEMENT;
 use frictionid_models::{clone_model, Coulomb, FrictionModel, StartContext, Stribeck};
-use serde::{Deserialize, Serialize};
 use std::sync::Arc;
-
-/// How a fit searches for its optimum.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Search {
-    /// Starts around the data-driven guess.
-    Local,
-    /// Static laws first; their optima start the target (the default for models with
-    /// internal states or more than two free parameters).
-    Staged,
-    /// Staged starts plus a Latin hypercube over the physical box.
-    Global,
-}
 
 /// Latin-hypercube starts a `global` search adds.
 pub const GLOBAL_STARTS: usize = 12;
@@ -50,53 +36,6 @@ pub const GLOBAL_SEED: u64 = 0x5eed_0014;
 /// Presliding displacements (multiples of the typical one) that map the last stage onto
 /// the target: the typical one and a stiffer contact.
 pub const STAGED_PRESLIDING: [f64; 2] = [1.0, 0.1];
-
-impl Search {
-    /// Config name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Local => "local",
-            Self::Staged => "staged",
-            Self::Global => "global",
-        }
-    }
-
-    /// The strategy asked for, else `staged` for a model with internal states or more than
-    /// two free parameters and `local` otherwise (a Coulomb fit stays one start, one run),
-    /// and `local` for a static law fitted along the measured motion
-    /// ([`fits_directly`]).
-    pub fn resolve(
-        asked: Option<Self>,
-        model: &dyn FrictionModel,
-        n_model_free: usize,
-        simulated: bool,
-    ) -> Self {
-        let wide = model.n_states() > 0 || n_model_free > 2;
-        asked.unwrap_or(if wide && !fits_directly(model, simulated) {
-            Self::Staged
-        } else {
-            Self::Local
-        })
-    }
-
-    /// Screened starts continued to convergence.
-    pub fn promoted(self) -> usize {
-        match self {
-            Self::Local => PROMOTED_STARTS,
-            Self::Staged => 2,
-            Self::Global => 3,
-        }
-    }
-}
-
-/// Whether `model` is a static law fitted without simulating the response (`simulated`
-/// false: the force domain). Its residuals are the law itself at the measured velocities:
-/// no phase error traps the solver and the data-driven guess puts the levels at the target
-/// force's, so the default is one start from the guess (the force route's speed; `search`
-/// and `multistart` still ask for more).
-pub fn fits_directly(model: &dyn FrictionModel, simulated: bool) -> bool {
-    !simulated && model.n_states() == 0
-}
 
 /// A starting point and where it came from.
 #[derive(Debug, Clone, PartialEq)]
@@ -480,23 +419,6 @@ fn global_points(layout: &Layout, n: usize, seed: u64) -> Vec<Seeded> {
         .collect()
 }
 
-/// Starts whose cost is within the statistical tolerance of the best: a cost difference of
-/// at most chi²(1 dof, 95 %) / 2 residual variances (at least 1: the best itself).
-pub fn starts_at_best(outcomes: &[StartOutcome], best_cost: f64, residual_variance: f64) -> usize {
-    let tolerance = if residual_variance.is_finite() && residual_variance > 0.0 {
-        PROFILE_DELTA * residual_variance
-    } else {
-        1e-6 * best_cost.abs()
-    };
-    outcomes
-        .iter()
-        .filter(
-            |o| matches!(o, StartOutcome::Finished { cost, .. } if *cost - best_cost <= tolerance),
-        )
-        .count()
-        .max(1)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -541,18 +463,5 @@ mod tests {
         };
         assert!((in_box(&f, 1e5, 0.0) / 1e3 - 1.0).abs() < 1e-12);
         assert!((in_box(&f, 1e5, 1.0) / 1e6 - 1.0).abs() < 1e-12);
-    }
-
-    #[test]
-    fn starts_count_at_the_best_within_chi_square_over_two_variances() {
-        let done = |start, cost| StartOutcome::Finished {
-            start,
-            cost,
-            iterations: 1,
-            termination: super::super::outcome::TerminationReason::GradientBelowTolerance,
-        };
-        // variance 1e-8: tolerance 1.92e-8.
-        let outcomes = [done(0, 1.0), done(1, 1.0 + 1.9e-8), done(2, 1.0 + 2.0e-8)];
-        assert_eq!(starts_at_best(&outcomes, 1.0, 1e-8), 2);
     }
 }

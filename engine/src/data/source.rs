@@ -25,10 +25,8 @@
 //! sampling_tolerance = 0.01
 //! ```
 
-use super::release::{detect_release, Release};
-use super::sanity::check_scales;
-use super::{Channel, NormalForce, Record};
-use crate::data::{read_record, DataError, DataFormat, ReadOptions};
+use super::{read_record, DataError, DataFormat, ReadOptions};
+use crate::record::{check_scales, detect_release, Channel, NormalForce, Record, Release};
 use crate::Oscillator;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -215,7 +213,7 @@ impl ResolvedSource {
     }
 
     /// [`ResolvedSource::load`], then the units checked against `osc`
-    /// ([`super::sanity::check_scales`]).
+    /// ([`crate::record::check_scales`]).
     pub fn load_checked(&self, osc: &Oscillator) -> Result<Record, DataError> {
         let record = self.load()?;
         check_scales(&record, osc)?;

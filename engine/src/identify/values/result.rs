@@ -1,11 +1,10 @@
 //! The values a fit returns.
 
-use super::budget::StdErrorComponents;
-use super::energy_check::EnergyForce;
-use super::identifiability::Identifiability;
+use super::uncertainty::StdErrorComponents;
+
 use super::outcome::{as_display, worst_status, Finding, StartOutcome, Status, TerminationReason};
-use super::residuals::SampleAxes;
-use super::strategy::Search;
+
+use super::search::Search;
 use crate::oscillator::Oscillator;
 use frictionid_models::FrictionModel;
 use serde::Serialize;
@@ -171,10 +170,72 @@ pub struct FitResult {
     pub warnings: Vec<String>,
     /// Wall time of the fit [s].
     pub wall_time_s: f64,
-    /// Its place in a model comparison (set by [`super::compare::compare`]; its keys join the
+    /// Its place in a model comparison (set by [`crate::identify::compare::compare`]; its keys join the
     /// fit's in JSON).
     #[serde(flatten)]
     pub rank: Option<Rank>,
+}
+
+/// The abscissae of a record's compared samples (one value per sample).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SampleAxes {
+    /// Time stamps \[s\].
+    pub time: Vec<f64>,
+    /// Displacement of the motion \[m\] (empty when not known).
+    pub displacement: Vec<f64>,
+    /// Velocity of the motion [m/s] (empty when not known).
+    pub velocity: Vec<f64>,
+}
+
+/// The energy-based force check of one record.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EnergyForce {
+    /// Mean |F_f| from Eq. 7 over the unmasked oscillating samples [N].
+    pub mean_abs: f64,
+    /// The reference level [N]: the model's mean |F| along the measured motion over the same
+    /// samples (mu N for Coulomb), or the given level.
+    pub reference: f64,
+    /// 100 (mean_abs - reference) / reference.
+    pub percent_difference: f64,
+    /// RMS of the energy-based minus model force [N] (NaN, `null` in JSON, for a level).
+    pub residual_rms: f64,
+    /// Samples compared (where the energy-based force is defined).
+    pub samples: usize,
+    /// Mean friction force of the half-cycles (energy balance, no differentiation) [N].
+    pub half_cycle_mean: f64,
+    /// The reference as a distance mean, comparable with the half-cycle estimate (energy
+    /// per distance): the model's sum |F| |v| / sum |v| over the samples compared, or the
+    /// given level [N].
+    pub half_cycle_reference: f64,
+    /// 100 (half_cycle_mean - half_cycle_reference) / half_cycle_reference (NaN without a
+    /// complete half-cycle).
+    pub half_cycle_percent_difference: f64,
+}
+
+/// What the records say about a fitted parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Identifiability {
+    /// Bounded on both sides: the value and its standard error stand.
+    Determined,
+    /// Only smaller values are excluded (at 95 %): the parameter exceeds `bound`.
+    LowerBound,
+    /// Only larger values are excluded: the parameter is below `bound`.
+    UpperBound,
+    /// Neither side is bounded within the profile.
+    NotIdentifiable,
+}
+
+impl Identifiability {
+    /// Config-style name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Determined => "determined",
+            Self::LowerBound => "lower_bound",
+            Self::UpperBound => "upper_bound",
+            Self::NotIdentifiable => "not_identifiable",
+        }
+    }
 }
 
 /// A fit's standing in a model comparison.
@@ -185,7 +246,7 @@ pub struct Rank {
     /// exp(-delta_aic / 2), normalised over the ranking: the weight of evidence for this
     /// model among those compared.
     pub akaike_weight: f64,
-    /// Within [`super::compare::INDISTINGUISHABLE_DELTA_AIC`] of the best: the data do not
+    /// Within [`crate::identify::compare::INDISTINGUISHABLE_DELTA_AIC`] of the best: the data do not
     /// tell it from the best.
     pub indistinguishable: bool,
 }

@@ -1,29 +1,29 @@
-//! What a fit compares: the [`Residuals`] trait. Its producers: the oscillator's response
-//! ([`VelocityResponse`] in `response.rs`: simulate the free vibration, compare every response
-//! channel) and the force along the measured motion (`force.rs`).
+//! What a fit compares: the [`Residuals`] trait. Its producers: the oscillator's simulated
+//! response ([`super::SimulatedResponse`]: simulate the free vibration, compare every response
+//! channel the records hold, stacked) and the force along the measured motion
+//! ([`super::ForceAlongMotion`]).
 //!
 //! A residual producer says which nuisance parameters it adds to every record (a velocity
 //! offset, a release-time shift, ...), what it measures and what the model predicts for it
 //! at given model, oscillator and nuisance values. The fit problem
-//! ([`super::problem::FitProblem`]) weighs and concatenates the residuals of all records and
-//! knows nothing else of them, so a producer in the force domain (replay the measured motion,
+//! ([`super::FitProblem`]) weighs and concatenates the residuals of all records and knows
+//! nothing else of them, so a producer in the force domain (replay the measured motion,
 //! compare a force) plugs in beside this one.
 
-use super::options::FitOptions;
-use super::work::WorkBudget;
+use super::analysis_cache::AnalysisCache;
+use super::step_allowance::StepAllowance;
 use crate::energy::{analyze_record, EnergyAnalysis, EnergyOptions};
 use crate::error::EngineError;
+use crate::identify::values::options::FitOptions;
+use crate::identify::values::{NuisanceKind, NuisanceValues, SampleAxes};
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use crate::simulate::{SimOptions, SimStats};
 use frictionid_models::{FrictionModel, GuessHint};
-use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::Arc;
 
-pub use super::response::VelocityResponse;
-
-/// Step budget of a simulation per sample of its record: a bound on cost, not on stiffness.
+/// Step limit of a simulation per sample of its record: a bound on cost, not on stiffness.
 /// With `Integrator::Auto` (`[fit.options] integrator = "auto"`) the fit integrates stiff
 /// bristle and element models with Rodas4, whose steps follow the motion's accuracy whatever the stiffness (about
 /// 1 000 steps for a 2 s LuGre record at sigma0 = 1e7..1e9 N/m, against 40 000 allowed): a
@@ -31,130 +31,6 @@ pub use super::response::VelocityResponse;
 /// many steps per sample interval (chattering, a runaway law) are still rejected as
 /// infeasible instead of integrated for seconds.
 pub const STEPS_PER_SAMPLE: u64 = 20;
-
-/// A per-record parameter that is not part of the friction law or the oscillator.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum NuisanceKind {
-    /// A constant added to the predicted velocity (an instrument's DC offset) [m/s].
-    VelocityOffset,
-    /// The release instant relative to the record's release time (its first time stamp unless
-    /// it was cut at a release found or given between samples) [s].
-    ReleaseShift,
-    /// The displacement at release [m], when the record's x0 is known only approximately.
-    StartDisplacement,
-    /// A constant added to the predicted force (a load cell's zero) \[N\].
-    ForceOffset,
-}
-
-impl NuisanceKind {
-    /// The key of its bounds in `FitOptions::bounds` and the prefix of its reported name
-    /// (`offset[x14mm.csv]`).
-    pub fn key(self) -> &'static str {
-        match self {
-            Self::VelocityOffset => "offset",
-            Self::ReleaseShift => "shift",
-            Self::StartDisplacement => "x0",
-            Self::ForceOffset => "force_offset",
-        }
-    }
-
-    /// SI unit.
-    pub fn unit(self) -> &'static str {
-        match self {
-            Self::VelocityOffset => "m/s",
-            Self::ReleaseShift => "s",
-            Self::StartDisplacement => "m",
-            Self::ForceOffset => "N",
-        }
-    }
-
-    /// The scale of its internal coordinate when its start value is 0.
-    pub fn typical(self) -> f64 {
-        match self {
-            Self::VelocityOffset => 1e-4,
-            Self::ReleaseShift => 1e-3,
-            Self::StartDisplacement => 1e-3,
-            Self::ForceOffset => 1e-2,
-        }
-    }
-
-    /// Bounds when the options give none: no bound for an offset; a quarter of the natural
-    /// period either way for a release shift (a later release is the next turning point's
-    /// business); x0 within 20 % of the record's value.
-    pub fn default_bounds(self, record: &Record, osc: &Oscillator) -> (f64, f64) {
-        match self {
-            Self::VelocityOffset | Self::ForceOffset => (f64::NEG_INFINITY, f64::INFINITY),
-            Self::ReleaseShift => {
-                let quarter = 0.5 * std::f64::consts::PI / osc.omega_n();
-                (-quarter, quarter)
-            }
-            Self::StartDisplacement => {
-                let half_width = X0_RELATIVE_BOUND * record.x0.abs();
-                (record.x0 - half_width, record.x0 + half_width)
-            }
-        }
-    }
-
-    /// The value a fit starts from (before clipping to the bounds): 0, or the record's x0.
-    pub fn start(self, record: &Record) -> f64 {
-        match self {
-            Self::VelocityOffset | Self::ReleaseShift | Self::ForceOffset => 0.0,
-            Self::StartDisplacement => record.x0,
-        }
-    }
-
-    /// Every kind, in the order a record's nuisance parameters are laid out.
-    pub const ALL: [NuisanceKind; 4] = [
-        Self::VelocityOffset,
-        Self::ReleaseShift,
-        Self::StartDisplacement,
-        Self::ForceOffset,
-    ];
-}
-
-/// Default half-width of the bounds of a fitted x0, relative to the record's value.
-pub const X0_RELATIVE_BOUND: f64 = 0.2;
-
-/// The nuisance values of one record (0, or the record's own x0, for those not fitted).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct NuisanceValues {
-    /// Velocity offset [m/s].
-    pub offset: f64,
-    /// Release-time shift [s].
-    pub shift: f64,
-    /// Fitted displacement at release [m] (`None`: the record's x0).
-    pub x0: Option<f64>,
-    /// Force offset \[N\].
-    pub force_offset: f64,
-}
-
-impl NuisanceValues {
-    /// The value of `kind` (`None` for an x0 that is not fitted).
-    pub fn get(&self, kind: NuisanceKind) -> Option<f64> {
-        match kind {
-            NuisanceKind::VelocityOffset => Some(self.offset),
-            NuisanceKind::ReleaseShift => Some(self.shift),
-            NuisanceKind::StartDisplacement => self.x0,
-            NuisanceKind::ForceOffset => Some(self.force_offset),
-        }
-    }
-
-    /// Sets the value of `kind`.
-    pub fn set(&mut self, kind: NuisanceKind, value: f64) {
-        match kind {
-            NuisanceKind::VelocityOffset => self.offset = value,
-            NuisanceKind::ReleaseShift => self.shift = value,
-            NuisanceKind::StartDisplacement => self.x0 = Some(value),
-            NuisanceKind::ForceOffset => self.force_offset = value,
-        }
-    }
-
-    /// The release displacement of `record` with these values.
-    pub fn x0_of(&self, record: &Record) -> f64 {
-        self.x0.unwrap_or(record.x0)
-    }
-}
 
 /// The values a producer evaluates at: the oscillator and model of one parameter vector, the
 /// simulation options, and a counter of the simulations run.
@@ -166,7 +42,7 @@ pub struct Evaluation<'a> {
     /// Simulation options.
     pub sim: &'a SimOptions,
     simulations: &'a AtomicU64,
-    work: Option<&'a WorkBudget>,
+    allowance: Option<&'a StepAllowance>,
     failed: Option<&'a AtomicUsize>,
 }
 
@@ -183,7 +59,7 @@ impl<'a> Evaluation<'a> {
             model,
             sim,
             simulations,
-            work: None,
+            allowance: None,
             failed: None,
         }
     }
@@ -198,35 +74,39 @@ impl<'a> Evaluation<'a> {
     }
 
     /// Whether record `index` no longer matters to the evaluation: a record before it failed
-    /// (whose error the evaluation reports whatever the later records do), and its work
-    /// budget is set (a record's first simulation, which sets it, always runs in full).
+    /// (whose error the evaluation reports whatever the later records do), and its step
+    /// allowance is set (a record's first simulation, which sets it, always runs in full).
     pub fn superseded(&self, index: usize) -> bool {
         let failed_before = self
             .failed
             .is_some_and(|f| f.load(Ordering::Relaxed) < index);
-        failed_before && self.work.is_some_and(|w| w.cap(index, 1).is_some())
+        failed_before && self.allowance.is_some_and(|w| w.cap(index, 1).is_some())
     }
 
-    /// The same, with simulations held to `work` ([`super::work`]).
-    pub fn with_work(self, work: &'a WorkBudget) -> Self {
+    /// The same, with simulations held to `allowance` ([`super::step_allowance`]).
+    pub fn with_step_allowance(self, allowance: &'a StepAllowance) -> Self {
         Self {
-            work: Some(work),
+            allowance: Some(allowance),
             ..self
         }
     }
 
-    /// `sim` with its step limit lowered to `base` and to record `index`'s work budget.
+    /// `sim` with its step limit lowered to `base` and to record `index`'s step allowance.
     pub fn capped(&self, index: usize, samples: usize, base: u64) -> SimOptions {
-        let budget = self.work.and_then(|w| w.cap(index, samples));
+        let allowed = self.allowance.and_then(|w| w.cap(index, samples));
         SimOptions {
-            max_steps: self.sim.max_steps.min(base).min(budget.unwrap_or(u64::MAX)),
+            max_steps: self
+                .sim
+                .max_steps
+                .min(base)
+                .min(allowed.unwrap_or(u64::MAX)),
             ..*self.sim
         }
     }
 
-    /// Records the work of a simulation of record `index` (the first sets its budget).
+    /// Records the work of a simulation of record `index` (the first sets its allowance).
     pub fn record_work(&self, index: usize, stats: &SimStats, samples: usize) {
-        if let Some(w) = self.work {
+        if let Some(w) = self.allowance {
             w.record(index, stats, samples);
         }
     }
@@ -235,17 +115,6 @@ impl<'a> Evaluation<'a> {
     pub fn count_simulation(&self) {
         self.simulations.fetch_add(1, Ordering::Relaxed);
     }
-}
-
-/// The abscissae of a record's compared samples (one value per sample).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct SampleAxes {
-    /// Time stamps \[s\].
-    pub time: Vec<f64>,
-    /// Displacement of the motion \[m\] (empty when not known).
-    pub displacement: Vec<f64>,
-    /// Velocity of the motion [m/s] (empty when not known).
-    pub velocity: Vec<f64>,
 }
 
 /// What produces a fit's residuals: a measured series per record and the model's prediction
@@ -278,22 +147,31 @@ pub trait Residuals: Send + Sync {
     }
 
     /// Data-driven hints for the starting values (default: from the energy analysis of the
-    /// velocity, [`super::setup::guess_hint`]).
+    /// velocity, [`super::guess::guess_hint`]).
     fn hint(&self, osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
-        super::setup::guess_hint(osc, records, opts)
+        super::guess::guess_hint(osc, records, opts)
+    }
+
+    /// Where the producer keeps the energy analyses of its records (default: nowhere, every
+    /// [`Residuals::energy_analysis`] computes its own).
+    fn analysis_cache(&self) -> Option<&AnalysisCache> {
+        None
     }
 
     /// The energy analysis (Eq. 7) of the fit's record `index`, its velocity as measured,
-    /// under `osc` (default: computed at every call; a producer may keep it for the energy
-    /// check, see [`super::analysis_cache`]).
+    /// under `osc`: from the producer's [`Residuals::analysis_cache`] when it has one, else
+    /// computed.
     fn energy_analysis(
         &self,
-        _index: usize,
+        index: usize,
         record: &Record,
         osc: &Oscillator,
         options: &EnergyOptions,
     ) -> Result<Arc<EnergyAnalysis>, EngineError> {
-        Ok(Arc::new(analyze_record(record, osc, options)?))
+        match self.analysis_cache() {
+            Some(cache) => cache.analysis(index, record, osc, options),
+            None => Ok(Arc::new(analyze_record(record, osc, options)?)),
+        }
     }
 
     /// Whether the prediction is the oscillator's simulated response: then the energy-balance
@@ -360,7 +238,7 @@ pub trait Residuals: Send + Sync {
 }
 
 /// One record as a producer evaluates it: its place in the fit (for the per-record state of
-/// the producer and the work budget), its data and its nuisance values.
+/// the producer and the step allowance), its data and its nuisance values.
 #[derive(Debug, Clone, Copy)]
 pub struct RecordCase<'a> {
     /// The record's place in the fit.
@@ -385,23 +263,4 @@ pub struct Segment {
     /// The factor on its residuals (besides sqrt(weight)): 1 for the fit's own unit, the ratio
     /// of noise levels for a channel stacked beside it.
     pub scale: f64,
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The default bounds: a quarter of the natural period 2 pi sqrt(m/k) for a shift, 20 %
-    /// of the stated x0 for x0.
-    #[test]
-    fn default_nuisance_bounds_come_from_the_record_and_the_oscillator() {
-        let osc = Oscillator::fmm();
-        let record = Record::new("r", vec![0.0, 1e-3], vec![0.0, 0.0], -0.014);
-        let quarter = 0.25 * 2.0 * std::f64::consts::PI * (osc.mass / osc.stiffness).sqrt();
-        let (lo, hi) = NuisanceKind::ReleaseShift.default_bounds(&record, &osc);
-        assert!((hi - quarter).abs() < 1e-12 && (lo + quarter).abs() < 1e-12);
-        let (lo, hi) = NuisanceKind::StartDisplacement.default_bounds(&record, &osc);
-        assert!((lo + 0.0168).abs() < 1e-12 && (hi + 0.0112).abs() < 1e-12);
-        assert_eq!(NuisanceKind::StartDisplacement.start(&record), -0.014);
-    }
 }

@@ -1,22 +1,10 @@
-//! The uncertainty budget: how the uncertainty of the oscillator's known properties (m, c,
-//! k, N; one standard deviation each) propagates into the fitted parameters, beside the
-//! data's own standard error.
-//!
-//! The sensitivity of the optimum to a property q is taken by refits at q + sigma and
-//! q - sigma (central difference, started from the optimum): the component of parameter
-//! theta is |theta(q + sigma) - theta(q - sigma)| / 2. The total standard error is the root
-//! sum of squares of the data component and every property component; the 95 % interval
-//! follows from the total.
+//! The uncertainty of the oscillator's known properties (m, c, k, N; one standard deviation
+//! each) and the parts of a fitted parameter's standard error it adds (see
+//! [`crate::identify::assessment::property_refits`]).
 
-use super::options::FitOptions;
-use super::residuals::Residuals;
-use super::result::{FitResult, FittedParam};
-use super::stats::t_quantile_975;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
-use frictionid_models::FrictionModel;
 use serde::{Deserialize, Serialize};
-use std::sync::Arc;
 
 /// One standard deviation of each oscillator property (0: known exactly).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -38,7 +26,8 @@ impl PropertyUncertainty {
         self.properties().iter().any(|(_, s)| *s > 0.0)
     }
 
-    fn properties(&self) -> [(Property, f64); 4] {
+    /// Every property with its standard deviation.
+    pub(crate) fn properties(&self) -> [(Property, f64); 4] {
         [
             (Property::Mass, self.mass),
             (Property::Damping, self.damping),
@@ -63,16 +52,22 @@ impl PropertyUncertainty {
     }
 }
 
+/// An oscillator property a fit can be uncertain of.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Property {
+pub(crate) enum Property {
+    /// The mass.
     Mass,
+    /// The damping.
     Damping,
+    /// The stiffness.
     Stiffness,
+    /// The normal force.
     NormalForce,
 }
 
 impl Property {
-    fn name(self) -> &'static str {
+    /// Config-style name.
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Self::Mass => "mass",
             Self::Damping => "damping",
@@ -81,7 +76,8 @@ impl Property {
         }
     }
 
-    fn shifted(self, osc: &Oscillator, by: f64) -> Oscillator {
+    /// `osc` with this property moved by `by`.
+    pub(crate) fn shifted(self, osc: &Oscillator, by: f64) -> Oscillator {
         let mut o = *osc;
         match self {
             Self::Mass => o.mass += by,
@@ -109,7 +105,8 @@ pub struct StdErrorComponents {
 }
 
 impl StdErrorComponents {
-    fn set(&mut self, p: Property, value: f64) {
+    /// Sets the component of `p`.
+    pub(crate) fn set(&mut self, p: Property, value: f64) {
         match p {
             Property::Mass => self.mass = value,
             Property::Damping => self.damping = value,
@@ -143,78 +140,6 @@ impl StdErrorComponents {
         )
         .0
     }
-}
-
-/// Everything a refit needs.
-pub(crate) struct Refit<'a, R: Residuals> {
-    pub residuals: Arc<R>,
-    pub osc: &'a Oscillator,
-    pub opts: &'a FitOptions,
-}
-
-/// Adds the property components to every free parameter of `result` and makes its standard
-/// error and interval the totals. Properties that the fit itself varies are skipped.
-pub(crate) fn apply_budget<R: Residuals + 'static>(
-    result: &mut FitResult,
-    refit: &Refit<'_, R>,
-    fit_with: impl Fn(
-        Arc<R>,
-        &Oscillator,
-        &(dyn FrictionModel + 'static),
-        &FitOptions,
-    ) -> FitResultOrError,
-) -> Result<(), EngineError> {
-    let sigma = refit.opts.uncertainty;
-    sigma.validate()?;
-    let mut opts = refit.opts.clone();
-    opts.uncertainty = PropertyUncertainty::default();
-    opts.guess = false;
-    opts.multistart = Some(1);
-    opts.progress = None;
-    let fitted: Vec<&str> = refit.opts.oscillator.iter().map(|q| q.name()).collect();
-    let mut components: Vec<StdErrorComponents> = result
-        .parameters
-        .iter()
-        .map(|p| StdErrorComponents {
-            data: p.std_error,
-            ..StdErrorComponents::default()
-        })
-        .collect();
-    for (property, s) in sigma.properties() {
-        if s <= 0.0 || fitted.contains(&property.name()) {
-            continue;
-        }
-        let at = |by: f64| {
-            fit_with(
-                refit.residuals.clone(),
-                &property.shifted(refit.osc, by),
-                result.fitted_model.as_ref(),
-                &opts,
-            )
-        };
-        let (up, down) = (at(s)?, at(-s)?);
-        for (c, p) in components.iter_mut().zip(&result.parameters) {
-            if let (Some(a), Some(b)) = (up.value(&p.name), down.value(&p.name)) {
-                c.set(property, ((a - b) / 2.0).abs());
-            }
-        }
-    }
-    let tq = t_quantile_975(result.samples.saturating_sub(result.free_parameters));
-    for (p, c) in result.parameters.iter_mut().zip(components) {
-        if p.free {
-            set_total(p, c, tq);
-        }
-    }
-    Ok(())
-}
-
-/// What a refit returns.
-pub(crate) type FitResultOrError = Result<FitResult, EngineError>;
-
-fn set_total(p: &mut FittedParam, c: StdErrorComponents, tq: f64) {
-    p.std_error = c.total();
-    p.ci95 = p.std_error.map(|s| [p.value - tq * s, p.value + tq * s]);
-    p.std_error_components = Some(c);
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 //! coefficient near 1; all others are divided by a scale (their starting magnitude). Bounds
 //! map to bounds of the internal coordinates, which the projected Levenberg-Marquardt keeps.
 
-use super::residuals::NuisanceKind;
+use super::nuisance::NuisanceKind;
 use serde::Serialize;
 
 /// What a free parameter is.

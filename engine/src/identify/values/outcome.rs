@@ -48,7 +48,7 @@ pub enum TerminationReason {
     },
     /// Abandoned: another start of the same fit had converged to a cost `factor` times lower
     /// or more, or (screening) the nested static law the model contains reached it
-    /// ([`super::lm::Pace`]); this one could not have become the best within reach.
+    /// ([`crate::identify::search::lm::Pace`]); this one could not have become the best within reach.
     Outpaced {
         /// The cost the other start converged to.
         best: f64,

@@ -12,11 +12,12 @@
 //! - Parameters at a bound, standard errors that cannot be computed, starts that disagree,
 //!   non-convergence.
 
-use super::energy_check::EnergyForce;
-use super::layout::FreeParam;
-use super::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
-use super::result::{FittedParam, RecordFit};
+use super::identifiability::PROFILE_DELTA;
 use crate::energy::cumulative_trapezoid;
+use crate::identify::values::layout::FreeParam;
+use crate::identify::values::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
+use crate::identify::values::result::EnergyForce;
+use crate::identify::values::result::{FittedParam, RecordFit};
 use crate::oscillator::Oscillator;
 
 /// An energy-balance difference above this many percent warns.
@@ -425,13 +426,30 @@ pub fn convergence(termination: &TerminationReason, model_params: &[String]) -> 
     }
 }
 
+/// Starts whose cost is within the statistical tolerance of the best: a cost difference of
+/// at most chi²(1 dof, 95 %) / 2 residual variances (at least 1: the best itself).
+pub fn starts_at_best(outcomes: &[StartOutcome], best_cost: f64, residual_variance: f64) -> usize {
+    let tolerance = if residual_variance.is_finite() && residual_variance > 0.0 {
+        PROFILE_DELTA * residual_variance
+    } else {
+        1e-6 * best_cost.abs()
+    };
+    outcomes
+        .iter()
+        .filter(
+            |o| matches!(o, StartOutcome::Finished { cost, .. } if *cost - best_cost <= tolerance),
+        )
+        .count()
+        .max(1)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::exact::coulomb_free_vibration;
-    use crate::identify::layout::ParamKind;
-    use crate::identify::residuals::SampleAxes;
-    use crate::identify::result::FitSeries;
+    use crate::identify::values::layout::ParamKind;
+    use crate::identify::values::result::FitSeries;
+    use crate::identify::values::result::SampleAxes;
     use rand::rngs::StdRng;
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
@@ -637,5 +655,18 @@ mod tests {
             "{}",
             none.message
         );
+    }
+
+    #[test]
+    fn starts_count_at_the_best_within_chi_square_over_two_variances() {
+        let done = |start, cost| StartOutcome::Finished {
+            start,
+            cost,
+            iterations: 1,
+            termination: TerminationReason::GradientBelowTolerance,
+        };
+        // variance 1e-8: tolerance 1.92e-8.
+        let outcomes = [done(0, 1.0), done(1, 1.0 + 1.9e-8), done(2, 1.0 + 2.0e-8)];
+        assert_eq!(starts_at_best(&outcomes, 1.0, 1e-8), 2);
     }
 }

@@ -1,16 +1,16 @@
 //! Multi-start strategy: where the starts begin, one Levenberg-Marquardt run per start, a short
 //! screening of every start and the continuation of the most promising one.
 
-use super::layout::{FreeParam, ParamKind};
 use super::lm::{
     termination_reason, DampingStart, LevenbergMarquardt, LmState, Pace, LARGEST_DIAGONAL_TAU,
 };
-use super::options::{FitOptions, Progress, ProgressFn};
-use super::outcome::{StartOutcome, TerminationReason};
-use super::problem::FitProblem;
-use super::residuals::Residuals;
-use super::strategy::fits_directly;
 use crate::error::EngineError;
+use crate::identify::problem::least_squares::FitProblem;
+use crate::identify::problem::residuals::Residuals;
+use crate::identify::values::layout::{FreeParam, ParamKind};
+use crate::identify::values::options::{FitOptions, Progress, ProgressFn};
+use crate::identify::values::outcome::{StartOutcome, TerminationReason};
+use crate::identify::values::search::fits_directly;
 use argmin::core::observers::{Observe, ObserverMode};
 use argmin::core::{Executor, State, KV};
 use frictionid_models::FrictionModel;
@@ -50,10 +50,6 @@ pub const SCREEN_ITERATIONS: u64 = 15;
 /// above it is abandoned.
 pub const SCREEN_GRACE: u64 = 5;
 
-/// Starts continued to convergence after the screening phase by a local search (the best
-/// one; see `Search::promoted`).
-pub const PROMOTED_STARTS: usize = 1;
-
 /// One start's run: where it ended and how.
 pub struct StartRun {
     /// Internal coordinates of its best point.
@@ -79,7 +75,7 @@ impl StartRun {
 
 /// The number of starts: as asked, else one when at most two model parameters are free or
 /// the fit is `direct` (a static law along the measured motion, see
-/// [`super::strategy::fits_directly`]).
+/// [`crate::identify::values::fits_directly`]).
 pub fn start_count(
     opts: &FitOptions,
     n_model_free: usize,

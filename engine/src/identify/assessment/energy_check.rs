@@ -6,7 +6,7 @@
 
 use crate::energy::{mean_abs_where_defined, percent_difference, EnergyAnalysis};
 use crate::error::EngineError;
-use serde::Serialize;
+use crate::identify::values::EnergyForce;
 
 /// What the energy-based force is compared with.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -18,31 +18,6 @@ pub enum ForceReference<'a> {
     ModelForce(&'a [f64]),
     /// A constant force level [N] (e.g. a measured mu N).
     Level(f64),
-}
-
-/// The energy-based force check of one record.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct EnergyForce {
-    /// Mean |F_f| from Eq. 7 over the unmasked oscillating samples [N].
-    pub mean_abs: f64,
-    /// The reference level [N]: the model's mean |F| along the measured motion over the same
-    /// samples (mu N for Coulomb), or the given level.
-    pub reference: f64,
-    /// 100 (mean_abs - reference) / reference.
-    pub percent_difference: f64,
-    /// RMS of the energy-based minus model force [N] (NaN, `null` in JSON, for a level).
-    pub residual_rms: f64,
-    /// Samples compared (where the energy-based force is defined).
-    pub samples: usize,
-    /// Mean friction force of the half-cycles (energy balance, no differentiation) [N].
-    pub half_cycle_mean: f64,
-    /// The reference as a distance mean, comparable with the half-cycle estimate (energy
-    /// per distance): the model's sum |F| |v| / sum |v| over the samples compared, or the
-    /// given level [N].
-    pub half_cycle_reference: f64,
-    /// 100 (half_cycle_mean - half_cycle_reference) / half_cycle_reference (NaN without a
-    /// complete half-cycle).
-    pub half_cycle_percent_difference: f64,
 }
 
 /// Holds the energy-based force of `analysis` against `reference`.

@@ -12,7 +12,7 @@
 //! through [`Jacobian`]. A residual vector with a non-finite entry (e.g. a simulation that
 //! failed for the trial parameters) is treated as an infinitely bad trial and rejected.
 
-use super::outcome::TerminationReason;
+use crate::identify::values::outcome::TerminationReason;
 use argmin::core::{
     Error, IterState, Jacobian, Operator, Problem, Solver, State,
     TerminationReason as ArgminReason, TerminationStatus, KV,
@@ -347,7 +347,7 @@ impl NormalEquations {
         // One free parameter (a Coulomb mu): two dot products, no transposed copy. Otherwise
         // one transposed copy for both products, gemm's summation order kept: column dots
         // (`tr_mul`) move the LuGre and Dahl fits onto slower paths (the five-model compare
-        // 2.0 -> 2.6-2.9 s when measured again in session 9).
+        // 2.0 -> 2.6-2.9 s on repeated measurement).
         let (a, g) = if j.ncols() == 1 {
             (j.tr_mul(j), j.tr_mul(r))
         } else {

@@ -1,0 +1,15 @@
+//! What a fit's optimum is worth, on the search's floor: the statistics ([`stats`]), which
+//! parameters the records determine ([`identifiability`]), the checks that become findings
+//! ([`diagnostics`]), the energy-balance check ([`energy_check`]), the per-record fits
+//! ([`record_fits`]), the sum-up into a `FitResult` ([`summary`]) and the refits under the
+//! oscillator's property uncertainties ([`property_refits`], handed the refit by the fit).
+
+pub mod diagnostics;
+pub mod energy_check;
+pub mod identifiability;
+pub mod property_refits;
+pub mod record_fits;
+pub mod stats;
+pub mod summary;
+
+pub use energy_check::{energy_force_check, ForceReference};

@@ -1,0 +1,397 @@
+//! The fit at its best start, as a [`FitResult`]: the statistics at the optimum (the
+//! covariance of the determined parameters, widened for autocorrelated residuals), every
+//! parameter's entry, the per-record fits and the findings, in report order.
+
+use super::diagnostics::{self, starts_at_best};
+use super::identifiability::{self, covariance_of_determined, Standing};
+use super::record_fits::{record_fits, RecordFits};
+use super::stats::{self, aic, bic, t_quantile_975, Covariance};
+use crate::error::EngineError;
+use crate::identify::problem::{FitProblem, Realised, Residuals};
+use crate::identify::search::starts::{MultiStart, StartRun};
+use crate::identify::search::Layout;
+use crate::identify::values::{
+    Check, Derived, Finding, FitOptions, FitResult, FittedParam, FreeParam, OscillatorParam,
+    ParamKind, Search, StartOutcome, Status,
+};
+use crate::oscillator::Oscillator;
+use nalgebra::DMatrix;
+use std::time::Instant;
+
+/// Correlations above this magnitude are reported as warnings.
+pub const CORRELATION_WARNING: f64 = 0.95;
+
+/// What the final phase needs besides the runs.
+pub struct FinishContext<'a, R: Residuals> {
+    /// The fit's options.
+    pub opts: &'a FitOptions,
+    /// Its free parameters.
+    pub layout: &'a Layout,
+    /// The problem at the fit's start, which evaluates the optimum.
+    pub reference: &'a FitProblem<R>,
+    /// Starts run.
+    pub n_starts: usize,
+    /// The search that ran them.
+    pub search: Search,
+    /// Where each start came from.
+    pub origins: &'a [String],
+    /// What the records say about each free parameter.
+    pub standings: &'a [Standing],
+}
+
+/// The statistics at the best parameters.
+struct Statistics {
+    p_best: Vec<f64>,
+    world: Realised,
+    cov: Covariance,
+    ssr: f64,
+    t_quantile: f64,
+    /// Says how the standard errors were widened for autocorrelated residuals.
+    widening: Option<Finding>,
+}
+
+fn statistics<R: Residuals>(
+    reference: &FitProblem<R>,
+    best: &StartRun,
+    standings: &[Standing],
+) -> Result<Statistics, EngineError> {
+    // Statistics in physical coordinates at the optimum, of the determined parameters.
+    let p_best = reference.physical(&best.u);
+    let (jac, r) = reference.jacobian_physical(&p_best)?;
+    let ssr = r.norm_squared();
+    let mut cov = covariance_of_determined(&jac, ssr, standings);
+    let segments: Vec<usize> = reference
+        .records
+        .iter()
+        .enumerate()
+        .map(|(i, rec)| reference.residuals.residual_count(i, rec))
+        .collect();
+    let widening = widen_for_autocorrelation(&mut cov, &jac, r.as_slice(), &segments);
+    let t_quantile = t_quantile_975(cov.dof);
+    let world = reference.realise(&p_best)?;
+    Ok(Statistics {
+        p_best,
+        world,
+        cov,
+        ssr,
+        t_quantile,
+        widening,
+    })
+}
+
+/// Noise lag-1 correlation above which standard errors are checked for widening (white
+/// noise gives about 1/sqrt(n), far below).
+pub const AUTOCORRELATION_THRESHOLD: f64 = 0.1;
+
+/// Widens the covariance when the residuals are autocorrelated: each standard error becomes
+/// the larger of the classical and the Newey-West one (Bartlett lags covering the noise's
+/// correlation time), keeping the correlations. Returns the finding that says so.
+fn widen_for_autocorrelation(
+    cov: &mut Covariance,
+    jac: &DMatrix<f64>,
+    r: &[f64],
+    segments: &[usize],
+) -> Option<Finding> {
+    let mut start = 0;
+    let parts: Vec<Vec<f64>> = segments
+        .iter()
+        .map(|&len| {
+            let part = r[start..(start + len).min(r.len())].to_vec();
+            start += len;
+            part
+        })
+        .collect();
+    let phi = diagnostics::noise_correlation(&parts);
+    if phi <= AUTOCORRELATION_THRESHOLD
+        || cov.singular
+        || cov.residual_variance.is_nan()
+        || cov.residual_variance <= 0.0
+    {
+        return None;
+    }
+    let shortest = segments.iter().copied().min().unwrap_or(0);
+    let lags = ((5.0 * (1.0 + phi) / (1.0 - phi)).ceil() as usize).clamp(1, shortest / 4 + 1);
+    let bread = &cov.matrix / cov.residual_variance;
+    let hac = stats::newey_west(jac, r, segments, lags, &bread);
+    let p = cov.std_errors.len();
+    let factors: Vec<f64> = (0..p)
+        .map(|i| (hac[(i, i)] / cov.matrix[(i, i)]).sqrt())
+        .map(|f| if f.is_finite() { f.max(1.0) } else { 1.0 })
+        .collect();
+    for a in 0..p {
+        for b in 0..p {
+            cov.matrix[(a, b)] *= factors[a] * factors[b];
+        }
+        cov.std_errors[a] *= factors[a];
+    }
+    let widest = factors.iter().copied().fold(1.0, f64::max);
+    Some(Finding::new(
+        Check::NoiseCorrelation,
+        Status::Pass,
+        Some(widest),
+        format!(
+            "residuals are autocorrelated (noise lag-1 correlation {phi:.2}): standard errors widened by up to {widest:.2}x (Newey-West, {lags} lags)"
+        ),
+    ))
+}
+
+/// Statistics, per-record fits, the energy check and the findings at the best start.
+pub fn summarise<R: Residuals>(
+    ctx: &FinishContext<'_, R>,
+    runs: MultiStart,
+    clock: Instant,
+) -> Result<FitResult, EngineError> {
+    let params = &ctx.layout.params;
+    let stats = statistics(ctx.reference, &runs.best, ctx.standings)?;
+    let mut simulations = runs.simulations + ctx.reference.simulations();
+    let fits = record_fits(ctx.reference, &stats.world, ctx.opts)?;
+    simulations += ctx.reference.records.len() as u64;
+    let parameters = parameter_entries(&stats, params, ctx.standings);
+    let findings = diagnose(ctx, &runs, &stats, &parameters, &fits);
+    let n_free = params.len();
+    let samples = ctx.reference.n_residuals();
+    let k = params.len();
+    let warnings = findings
+        .iter()
+        .filter(|f| f.status != Status::Pass)
+        .map(|f| f.message.clone())
+        .collect();
+    Ok(FitResult {
+        model: stats.world.model.name().to_string(),
+        parameters,
+        correlation_names: params.iter().map(|f| f.name.clone()).collect(),
+        correlation: (0..k)
+            .map(|a| (0..k).map(|b| stats.cov.correlation[(a, b)]).collect())
+            .collect(),
+        derived: derived_ratios(&stats.world.oscillator, params, &stats.cov.matrix, ctx.opts),
+        records: fits.records,
+        rms_residual: (fits.sum_sq / fits.n_total.max(1) as f64).sqrt(),
+        compared: ctx.reference.residuals.channel().to_string(),
+        residual_unit: ctx.reference.residuals.unit().to_string(),
+        cost: 0.5 * stats.ssr,
+        aic: aic(samples, stats.ssr, n_free),
+        bic: bic(samples, stats.ssr, n_free),
+        samples,
+        free_parameters: n_free,
+        converged: runs.best.converged(),
+        termination: runs.best.termination,
+        iterations: runs.iterations,
+        simulations,
+        starts: ctx.n_starts,
+        starts_at_best: starts_at_best(&runs.outcomes, runs.best.cost, stats.cov.residual_variance),
+        search: ctx.search,
+        best_start: runs.best_start,
+        best_start_origin: ctx
+            .origins
+            .get(runs.best_start)
+            .cloned()
+            .unwrap_or_default(),
+        start_outcomes: runs.outcomes,
+        diagnostics: findings,
+        warnings,
+        wall_time_s: clock.elapsed().as_secs_f64(),
+        rank: None,
+        fitted_model: stats.world.model,
+        oscillator: stats.world.oscillator,
+    })
+}
+
+/// Every check of the fit, in report order.
+fn diagnose<R: Residuals>(
+    ctx: &FinishContext<'_, R>,
+    runs: &MultiStart,
+    stats: &Statistics,
+    parameters: &[FittedParam],
+    fits: &RecordFits,
+) -> Vec<Finding> {
+    let params = &ctx.layout.params;
+    let model_params: Vec<String> = params
+        .iter()
+        .filter(|f| matches!(f.kind, ParamKind::Model(_)))
+        .map(|f| f.name.clone())
+        .collect();
+    let mut findings = vec![diagnostics::convergence(
+        &runs.best.termination,
+        &model_params,
+    )];
+    findings.extend(start_findings(&runs.outcomes));
+    findings.extend(diagnostics::start_agreement(
+        &runs.outcomes,
+        runs.best.cost,
+        stats.cov.residual_variance,
+    ));
+    findings.extend(correlation_findings(params, &stats.cov));
+    findings.push(diagnostics::standard_errors(parameters, stats.cov.singular));
+    findings.extend(stats.widening.clone());
+    findings.extend(identifiability_findings(
+        ctx.opts,
+        ctx.layout.n_model_free(),
+    ));
+    let names: Vec<(String, String)> = params
+        .iter()
+        .map(|f| (f.name.clone(), f.unit.clone()))
+        .collect();
+    findings.extend(identifiability::findings(&names, ctx.standings));
+    findings.extend(identifiability::consistency_findings(
+        stats.world.model.as_ref(),
+    ));
+    findings.extend(diagnostics::parameters_at_bounds(params, &stats.p_best));
+    findings.extend(fits.findings.iter().cloned());
+    if ctx.reference.residuals.simulates_response() {
+        findings.push(diagnostics::residual_structure(
+            &fits.records,
+            &stats.world.oscillator,
+            ctx.opts.energy.velocity_threshold,
+        ));
+    }
+    findings
+}
+
+/// A warning per failed start: screening failures first, then failed continuations.
+fn start_findings(outcomes: &[StartOutcome]) -> Vec<Finding> {
+    let continued = |o: &&StartOutcome| matches!(o, StartOutcome::ContinuationFailed { .. });
+    let screening = outcomes.iter().filter(|o| !continued(o));
+    screening
+        .chain(outcomes.iter().filter(continued))
+        .filter_map(StartOutcome::warning)
+        .map(|w| Finding::warn(Check::StartFailure, None, w))
+        .collect()
+}
+
+/// Every model parameter (fitted or fixed), then the free oscillator and nuisance parameters.
+fn parameter_entries(
+    stats: &Statistics,
+    params: &[FreeParam],
+    standings: &[Standing],
+) -> Vec<FittedParam> {
+    let se = &stats.cov.std_errors;
+    let tq = stats.t_quantile;
+    let stand = |mut p: FittedParam, slot: Option<usize>| {
+        if let Some(s) = slot.and_then(|s| standings.get(s)) {
+            p.identifiability = Some(s.class);
+            p.bound = s.bound;
+        }
+        p
+    };
+    let model = &stats.world.model;
+    let mut out: Vec<FittedParam> = model
+        .param_info()
+        .iter()
+        .zip(model.params())
+        .enumerate()
+        .map(|(i, (p, v))| {
+            let slot = params.iter().position(|f| f.kind == ParamKind::Model(i));
+            stand(param_entry(&p.name, &p.unit, v, slot, se, tq), slot)
+        })
+        .collect();
+    for (slot, f) in params.iter().enumerate() {
+        if !matches!(f.kind, ParamKind::Model(_)) {
+            let value = stats.p_best[slot];
+            let entry = param_entry(&f.name, &f.unit, value, Some(slot), se, tq);
+            out.push(stand(entry, Some(slot)));
+        }
+    }
+    out
+}
+
+fn param_entry(
+    name: &str,
+    unit: &str,
+    value: f64,
+    slot: Option<usize>,
+    se: &[f64],
+    tq: f64,
+) -> FittedParam {
+    let std_error = slot
+        .and_then(|s| se.get(s).copied())
+        .filter(|s| s.is_finite() && *s > 0.0);
+    FittedParam {
+        name: name.to_string(),
+        value,
+        std_error,
+        ci95: std_error.map(|s| [value - tq * s, value + tq * s]),
+        unit: unit.to_string(),
+        free: slot.is_some(),
+        identifiability: None,
+        bound: None,
+        std_error_components: None,
+    }
+}
+
+/// A warning for every pair of free parameters correlated above [`CORRELATION_WARNING`].
+fn correlation_findings(params: &[FreeParam], cov: &Covariance) -> Vec<Finding> {
+    let mut out = Vec::new();
+    for a in 0..params.len() {
+        for b in (a + 1)..params.len() {
+            let rho = cov.correlation[(a, b)];
+            if rho.abs() > CORRELATION_WARNING {
+                out.push(Finding::warn(
+                    Check::Correlation,
+                    Some(rho),
+                    format!(
+                        "`{}` and `{}` are strongly correlated (rho = {rho:.3}): the data barely separate them",
+                        params[a].name, params[b].name
+                    ),
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// A warning for a free mass with anything that scales with it.
+fn identifiability_findings(opts: &FitOptions, n_model_free: usize) -> Vec<Finding> {
+    let mut out = Vec::new();
+    let osc_free = |q: OscillatorParam| opts.oscillator.contains(&q);
+    if osc_free(OscillatorParam::Mass)
+        && (osc_free(OscillatorParam::Stiffness)
+            || osc_free(OscillatorParam::Damping)
+            || n_model_free > 0)
+    {
+        out.push(Finding::warn(
+            Check::Identifiability,
+            None,
+            "velocity alone fixes k/m, c/m and friction/m, not m: with the mass free, scaling m, c, k and the friction level together leaves the motion unchanged; fix the mass (or another of them) to identify the rest".into(),
+        ));
+    }
+    out
+}
+
+/// k/m and c/m (the combinations velocity data fix) with delta-method standard errors.
+fn derived_ratios(
+    osc: &Oscillator,
+    layout: &[FreeParam],
+    cov: &DMatrix<f64>,
+    opts: &FitOptions,
+) -> Vec<Derived> {
+    if opts.oscillator.is_empty() {
+        return Vec::new();
+    }
+    let slot = |kind: ParamKind| layout.iter().position(|f| f.kind == kind);
+    let (m, c, k) = (osc.mass, osc.damping, osc.stiffness);
+    let sm = slot(ParamKind::Mass);
+    let mut out = Vec::new();
+    for (name, unit, num, kind) in [
+        ("k/m", "1/s^2", k, ParamKind::Stiffness),
+        ("c/m", "1/s", c, ParamKind::Damping),
+    ] {
+        let sn = slot(kind);
+        // gradient of num/m with respect to (num, m)
+        let g = [(sn, 1.0 / m), (sm, -num / (m * m))];
+        let mut var = 0.0;
+        for (a, ga) in g {
+            for (b, gb) in g {
+                if let (Some(a), Some(b)) = (a, b) {
+                    var += ga * gb * cov[(a, b)];
+                }
+            }
+        }
+        out.push(Derived {
+            name: name.into(),
+            value: num / m,
+            std_error: (var.is_finite() && var >= 0.0).then(|| var.sqrt()),
+            unit: unit.into(),
+        });
+    }
+    out
+}

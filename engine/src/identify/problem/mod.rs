@@ -1,0 +1,23 @@
+//! The problem a fit solves, on the values' floor: what it compares ([`Residuals`], with its
+//! two producers [`SimulatedResponse`] and [`ForceAlongMotion`]), the data-driven guess that
+//! starts it, the caches and the step allowance of its evaluations, and the least-squares
+//! problem over the free parameters ([`FitProblem`], argmin's `Operator` and `Jacobian`).
+//! Imports the values only; knows nothing of solvers, starts or findings.
+
+pub mod analysis_cache;
+pub mod force_along_motion;
+pub mod guess;
+pub mod least_squares;
+pub mod residuals;
+pub mod simulated_response;
+pub mod state_cache;
+pub mod step_allowance;
+
+pub use force_along_motion::{
+    check_force_domain, require_mechanics, require_oscillator, ForceAlongMotion,
+};
+pub use guess::guess_hint;
+pub use least_squares::{FitProblem, ProblemParts, Realised};
+pub use residuals::{Evaluation, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE};
+pub use simulated_response::SimulatedResponse;
+pub use step_allowance::StepAllowance;

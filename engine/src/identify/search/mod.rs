@@ -1,0 +1,15 @@
+//! The search for the optimum, on the problem's floor: the free parameters the options ask
+//! for ([`free_params`]), the bounded Levenberg-Marquardt solver ([`lm`]), the multi-start
+//! runs ([`starts`]), where the starts come from ([`strategy`]: local, staged from simpler
+//! laws, global) and the force-domain prefit's options and finding ([`prefit`]).
+//! Imports the values and the problem; knows nothing of statistics or findings of a fit.
+
+pub mod free_params;
+pub mod lm;
+pub mod prefit;
+pub mod starts;
+pub mod strategy;
+
+pub use free_params::{build_layout, Layout};
+pub use lm::LevenbergMarquardt;
+pub use starts::{DEFAULT_STARTS, MAX_STARTS, SCREEN_ITERATIONS};

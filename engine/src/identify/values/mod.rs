@@ -1,0 +1,26 @@
+//! The values of the identifier: what a fit is asked ([`FitOptions`], the [`Search`] it
+//! asks for, the [`PropertyUncertainty`] of the oscillator), the parameter layout
+//! ([`FreeParam`]) and the per-record nuisance parameters ([`NuisanceKind`]), and what a fit
+//! returns ([`FitResult`], its typed outcomes and findings). Nothing here imports from the
+//! floors above (problem, search, assessment).
+
+pub mod layout;
+pub mod nuisance;
+pub mod options;
+pub mod outcome;
+pub mod result;
+pub mod search;
+pub mod uncertainty;
+
+pub use layout::{BoundSide, FreeParam, ParamKind};
+pub use nuisance::{non_model_bound_keys, NuisanceKind, NuisanceValues, X0_RELATIVE_BOUND};
+pub use options::{
+    FitDomain, FitOptions, ForceTarget, OscillatorParam, Progress, ProgressFn, FIT_MAX_STEPS,
+};
+pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
+pub use result::{
+    ChannelFit, Derived, EnergyForce, FitResult, FitSeries, FittedParam, Identifiability, Rank,
+    RecordFit, SampleAxes, Verdict,
+};
+pub use search::{fits_directly, Search, PROMOTED_STARTS};
+pub use uncertainty::{PropertyUncertainty, StdErrorComponents};
