@@ -18,6 +18,10 @@ pub enum OscillatorParam {
     Damping,
     /// k [N/m].
     Stiffness,
+    /// The pendulum's gravity moment m g l [N m] (`restoring = { type = "pendulum" }`).
+    GravityMoment,
+    /// The constant force F_0 of the balance [N] (see `Oscillator::force_offset`).
+    ForceOffset,
 }
 
 impl OscillatorParam {
@@ -27,6 +31,8 @@ impl OscillatorParam {
             Self::Mass => "mass",
             Self::Damping => "damping",
             Self::Stiffness => "stiffness",
+            Self::GravityMoment => "gravity_moment",
+            Self::ForceOffset => "force_offset",
         }
     }
     /// SI unit.
@@ -35,14 +41,18 @@ impl OscillatorParam {
             Self::Mass => "kg",
             Self::Damping => "N s/m",
             Self::Stiffness => "N/m",
+            Self::GravityMoment => "N m",
+            Self::ForceOffset => "N",
         }
     }
     /// Parses a config name.
     pub fn parse(name: &str) -> Option<Self> {
         match name {
-            "mass" => Some(Self::Mass),
+            "mass" | "inertia" => Some(Self::Mass),
             "damping" => Some(Self::Damping),
             "stiffness" => Some(Self::Stiffness),
+            "gravity_moment" => Some(Self::GravityMoment),
+            "force_offset" => Some(Self::ForceOffset),
             _ => None,
         }
     }
