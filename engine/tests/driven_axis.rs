@@ -1,5 +1,5 @@
-//! A driven linear axis without a spring (a motor-driven slide): M x'' + Fv x' + Fc sgn(x')
-//! + F0 = u(t) under a measured multisine input, against an independent reference written
+//! A driven linear axis without a spring (a motor-driven slide),
+//! M x'' + Fv x' + Fc sgn(x') + F0 = u(t), under a measured multisine input, against an independent reference written
 //! here: fixed-step RK4 (1e-5 s, steps never straddling an input sample), reversals located
 //! by bisection on the step, and sticks held while |u - F0| <= Fc with their ends located by
 //! bisection on the piecewise-linear input. The velocity route (simulate the axis under the
