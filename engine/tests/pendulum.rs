@@ -175,3 +175,38 @@ fn the_pendulum_is_identified_from_encoder_angles_and_the_spring_is_rejected() {
     assert!(s.rms_residual > 5.0 * r.rms_residual);
     assert!(s.aic - r.aic > 1000.0, "AIC {} vs {}", s.aic, r.aic);
 }
+
+#[test]
+fn an_angle_in_degrees_read_as_radians_is_refused_naming_the_record_and_the_scale() {
+    let q0 = 90f64.to_radians();
+    let mut csv = String::from("time,angle_deg\n");
+    for (t, q) in reference(q0) {
+        let _ = writeln!(csv, "{t:.6},{:.4}", q.to_degrees());
+    }
+    let dir = scratch();
+    std::fs::write(dir.join("degrees.csv"), csv).expect("written");
+    let source = RecordSource {
+        file: Some("degrees.csv".into()),
+        x0: Some(q0),
+        displacement_column: Some("angle_deg".into()),
+        ..RecordSource::default()
+    };
+    let truth = pendulum(GRAVITY_MOMENT, DAMPING);
+    let e = source
+        .load_checked(&dir, &truth)
+        .expect_err("degrees read as radians");
+    let message = e.to_string();
+    eprintln!("{message}");
+    assert!(message.starts_with("degrees.csv: "), "{message}");
+    assert!(
+        message.contains("set displacement_scale = 0.0174533"),
+        "{message}"
+    );
+    assert!(!message.contains('\n'));
+    // Read in radians, the same record passes.
+    let radians = RecordSource {
+        displacement_scale: Some(PI / 180.0),
+        ..source
+    };
+    assert!(radians.load_checked(&dir, &truth).is_ok());
+}
