@@ -26,11 +26,12 @@ pub struct Oscillator {
     /// The restoring law R (the linear spring k x by default).
     #[serde(default, skip_serializing_if = "Restoring::is_linear_spring")]
     pub restoring: Restoring,
-    /// A constant force (torque) F_0 in the balance, J q'' + c q' + R(q) + F_f + F_0 = u
-    /// [N or N m]: a drive's offset (the "offset" of inverse-dynamics identification), a
-    /// load cell's zero error, gravity along an inclined axis. 0 by default.
+    /// The input's offset F_0 [N or N m]: a constant force (torque) in the balance
+    /// J q'' + c q' + R(q) + F_f + F_0 = u, the "offset" of a drive's inverse-dynamics
+    /// identification (u = J a + F_f(v) + offset), or gravity along an inclined axis. It acts
+    /// with or without an input; 0 by default.
     #[serde(default, skip_serializing_if = "is_zero")]
-    pub force_offset: f64,
+    pub input_offset: f64,
 }
 
 fn is_zero(value: &f64) -> bool {
@@ -71,7 +72,7 @@ impl OscillatorInput {
             normal_force: take("normal_force", self.normal_force, 0.0),
             axis: Axis::Linear,
             restoring: Restoring::default(),
-            force_offset: 0.0,
+            input_offset: 0.0,
         };
         (osc, missing)
     }
@@ -92,7 +93,7 @@ impl Oscillator {
             normal_force,
             axis: Axis::Linear,
             restoring: Restoring::default(),
-            force_offset: 0.0,
+            input_offset: 0.0,
         };
         o.validate()?;
         Ok(o)
@@ -108,7 +109,7 @@ impl Oscillator {
             normal_force: 14.5,
             axis: Axis::Linear,
             restoring: Restoring::default(),
-            force_offset: 0.0,
+            input_offset: 0.0,
         }
     }
 
@@ -132,10 +133,10 @@ impl Oscillator {
             ("stiffness", self.stiffness, law.reads_stiffness()),
             ("normal_force", self.normal_force, false),
         ];
-        if !self.force_offset.is_finite() {
+        if !self.input_offset.is_finite() {
             return Err(EngineError::InvalidOscillator(format!(
-                "`force_offset` must be finite, got {}",
-                self.force_offset
+                "`input_offset` must be finite, got {}",
+                self.input_offset
             )));
         }
         self.restoring

@@ -149,9 +149,9 @@ pub struct OscillatorInput {
     /// The restoring law (default: the linear spring of `stiffness`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     restoring: Option<Restoring>,
-    /// A constant force (torque) in the balance [N or N m] (default 0).
+    /// The input's offset: a constant force (torque) in the balance [N or N m] (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    force_offset: Option<f64>,
+    input_offset: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     damping: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -182,7 +182,7 @@ impl TryFrom<OscillatorInput> for OscillatorSpec {
         .resolve();
         oscillator.axis = axis;
         oscillator.restoring = restoring;
-        oscillator.force_offset = o.force_offset.unwrap_or(0.0);
+        oscillator.input_offset = o.input_offset.unwrap_or(0.0);
         for name in unknown.iter_mut().filter(|n| *n == "mass") {
             *name = axis.inertia_name().to_string();
         }
@@ -245,7 +245,7 @@ impl From<OscillatorSpec> for OscillatorInput {
             axis: rotary.then_some(p.axis),
             inertia: given("inertia", p.mass).filter(|_| rotary),
             restoring: (!p.restoring.is_linear_spring()).then_some(p.restoring),
-            force_offset: (p.force_offset != 0.0).then_some(p.force_offset),
+            input_offset: (p.input_offset != 0.0).then_some(p.input_offset),
             mass: given("mass", p.mass).filter(|_| !rotary),
             damping: given("damping", p.damping),
             stiffness: given("stiffness", p.stiffness)

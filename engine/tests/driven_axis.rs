@@ -135,7 +135,7 @@ fn identify(records: &[Record]) -> FitResult {
         ..Oscillator::fmm()
     };
     let opts = FitOptions {
-        oscillator: vec![OscillatorParam::Mass, OscillatorParam::ForceOffset],
+        oscillator: vec![OscillatorParam::Mass, OscillatorParam::InputOffset],
         guess: false,
         ..FitOptions::default()
     };
@@ -150,7 +150,7 @@ const TRUTH: [(&str, f64); 4] = [
     ("mass", MASS),
     ("viscous", VISCOUS),
     ("mu", COULOMB),
-    ("force_offset", OFFSET),
+    ("input_offset", OFFSET),
 ];
 
 #[test]
@@ -210,7 +210,7 @@ fn the_engine_follows_the_reference_under_the_input() {
         stiffness: 1.0,
         normal_force: 1.0,
         restoring: Restoring::None(NoRestoring),
-        force_offset: OFFSET,
+        input_offset: OFFSET,
         ..Oscillator::fmm()
     };
     let model = ViscousCoulomb {

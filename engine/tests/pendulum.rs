@@ -117,7 +117,7 @@ fn pendulum(gravity_moment: f64, damping: f64) -> Oscillator {
         normal_force: 1.0,
         axis: Axis::Rotary,
         restoring: Restoring::Pendulum(Pendulum { gravity_moment }),
-        force_offset: 0.0,
+        input_offset: 0.0,
     }
 }
 

@@ -549,8 +549,8 @@ pub(crate) struct Dynamics<'a> {
     pub law: Law,
     /// The measured input (`None`: free vibration).
     pub input: Option<&'a Input>,
-    /// The constant force F_0 of the balance (see [`Oscillator::force_offset`]).
-    pub force_offset: f64,
+    /// The constant force F_0 of the balance (see [`Oscillator::input_offset`]).
+    pub input_offset: f64,
 }
 
 /// What happens at a state with (possibly) zero velocity.
@@ -574,7 +574,7 @@ impl<'a> Dynamics<'a> {
             model,
             law: classify_law(model, osc.normal_force)?,
             input: None,
-            force_offset: osc.force_offset,
+            input_offset: osc.input_offset,
         })
     }
 
@@ -609,13 +609,13 @@ impl Dynamics<'_> {
     /// The external force u(t) - F_0 (0 in free vibration).
     #[inline]
     pub fn input_at(&self, t: f64) -> f64 {
-        self.input.map_or(0.0, |u| u.at(t)) - self.force_offset
+        self.input.map_or(0.0, |u| u.at(t)) - self.input_offset
     }
 
     /// Whether an input or a constant force acts (else the motion is free vibration).
     #[inline]
     pub fn driven(&self) -> bool {
-        self.input.is_some() || self.force_offset != 0.0
+        self.input.is_some() || self.input_offset != 0.0
     }
 
     /// The force the contact holds at rest at (t, x): u(t) - F_0 - R(x) (the static

@@ -158,7 +158,7 @@ impl<R: Residuals> FitProblem<R> {
                 ParamKind::GravityMoment => {
                     osc.restoring.set_parameter("gravity_moment", x);
                 }
-                ParamKind::ForceOffset => osc.force_offset = x,
+                ParamKind::InputOffset => osc.input_offset = x,
                 ParamKind::Nuisance { kind, record } => {
                     if let Some(n) = nuisance.get_mut(record) {
                         n.set(kind, x);

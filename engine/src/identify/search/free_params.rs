@@ -176,7 +176,7 @@ fn model_param(p: &ParamInfo, index: usize, value: f64, opts: &FitOptions) -> (F
 }
 
 /// A free oscillator property: mass, stiffness and gravity moment in log coordinates,
-/// damping and the force offset linear (the offset unbounded).
+/// damping and the input offset linear (the offset unbounded).
 fn oscillator_param(osc: &Oscillator, q: OscillatorParam, opts: &FitOptions) -> (FreeParam, f64) {
     let gravity_moment = osc.restoring.parameter("gravity_moment");
     let (current, kind) = match q {
@@ -186,20 +186,20 @@ fn oscillator_param(osc: &Oscillator, q: OscillatorParam, opts: &FitOptions) -> 
         OscillatorParam::GravityMoment => {
             (gravity_moment.unwrap_or(f64::NAN), ParamKind::GravityMoment)
         }
-        OscillatorParam::ForceOffset => (osc.force_offset, ParamKind::ForceOffset),
+        OscillatorParam::InputOffset => (osc.input_offset, ParamKind::InputOffset),
     };
-    let linear = matches!(q, OscillatorParam::Damping | OscillatorParam::ForceOffset);
+    let linear = matches!(q, OscillatorParam::Damping | OscillatorParam::InputOffset);
     let log = !linear;
     let unbounded = (f64::NEG_INFINITY, f64::INFINITY);
     let default_bounds = match q {
-        OscillatorParam::ForceOffset => unbounded,
+        OscillatorParam::InputOffset => unbounded,
         _ => (0.0, f64::INFINITY),
     };
     let (lo, hi) = opts.bounds.get(q.name()).copied().unwrap_or(default_bounds);
     let typical = match q {
         // A damping's scale: 2e-3 of the critical damping of small motions (of a
         // kilogram-second without a restoring force); an offset's: a newton.
-        OscillatorParam::ForceOffset => 1.0,
+        OscillatorParam::InputOffset => 1.0,
         _ if osc.small_motion_stiffness() > 0.0 => {
             2e-3 * (osc.mass * osc.small_motion_stiffness()).sqrt()
         }

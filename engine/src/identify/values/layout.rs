@@ -22,8 +22,8 @@ pub enum ParamKind {
     Stiffness,
     /// The pendulum's gravity moment.
     GravityMoment,
-    /// The constant force of the balance.
-    ForceOffset,
+    /// The input's offset.
+    InputOffset,
     /// A nuisance parameter of one record.
     Nuisance {
         /// What it is.

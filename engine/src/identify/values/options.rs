@@ -20,8 +20,8 @@ pub enum OscillatorParam {
     Stiffness,
     /// The pendulum's gravity moment m g l [N m] (`restoring = { type = "pendulum" }`).
     GravityMoment,
-    /// The constant force F_0 of the balance [N] (see `Oscillator::force_offset`).
-    ForceOffset,
+    /// The input's offset F_0 [N] (see `Oscillator::input_offset`).
+    InputOffset,
 }
 
 impl OscillatorParam {
@@ -32,7 +32,7 @@ impl OscillatorParam {
             Self::Damping => "damping",
             Self::Stiffness => "stiffness",
             Self::GravityMoment => "gravity_moment",
-            Self::ForceOffset => "force_offset",
+            Self::InputOffset => "input_offset",
         }
     }
     /// SI unit.
@@ -42,7 +42,7 @@ impl OscillatorParam {
             Self::Damping => "N s/m",
             Self::Stiffness => "N/m",
             Self::GravityMoment => "N m",
-            Self::ForceOffset => "N",
+            Self::InputOffset => "N",
         }
     }
     /// Parses a config name.
@@ -52,7 +52,7 @@ impl OscillatorParam {
             "damping" => Some(Self::Damping),
             "stiffness" => Some(Self::Stiffness),
             "gravity_moment" => Some(Self::GravityMoment),
-            "force_offset" => Some(Self::ForceOffset),
+            "input_offset" => Some(Self::InputOffset),
             _ => None,
         }
     }
