@@ -24,6 +24,7 @@ fn oscillator() -> impl Strategy<Value = Oscillator> {
             damping: c,
             stiffness: k,
             normal_force: n,
+            ..Oscillator::fmm()
         }
     })
 }

@@ -51,6 +51,7 @@ fn draw_rig(
         damping: draw(nominal.damping, sigma.damping)?,
         stiffness: draw(nominal.stiffness, sigma.stiffness)?,
         normal_force: draw(nominal.normal_force, sigma.normal_force)?,
+        ..*nominal
     })
 }
 

@@ -3,6 +3,7 @@
 //!
 //! Library code: values in, values out; no printing.
 
+pub mod axis;
 pub mod data;
 pub mod energy;
 pub mod error;
@@ -17,6 +18,7 @@ pub mod spec;
 pub mod synthetic;
 pub mod testing;
 
+pub use axis::{Axis, Restoring};
 pub use energy::{
     analyze_record, analyze_states, force_residuals, model_force_along, percent_difference,
     Differentiator, EnergyAnalysis, EnergyOptions, ForceResiduals, HalfCycle, MechanicalEnergy,

@@ -1,20 +1,41 @@
-//! The single-degree-of-freedom oscillator of the paper's Eq. (1).
+//! The single-degree-of-freedom oscillator of the paper's Eq. (1), generalised to any axis:
+//! J q'' + c q' + R(q) + F_f = u(t).
 
+use crate::axis::{Axis, Restoring};
 use crate::error::EngineError;
 use serde::{Deserialize, Serialize};
 
-/// m x'' + c x' + k x + F_f = 0, with the normal force N acting on the friction contact.
+/// m x'' + c x' + R(x) + F_f = u, with the normal force N acting on the friction contact;
+/// R is the axis's restoring law (the linear spring k x by default) and u the input (none in
+/// free vibration). On a rotary axis x is an angle, m a moment of inertia and the forces are
+/// torques (see [`Axis`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Oscillator {
-    /// Mass m [kg] (> 0).
+    /// Mass m [kg] (> 0); on a rotary axis the moment of inertia J [kg m^2].
     pub mass: f64,
     /// Viscous damping c [N s/m] (>= 0).
     pub damping: f64,
-    /// Stiffness k [N/m] (> 0).
+    /// Stiffness k [N/m] (> 0 where the restoring law reads it).
     pub stiffness: f64,
     /// Normal force N [N] (>= 0).
     pub normal_force: f64,
+    /// Linear (the default) or rotary.
+    #[serde(default, skip_serializing_if = "Axis::is_linear")]
+    pub axis: Axis,
+    /// The restoring law R (the linear spring k x by default).
+    #[serde(default, skip_serializing_if = "Restoring::is_linear_spring")]
+    pub restoring: Restoring,
+    /// The input's offset F_0 [N or N m]: a constant force (torque) in the balance
+    /// J q'' + c q' + R(q) + F_f + F_0 = u, the "offset" of a drive's inverse-dynamics
+    /// identification (u = J a + F_f(v) + offset), or gravity along an inclined axis. It acts
+    /// with or without an input; 0 by default.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub input_offset: f64,
+}
+
+fn is_zero(value: &f64) -> bool {
+    *value == 0.0
 }
 
 /// `[oscillator]` as written: every key optional. A force-domain fit on a measured force
@@ -49,6 +70,9 @@ impl OscillatorInput {
             damping: take("damping", self.damping, 0.0),
             stiffness: take("stiffness", self.stiffness, 1.0),
             normal_force: take("normal_force", self.normal_force, 0.0),
+            axis: Axis::Linear,
+            restoring: Restoring::default(),
+            input_offset: 0.0,
         };
         (osc, missing)
     }
@@ -67,6 +91,9 @@ impl Oscillator {
             damping,
             stiffness,
             normal_force,
+            axis: Axis::Linear,
+            restoring: Restoring::default(),
+            input_offset: 0.0,
         };
         o.validate()?;
         Ok(o)
@@ -80,17 +107,41 @@ impl Oscillator {
             damping: 0.275,
             stiffness: 1982.0,
             normal_force: 14.5,
+            axis: Axis::Linear,
+            restoring: Restoring::default(),
+            input_offset: 0.0,
         }
     }
 
-    /// Checks that every property is finite, m and k > 0, c and N >= 0.
+    /// The same oscillator on `axis`.
+    pub fn with_axis(self, axis: Axis) -> Self {
+        Self { axis, ..self }
+    }
+
+    /// The same oscillator with the restoring law `restoring`.
+    pub fn with_restoring(self, restoring: Restoring) -> Self {
+        Self { restoring, ..self }
+    }
+
+    /// Checks that every property is finite, m > 0 (and k > 0 where the restoring law reads
+    /// it), c and N >= 0, and the restoring law's own parameters.
     pub fn validate(&self) -> Result<(), EngineError> {
+        let law = self.restoring.law();
         let checks = [
-            ("mass", self.mass, true),
+            (self.axis.inertia_name(), self.mass, true),
             ("damping", self.damping, false),
-            ("stiffness", self.stiffness, true),
+            ("stiffness", self.stiffness, law.reads_stiffness()),
             ("normal_force", self.normal_force, false),
         ];
+        if !self.input_offset.is_finite() {
+            return Err(EngineError::InvalidOscillator(format!(
+                "`input_offset` must be finite, got {}",
+                self.input_offset
+            )));
+        }
+        self.restoring
+            .check()
+            .map_err(|e| EngineError::InvalidOscillator(e.to_string()))?;
         for (name, value, strictly_positive) in checks {
             if !value.is_finite() {
                 return Err(EngineError::InvalidOscillator(format!(
@@ -111,18 +162,56 @@ impl Oscillator {
         Ok(())
     }
 
-    /// Undamped natural angular frequency sqrt(k/m) [rad/s].
-    pub fn omega_n(&self) -> f64 {
-        (self.stiffness / self.mass).sqrt()
+    /// The restoring force (torque) R(q) [N or N m].
+    #[inline]
+    pub fn restoring_force(&self, q: f64) -> f64 {
+        self.restoring.law().force(q, self.stiffness)
     }
 
-    /// Undamped natural period T_n = 2 pi / omega_n [s].
+    /// The restoring law's stiffness dR/dq at q [N/m or N m/rad].
+    #[inline]
+    pub fn restoring_stiffness(&self, q: f64) -> f64 {
+        self.restoring.law().stiffness(q, self.stiffness)
+    }
+
+    /// The potential energy V(q) of the restoring law (V(0) = 0) [J].
+    #[inline]
+    pub fn potential(&self, q: f64) -> f64 {
+        self.restoring.law().potential(q, self.stiffness)
+    }
+
+    /// The stiffness of small motions about q = 0, dR/dq(0): k for the spring, the gravity
+    /// moment for the pendulum, 0 without a restoring law.
+    pub fn small_motion_stiffness(&self) -> f64 {
+        self.restoring_stiffness(0.0)
+    }
+
+    /// Whether R(q) is exactly k q (the closed-form propagator applies).
+    pub fn has_linear_spring(&self) -> bool {
+        self.restoring.law().is_linear_spring()
+    }
+
+    /// Undamped natural angular frequency of small motions sqrt(R'(0)/m) [rad/s] (0 without
+    /// a restoring law).
+    pub fn omega_n(&self) -> f64 {
+        (self.small_motion_stiffness() / self.mass).sqrt()
+    }
+
+    /// Undamped natural period of small motions T_n = 2 pi / omega_n [s]; infinite without
+    /// a restoring law (see [`Oscillator::period`]).
     pub fn natural_period(&self) -> f64 {
         2.0 * std::f64::consts::PI / self.omega_n()
     }
 
-    /// Viscous damping ratio zeta = c / (2 sqrt(k m)).
+    /// The natural period of small motions, if the axis has one (not without a restoring
+    /// force, nor about an unstable equilibrium).
+    pub fn period(&self) -> Option<f64> {
+        let t = self.natural_period();
+        (t.is_finite() && t > 0.0).then_some(t)
+    }
+
+    /// Viscous damping ratio of small motions zeta = c / (2 sqrt(R'(0) m)).
     pub fn damping_ratio(&self) -> f64 {
-        self.damping / (2.0 * (self.stiffness * self.mass).sqrt())
+        self.damping / (2.0 * (self.small_motion_stiffness() * self.mass).sqrt())
     }
 }

@@ -10,6 +10,7 @@
 //! The measured records are not part of this value yet: front ends read them and hand them
 //! to the jobs in [`crate::jobs`].
 
+use crate::axis::{Axis, Restoring};
 use crate::data::MAX_SAMPLES;
 use crate::energy::{Differentiator, EnergyOptions};
 use crate::identify::{
@@ -137,8 +138,20 @@ pub struct OscillatorSpec {
 #[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OscillatorInput {
+    /// `linear` (default) or `rotary`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    axis: Option<Axis>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     mass: Option<f64>,
+    /// The rotary name of `mass` [kg m^2].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    inertia: Option<f64>,
+    /// The restoring law (default: the linear spring of `stiffness`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    restoring: Option<Restoring>,
+    /// The input's offset: a constant force (torque) in the balance [N or N m] (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    input_offset: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     damping: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -159,13 +172,23 @@ impl TryFrom<OscillatorInput> for OscillatorSpec {
     type Error = SpecError;
 
     fn try_from(o: OscillatorInput) -> Result<Self, SpecError> {
-        let (oscillator, unknown) = crate::oscillator::OscillatorInput {
-            mass: o.mass,
+        let (axis, restoring) = axis_of(&o)?;
+        let (mut oscillator, mut unknown) = crate::oscillator::OscillatorInput {
+            mass: o.mass.or(o.inertia),
             damping: o.damping,
             stiffness: o.stiffness,
             normal_force: o.normal_force,
         }
         .resolve();
+        oscillator.axis = axis;
+        oscillator.restoring = restoring;
+        oscillator.input_offset = o.input_offset.unwrap_or(0.0);
+        for name in unknown.iter_mut().filter(|n| *n == "mass") {
+            *name = axis.inertia_name().to_string();
+        }
+        if !restoring.law().reads_stiffness() {
+            unknown.retain(|n| n != "stiffness");
+        }
         let spec = Self {
             oscillator,
             uncertainty: PropertyUncertainty {
@@ -181,15 +204,52 @@ impl TryFrom<OscillatorInput> for OscillatorSpec {
     }
 }
 
+/// The axis and the restoring law of `[oscillator]`: the pendulum turns (a rotary axis
+/// unless the axis is given, an error on a linear one); `inertia` belongs to a rotary
+/// axis and names the same property as `mass`.
+fn axis_of(o: &OscillatorInput) -> Result<(Axis, Restoring), SpecError> {
+    let restoring = o.restoring.unwrap_or_default();
+    let turns = matches!(restoring, Restoring::Pendulum(_));
+    let axis = match (o.axis, turns) {
+        (Some(Axis::Linear), true) => {
+            return Err(SpecError::Oscillator(
+                "`restoring` = pendulum turns about an axis: set `axis = \"rotary\"`".into(),
+            ))
+        }
+        (Some(axis), _) => axis,
+        (None, true) => Axis::Rotary,
+        (None, false) => Axis::Linear,
+    };
+    if o.mass.is_some() && o.inertia.is_some() {
+        return Err(SpecError::Oscillator(
+            "give `inertia` or `mass` (the same property), not both".into(),
+        ));
+    }
+    if o.inertia.is_some() && axis.is_linear() {
+        return Err(SpecError::Oscillator(
+            "`inertia` is the rotary axis's name of `mass`: set `axis = \"rotary\"` or \
+             write `mass`"
+                .into(),
+        ));
+    }
+    Ok((axis, restoring))
+}
+
 impl From<OscillatorSpec> for OscillatorInput {
     fn from(o: OscillatorSpec) -> Self {
         let (p, u) = (o.oscillator, o.uncertainty);
         let given =
             |name: &str, value: f64| (!o.unknown.iter().any(|k| k == name)).then_some(value);
+        let rotary = !p.axis.is_linear();
         Self {
-            mass: given("mass", p.mass),
+            axis: rotary.then_some(p.axis),
+            inertia: given("inertia", p.mass).filter(|_| rotary),
+            restoring: (!p.restoring.is_linear_spring()).then_some(p.restoring),
+            input_offset: (p.input_offset != 0.0).then_some(p.input_offset),
+            mass: given("mass", p.mass).filter(|_| !rotary),
             damping: given("damping", p.damping),
-            stiffness: given("stiffness", p.stiffness),
+            stiffness: given("stiffness", p.stiffness)
+                .filter(|_| p.restoring.law().reads_stiffness()),
             normal_force: given("normal_force", p.normal_force),
             mass_std: u.mass,
             damping_std: u.damping,

@@ -423,6 +423,7 @@ fn a_watched_run_stops_when_its_watch_says_so() {
             sample_times: &times,
             v_out,
             watch: &mut watch,
+            input: None,
         };
         simulate_velocity_watched(&osc, model.as_ref(), &init, 2.0, &opts, run)
     };

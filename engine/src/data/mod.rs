@@ -118,8 +118,11 @@ impl Default for ReadOptions {
         Self {
             format: DataFormat::Auto,
             time: ColumnSpec::named("time"),
+            // The input is read where its column or scale is named: a column of that name
+            // alone is not a record of the motion.
             channels: Channel::ALL
                 .into_iter()
+                .filter(|&c| c != Channel::InputForce)
                 .map(|c| (c, ColumnSpec::default_for(c)))
                 .collect(),
             min_samples: 10,

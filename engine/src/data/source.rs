@@ -76,6 +76,11 @@ pub struct RecordSource {
     pub normal_force_column: Option<String>,
     /// Factor from the file's normal-force unit to N (default 1).
     pub normal_force_scale: Option<f64>,
+    /// Header name of the input-force column (default `input_force`): the force (torque)
+    /// that drives the axis.
+    pub input_force_column: Option<String>,
+    /// Factor from the file's input unit to N (N m on a rotary axis) (default 1).
+    pub input_force_scale: Option<f64>,
     /// This record's constant normal force \[N\] (default: the oscillator's, or the channel).
     pub normal_force: Option<f64>,
     /// Noise level of the velocity channel [m/s] (default: estimated from the record).
@@ -159,6 +164,8 @@ macro_rules! record_keys {
             force_scale,
             normal_force_column,
             normal_force_scale,
+            input_force_column,
+            input_force_scale,
             normal_force,
             velocity_noise,
             displacement_noise,
@@ -391,7 +398,7 @@ impl RecordSource {
     }
 
     /// The column and scale keys of each channel.
-    fn channel_keys(&self) -> [(Channel, Option<&String>, Option<f64>); 5] {
+    fn channel_keys(&self) -> [(Channel, Option<&String>, Option<f64>); 6] {
         [
             (
                 Channel::Velocity,
@@ -413,6 +420,11 @@ impl RecordSource {
                 Channel::NormalForce,
                 self.normal_force_column.as_ref(),
                 self.normal_force_scale,
+            ),
+            (
+                Channel::InputForce,
+                self.input_force_column.as_ref(),
+                self.input_force_scale,
             ),
         ]
     }

@@ -332,7 +332,7 @@ pub(crate) fn half_cycles(
     motion: &Motion,
     osc: &Oscillator,
 ) -> (Vec<HalfCycle>, f64, f64) {
-    let energy = |tp: &Turning| 0.5 * osc.stiffness * tp.x * tp.x + 0.5 * osc.mass * tp.v * tp.v;
+    let energy = |tp: &Turning| osc.potential(tp.x) + 0.5 * osc.mass * tp.v * tp.v;
     let cycles: Vec<HalfCycle> = motion
         .turning
         .windows(2)

@@ -487,10 +487,12 @@ fn assemble(
     sources: SeriesSources,
 ) -> EnergyAnalysis {
     let s = &series.samples();
-    let (m, c, k) = (osc.mass, osc.damping, osc.stiffness);
+    let (m, c) = (osc.mass, osc.damping);
     let n = s.time.len();
-    let mechanical = MechanicalEnergy::of(m, k, s.x, s.v);
-    let de_dt: Vec<f64> = (0..n).map(|i| s.v[i] * (m * s.a[i] + k * s.x[i])).collect();
+    let mechanical = MechanicalEnergy::of(osc, s.x, s.v);
+    let de_dt: Vec<f64> = (0..n)
+        .map(|i| s.v[i] * (m * s.a[i] + osc.restoring_force(s.x[i])))
+        .collect();
     let friction: Vec<f64> = (0..n)
         .map(|i| {
             let v = s.v[i];

@@ -8,6 +8,12 @@
 //!   produce, such as x0 in mm).
 //! - Time: friction and light damping barely change the period of the oscillation, 2 pi / w.
 //!   A measured period [`MAX_PERIOD_RATIO`] times longer or shorter is a unit error.
+//! - Angles: on a rotary axis whose restoring law is not linear (the pendulum), no passive
+//!   motion within the record's swing |q| <= A moves faster than sqrt(2 (max V - min V) / J +
+//!   v0^2) over [-A, A]. An angular speed (measured, else differentiated from the angle)
+//!   [`MAX_SPEED_RATIO`] times that is an angle read in the wrong unit: degrees read as
+//!   radians make it 57.3 times the truth while the potential stays bounded. A linear spring
+//!   scales with the angle, so its records cannot tell.
 
 use super::{Channel, Record};
 use crate::Oscillator;
@@ -50,6 +56,18 @@ pub enum ScaleError {
         ratio: f64,
         advice: String,
     },
+    /// The angular speed is far above what the restoring law allows over the swing.
+    #[error(
+        "{record}: peak angular speed {peak:.4e} rad/s is {} than the restoring law and the inertia allow over the record's swing of +-{swing:.4e} rad ({expected:.4e} rad/s): is the angle in degrees? set displacement_scale = 0.0174533 (pi/180)",
+        ratio_words(*ratio)
+    )]
+    Angle {
+        record: String,
+        peak: f64,
+        expected: f64,
+        swing: f64,
+        ratio: f64,
+    },
 }
 
 /// `1000x larger` / `1000x smaller`.
@@ -81,6 +99,7 @@ fn suggested_scale(ratio: f64) -> String {
 /// Checks the units of a velocity record against `osc` (see the module docs). Records without
 /// velocity, or released at rest from x0 = 0, are not checked.
 pub fn check_scales(record: &Record, osc: &Oscillator) -> Result<(), ScaleError> {
+    check_angle(record, osc)?;
     if record.channel(Channel::Velocity).is_none() {
         return Ok(());
     }
@@ -88,8 +107,57 @@ pub fn check_scales(record: &Record, osc: &Oscillator) -> Result<(), ScaleError>
     check_period(record, osc)
 }
 
+/// Samples of the potential over the swing in [`check_angle`].
+const SWING_SAMPLES: usize = 400;
+
+/// Half-width in samples of the central difference that differentiates an angle (an
+/// encoder's steps averaged over 2 x 5 samples).
+const ANGLE_SPAN: usize = 5;
+
+fn check_angle(record: &Record, osc: &Oscillator) -> Result<(), ScaleError> {
+    if osc.axis.is_linear() || osc.has_linear_spring() {
+        return Ok(());
+    }
+    let Some(q) = record.channel(Channel::Displacement) else {
+        return Ok(());
+    };
+    let swing = robust_peak(q).max(record.x0.abs());
+    let potential = (0..=SWING_SAMPLES)
+        .map(|i| osc.potential(swing * (2.0 * i as f64 / SWING_SAMPLES as f64 - 1.0)));
+    let (low, high) = potential.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    let expected = (2.0 * (high - low) / osc.mass + record.v0 * record.v0).sqrt();
+    let peak = match record.channel(Channel::Velocity) {
+        Some(v) => robust_peak(v),
+        None => robust_peak(&central_difference(record.time(), q, ANGLE_SPAN)),
+    };
+    if !(expected > 0.0 && expected.is_finite() && peak.is_finite()) {
+        return Ok(());
+    }
+    let ratio = peak / expected;
+    if ratio <= MAX_SPEED_RATIO {
+        return Ok(());
+    }
+    Err(ScaleError::Angle {
+        record: record.name.clone(),
+        peak,
+        expected,
+        swing,
+        ratio,
+    })
+}
+
+/// (q[i+s] - q[i-s]) / (t[i+s] - t[i-s]) wherever both samples exist.
+fn central_difference(time: &[f64], q: &[f64], span: usize) -> Vec<f64> {
+    let n = time.len().min(q.len());
+    (span..n.saturating_sub(span))
+        .map(|i| (q[i + span] - q[i - span]) / (time[i + span] - time[i - span]))
+        .collect()
+}
+
 fn check_speed(record: &Record, osc: &Oscillator) -> Result<(), ScaleError> {
-    let omega = (osc.stiffness / osc.mass).sqrt();
+    let omega = (osc.small_motion_stiffness() / osc.mass).sqrt();
     let expected = (record.x0 * omega).hypot(record.v0);
     let peak = robust_peak(record.velocity());
     if !(expected > 0.0 && expected.is_finite() && peak > 0.0) {
@@ -119,7 +187,11 @@ fn check_speed(record: &Record, osc: &Oscillator) -> Result<(), ScaleError> {
 }
 
 fn check_period(record: &Record, osc: &Oscillator) -> Result<(), ScaleError> {
-    let natural = 2.0 * std::f64::consts::PI * (osc.mass / osc.stiffness).sqrt();
+    let natural = 2.0 * std::f64::consts::PI * (osc.mass / osc.small_motion_stiffness()).sqrt();
+    if !natural.is_finite() {
+        // No restoring force: no natural period to compare with.
+        return Ok(());
+    }
     let Some(period) = oscillation_period(record.time(), record.velocity()) else {
         return Ok(());
     };

@@ -45,23 +45,27 @@ impl BlockBuffer {
         let affine = dynamics
             .switching
             .and_then(|law| law.affine_slip(dir, dynamics.normal));
-        let rows = self.x[..n].iter().zip(&self.v[..n]);
-        for ((&x, &v), (a, f)) in rows.zip(self.a[..n].iter_mut().zip(&mut self.friction[..n])) {
+        let rows = times.iter().zip(&self.x[..n]).zip(&self.v[..n]);
+        let out = self.a[..n].iter_mut().zip(&mut self.friction[..n]);
+        for (((&t, &x), &v), (a, f)) in rows.zip(out) {
             *f = match affine {
                 Some((offset, slope)) => offset + slope * v,
                 None => dynamics.force(v, &[], dir),
             };
-            *a = dynamics.accel(x, v, *f);
+            *a = dynamics.accel(t, x, v, *f);
         }
     }
 
-    /// `n` samples at rest at `x` held by the spring force (friction -k x, no acceleration).
-    pub fn at_rest(&mut self, n: usize, x: f64, friction: f64) {
+    /// `n` samples at rest at `x`, the friction of row i `friction(i)` (what holds the mass
+    /// against the restoring force and the input), no acceleration.
+    pub fn at_rest(&mut self, n: usize, x: f64, friction: impl Fn(usize) -> f64) {
         let n = n.min(BLOCK);
         self.x[..n].fill(x);
         self.v[..n].fill(0.0);
         self.a[..n].fill(0.0);
-        self.friction[..n].fill(friction);
+        for (i, f) in self.friction[..n].iter_mut().enumerate() {
+            *f = friction(i);
+        }
     }
 
     /// The first `times.len()` rows with their times.

@@ -7,6 +7,7 @@ use super::root::illinois;
 use super::stepper::{AffineMotion, OdeSystem, StepOutcome, Stepper};
 use super::{Dynamics, Event, EventKind, Law, Recorder, Rest, SimStats, Start};
 use crate::error::{EngineError, IntegrationFailure};
+use frictionid_models::sgn;
 
 /// Width of the final bracket of a turning point's time [s].
 pub(crate) const EVENT_TOL: f64 = 1e-13;
@@ -19,8 +20,8 @@ struct Segment<'a> {
 
 impl OdeSystem for Segment<'_> {
     #[inline]
-    fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
-        self.dynamics.rhs(y, dy, self.dir);
+    fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+        self.dynamics.rhs(t, y, dy, self.dir);
     }
 
     fn jacobian(&self, _t: f64, y: &[f64], jac: &mut [f64]) {
@@ -87,9 +88,10 @@ impl<R: Recorder> Driver<'_, R> {
         // Below this remaining time a segment is not started (the step would underflow).
         let tiny = 1e-13 * (1.0 + t_end);
         loop {
-            let Some(dir) = self.decide(t, &y)? else {
+            let Some((t_start, dir)) = self.decide(t, &y, t_end)? else {
                 return Ok(());
             };
+            t = t_start;
             if t_end - t <= tiny {
                 self.fill_end(&y, dir);
                 return Ok(());
@@ -223,7 +225,7 @@ impl<R: Recorder> Driver<'_, R> {
         if let [x, v, z @ ..] = y {
             let (a, f) = if self.rec.wants_forces() {
                 let f = self.dynamics.force(*v, z, dir);
-                (self.dynamics.accel(*x, *v, f), f)
+                (self.dynamics.accel(t, *x, *v, f), f)
             } else {
                 (f64::NAN, f64::NAN)
             };
@@ -232,23 +234,34 @@ impl<R: Recorder> Driver<'_, R> {
         self.next += 1;
     }
 
-    /// Fills every remaining sample with the state at rest `y` (v = 0, a = 0).
-    fn fill_rest(&mut self, y: &[f64]) {
+    /// Fills the remaining samples before `until` (all of them with `None`) with the state
+    /// at rest `y` (v = 0, a = 0, the friction holding u - R(x)).
+    fn fill_rest(&mut self, y: &[f64], until: Option<f64>) {
+        let pending = self.samples.get(self.next..).unwrap_or_default();
+        let due = match until {
+            None => pending.len(),
+            Some(t) => pending.partition_point(|&ts| ts < t),
+        };
+        let due = &pending[..due];
+        let dynamics = self.dynamics;
         if let [x, _] = y {
-            let pending = self.samples.get(self.next..).unwrap_or_default();
-            for times in pending.chunks(BLOCK) {
-                self.block
-                    .at_rest(times.len(), *x, -self.dynamics.stiffness * x);
+            for times in due.chunks(BLOCK) {
+                if dynamics.driven() {
+                    let held = |i: usize| dynamics.held_force(times[i], *x);
+                    self.block.at_rest(times.len(), *x, held);
+                } else {
+                    let held = dynamics.held_force(0.0, *x);
+                    self.block.at_rest(times.len(), *x, |_| held);
+                }
                 self.rec.sample_block(&self.block.view(times));
             }
-            self.next += pending.len();
         } else if let [x, _, z @ ..] = y {
-            let f = -self.dynamics.stiffness * x;
-            while let Some(&ts) = self.samples.get(self.next) {
-                self.rec.sample(ts, *x, 0.0, z, 0.0, f);
-                self.next += 1;
+            for &ts in due {
+                self.rec
+                    .sample(ts, *x, 0.0, z, 0.0, dynamics.held_force(ts, *x));
             }
         }
+        self.next += due.len();
     }
 
     /// Fills every remaining sample with the (moving) state `y` at the end time.
@@ -281,13 +294,16 @@ impl<R: Recorder> Driver<'_, R> {
     }
 
     /// Decides the mode at time `t` for state `y` (a turning point or the start): returns the
-    /// slip direction, or `None` after recording the rest and filling the remaining samples.
-    fn decide(&mut self, t: f64, y: &[f64]) -> Result<Option<f64>, EngineError> {
+    /// time the next segment starts at (later than `t` after a stick that an input ends)
+    /// and its slip direction, or `None` after recording the rest and filling the remaining
+    /// samples.
+    fn decide(&mut self, t: f64, y: &[f64], t_end: f64) -> Result<Option<(f64, f64)>, EngineError> {
         let [x, v, z @ ..] = y else {
             return Ok(None);
         };
-        let mut start = self.dynamics.start(*x, *v, z);
-        if *v == 0.0 && !matches!(self.dynamics.law, Law::Switched { .. }) {
+        let mut start = self.dynamics.start(t, *x, *v, z);
+        let driven = self.dynamics.driven();
+        if *v == 0.0 && !driven && !matches!(self.dynamics.law, Law::Switched { .. }) {
             if let Some(prev) = self.last_turn {
                 if (x - prev).abs() < self.rest_swing {
                     start = Start::Rest;
@@ -298,17 +314,42 @@ impl<R: Recorder> Driver<'_, R> {
             self.last_turn = Some(*x);
         }
         match start {
-            Start::Slip(d) => Ok(Some(d)),
+            Start::Slip(d) => Ok(Some((t, d))),
             Start::Rest => {
                 self.push_event(t, EventKind::Stick, *x)?;
+                if let Some(resume) = self.breakaway(t, *x, t_end) {
+                    self.fill_rest(y, Some(resume.0));
+                    self.push_event(resume.0, EventKind::Breakaway, *x)?;
+                    return Ok(Some(resume));
+                }
                 self.rest = Some(Rest {
                     time: t,
                     displacement: *x,
                 });
-                self.fill_rest(y);
+                self.fill_rest(y, None);
                 Ok(None)
             }
         }
+    }
+
+    /// When a mass stuck at (t, x) under an input breaks away, and in which direction: the
+    /// first time |u - R(x)| exceeds the static limit (a switched law's stick), located on
+    /// the piecewise-linear input. `None` in free vibration, for laws without a static limit
+    /// and when the stick lasts to the end.
+    fn breakaway(&self, t: f64, x: f64, t_end: f64) -> Option<(f64, f64)> {
+        let input = self.dynamics.input?;
+        let Law::Switched { limit } = self.dynamics.law else {
+            return None;
+        };
+        // The input itself must leave the band about R(x) + F_0.
+        let centre = self.dynamics.restoring_force(x) + self.dynamics.input_offset;
+        let t_b = input.first_exceedance(t, t_end, centre, limit)?;
+        // A stick that the input leaves at once is a stick the slip force cannot end
+        // (a law whose slip force at rest exceeds its static limit): it lasts.
+        if t_b <= t {
+            return None;
+        }
+        Some((t_b, sgn(self.dynamics.held_force(t_b, x))))
     }
 }
 

@@ -23,7 +23,7 @@ impl Dynamics<'_> {
     /// methods do, up to [`STACK_STATES`] internal states.
     pub fn jacobian(&self, y: &[f64], dir: f64, jac: &mut [f64]) {
         let n = y.len();
-        let ([_, v, z @ ..], true) = (y, jac.len() == n * n) else {
+        let ([x, v, z @ ..], true) = (y, jac.len() == n * n) else {
             return;
         };
         // At a segment's start v = 0 exactly: differentiate on the side of the slip direction
@@ -41,7 +41,7 @@ impl Dynamics<'_> {
             row0.fill(0.0);
             row0[1] = 1.0;
         }
-        jac[n] = -self.stiffness / self.mass;
+        jac[n] = -self.restoring_stiffness(*x) / self.mass;
         jac[n + 1] = -(self.damping + df_dv) / self.mass;
     }
 
@@ -119,9 +119,9 @@ mod tests {
             let step = 1e-6 * y[j].abs().max(1e-3);
             let mut probe = y.to_vec();
             probe[j] = y[j] + step;
-            d.rhs(&probe, &mut plus, dir);
+            d.rhs(0.0, &probe, &mut plus, dir);
             probe[j] = y[j] - step;
-            d.rhs(&probe, &mut minus, dir);
+            d.rhs(0.0, &probe, &mut minus, dir);
             for i in 0..n {
                 jac[i * n + j] = (plus[i] - minus[i]) / (2.0 * step);
             }

@@ -2,6 +2,7 @@
 //! place where kinetic and potential energy are computed, for simulated trajectories and for
 //! the energy analysis of records alike.
 
+use crate::oscillator::Oscillator;
 use serde::{Deserialize, Serialize};
 
 /// Kinetic, potential and mechanical energy, one value per sample.
@@ -9,7 +10,7 @@ use serde::{Deserialize, Serialize};
 pub struct MechanicalEnergy {
     /// Kinetic energy m v^2 / 2 \[J\] (Eq. 3).
     pub kinetic: Vec<f64>,
-    /// Potential energy k x^2 / 2 \[J\] (Eq. 2).
+    /// Potential energy V(x) of the restoring law \[J\] (Eq. 2: k x^2 / 2 for the spring).
     pub potential: Vec<f64>,
     /// Mechanical energy E = KE + PE \[J\] (the paper's E; without energy stored in a
     /// friction model's states).
@@ -17,11 +18,12 @@ pub struct MechanicalEnergy {
 }
 
 impl MechanicalEnergy {
-    /// The energies of mass `mass` \[kg\] on a spring `stiffness` \[N/m\] at displacements
-    /// `x` and velocities `v` (same length).
-    pub fn of(mass: f64, stiffness: f64, x: &[f64], v: &[f64]) -> Self {
+    /// The energies of `osc` (its inertia and restoring law) at displacements `x` and
+    /// velocities `v` (same length).
+    pub fn of(osc: &Oscillator, x: &[f64], v: &[f64]) -> Self {
+        let mass = osc.mass;
         let kinetic: Vec<f64> = v.iter().map(|&v| 0.5 * mass * v * v).collect();
-        let potential: Vec<f64> = x.iter().map(|&x| 0.5 * stiffness * x * x).collect();
+        let potential: Vec<f64> = x.iter().map(|&x| osc.potential(x)).collect();
         let energy = kinetic
             .iter()
             .zip(&potential)

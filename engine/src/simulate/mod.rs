@@ -43,6 +43,7 @@ mod closed_form;
 mod dopri;
 mod driver;
 mod euler;
+mod input;
 mod jacobian;
 pub mod mechanical;
 mod rodas;
@@ -53,6 +54,7 @@ mod stepper;
 pub use closed_form::ClosedForm;
 pub use dopri::Dopri5;
 pub use euler::Euler;
+pub use input::Input;
 pub use mechanical::MechanicalEnergy;
 pub use rodas::Rodas4;
 pub use stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper, Tolerance};
@@ -60,6 +62,7 @@ pub use stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper, Tol
 use auto::resolve_method;
 use driver::Driver;
 
+use crate::axis::Restoring;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use frictionid_models::{sgn, Derivatives, FrictionModel, InternalStates, SwitchedLaw};
@@ -180,8 +183,12 @@ impl Initial {
 pub enum EventKind {
     /// The velocity crossed zero.
     TurningPoint,
-    /// The mass stuck for good (free vibration: it stays at rest).
+    /// The mass stuck: for good in free vibration; under an input until the input
+    /// overcomes the static friction ([`EventKind::Breakaway`]).
     Stick,
+    /// A stuck mass broke away: the input less the restoring force left the static
+    /// friction's band.
+    Breakaway,
 }
 
 /// An event of the simulation.
@@ -283,9 +290,37 @@ pub fn simulate(
     sample_times: &[f64],
     opts: &SimOptions,
 ) -> Result<Trajectory, EngineError> {
+    let times = SampleGrid {
+        t_end,
+        sample_times,
+    };
+    simulate_driven(osc, model, init, None, times, opts)
+}
+
+/// The end time of a run and the times to sample it at (sorted, within [0, t_end]).
+#[derive(Debug, Clone, Copy)]
+pub struct SampleGrid<'a> {
+    /// The end time [s].
+    pub t_end: f64,
+    /// The sample times [s].
+    pub sample_times: &'a [f64],
+}
+
+/// [`simulate`] under the measured `input` u(t) (free vibration without one): the axis
+/// sticks while |u - R(q)| stays within the static friction and breaks away, at the time
+/// located exactly on the piecewise-linear input, when it leaves it.
+pub fn simulate_driven(
+    osc: &Oscillator,
+    model: &dyn FrictionModel,
+    init: &Initial,
+    input: Option<&Input>,
+    grid: SampleGrid<'_>,
+    opts: &SimOptions,
+) -> Result<Trajectory, EngineError> {
+    let sample_times = grid.sample_times;
     let n_states = model.n_states();
     let mut rec = FullRecorder::new(osc, model, sample_times.len(), n_states);
-    let out = run(osc, model, init, t_end, sample_times, opts, &mut rec)?;
+    let out = run(osc, model, init, input, grid, opts, &mut rec)?;
     rec.finish_energies();
     Ok(Trajectory {
         events: out.events,
@@ -312,6 +347,7 @@ pub fn simulate_velocity(
         sample_times,
         v_out,
         watch: &mut no_watch,
+        input: None,
     };
     simulate_velocity_watched(osc, model, init, t_end, opts, velocity)
 }
@@ -325,6 +361,8 @@ pub struct VelocityRun<'a> {
     /// Called after each step with the number of samples written so far; `true` stops the
     /// run with [`IntegrationFailure::Halted`].
     pub watch: &'a mut dyn FnMut(usize) -> bool,
+    /// The measured input driving the axis (`None`: free vibration).
+    pub input: Option<&'a Input>,
 }
 
 /// [`simulate_velocity`] with a watch asked after every step: a fit stops the simulation of a
@@ -341,11 +379,16 @@ pub fn simulate_velocity_watched(
         sample_times,
         v_out,
         watch,
+        input,
     } = run_to;
     v_out.clear();
     v_out.reserve(sample_times.len());
     let mut rec = VelocityRecorder { v: v_out, watch };
-    Ok(run(osc, model, init, t_end, sample_times, opts, &mut rec)?.stats)
+    let grid = SampleGrid {
+        t_end,
+        sample_times,
+    };
+    Ok(run(osc, model, init, input, grid, opts, &mut rec)?.stats)
 }
 
 /// Events, rest and statistics of a run.
@@ -395,8 +438,7 @@ pub(crate) struct SampleBlock<'a> {
 /// the run's, added after it).
 struct FullRecorder<'a> {
     states: Option<&'a dyn InternalStates>,
-    mass: f64,
-    stiffness: f64,
+    osc: Oscillator,
     normal: f64,
     series: Trajectory,
 }
@@ -406,8 +448,7 @@ impl<'a> FullRecorder<'a> {
         let col = || Vec::with_capacity(n);
         Self {
             states: model.states(),
-            mass: osc.mass,
-            stiffness: osc.stiffness,
+            osc: *osc,
             normal: osc.normal_force,
             series: Trajectory {
                 time: col(),
@@ -454,9 +495,8 @@ impl FullRecorder<'_> {
     /// The energy columns from the recorded states, in one pass each after the run (the
     /// per-sample work stays with the samples themselves).
     fn finish_energies(&mut self) {
-        let (m, k) = (self.mass, self.stiffness);
         let out = &mut self.series;
-        out.mechanical = MechanicalEnergy::of(m, k, &out.x, &out.v);
+        out.mechanical = MechanicalEnergy::of(&self.osc, &out.x, &out.v);
         if out.stored.len() < out.time.len() {
             out.stored.resize(out.time.len(), 0.0);
         }
@@ -507,11 +547,16 @@ pub(crate) struct Dynamics<'a> {
     pub mass: f64,
     pub damping: f64,
     pub stiffness: f64,
+    pub restoring: Restoring,
     pub normal: f64,
     pub model: &'a dyn FrictionModel,
     /// The law's switched-system facts, fetched once for the run.
     pub switching: Option<&'a dyn SwitchedLaw>,
     pub law: Law<'a>,
+    /// The measured input (`None`: free vibration).
+    pub input: Option<&'a Input>,
+    /// The constant force F_0 of the balance (see [`Oscillator::input_offset`]).
+    pub input_offset: f64,
 }
 
 /// What happens at a state with (possibly) zero velocity.
@@ -530,11 +575,19 @@ impl<'a> Dynamics<'a> {
             mass: osc.mass,
             damping: osc.damping,
             stiffness: osc.stiffness,
+            restoring: osc.restoring,
             normal: osc.normal_force,
             model,
             switching: model.switching(),
             law: classify_law(model, osc.normal_force)?,
+            input: None,
+            input_offset: osc.input_offset,
         })
+    }
+
+    /// The same equation of motion driven by `input`.
+    pub(crate) fn driven_by(self, input: Option<&'a Input>) -> Self {
+        Self { input, ..self }
     }
 }
 
@@ -558,15 +611,51 @@ impl Dynamics<'_> {
         }
     }
 
-    /// The acceleration for friction force `f`.
+    /// The restoring force R(x).
     #[inline]
-    pub fn accel(&self, x: f64, v: f64, f: f64) -> f64 {
-        -(self.damping * v + self.stiffness * x + f) / self.mass
+    pub fn restoring_force(&self, x: f64) -> f64 {
+        self.restoring.law().force(x, self.stiffness)
     }
 
-    /// The right-hand side of the first-order system y = [x, v, z...] in direction `dir`.
+    /// dR/dx at x.
     #[inline]
-    pub fn rhs(&self, y: &[f64], dy: &mut [f64], dir: f64) {
+    pub fn restoring_stiffness(&self, x: f64) -> f64 {
+        self.restoring.law().stiffness(x, self.stiffness)
+    }
+
+    /// The external force u(t) - F_0 (0 in free vibration).
+    #[inline]
+    pub fn input_at(&self, t: f64) -> f64 {
+        self.input.map_or(0.0, |u| u.at(t)) - self.input_offset
+    }
+
+    /// Whether an input or a constant force acts (else the motion is free vibration).
+    #[inline]
+    pub fn driven(&self) -> bool {
+        self.input.is_some() || self.input_offset != 0.0
+    }
+
+    /// The force the contact holds at rest at (t, x): u(t) - F_0 - R(x) (the static
+    /// friction that keeps the mass where it is).
+    #[inline]
+    pub fn held_force(&self, t: f64, x: f64) -> f64 {
+        if self.driven() {
+            self.input_at(t) - self.restoring_force(x)
+        } else {
+            -self.restoring_force(x)
+        }
+    }
+
+    /// The acceleration at time `t` for friction force `f`.
+    #[inline]
+    pub fn accel(&self, t: f64, x: f64, v: f64, f: f64) -> f64 {
+        -(self.damping * v + self.restoring_force(x) + f - self.input_at(t)) / self.mass
+    }
+
+    /// The right-hand side of the first-order system y = [x, v, z...] at time `t` in
+    /// direction `dir`.
+    #[inline]
+    pub fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64], dir: f64) {
         let ([x, v, z @ ..], [dx, dv, dz @ ..]) = (y, dy) else {
             return;
         };
@@ -577,12 +666,16 @@ impl Dynamics<'_> {
             _ => self.slip_force(*v, dir),
         };
         *dx = *v;
-        *dv = self.accel(*x, *v, f);
+        *dv = self.accel(t, *x, *v, f);
     }
 
-    /// The segment's linear equation when the law is affine in v in direction `dir`.
+    /// The segment's linear equation when the law is affine in v in direction `dir`, on a
+    /// linear spring in free vibration.
     pub fn affine_motion(&self, dir: f64) -> Option<AffineMotion> {
-        if matches!(self.law, Law::Dynamic { .. }) {
+        if matches!(self.law, Law::Dynamic { .. })
+            || self.driven()
+            || !self.restoring.law().is_linear_spring()
+        {
             return None;
         }
         let (offset, slope) = self.switching?.affine_slip(dir, self.normal)?;
@@ -602,19 +695,21 @@ impl Dynamics<'_> {
         })
     }
 
-    /// The mode at the start of a segment from state (x, v, z).
-    pub fn start(&self, x: f64, v: f64, z: &[f64]) -> Start {
+    /// The mode at the start of a segment from state (x, v, z) at time `t`: with a
+    /// set-valued law the mass sticks while the force it must hold, |u - R(x)|, is within
+    /// the static limit.
+    pub fn start(&self, t: f64, x: f64, v: f64, z: &[f64]) -> Start {
         if v != 0.0 {
             return Start::Slip(sgn(v));
         }
         match self.law {
             Law::Switched { limit } => {
-                let spring = self.stiffness * x;
-                if spring.abs() <= limit {
+                let held = self.held_force(t, x);
+                if held.abs() <= limit {
                     return Start::Rest;
                 }
-                let dir = -sgn(spring);
-                let a = self.accel(x, 0.0, self.slip_force(0.0, dir));
+                let dir = sgn(held);
+                let a = self.accel(t, x, 0.0, self.slip_force(0.0, dir));
                 if dir * a > 0.0 {
                     Start::Slip(dir)
                 } else {
@@ -622,7 +717,7 @@ impl Dynamics<'_> {
                 }
             }
             Law::Smooth | Law::Dynamic { .. } => {
-                let a = self.accel(x, 0.0, self.force(0.0, z, 0.0));
+                let a = self.accel(t, x, 0.0, self.force(0.0, z, 0.0));
                 if a == 0.0 || !a.is_finite() {
                     Start::Rest
                 } else {
@@ -638,17 +733,21 @@ pub(crate) fn run<R: Recorder>(
     osc: &Oscillator,
     model: &dyn FrictionModel,
     init: &Initial,
-    t_end: f64,
-    sample_times: &[f64],
+    input: Option<&Input>,
+    grid: SampleGrid<'_>,
     opts: &SimOptions,
     rec: &mut R,
 ) -> Result<RunOutput, EngineError> {
+    let SampleGrid {
+        t_end,
+        sample_times,
+    } = grid;
     osc.validate()?;
     model.validate()?;
     let y0 = initial_state(model, init)?;
     check_times(t_end, sample_times)?;
     check_options(opts)?;
-    let dynamics = Dynamics::new(osc, model)?;
+    let dynamics = Dynamics::new(osc, model)?.driven_by(input);
     let mut driver = Driver {
         dynamics,
         samples: sample_times,
@@ -663,11 +762,18 @@ pub(crate) fn run<R: Recorder>(
         rest_swing: REST_SWING_ATOLS * opts.atol,
         block: BlockBuffer::new(),
     };
-    let period = osc.natural_period();
+    let period = time_scale(osc, t_end);
     let atol_scales = component_tolerance_scales(model, y0.len());
     match resolve_method(opts.integrator, &dynamics, &y0, period)? {
         Integrator::Exact => driver.run(&mut ClosedForm::new(), &y0, t_end)?,
         Integrator::Euler { steps_per_period } => {
+            let Some(period) = osc.period() else {
+                return Err(EngineError::InvalidInput(
+                    "the Euler integrator's step is a fraction of the natural period, and \
+                     an axis without a restoring force has none: use dopri5 or auto"
+                        .into(),
+                ));
+            };
             let mut stepper = Euler::new(y0.len(), period / steps_per_period);
             driver.run(&mut stepper, &y0, t_end)?;
         }
@@ -690,6 +796,14 @@ pub(crate) fn run<R: Recorder>(
         rest: driver.rest,
         stats: driver.stats,
     })
+}
+
+/// The time scale of a run: the natural period of small motions, or, on an axis without
+/// one (no restoring force), the run's length. The largest step and `auto`'s stiffness
+/// estimate are fractions of it.
+fn time_scale(osc: &Oscillator, t_end: f64) -> f64 {
+    osc.period()
+        .unwrap_or(if t_end > 0.0 { t_end } else { 1.0 })
 }
 
 /// The multipliers of Rodas4's absolute tolerance for the `dim` components [x, v, z...]: 1

@@ -13,9 +13,8 @@ use std::sync::{Arc, Mutex};
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Key {
     index: usize,
-    mass: f64,
-    damping: f64,
-    stiffness: f64,
+    /// The whole oscillator: its inertia, damping and restoring law enter the analysis.
+    oscillator: Oscillator,
     x0: f64,
     options: EnergyOptions,
 }
@@ -38,9 +37,7 @@ impl AnalysisCache {
     ) -> Result<Arc<EnergyAnalysis>, EngineError> {
         let key = Key {
             index,
-            mass: osc.mass,
-            damping: osc.damping,
-            stiffness: osc.stiffness,
+            oscillator: *osc,
             x0: record.x0,
             options: *options,
         };

@@ -155,6 +155,10 @@ impl<R: Residuals> FitProblem<R> {
                 ParamKind::Mass => osc.mass = x,
                 ParamKind::Damping => osc.damping = x,
                 ParamKind::Stiffness => osc.stiffness = x,
+                ParamKind::GravityMoment => {
+                    osc.restoring.set_parameter("gravity_moment", x);
+                }
+                ParamKind::InputOffset => osc.input_offset = x,
                 ParamKind::Nuisance { kind, record } => {
                     if let Some(n) = nuisance.get_mut(record) {
                         n.set(kind, x);

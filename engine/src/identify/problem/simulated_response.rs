@@ -22,7 +22,9 @@ use crate::identify::values::nuisance::{NuisanceKind, NuisanceValues};
 use crate::identify::values::options::FitOptions;
 use crate::oscillator::Oscillator;
 use crate::record::{channel_list, Channel, Record};
-use crate::simulate::{simulate, simulate_velocity_watched, Initial, SimOptions, VelocityRun};
+use crate::simulate::{
+    simulate_driven, simulate_velocity_watched, Initial, Input, SampleGrid, SimOptions, VelocityRun,
+};
 use frictionid_models::GuessHint;
 use std::borrow::Cow;
 
@@ -123,10 +125,12 @@ impl SimulatedResponse {
             let init = initial(record, nuisance);
             let opts = within_allowance(at, index, record, clock.times.len());
             let mut superseded = |_: usize| at.superseded(index);
+            let input = clock.input(record)?;
             let run = VelocityRun {
                 sample_times: &clock.times,
                 v_out: &mut sim,
                 watch: &mut superseded,
+                input: input.as_ref(),
             };
             let stats =
                 simulate_velocity_watched(at.oscillator, at.model, &init, t_end, &opts, run)?;
@@ -155,8 +159,13 @@ impl SimulatedResponse {
                 at.count_simulation();
                 let opts = within_allowance(at, index, record, clock.times.len());
                 let init = initial(record, nuisance);
+                let input = clock.input(record)?;
+                let grid = SampleGrid {
+                    t_end,
+                    sample_times: &clock.times,
+                };
                 let trajectory =
-                    simulate(at.oscillator, at.model, &init, t_end, &clock.times, &opts)?;
+                    simulate_driven(at.oscillator, at.model, &init, input.as_ref(), grid, &opts)?;
                 at.record_work(index, &trajectory.stats, clock.times.len());
                 Some(trajectory)
             }
@@ -193,6 +202,8 @@ impl SimulatedResponse {
 struct ReleaseClock<'a> {
     before: usize,
     times: Cow<'a, [f64]>,
+    /// The release instant on the record's clock.
+    release: f64,
 }
 
 impl<'a> ReleaseClock<'a> {
@@ -207,7 +218,25 @@ impl<'a> ReleaseClock<'a> {
         } else {
             Cow::Owned(after.iter().map(|&t| t - release).collect())
         };
-        Self { before, times }
+        Self {
+            before,
+            times,
+            release,
+        }
+    }
+
+    /// The record's input channel on the simulation clock, if it has one.
+    fn input(&self, record: &Record) -> Result<Option<Input>, EngineError> {
+        let Some(u) = record.channel(Channel::InputForce) else {
+            return Ok(None);
+        };
+        let time = record.time().iter().map(|&t| t - self.release).collect();
+        Input::new(time, u.to_vec())
+            .map(Some)
+            .map_err(|e| EngineError::Record {
+                record: record.name.clone(),
+                reason: e.to_string(),
+            })
     }
 }
 

@@ -177,23 +177,39 @@ fn model_param(p: &ParamInfo, index: usize, value: f64, opts: &FitOptions) -> (F
     (f, x)
 }
 
-/// A free oscillator property: mass and stiffness in log coordinates, damping linear.
+/// A free oscillator property: mass, stiffness and gravity moment in log coordinates,
+/// damping and the input offset linear (the offset unbounded).
 fn oscillator_param(osc: &Oscillator, q: OscillatorParam, opts: &FitOptions) -> (FreeParam, f64) {
+    let gravity_moment = osc.restoring.parameter("gravity_moment");
     let (current, kind) = match q {
         OscillatorParam::Mass => (osc.mass, ParamKind::Mass),
         OscillatorParam::Damping => (osc.damping, ParamKind::Damping),
         OscillatorParam::Stiffness => (osc.stiffness, ParamKind::Stiffness),
+        OscillatorParam::GravityMoment => {
+            (gravity_moment.unwrap_or(f64::NAN), ParamKind::GravityMoment)
+        }
+        OscillatorParam::InputOffset => (osc.input_offset, ParamKind::InputOffset),
     };
-    let log = !matches!(q, OscillatorParam::Damping);
-    let (lo, hi) = opts
-        .bounds
-        .get(q.name())
-        .copied()
-        .unwrap_or((0.0, f64::INFINITY));
-    let typical = 2e-3 * (osc.mass * osc.stiffness).sqrt();
+    let linear = matches!(q, OscillatorParam::Damping | OscillatorParam::InputOffset);
+    let log = !linear;
+    let unbounded = (f64::NEG_INFINITY, f64::INFINITY);
+    let default_bounds = match q {
+        OscillatorParam::InputOffset => unbounded,
+        _ => (0.0, f64::INFINITY),
+    };
+    let (lo, hi) = opts.bounds.get(q.name()).copied().unwrap_or(default_bounds);
+    let typical = match q {
+        // A damping's scale: 2e-3 of the critical damping of small motions (of a
+        // kilogram-second without a restoring force); an offset's: a newton.
+        OscillatorParam::InputOffset => 1.0,
+        _ if osc.small_motion_stiffness() > 0.0 => {
+            2e-3 * (osc.mass * osc.small_motion_stiffness()).sqrt()
+        }
+        _ => 2e-3 * osc.mass,
+    };
     let mut f = FreeParam::linear(
         q.name().to_string(),
-        q.unit(),
+        &osc.axis.unit(q.unit()),
         kind,
         (lo, hi),
         current,

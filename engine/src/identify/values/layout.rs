@@ -20,6 +20,10 @@ pub enum ParamKind {
     Damping,
     /// The oscillator stiffness.
     Stiffness,
+    /// The pendulum's gravity moment.
+    GravityMoment,
+    /// The input's offset.
+    InputOffset,
     /// A nuisance parameter of one record.
     Nuisance {
         /// What it is.

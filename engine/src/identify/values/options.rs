@@ -18,6 +18,10 @@ pub enum OscillatorParam {
     Damping,
     /// k [N/m].
     Stiffness,
+    /// The pendulum's gravity moment m g l [N m] (`restoring = { type = "pendulum" }`).
+    GravityMoment,
+    /// The input's offset F_0 [N] (see `Oscillator::input_offset`).
+    InputOffset,
 }
 
 impl OscillatorParam {
@@ -27,6 +31,8 @@ impl OscillatorParam {
             Self::Mass => "mass",
             Self::Damping => "damping",
             Self::Stiffness => "stiffness",
+            Self::GravityMoment => "gravity_moment",
+            Self::InputOffset => "input_offset",
         }
     }
     /// SI unit.
@@ -35,14 +41,18 @@ impl OscillatorParam {
             Self::Mass => "kg",
             Self::Damping => "N s/m",
             Self::Stiffness => "N/m",
+            Self::GravityMoment => "N m",
+            Self::InputOffset => "N",
         }
     }
     /// Parses a config name.
     pub fn parse(name: &str) -> Option<Self> {
         match name {
-            "mass" => Some(Self::Mass),
+            "mass" | "inertia" => Some(Self::Mass),
             "damping" => Some(Self::Damping),
             "stiffness" => Some(Self::Stiffness),
+            "gravity_moment" => Some(Self::GravityMoment),
+            "input_offset" => Some(Self::InputOffset),
             _ => None,
         }
     }
