@@ -14,11 +14,12 @@
 //! time_column = "time"        # and time_scale (1e-3 for milliseconds)
 //! velocity_column = "velocity"
 //! velocity_scale = 1e-3       # the file's velocity unit in m/s (here mm/s)
-//! # displacement_, acceleration_, force_ and normal_force_ column and scale alike: a channel
+//! # displacement_, acceleration_, force_, normal_force_ and input_force_ column and scale
+//! # alike (input_force: the force driving the axis, a drive's motor force): a channel
 //! # is read when its column is found (default: the channel's own name); a negative scale
 //! # flips a sign convention
 //! velocity_noise = 2e-4       # m/s, the channel's noise level (default: estimated from it);
-//! # displacement_, acceleration_ and force_noise alike, in the channel's SI unit
+//! # displacement_, acceleration_, force_ and input_force_noise alike, in the channel's SI unit
 //! normal_force = 14.5         # N, this record's constant normal force (else the oscillator's)
 //! release = "auto"            # or a time in s: drop the pre-trigger rest (default: none)
 //! min_samples = 10
@@ -78,6 +79,11 @@ pub struct RecordSource {
     pub normal_force_scale: Option<f64>,
     /// This record's constant normal force \[N\] (default: the oscillator's, or the channel).
     pub normal_force: Option<f64>,
+    /// Header name of the input-force column, the force driving the axis (default
+    /// `input_force`).
+    pub input_force_column: Option<String>,
+    /// Factor from the file's input-force unit to N (default 1).
+    pub input_force_scale: Option<f64>,
     /// Noise level of the velocity channel [m/s] (default: estimated from the record).
     pub velocity_noise: Option<f64>,
     /// Noise level of the displacement channel \[m\] (default: estimated).
@@ -86,6 +92,8 @@ pub struct RecordSource {
     pub acceleration_noise: Option<f64>,
     /// Noise level of the force channel \[N\] (default: estimated).
     pub force_noise: Option<f64>,
+    /// Noise level of the input-force channel \[N\] (default: estimated).
+    pub input_force_noise: Option<f64>,
     /// Where the free vibration starts (default: at the first sample).
     pub release: Option<Release>,
     /// Fewest samples accepted (default 10).
@@ -160,10 +168,13 @@ macro_rules! record_keys {
             normal_force_column,
             normal_force_scale,
             normal_force,
+            input_force_column,
+            input_force_scale,
             velocity_noise,
             displacement_noise,
             acceleration_noise,
             force_noise,
+            input_force_noise,
             release,
             min_samples,
             sampling_tolerance
@@ -371,6 +382,7 @@ impl RecordSource {
             (Channel::Displacement, self.displacement_noise),
             (Channel::Acceleration, self.acceleration_noise),
             (Channel::Force, self.force_noise),
+            (Channel::InputForce, self.input_force_noise),
         ];
         given
             .into_iter()
@@ -391,7 +403,7 @@ impl RecordSource {
     }
 
     /// The column and scale keys of each channel.
-    fn channel_keys(&self) -> [(Channel, Option<&String>, Option<f64>); 5] {
+    fn channel_keys(&self) -> [(Channel, Option<&String>, Option<f64>); 6] {
         [
             (
                 Channel::Velocity,
@@ -413,6 +425,11 @@ impl RecordSource {
                 Channel::NormalForce,
                 self.normal_force_column.as_ref(),
                 self.normal_force_scale,
+            ),
+            (
+                Channel::InputForce,
+                self.input_force_column.as_ref(),
+                self.input_force_scale,
             ),
         ]
     }

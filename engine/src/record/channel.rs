@@ -19,16 +19,20 @@ pub enum Channel {
     Force,
     /// Normal force of the contact \[N\].
     NormalForce,
+    /// The force (a torque on a rotary axis) driving the axis \[N\]: a drive's motor force,
+    /// the u of J q'' + c q' + R(q) + F = u.
+    InputForce,
 }
 
 impl Channel {
     /// Every channel, in the order readers look for them.
-    pub const ALL: [Channel; 5] = [
+    pub const ALL: [Channel; 6] = [
         Channel::Velocity,
         Channel::Displacement,
         Channel::Acceleration,
         Channel::Force,
         Channel::NormalForce,
+        Channel::InputForce,
     ];
 
     /// The channel's name: its configuration key prefix and default column name.
@@ -39,6 +43,7 @@ impl Channel {
             Channel::Acceleration => "acceleration",
             Channel::Force => "force",
             Channel::NormalForce => "normal_force",
+            Channel::InputForce => "input_force",
         }
     }
 
@@ -48,7 +53,7 @@ impl Channel {
             Channel::Velocity => "m/s",
             Channel::Displacement => "m",
             Channel::Acceleration => "m/s^2",
-            Channel::Force | Channel::NormalForce => "N",
+            Channel::Force | Channel::NormalForce | Channel::InputForce => "N",
         }
     }
 
