@@ -11,8 +11,8 @@ use crate::identify::problem::{FitProblem, Realised, Residuals};
 use crate::identify::search::starts::{MultiStart, StartRun};
 use crate::identify::search::Layout;
 use crate::identify::values::{
-    Check, Derived, Finding, FitOptions, FitResult, FittedParam, FreeParam, OscillatorParam,
-    ParamKind, Search, StartOutcome, Status,
+    Check, Derived, Finding, FitOptions, FitResult, FittedParam, FreeParam, FrictionLevels,
+    OscillatorParam, ParamKind, Search, StartOutcome, Status,
 };
 use crate::oscillator::Oscillator;
 use nalgebra::DMatrix;
@@ -146,7 +146,8 @@ pub fn summarise<R: Residuals>(
     let mut simulations = runs.simulations + ctx.reference.simulations();
     let fits = record_fits(ctx.reference, &stats.world, ctx.opts)?;
     simulations += ctx.reference.records.len() as u64;
-    let parameters = parameter_entries(&stats, params, ctx.standings);
+    let levels = ctx.reference.residuals.friction_levels();
+    let parameters = parameter_entries(&stats, params, ctx.standings, levels);
     let findings = diagnose(ctx, &runs, &stats, &parameters, &fits);
     let n_free = params.len();
     let samples = ctx.reference.n_residuals();
@@ -234,6 +235,7 @@ fn diagnose<R: Residuals>(
     findings.extend(identifiability::findings(&names, ctx.standings));
     findings.extend(identifiability::consistency_findings(
         stats.world.model.as_ref(),
+        ctx.reference.residuals.friction_levels(),
     ));
     findings.extend(diagnostics::parameters_at_bounds(params, &stats.p_best));
     findings.extend(fits.findings.iter().cloned());
@@ -263,6 +265,7 @@ fn parameter_entries(
     stats: &Statistics,
     params: &[FreeParam],
     standings: &[Standing],
+    levels: FrictionLevels,
 ) -> Vec<FittedParam> {
     let se = &stats.cov.std_errors;
     let tq = stats.t_quantile;
@@ -281,7 +284,8 @@ fn parameter_entries(
         .enumerate()
         .map(|(i, (p, v))| {
             let slot = params.iter().position(|f| f.kind == ParamKind::Model(i));
-            stand(param_entry(&p.name, &p.unit, v, slot, se, tq), slot)
+            let unit = levels.unit(p);
+            stand(param_entry(&p.name, &unit, v, slot, se, tq), slot)
         })
         .collect();
     for (slot, f) in params.iter().enumerate() {
