@@ -164,7 +164,12 @@ pub fn summarise<R: Residuals>(
         correlation: (0..k)
             .map(|a| (0..k).map(|b| stats.cov.correlation[(a, b)]).collect())
             .collect(),
-        derived: derived_ratios(&stats.world.oscillator, params, &stats.cov.matrix, ctx.opts),
+        derived: if ctx.reference.residuals.simulates_response() {
+            derived_ratios(&stats.world.oscillator, params, &stats.cov.matrix, ctx.opts)
+        } else {
+            // The ratios a free response fixes; a force balance fixes the properties.
+            Vec::new()
+        },
         records: fits.records,
         rms_residual: (fits.sum_sq / fits.n_total.max(1) as f64).sqrt(),
         compared: ctx.reference.residuals.channel().to_string(),
@@ -224,10 +229,12 @@ fn diagnose<R: Residuals>(
     findings.extend(correlation_findings(params, &stats.cov));
     findings.push(diagnostics::standard_errors(parameters, stats.cov.singular));
     findings.extend(stats.widening.clone());
-    findings.extend(identifiability_findings(
-        ctx.opts,
-        ctx.layout.n_model_free(),
-    ));
+    if ctx.reference.residuals.simulates_response() {
+        findings.extend(identifiability_findings(
+            ctx.opts,
+            ctx.layout.n_model_free(),
+        ));
+    }
     let names: Vec<(String, String)> = params
         .iter()
         .map(|f| (f.name.clone(), f.unit.clone()))
@@ -343,7 +350,8 @@ fn correlation_findings(params: &[FreeParam], cov: &Covariance) -> Vec<Finding> 
     out
 }
 
-/// A warning for a free mass with anything that scales with it.
+/// A warning for a free mass with anything that scales with it (a fit of the free response:
+/// a measured input force fixes the scale).
 fn identifiability_findings(opts: &FitOptions, n_model_free: usize) -> Vec<Finding> {
     let mut out = Vec::new();
     let osc_free = |q: OscillatorParam| opts.oscillator.contains(&q);
