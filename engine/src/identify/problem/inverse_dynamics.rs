@@ -189,9 +189,12 @@ pub fn linear_start(
             row[columns.len()..].iter_mut().for_each(|x| *x = 0.0);
             row[columns.len() + r] = 1.0;
             let y = rec.input[k] - known;
-            let x = DVector::from_column_slice(&row);
-            normal += &x * x.transpose();
-            rhs += x * y;
+            for (p, &xp) in row.iter().enumerate() {
+                rhs[p] += xp * y;
+                for (q, &xq) in row.iter().enumerate() {
+                    normal[(p, q)] += xp * xq;
+                }
+            }
         }
     }
     let solution = normal.svd(true, true).solve(&rhs, 1e-12).ok()?;
