@@ -189,7 +189,10 @@ proptest! {
             p[0] = p[0].max(p[1] / 3.0);
             model.set_params(&p).expect("five parameters");
         }
-        let limit = model.static_limit(osc.normal_force).expect("a static law");
+        let limit = model
+            .switching()
+            .and_then(|law| law.static_limit(osc.normal_force))
+            .expect("a static law");
         let band = limit / osc.stiffness;
         let x0 = ratio * band;
         let t_end = 60.0 * osc.natural_period();

@@ -6,7 +6,7 @@
 use crate::simulate::{simulate, Initial, Integrator, SimOptions};
 use crate::synthetic::uniform_times;
 use crate::Oscillator;
-use frictionid_models::testing::motion::{Integration, Motion, Simulator};
+use frictionid_models::testing::motion::{Integration, Motion, Release, Simulator};
 use frictionid_models::testing::Model;
 
 /// Releases of an oscillator simulated by the engine, sampled at 1 kHz.
@@ -36,13 +36,12 @@ impl Simulator for EngineSimulator {
         self.0.normal_force
     }
 
-    fn release(
-        &self,
-        model: &Model,
-        x0: f64,
-        t_end: f64,
-        integration: Integration,
-    ) -> Result<Motion, String> {
+    fn release(&self, model: &Model, release: Release) -> Result<Motion, String> {
+        let Release {
+            x0,
+            t_end,
+            integration,
+        } = release;
         let times = uniform_times(t_end, 1000.0);
         let opts = Self::options(integration);
         let sim = simulate(&self.0, model, &Initial::at_rest(x0), t_end, &times, &opts)

@@ -12,7 +12,7 @@ use frictionid_engine::{
     analyze_record, analyze_states, force_residuals, model_force_along, percent_difference,
     simulate, Differentiator, EnergyOptions, EngineError, Initial, Oscillator, Record, SimOptions,
 };
-use frictionid_models::{Coulomb, Dahl, FrictionModel, LuGre};
+use frictionid_models::{Coulomb, Dahl, FrictionModel, InternalStates, LuGre};
 use serde::{Deserialize, Serialize};
 
 const MU: f64 = 0.24;
@@ -674,17 +674,21 @@ impl FrictionModel for Lag {
         equation: "z' = (v - z)/tau, F = gain z",
         no_params
     );
-    fn n_states(&self) -> usize {
-        1
-    }
-    fn state_derivative(&self, v: f64, z: &[f64], _normal: f64, dz: &mut [f64]) {
-        dz[0] = (v - z[0]) / self.tau;
-    }
     fn force(&self, _v: f64, z: &[f64], _normal: f64) -> f64 {
         self.gain * z[0]
     }
     fn steady_state(&self, v: f64, _normal: f64) -> f64 {
         self.gain * v
+    }
+    frictionid_models::law_groups!(states);
+}
+
+impl InternalStates for Lag {
+    fn n_states(&self) -> usize {
+        1
+    }
+    fn state_derivative(&self, v: f64, z: &[f64], _normal: f64, dz: &mut [f64]) {
+        dz[0] = (v - z[0]) / self.tau;
     }
 }
 

@@ -6,7 +6,7 @@
 use frictionid_engine::synthetic::uniform_times;
 use frictionid_engine::{simulate, EngineError, Initial, Integrator, Oscillator, SimOptions};
 use frictionid_models::testing::motion::first_mismatch;
-use frictionid_models::{sgn, Dahl, FrictionModel};
+use frictionid_models::{sgn, Dahl, FrictionModel, InternalStates};
 use serde::{Deserialize, Serialize};
 
 /// Viscous friction that breaks down (NaN) below v = -0.1 m/s.
@@ -95,6 +95,16 @@ impl FrictionModel for TripleDahl {
         equation: "F = z1 + z2 + z3, dzi/dt = s v (1 - 3 zi sgn(v) / (mu_c N))",
         no_params
     );
+    fn force(&self, _v: f64, z: &[f64], _normal: f64) -> f64 {
+        z.iter().sum()
+    }
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        self.mu_c * normal * sgn(v)
+    }
+    frictionid_models::law_groups!(states);
+}
+
+impl InternalStates for TripleDahl {
     fn n_states(&self) -> usize {
         3
     }
@@ -103,12 +113,6 @@ impl FrictionModel for TripleDahl {
         for (d, zi) in dz.iter_mut().zip(z) {
             *d = self.s * v * (1.0 - zi * sgn(v) / fc);
         }
-    }
-    fn force(&self, _v: f64, z: &[f64], _normal: f64) -> f64 {
-        z.iter().sum()
-    }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.mu_c * normal * sgn(v)
     }
     fn stored_energy(&self, z: &[f64], _normal: f64) -> f64 {
         z.iter().map(|zi| zi * zi / (2.0 * self.s)).sum()

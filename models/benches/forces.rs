@@ -2,7 +2,9 @@
 //! formula, and the gms right-hand side.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use frictionid_models::{Expression, FrictionModel, Gms, Makkar, Stribeck};
+use frictionid_models::{
+    Expression, FrictionModel, Gms, InternalStates, Makkar, Stribeck, SwitchedLaw,
+};
 use std::hint::black_box;
 
 const N: f64 = 14.5;

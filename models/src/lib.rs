@@ -8,7 +8,10 @@
 pub mod builtin;
 pub mod error;
 pub mod formula;
+pub mod hints;
+pub mod linearisation;
 pub mod model;
+pub mod param_info;
 pub mod params;
 pub mod registry;
 pub mod start;
@@ -17,10 +20,13 @@ pub mod testing;
 
 pub use builtin::*;
 pub use error::ModelError;
+pub use hints::{GuessHint, StartContext};
+pub use linearisation::Linearisation;
 pub use model::{
-    check_bounds, check_len, clone_model, decay, sgn, FrictionModel, GuessHint, Linearisation,
-    ParamInfo, RigidLimit,
+    clone_model, decay, sgn, Derivatives, FrictionModel, InternalStates, Jacobians, RigidLimit,
+    Staging, SwitchedLaw,
 };
+pub use param_info::{check_bounds, check_len, ParamInfo};
 pub use params::{DeclaredParams, ParamSpec};
 pub use registry::{build_json, build_toml, default_model, listings, names, Built, ModelListing};
-pub use start::{StartContext, StribeckLevels};
+pub use start::StribeckLevels;

@@ -9,7 +9,7 @@
 //! written table is the rendered one. Models with a variable number of parameters (`gms`)
 //! build their `ParamInfo`s from `ParamSpec`s too.
 
-use crate::model::ParamInfo;
+use crate::param_info::ParamInfo;
 
 /// The declaration of one model parameter; `const`-constructible, so a model keeps its
 /// declarations in a `const` table.

@@ -5,7 +5,8 @@
 //! defined in any linked crate appears here with no second registration step.
 
 use crate::error::ModelError;
-use crate::model::{FrictionModel, ParamInfo};
+use crate::model::FrictionModel;
+use crate::param_info::ParamInfo;
 use serde::Serialize;
 
 /// A registered model with its metadata, for listings (`frictionid models`).

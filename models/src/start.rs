@@ -1,7 +1,7 @@
-//! Starts from simpler models, for staged identification (issue 14): a Coulomb or Stribeck
+//! Starts from simpler models, for staged identification: a Coulomb or Stribeck
 //! fit gives the levels of the steady-state curve, from which a dynamic model takes its start
-//! (`FrictionModel::start_from`), and the data-driven first guess of every Stribeck-type
-//! model (`FrictionModel::apply_guess`) is written once, here.
+//! (`Staging::start_from`), and the data-driven first guess of every Stribeck-type
+//! model (`Staging::apply_guess`) is written once, here.
 //!
 //! The mappings keep the steady-state curve of the simpler fit: LuGre, GMS and a Stribeck
 //! model started from a Stribeck fit (delta = 2 for LuGre) slide at exactly its force, and
@@ -10,44 +10,9 @@
 //!   with x_p a few tens of micrometres for dry contacts unless the caller knows better;
 //! - LuGre's bristle damping at the critical damping of the bristle mode, 2 sqrt(sigma0 m).
 
-use crate::model::{FrictionModel, GuessHint};
-
-/// A typical presliding displacement of a dry contact \[m\]: the bristle or element
-/// deflection at which the friction force reaches its sliding level.
-pub const TYPICAL_PRESLIDING_DISPLACEMENT: f64 = 2e-5;
-
-/// What a start mapping knows beyond the fitted model.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StartContext {
-    /// The normal force \[N\].
-    pub normal_force: f64,
-    /// The oscillator mass \[kg\] (for damping at the critical damping of a bristle mode).
-    pub mass: f64,
-    /// The displacement at which the contact reaches its sliding force \[m\].
-    pub presliding_displacement: f64,
-}
-
-impl StartContext {
-    /// A context with the typical presliding displacement.
-    pub fn new(normal_force: f64, mass: f64) -> Self {
-        Self {
-            normal_force,
-            mass,
-            presliding_displacement: TYPICAL_PRESLIDING_DISPLACEMENT,
-        }
-    }
-
-    /// The contact stiffness that reaches the force `level` \[N\] at the presliding
-    /// displacement (at least 1 N/m).
-    pub fn stiffness_for(&self, level: f64) -> f64 {
-        (level / self.presliding_displacement).max(1.0)
-    }
-
-    /// The critical damping 2 sqrt(k m) of a contact of stiffness `k` carrying the mass.
-    pub fn critical_damping(&self, k: f64) -> f64 {
-        2.0 * (k * self.mass).sqrt()
-    }
-}
+use crate::hints::GuessHint;
+pub use crate::hints::{StartContext, TYPICAL_PRESLIDING_DISPLACEMENT};
+use crate::model::FrictionModel;
 
 /// The levels of a Stribeck-type steady-state curve,
 /// F_ss = N (mu_c + (mu_s - mu_c) exp(-|v / v_s|^delta)) sgn(v) + viscous v.
@@ -169,15 +134,5 @@ mod tests {
             0.5
         );
         assert!(StribeckLevels::from_model(&crate::NoFriction {}).is_none());
-    }
-
-    #[test]
-    fn scales_by_hand() {
-        let ctx = StartContext::new(14.5, 10.391);
-        // mu_c N = 2.9 N at 20 micrometres: 1.45e5 N/m.
-        assert!((ctx.stiffness_for(2.9) - 1.45e5).abs() < 1e-9);
-        // 2 sqrt(1e5 * 10.391) = 2 * 1019.362...
-        assert!((ctx.critical_damping(1e5) - 2.0 * 1_039_100f64.sqrt()).abs() < 1e-9);
-        assert_eq!(ctx.stiffness_for(0.0), 1.0);
     }
 }

@@ -22,7 +22,8 @@
 pub mod motion;
 
 use crate::error::ModelError;
-use crate::model::{FrictionModel, Linearisation};
+use crate::linearisation::Linearisation;
+use crate::model::{Derivatives, FrictionModel, SwitchedLaw};
 use crate::registry::{build_json, build_toml, default_model, names};
 use crate::ParamInfo;
 use thiserror::Error;
@@ -208,7 +209,9 @@ pub fn check_declarations(model: &Model) -> Outcome {
 
 /// Part of [`Check::Declarations`]: one tolerance scale per state, each finite and > 0.
 fn check_state_tolerance_scales(model: &Model) -> Outcome {
-    let scales = model.state_tolerance_scales();
+    let scales = model
+        .states()
+        .map_or_else(Vec::new, |s| s.state_tolerance_scales());
     ensure(
         model,
         Check::Declarations,
@@ -422,14 +425,30 @@ fn for_each_probe(model: &Model, mut probe: impl FnMut(f64, &[f64], f64) -> Outc
 
 fn derivative(model: &Model, v: f64, z: &[f64], normal: f64) -> Vec<f64> {
     let mut dz = vec![0.0; model.n_states()];
-    model.state_derivative(v, z, normal, &mut dz);
+    if let Some(states) = model.states() {
+        states.state_derivative(v, z, normal, &mut dz);
+    }
     dz
+}
+
+/// The stored energy at `z` (0 for a law without states).
+fn stored_energy(model: &Model, z: &[f64], normal: f64) -> f64 {
+    model.states().map_or(0.0, |s| s.stored_energy(z, normal))
+}
+
+/// The switched-law facts with the breakaway force at `normal`, for a set-valued law.
+fn set_valued(model: &Model, normal: f64) -> Option<(&dyn SwitchedLaw, f64)> {
+    let law = model.switching()?;
+    Some((law, law.static_limit(normal)?))
 }
 
 /// [`Check::ForceOnlyParams`]: each declared index exists, and moving that parameter alone
 /// (to a nearby admissible value) changes no state derivative at any probe point.
 pub fn check_force_only_params(model: &Model) -> Outcome {
-    check_state_free(model, &model.force_only_params())
+    let declared = model
+        .states()
+        .map_or_else(Vec::new, |s| s.force_only_params());
+    check_state_free(model, &declared)
 }
 
 /// Whether moving each parameter of `indices` alone leaves the state derivative unchanged.
@@ -479,7 +498,10 @@ pub fn check_combined_rhs(model: &Model) -> Outcome {
     for_each_probe(model, |v, z, normal| {
         let separate = (derivative(model, v, z, normal), model.force(v, z, normal));
         let mut dz = vec![0.0; model.n_states()];
-        let force = model.state_derivative_and_force(v, z, normal, &mut dz);
+        let force = match model.states() {
+            Some(states) => states.state_derivative_and_force(v, z, normal, &mut dz),
+            None => model.force(v, z, normal),
+        };
         let bits = |x: &f64| x.to_bits();
         let same = force.to_bits() == separate.1.to_bits()
             && dz.iter().map(bits).eq(separate.0.iter().map(bits));
@@ -496,12 +518,16 @@ pub fn check_combined_rhs(model: &Model) -> Outcome {
 /// three separate calls, bit for bit (a stiff step's Jacobian, and so every trajectory, must
 /// not depend on which the engine calls).
 pub fn check_combined_linearisation(model: &Model) -> Outcome {
-    let n = model.n_states();
+    let Some(states) = model.states() else {
+        return Ok(());
+    };
+    let n = states.n_states();
+    let derivatives = Derivatives::of(states);
     for_each_probe(model, |v, z, normal| {
         let (mut dz_dz, mut dz_dv, mut df_dz) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
-        model.state_jacobian(v, z, normal, &mut dz_dz);
-        model.state_velocity_derivative(v, z, normal, &mut dz_dv);
-        let df_dv = model.force_gradient(v, z, normal, &mut df_dz);
+        derivatives.state_jacobian(v, z, normal, &mut dz_dz);
+        derivatives.state_velocity_derivative(v, z, normal, &mut dz_dv);
+        let df_dv = derivatives.force_gradient(v, z, normal, &mut df_dz);
         let separate = [dz_dz, dz_dv, df_dz, vec![df_dv]];
         let (mut dz_dz, mut dz_dv, mut df_dz) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
         let out = Linearisation {
@@ -509,7 +535,7 @@ pub fn check_combined_linearisation(model: &Model) -> Outcome {
             dz_dv: &mut dz_dv,
             df_dz: &mut df_dz,
         };
-        let df_dv = model.linearisation(v, z, normal, out);
+        let df_dv = derivatives.linearisation(v, z, normal, out);
         let combined = [dz_dz, dz_dv, df_dz, vec![df_dv]];
         let bits = |parts: &[Vec<f64>; 4]| -> Vec<u64> {
             parts.iter().flatten().map(|x| x.to_bits()).collect()
@@ -531,10 +557,13 @@ pub fn check_combined_linearisation(model: &Model) -> Outcome {
 /// speeds of both signs dz/dt vanishes (to 1e-9 of |v| per state) and the force is the
 /// steady-state force (to 1e-9 relative).
 pub fn check_sliding_states(model: &Model) -> Outcome {
+    let Some(states) = model.states() else {
+        return Ok(());
+    };
     let normal = 10.0;
     for v in [1e-3, 0.05, 0.3, 2.0].into_iter().flat_map(|v| [v, -v]) {
-        let mut z = vec![0.0; model.n_states()];
-        if !model.sliding_states(v, normal, &mut z) {
+        let mut z = vec![0.0; states.n_states()];
+        if !states.sliding_states(v, normal, &mut z) {
             return Ok(());
         }
         let dz = derivative(model, v, &z, normal);
@@ -569,11 +598,11 @@ pub fn check_finite(model: &Model) -> Outcome {
             dz.iter().all(|d| d.is_finite()),
             || format!("dz/dt {dz:?} at {}", at()),
         )?;
-        let e = model.stored_energy(z, normal);
+        let e = stored_energy(model, z, normal);
         ensure(model, Check::Finite, e.is_finite(), || {
             format!("stored energy {e} at {}", at())
         })?;
-        if let Some(limit) = model.static_limit(normal) {
+        if let Some((law, limit)) = set_valued(model, normal) {
             ensure(
                 model,
                 Check::Finite,
@@ -581,7 +610,7 @@ pub fn check_finite(model: &Model) -> Outcome {
                 || format!("static limit {limit} at N = {normal}"),
             )?;
             for d in [1.0, -1.0] {
-                let f = model.slip_force(v, d, normal);
+                let f = law.slip_force(v, d, normal);
                 ensure(model, Check::Finite, f.is_finite(), || {
                     format!("slip force {f} in direction {d} at {}", at())
                 })?;
@@ -615,10 +644,10 @@ pub fn check_odd_symmetry(model: &Model) -> Outcome {
         ensure(model, Check::OddSymmetry, sn == -s, || {
             format!("F_ss = {s} but F_ss(-v) = {sn} at {}", at())
         })?;
-        if model.static_limit(normal).is_some() {
+        if let Some((law, _)) = set_valued(model, normal) {
             let (p, pn) = (
-                model.slip_force(v, 1.0, normal),
-                model.slip_force(-v, -1.0, normal),
+                law.slip_force(v, 1.0, normal),
+                law.slip_force(-v, -1.0, normal),
             );
             ensure(model, Check::OddSymmetry, pn == -p, || {
                 format!("slip(v, +1) = {p} but slip(-v, -1) = {pn} at {}", at())
@@ -644,11 +673,11 @@ pub fn check_dissipative(model: &Model) -> Outcome {
 /// [`Check::SlipDirection`] (set-valued laws only).
 pub fn check_slip_direction(model: &Model) -> Outcome {
     for normal in NORMAL_FORCES {
-        let Some(limit) = model.static_limit(normal) else {
+        let Some((law, limit)) = set_valued(model, normal) else {
             continue;
         };
         for d in [1.0, -1.0] {
-            let f0 = model.slip_force(0.0, d, normal);
+            let f0 = law.slip_force(0.0, d, normal);
             ensure(
                 model,
                 Check::SlipDirection,
@@ -657,7 +686,7 @@ pub fn check_slip_direction(model: &Model) -> Outcome {
                     format!("slip force {f0} at v = 0 in direction {d}, breakaway {limit}, N = {normal}")
                 },
             )?;
-            let wrong = model.slip_force(-d * 1e-15, d, normal);
+            let wrong = law.slip_force(-d * 1e-15, d, normal);
             ensure(
                 model,
                 Check::SlipDirection,
@@ -678,12 +707,12 @@ pub fn check_slip_direction(model: &Model) -> Outcome {
 pub fn check_stored_energy(model: &Model) -> Outcome {
     let rest = vec![0.0; model.n_states()];
     for normal in NORMAL_FORCES {
-        let e0 = model.stored_energy(&rest, normal);
+        let e0 = stored_energy(model, &rest, normal);
         ensure(model, Check::StoredEnergy, e0 == 0.0, || {
             format!("{e0} in the undeflected state at N = {normal}")
         })?;
         for z in states(model.n_states()) {
-            let e = model.stored_energy(&z, normal);
+            let e = stored_energy(model, &z, normal);
             ensure(model, Check::StoredEnergy, e >= 0.0, || {
                 format!("{e} at z = {z:?}, N = {normal}")
             })?;
@@ -709,6 +738,7 @@ pub fn doc_table_mismatch(source: &str, info: &[ParamInfo]) -> Option<String> {
 mod tests {
     use super::*;
     use crate::builtin::LuGre;
+    use crate::model::{InternalStates, Jacobians};
     use serde::{Deserialize, Serialize};
 
     /// LuGre with a one-call right-hand side that forgets the bristle damping.
@@ -717,6 +747,27 @@ mod tests {
 
     #[typetag::serde(name = "testing_rs_forgetful_lugre")]
     impl FrictionModel for ForgetfulLuGre {
+        crate::declared_param_methods!(
+            name: "testing_rs_forgetful_lugre",
+            equation: "",
+            no_params
+        );
+        fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
+            self.0.force(v, z, normal)
+        }
+        fn steady_state(&self, v: f64, normal: f64) -> f64 {
+            self.0.steady_state(v, normal)
+        }
+        crate::law_groups!(states);
+    }
+
+    impl InternalStates for ForgetfulLuGre {
+        fn n_states(&self) -> usize {
+            self.0.n_states()
+        }
+        fn state_derivative(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) {
+            self.0.state_derivative(v, z, normal, dz);
+        }
         fn state_derivative_and_force(
             &self,
             v: f64,
@@ -727,26 +778,14 @@ mod tests {
             self.0.state_derivative(v, z, normal, dz);
             self.0.sigma0 * z[0] + self.0.sigma2 * v
         }
+        crate::law_groups!(jacobians);
+    }
+
+    /// The three derivatives by finite differences, the one call LuGre's without sigma1.
+    impl Jacobians for ForgetfulLuGre {
         fn linearisation(&self, v: f64, z: &[f64], normal: f64, out: Linearisation<'_>) -> f64 {
             self.0.linearisation(v, z, normal, out);
             self.0.sigma2
-        }
-        crate::declared_param_methods!(
-            name: "testing_rs_forgetful_lugre",
-            equation: "",
-            no_params
-        );
-        fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
-            self.0.force(v, z, normal)
-        }
-        fn state_derivative(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) {
-            self.0.state_derivative(v, z, normal, dz);
-        }
-        fn steady_state(&self, v: f64, normal: f64) -> f64 {
-            self.0.steady_state(v, normal)
-        }
-        fn n_states(&self) -> usize {
-            self.0.n_states()
         }
     }
 

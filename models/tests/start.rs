@@ -1,4 +1,4 @@
-//! Starts from simpler models (`FrictionModel::start_from`): the started model slides at
+//! Starts from simpler models (`Staging::start_from`): the started model slides at
 //! exactly the steady-state curve of the fitted simpler one, and its presliding scales are
 //! the physical ones (stiffness from the presliding displacement, critical bristle damping).
 
@@ -150,7 +150,7 @@ fn rigid_limits_slide_at_the_models_steady_state_curve() {
     gms.delta = 1.3;
     gms.viscous = 0.7;
     let ctx = StartContext::new(N, MASS);
-    for model in [&lugre as &dyn FrictionModel, &dahl, &gms] {
+    for model in [&lugre as &dyn InternalStates, &dahl, &gms] {
         let limit = model
             .rigid_limit()
             .expect("a bristle model has a rigid limit");
@@ -161,7 +161,7 @@ fn rigid_limits_slide_at_the_models_steady_state_curve() {
             "{}: the limit is a static law",
             model.name()
         );
-        assert!(law.start_from(model, &ctx));
+        assert!(law.staging().is_some_and(|s| s.start_from(model, &ctx)));
         same_steady_state(law.as_ref(), model);
         let info = model.param_info();
         assert!(!limit.stiffnesses.is_empty());
@@ -179,6 +179,7 @@ fn rigid_limits_slide_at_the_models_steady_state_curve() {
         &fitted_stribeck() as &dyn FrictionModel,
         &Coulomb { mu: 0.2 },
     ] {
-        assert!(model.rigid_limit().is_none(), "{}", model.name());
+        let limit = model.states().and_then(|s| s.rigid_limit());
+        assert!(limit.is_none(), "{}", model.name());
     }
 }

@@ -24,7 +24,7 @@ use crate::error::{EngineError, IntegrationFailure};
 use crate::oscillator::Oscillator;
 use crate::record::NormalForce;
 use crate::simulate::{Dopri5, OdeSystem, StepOutcome, Stepper};
-use frictionid_models::FrictionModel;
+use frictionid_models::{FrictionModel, InternalStates};
 use serde::Serialize;
 
 const RTOL: f64 = 1e-8;
@@ -89,19 +89,30 @@ pub fn states_along(
     max_substeps: u64,
 ) -> Result<Vec<f64>, EngineError> {
     check_motion(time, v, normal)?;
-    states_along_checked(model, time, v, normal, max_substeps)
+    states_along_checked(model, CheckedMotion { time, v, normal }, max_substeps)
+}
+
+/// A motion already checked by [`check_motion`]: its sample times, velocities and normal
+/// force.
+#[derive(Clone, Copy)]
+pub(crate) struct CheckedMotion<'a> {
+    pub time: &'a [f64],
+    pub v: &'a [f64],
+    pub normal: &'a NormalForce,
 }
 
 /// [`states_along`] of a motion already checked by [`check_motion`] (a fit checks it once,
 /// not at every evaluation).
 pub(crate) fn states_along_checked(
     model: &dyn FrictionModel,
-    time: &[f64],
-    v: &[f64],
-    normal: &NormalForce,
+    motion: CheckedMotion<'_>,
     max_substeps: u64,
 ) -> Result<Vec<f64>, EngineError> {
-    let ns = model.n_states();
+    let CheckedMotion { time, v, normal } = motion;
+    let Some(states) = model.states() else {
+        return Ok(Vec::new());
+    };
+    let ns = states.n_states();
     let mut z = vec![0.0; ns];
     let mut out = Vec::with_capacity(v.len() * ns);
     if ns == 0 {
@@ -111,7 +122,7 @@ pub(crate) fn states_along_checked(
     for i in 0..time.len() {
         if i > 0 {
             let along = AlongMotion {
-                model,
+                states,
                 n0: normal.at(i - 1),
                 n1: normal.at(i),
                 t0: time[i - 1],
@@ -254,7 +265,7 @@ pub fn force_residuals(
 /// The states' equation along one sample interval: z' = f(v(t), z, N(t)) with v linear from
 /// (t0, v0) to (t0 + span, v1) and N linear from n0 to n1.
 struct AlongMotion<'a> {
-    model: &'a dyn FrictionModel,
+    states: &'a dyn InternalStates,
     n0: f64,
     n1: f64,
     t0: f64,
@@ -279,7 +290,7 @@ impl OdeSystem for AlongMotion<'_> {
         let s = (t - self.t0) / self.span;
         let v = self.v0 + (self.v1 - self.v0) * s;
         let normal = self.n0 + (self.n1 - self.n0) * s;
-        self.model.state_derivative(v, z, normal, dz);
+        self.states.state_derivative(v, z, normal, dz);
     }
 }
 

@@ -5,7 +5,7 @@
 //! Stiffness estimate: the spectral radius rho of the Jacobian of the full system at a
 //! representative sliding state (x = 0, v = the larger of |v0| and omega_n |x0|, the initial
 //! internal states, and the law's steady sliding states where it states them:
-//! `FrictionModel::sliding_states`; GMS elements are soft when relaxed and stiff when
+//! `InternalStates::sliding_states`; GMS elements are soft when relaxed and stiff when
 //! loaded, and Dahl's rate with alpha < 1 has an unbounded slope where its force reaches its
 //! level), times the step Dopri5 takes for accuracy on a free vibration at the
 //! default tolerances (about T_n / 100). Dopri5's stability region reaches about 3.3 along
@@ -18,6 +18,7 @@
 
 use super::{Dynamics, Integrator, Law};
 use crate::error::EngineError;
+use frictionid_models::InternalStates;
 use nalgebra::DMatrix;
 
 /// Dopri5's accuracy-limited step on a free vibration, as a fraction of T_n.
@@ -26,9 +27,9 @@ const ACCURACY_STEP_PERIODS: f64 = 1.0 / 100.0;
 /// rho(J) h above which the stiff method is chosen: near where the two methods break even
 /// (see the module docs), lowered to where the fits are fastest. Inside a fit, where trial
 /// points wander, the FMM five-model `compare` took 3.4 s with 50, 4.0 s with 100 and 4.3-7 s
-/// with 500 (session 5, back to back, median of 3); with 5 it took 9.9 s (Dahl's Rodas4 steps
-/// cost a `powf` per Jacobian as well). Session 8, after the rigid-limit test: 3.7-4.1 s
-/// with 50, 3.6 with 35, 3.0-3.3 with 25, 3.4-3.6 with 18, 3.2-3.4 with 12 (two rounds each):
+/// with 500 (back to back, median of 3); with 5 it took 9.9 s (Dahl's Rodas4 steps cost a
+/// `powf` per Jacobian as well). With the rigid-limit test in the fits: 3.7-4.1 s with 50,
+/// 3.6 with 35, 3.0-3.3 with 25, 3.4-3.6 with 18, 3.2-3.4 with 12 (two rounds each):
 /// Dahl's Dopri5 right-hand side costs a `powf`, so it breaks even below LuGre's ratio.
 pub(crate) const STIFF_RATIO: f64 = 25.0;
 
@@ -79,18 +80,22 @@ pub(crate) fn stiffness_ratio(dynamics: &Dynamics<'_>, y0: &[f64], period: f64) 
             .map(|v| spectral_radius(dynamics, v, &[]))
             .into_iter()
             .fold(0.0, f64::max),
-        Law::Dynamic => dynamic_radius(dynamics, speed, z0),
+        Law::Dynamic { states, .. } => dynamic_radius(dynamics, states, speed, z0),
     };
     radius * period * ACCURACY_STEP_PERIODS
 }
 
 /// The larger rho(J) of a dynamic law sliding at `speed` with its initial states `z0` and
-/// with its steady sliding states (`FrictionModel::sliding_states`, where the law states
+/// with its steady sliding states (`InternalStates::sliding_states`, where the law states
 /// them).
-fn dynamic_radius(dynamics: &Dynamics<'_>, speed: f64, z0: &[f64]) -> f64 {
+fn dynamic_radius(
+    dynamics: &Dynamics<'_>,
+    states: &dyn InternalStates,
+    speed: f64,
+    z0: &[f64],
+) -> f64 {
     let mut loaded = vec![0.0; z0.len()];
-    let sliding = dynamics
-        .model
+    let sliding = states
         .sliding_states(speed, dynamics.normal, &mut loaded)
         .then_some(loaded);
     [Some(z0.to_vec()), sliding]

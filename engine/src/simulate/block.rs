@@ -42,7 +42,9 @@ impl BlockBuffer {
         let Some((dynamics, dir)) = motion else {
             return;
         };
-        let affine = dynamics.model.affine_slip(dir, dynamics.normal);
+        let affine = dynamics
+            .switching
+            .and_then(|law| law.affine_slip(dir, dynamics.normal));
         let rows = self.x[..n].iter().zip(&self.v[..n]);
         for ((&x, &v), (a, f)) in rows.zip(self.a[..n].iter_mut().zip(&mut self.friction[..n])) {
             *f = match affine {

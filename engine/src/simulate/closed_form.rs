@@ -1,5 +1,5 @@
 //! The exact propagator for laws affine in the velocity within a sliding mode
-//! ([`frictionid_models::FrictionModel::affine_slip`]: F = a + b v): in each segment
+//! ([`frictionid_models::SwitchedLaw::affine_slip`]: F = a + b v): in each segment
 //! m x'' + (c + b) x' + k x + a = 0 is a damped harmonic motion about x_eq = -a / k with the
 //! closed-form solution
 //!

@@ -14,8 +14,8 @@
 //! 2 x 2 mechanics remain, with d(slip_force)/dv taken by finite differences.
 
 use super::{Dynamics, Law};
-use frictionid_models::model::velocity_step;
-use frictionid_models::Linearisation;
+use frictionid_models::linearisation::velocity_step;
+use frictionid_models::{Derivatives, Linearisation};
 
 impl Dynamics<'_> {
     /// Writes the Jacobian of [`Dynamics::rhs`] at `y` in slip direction `dir`, row-major,
@@ -34,7 +34,7 @@ impl Dynamics<'_> {
             *v
         };
         let df_dv = match self.law {
-            Law::Dynamic => self.state_blocks(v, z, jac),
+            Law::Dynamic { derivatives, .. } => self.state_blocks(&derivatives, v, z, jac),
             _ => self.slip_slope(v, dir),
         };
         if let Some(row0) = jac.get_mut(..n) {
@@ -48,7 +48,7 @@ impl Dynamics<'_> {
     /// d(slip_force)/dv of a static law in direction `dir`.
     fn slip_slope(&self, v: f64, dir: f64) -> f64 {
         let (width, hi, lo) = velocity_step(v);
-        let force = |u: f64| self.model.slip_force(u, dir, self.normal);
+        let force = |u: f64| self.slip_force(u, dir);
         (force(hi) - force(lo)) / width
     }
 
@@ -58,7 +58,13 @@ impl Dynamics<'_> {
     /// One call of the model's `linearisation` (LuGre shares its Stribeck exponential between
     /// the three derivatives) into scratch on the stack for up to [`STACK_STATES`] states (a
     /// heap buffer beyond), then each entry into its block.
-    fn state_blocks(&self, v: f64, z: &[f64], jac: &mut [f64]) -> f64 {
+    fn state_blocks(
+        &self,
+        derivatives: &Derivatives<'_>,
+        v: f64,
+        z: &[f64],
+        jac: &mut [f64],
+    ) -> f64 {
         let nz = z.len();
         let n = nz + 2;
         let need = nz * nz + 2 * nz;
@@ -77,7 +83,7 @@ impl Dynamics<'_> {
             dz_dv,
             df_dz,
         };
-        let df_dv = self.model.linearisation(v, z, self.normal, out);
+        let df_dv = derivatives.linearisation(v, z, self.normal, out);
         let (dz_dz, rest) = scratch.split_at(nz * nz);
         let (dz_dv, df_dz) = rest.split_at(nz);
         for i in 0..nz {

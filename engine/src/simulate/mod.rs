@@ -62,7 +62,7 @@ use driver::Driver;
 
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
-use frictionid_models::{sgn, FrictionModel};
+use frictionid_models::{sgn, Derivatives, FrictionModel, InternalStates, SwitchedLaw};
 use serde::{Deserialize, Serialize};
 
 /// A motion whose swing between consecutive turning points is below this many absolute
@@ -394,7 +394,7 @@ pub(crate) struct SampleBlock<'a> {
 /// Records every output into the series of a [`Trajectory`] (events, rest and statistics are
 /// the run's, added after it).
 struct FullRecorder<'a> {
-    model: &'a dyn FrictionModel,
+    states: Option<&'a dyn InternalStates>,
     mass: f64,
     stiffness: f64,
     normal: f64,
@@ -405,7 +405,7 @@ impl<'a> FullRecorder<'a> {
     fn new(osc: &Oscillator, model: &'a dyn FrictionModel, n: usize, n_states: usize) -> Self {
         let col = || Vec::with_capacity(n);
         Self {
-            model,
+            states: model.states(),
             mass: osc.mass,
             stiffness: osc.stiffness,
             normal: osc.normal_force,
@@ -435,8 +435,8 @@ impl Recorder for FullRecorder<'_> {
         }
         out.friction.push(friction);
         // Static laws store nothing: the column is filled once at the end.
-        if !z.is_empty() {
-            out.stored.push(self.model.stored_energy(z, self.normal));
+        if let (false, Some(states)) = (z.is_empty(), self.states) {
+            out.stored.push(states.stored_energy(z, self.normal));
         }
     }
 
@@ -487,14 +487,18 @@ impl Recorder for VelocityRecorder<'_> {
 }
 
 /// How the friction law is treated.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Law {
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Law<'a> {
     /// Static law with a set-valued force at v = 0: switched system (slip+, slip-, stick).
     Switched { limit: f64 },
     /// Smooth static law: no mode switch, restart at turning points.
     Smooth,
-    /// Dynamic model with internal states integrated alongside x and v.
-    Dynamic,
+    /// Dynamic model with internal states integrated alongside x and v: its states' law
+    /// and derivatives, fetched once for the run.
+    Dynamic {
+        states: &'a dyn InternalStates,
+        derivatives: Derivatives<'a>,
+    },
 }
 
 /// The equation of motion with its friction law.
@@ -505,7 +509,9 @@ pub(crate) struct Dynamics<'a> {
     pub stiffness: f64,
     pub normal: f64,
     pub model: &'a dyn FrictionModel,
-    pub law: Law,
+    /// The law's switched-system facts, fetched once for the run.
+    pub switching: Option<&'a dyn SwitchedLaw>,
+    pub law: Law<'a>,
 }
 
 /// What happens at a state with (possibly) zero velocity.
@@ -526,6 +532,7 @@ impl<'a> Dynamics<'a> {
             stiffness: osc.stiffness,
             normal: osc.normal_force,
             model,
+            switching: model.switching(),
             law: classify_law(model, osc.normal_force)?,
         })
     }
@@ -536,8 +543,18 @@ impl Dynamics<'_> {
     #[inline]
     pub fn force(&self, v: f64, z: &[f64], dir: f64) -> f64 {
         match self.law {
-            Law::Dynamic => self.model.force(v, z, self.normal),
-            _ => self.model.slip_force(v, dir, self.normal),
+            Law::Dynamic { .. } => self.model.force(v, z, self.normal),
+            _ => self.slip_force(v, dir),
+        }
+    }
+
+    /// The force of a static law slipping in direction `dir` (its force at `v` when it is
+    /// not a switched law).
+    #[inline]
+    pub fn slip_force(&self, v: f64, dir: f64) -> f64 {
+        match self.switching {
+            Some(law) => law.slip_force(v, dir, self.normal),
+            None => self.model.force(v, &[], self.normal),
         }
     }
 
@@ -554,10 +571,10 @@ impl Dynamics<'_> {
             return;
         };
         let f = match self.law {
-            Law::Dynamic => self
-                .model
-                .state_derivative_and_force(*v, z, self.normal, dz),
-            _ => self.model.slip_force(*v, dir, self.normal),
+            Law::Dynamic { states, .. } => {
+                states.state_derivative_and_force(*v, z, self.normal, dz)
+            }
+            _ => self.slip_force(*v, dir),
         };
         *dx = *v;
         *dv = self.accel(*x, *v, f);
@@ -565,10 +582,10 @@ impl Dynamics<'_> {
 
     /// The segment's linear equation when the law is affine in v in direction `dir`.
     pub fn affine_motion(&self, dir: f64) -> Option<AffineMotion> {
-        if self.law == Law::Dynamic {
+        if matches!(self.law, Law::Dynamic { .. }) {
             return None;
         }
-        let (offset, slope) = self.model.affine_slip(dir, self.normal)?;
+        let (offset, slope) = self.switching?.affine_slip(dir, self.normal)?;
         Some(AffineMotion {
             mass: self.mass,
             damping: self.damping + slope,
@@ -597,14 +614,14 @@ impl Dynamics<'_> {
                     return Start::Rest;
                 }
                 let dir = -sgn(spring);
-                let a = self.accel(x, 0.0, self.model.slip_force(0.0, dir, self.normal));
+                let a = self.accel(x, 0.0, self.slip_force(0.0, dir));
                 if dir * a > 0.0 {
                     Start::Slip(dir)
                 } else {
                     Start::Rest
                 }
             }
-            Law::Smooth | Law::Dynamic => {
+            Law::Smooth | Law::Dynamic { .. } => {
                 let a = self.accel(x, 0.0, self.force(0.0, z, 0.0));
                 if a == 0.0 || !a.is_finite() {
                     Start::Rest
@@ -676,7 +693,7 @@ pub(crate) fn run<R: Recorder>(
 }
 
 /// The multipliers of Rodas4's absolute tolerance for the `dim` components [x, v, z...]: 1
-/// for x and v, the model's [`FrictionModel::state_tolerance_scales`] for its states (1 in
+/// for x and v, the model's [`InternalStates::state_tolerance_scales`] for its states (1 in
 /// place of a declared scale that is not finite and > 0). Dahl at sigma0 = 1e7 N/m: 17 394 ->
 /// 10 056 RHS evaluations with them alone, 1e-8 m of x kept.
 ///
@@ -688,20 +705,24 @@ pub(crate) fn run<R: Recorder>(
 /// 1e-5 N of `simulate_custom`'s test).
 fn component_tolerance_scales(model: &dyn FrictionModel, dim: usize) -> Vec<f64> {
     let mut scales = vec![1.0, 1.0];
-    if model.n_states() > 0 {
+    if let Some(states) = model.states().filter(|s| s.n_states() > 0) {
         let usable = |s: f64| if s.is_finite() && s > 0.0 { s } else { 1.0 };
-        scales.extend(model.state_tolerance_scales().into_iter().map(usable));
+        scales.extend(states.state_tolerance_scales().into_iter().map(usable));
     }
     scales.resize(dim, 1.0);
     scales
 }
 
 /// How the engine treats `model`'s law: dynamic, switched (with its static limit) or smooth.
-fn classify_law(model: &dyn FrictionModel, normal: f64) -> Result<Law, EngineError> {
-    if model.n_states() > 0 {
-        return Ok(Law::Dynamic);
+fn classify_law(model: &dyn FrictionModel, normal: f64) -> Result<Law<'_>, EngineError> {
+    if let Some(states) = model.states().filter(|s| s.n_states() > 0) {
+        let derivatives = Derivatives::of(states);
+        return Ok(Law::Dynamic {
+            states,
+            derivatives,
+        });
     }
-    match model.static_limit(normal) {
+    match model.switching().and_then(|law| law.static_limit(normal)) {
         Some(limit) if limit.is_finite() && limit >= 0.0 => Ok(Law::Switched { limit }),
         Some(limit) => Err(EngineError::InvalidInput(format!(
             "model `{}` reports a static limit of {limit} N",

@@ -21,7 +21,7 @@
 //! was a guess; the error it measured is the first information on the scale of the motion).
 //! On Dahl with sigma0 = 1e7 N/m, whose elastic tail restarts 72 times in the last 0.4 s,
 //! these took 17 394 RHS evaluations to 8 885 together with the force state's tolerance
-//! scale (see `FrictionModel::state_tolerance_scales`). The system is autonomous (the
+//! scale (see `InternalStates::state_tolerance_scales`). The system is autonomous (the
 //! driver's right-hand side does not depend on t), so no time derivative enters the
 //! stages.
 //!

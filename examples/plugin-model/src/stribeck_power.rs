@@ -34,7 +34,8 @@
 //! with supplemental fluid dampers", The Structural Design of Tall Buildings 2(2), 93-132, 1993.
 
 use frictionid_models::{
-    check_bounds, mu_s_warning, sgn, FrictionModel, GuessHint, ModelError, StribeckLevels,
+    check_bounds, mu_s_warning, sgn, FrictionModel, GuessHint, ModelError, Staging, StribeckLevels,
+    SwitchedLaw,
 };
 
 /// The registry name of the model.
@@ -89,34 +90,36 @@ impl FrictionModel for StribeckPower {
         name: NAME,
         equation: "F = sgn(v) (N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)) + viscous v_ref |v/v_ref|^alpha)",
     );
-
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         sgn(v) * (normal * self.coefficient(v) + self.viscous_force(v))
     }
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        self.force(v, &[], normal)
+    }
+    frictionid_models::law_groups!(switching, staging);
+    fn validate(&self) -> Result<Vec<String>, ModelError> {
+        check_bounds(NAME, &self.param_info(), &self.params())?;
+        Ok(mu_s_warning(NAME, self.mu_s, self.mu_c))
+    }
+}
 
+impl SwitchedLaw for StribeckPower {
     fn static_limit(&self, normal: f64) -> Option<f64> {
         Some(self.mu_s * normal)
     }
-
     fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
         // The dry part takes its sign from the slip mode; the viscous part vanishes at v = 0
         // and is continuous there, so sgn(v) is safe for it.
         direction * normal * self.coefficient(v) + sgn(v) * self.viscous_force(v)
     }
+}
 
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.force(v, &[], normal)
-    }
-
+impl Staging for StribeckPower {
     fn apply_guess(&mut self, hint: &GuessHint) {
         let levels = StribeckLevels::guess(hint);
         self.mu_c = levels.mu_c;
         self.mu_s = levels.mu_s;
         self.v_s = levels.v_s.unwrap_or(self.v_s);
         self.viscous = levels.viscous;
-    }
-    fn validate(&self) -> Result<Vec<String>, ModelError> {
-        check_bounds(NAME, &self.param_info(), &self.params())?;
-        Ok(mu_s_warning(NAME, self.mu_s, self.mu_c))
     }
 }

@@ -2,7 +2,9 @@
 //! `stribeck` model at alpha = 1, odd symmetry, the set-valued static part, and its
 //! registration in the typetag registry of a binary that links this crate.
 
-use frictionid_models::{build_json, names, testing, FrictionModel, ModelError, Stribeck};
+use frictionid_models::{
+    build_json, names, testing, FrictionModel, ModelError, Stribeck, SwitchedLaw,
+};
 use frictionid_plugin_example::{StribeckPower, NAME};
 
 const N: f64 = 14.5;
@@ -45,7 +47,7 @@ fn forces_match_hand_computed_values() {
     assert!(close(m2.viscous_force(0.3), 4.0 * 0.1 * 9.0, 1e-14));
     // sgn(0) = 0 and no dependence on states.
     assert_eq!(m.force(0.0, &[], N), 0.0);
-    assert_eq!(m.n_states(), 0);
+    assert!(m.states().is_none(), "no internal states");
     assert_eq!(m.steady_state(0.05, N), m.force(0.05, &[], N));
 }
 

@@ -9,7 +9,8 @@
 //! Reference: C.-A. de Coulomb, *Théorie des machines simples* (1785); the oscillator with
 //! Coulomb friction is the paper's Eq. (1).
 
-use crate::model::{sgn, FrictionModel, GuessHint};
+use crate::hints::GuessHint;
+use crate::model::{sgn, FrictionModel, Staging, SwitchedLaw};
 use crate::start::{StartContext, StribeckLevels};
 
 crate::declare_params! {
@@ -25,10 +26,16 @@ impl FrictionModel for Coulomb {
         name: "coulomb",
         equation: "F = mu N sgn(v)",
     );
-
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         self.mu * normal * sgn(v)
     }
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        self.force(v, &[], normal)
+    }
+    crate::law_groups!(switching, staging);
+}
+
+impl SwitchedLaw for Coulomb {
     fn static_limit(&self, normal: f64) -> Option<f64> {
         Some(self.mu * normal)
     }
@@ -38,9 +45,9 @@ impl FrictionModel for Coulomb {
     fn affine_slip(&self, direction: f64, normal: f64) -> Option<(f64, f64)> {
         Some((self.mu * normal * direction, 0.0))
     }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.force(v, &[], normal)
-    }
+}
+
+impl Staging for Coulomb {
     fn apply_guess(&mut self, hint: &GuessHint) {
         self.mu = hint.mu;
     }

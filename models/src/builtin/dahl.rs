@@ -22,7 +22,8 @@
 //! The Aerospace Corporation, 1968.
 
 use crate::builtin::coulomb::Coulomb;
-use crate::model::{sgn, FrictionModel, GuessHint, RigidLimit};
+use crate::hints::GuessHint;
+use crate::model::{sgn, FrictionModel, InternalStates, Jacobians, RigidLimit, Staging};
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
 crate::declare_params! {
@@ -56,7 +57,16 @@ impl FrictionModel for Dahl {
         name: "dahl",
         equation: "dF/dt = sigma0 v |1 - F sgn(v)/(mu_c N)|^alpha sgn(1 - F sgn(v)/(mu_c N)), friction = F",
     );
+    fn force(&self, _v: f64, z: &[f64], _normal: f64) -> f64 {
+        z.first().copied().unwrap_or(0.0)
+    }
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        self.mu_c * normal * sgn(v)
+    }
+    crate::law_groups!(states, staging);
+}
 
+impl InternalStates for Dahl {
     fn state_derivative(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) {
         let (Some(&f), Some(d)) = (z.first(), dz.first_mut()) else {
             return;
@@ -77,6 +87,34 @@ impl FrictionModel for Dahl {
     fn state_tolerance_scales(&self) -> Vec<f64> {
         vec![self.sigma0]
     }
+    /// Steady sliding: the force at its Coulomb level, F = mu_c N sgn(v) (r = 0). For alpha < 1
+    /// the rate's slope is unbounded there and the force reaches the level in finite time: an
+    /// explicit method chatters about it (Dopri5 took 26 000 steps for the FMM release at
+    /// sigma0 1e5, alpha 0.8, against Rodas4's 1 000), so the stiffness estimate looks here.
+    fn sliding_states(&self, v: f64, normal: f64, out: &mut [f64]) -> bool {
+        let Some(f) = out.first_mut() else {
+            return false;
+        };
+        *f = self.mu_c * normal * sgn(v);
+        true
+    }
+    fn stored_energy(&self, z: &[f64], _normal: f64) -> f64 {
+        let f = z.first().copied().unwrap_or(0.0);
+        f * f / (2.0 * self.sigma0)
+    }
+    /// Rigid bristles: the force jumps between +-mu_c N at each reversal, Coulomb's law.
+    fn rigid_limit(&self) -> Option<RigidLimit> {
+        Some(RigidLimit {
+            law: Box::new(Coulomb::default()),
+            stiffnesses: vec![0],
+            presliding: vec![2],
+            also_free: Vec::new(),
+        })
+    }
+    crate::law_groups!(jacobians);
+}
+
+impl Jacobians for Dahl {
     /// d(dF/dt)/dF = -sigma0 |v| alpha |r|^(alpha - 1) / (mu_c N), r = 1 - F sgn(v) / (mu_c N);
     /// 0 without normal load. At r = 0 with alpha < 1 the derivative is unbounded: there
     /// the finite-difference default gives a finite slope instead.
@@ -122,27 +160,9 @@ impl FrictionModel for Dahl {
             0.0
         };
     }
-    fn force(&self, _v: f64, z: &[f64], _normal: f64) -> f64 {
-        z.first().copied().unwrap_or(0.0)
-    }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.mu_c * normal * sgn(v)
-    }
-    /// Steady sliding: the force at its Coulomb level, F = mu_c N sgn(v) (r = 0). For alpha < 1
-    /// the rate's slope is unbounded there and the force reaches the level in finite time: an
-    /// explicit method chatters about it (Dopri5 took 26 000 steps for the FMM release at
-    /// sigma0 1e5, alpha 0.8, against Rodas4's 1 000), so the stiffness estimate looks here.
-    fn sliding_states(&self, v: f64, normal: f64, out: &mut [f64]) -> bool {
-        let Some(f) = out.first_mut() else {
-            return false;
-        };
-        *f = self.mu_c * normal * sgn(v);
-        true
-    }
-    fn stored_energy(&self, z: &[f64], _normal: f64) -> f64 {
-        let f = z.first().copied().unwrap_or(0.0);
-        f * f / (2.0 * self.sigma0)
-    }
+}
+
+impl Staging for Dahl {
     fn apply_guess(&mut self, hint: &GuessHint) {
         self.mu_c = hint.mu;
         // Presliding displacements of dry contacts are typically a few tens of micrometres.
@@ -157,14 +177,5 @@ impl FrictionModel for Dahl {
         self.mu_c = levels.mu_c;
         self.sigma0 = ctx.stiffness_for(levels.mu_c * ctx.normal_force);
         true
-    }
-    /// Rigid bristles: the force jumps between +-mu_c N at each reversal, Coulomb's law.
-    fn rigid_limit(&self) -> Option<RigidLimit> {
-        Some(RigidLimit {
-            law: Box::new(Coulomb::default()),
-            stiffnesses: vec![0],
-            presliding: vec![2],
-            also_free: Vec::new(),
-        })
     }
 }

@@ -41,7 +41,9 @@
 
 use crate::error::ModelError;
 use crate::formula::{self, Formula, Parsed};
-use crate::model::{check_bounds, check_len, FrictionModel, GuessHint, ParamInfo};
+use crate::hints::GuessHint;
+use crate::model::{FrictionModel, Staging, SwitchedLaw};
+use crate::param_info::{check_bounds, check_len, ParamInfo};
 use crate::params::ParamSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -346,6 +348,17 @@ impl FrictionModel for Expression {
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         self.eval(&self.compiled, v, normal, None)
     }
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        self.force(v, &[], normal)
+    }
+    crate::law_groups!(switching, staging);
+    fn validate(&self) -> Result<Vec<String>, ModelError> {
+        check_bounds(self.name(), &self.param_info(), &self.params())?;
+        Ok(Vec::new())
+    }
+}
+
+impl SwitchedLaw for Expression {
     fn static_limit(&self, normal: f64) -> Option<f64> {
         self.breakaway(normal)
     }
@@ -355,9 +368,9 @@ impl FrictionModel for Expression {
             None => self.force(v, &[], normal),
         }
     }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.force(v, &[], normal)
-    }
+}
+
+impl Staging for Expression {
     fn apply_guess(&mut self, hint: &GuessHint) {
         // Only the conventional name is guessed: a parameter `mu` is the mean coefficient.
         for p in &mut self.params {
@@ -366,9 +379,5 @@ impl FrictionModel for Expression {
                 p.value = hint.mu.clamp(lo, hi);
             }
         }
-    }
-    fn validate(&self) -> Result<Vec<String>, ModelError> {
-        check_bounds(self.name(), &self.param_info(), &self.params())?;
-        Ok(Vec::new())
     }
 }

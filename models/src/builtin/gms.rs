@@ -87,10 +87,12 @@
 
 use crate::builtin::stribeck::{mu_s_warning, Stribeck};
 use crate::error::ModelError;
+use crate::hints::GuessHint;
 use crate::model::{
-    check_bounds, check_len, decay, finite_difference_force_gradient,
-    finite_difference_velocity_derivative, sgn, FrictionModel, GuessHint, ParamInfo, RigidLimit,
+    decay, finite_difference_force_gradient, finite_difference_velocity_derivative, sgn,
+    FrictionModel, InternalStates, Jacobians, RigidLimit, Staging,
 };
+use crate::param_info::{check_bounds, check_len, ParamInfo};
 use crate::params::ParamSpec;
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 use serde::de::{self, SeqAccess, Visitor};
@@ -610,6 +612,48 @@ impl FrictionModel for Gms {
         }
         Ok(())
     }
+    fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
+        let s = self.s(v, normal);
+        let elements: f64 = self
+            .elements
+            .iter()
+            .enumerate()
+            .map(|(i, e)| {
+                let zi = z.get(i).copied().unwrap_or(0.0);
+                if e.damping == 0.0 {
+                    e.stiffness * zi
+                } else {
+                    Self::element_force(e, zi, self.z_dot(e, v, zi, s))
+                }
+            })
+            .sum();
+        elements + self.viscous * v
+    }
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        let total_weight: f64 = self.elements.iter().map(|e| e.weight).sum();
+        total_weight * self.s(v, normal) * sgn(v) + self.viscous * v
+    }
+    crate::law_groups!(states, staging);
+    fn validate(&self) -> Result<Vec<String>, ModelError> {
+        if self.elements.is_empty() {
+            return Err(bad_key(
+                "elements",
+                "the model needs at least one element".into(),
+            ));
+        }
+        check_bounds(self.name(), &self.param_info(), &self.params())?;
+        let mut warnings = mu_s_warning(self.name(), self.mu_s, self.mu_c);
+        let total: f64 = self.elements.iter().map(|e| e.weight).sum();
+        if (total - 1.0).abs() > 1e-9 {
+            warnings.push(format!(
+                "model `gms`: the weights sum to {total}, so the sliding force is {total} times the Stribeck curve"
+            ));
+        }
+        Ok(warnings)
+    }
+}
+
+impl InternalStates for Gms {
     fn n_states(&self) -> usize {
         self.elements.len()
     }
@@ -624,6 +668,68 @@ impl FrictionModel for Gms {
             *d = self.z_dot(e, v, zi, s);
         }
     }
+    /// The Stribeck curve once, and each element's rate once for its derivative and force.
+    fn state_derivative_and_force(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) -> f64 {
+        let s = self.s(v, normal);
+        let elements: f64 = self
+            .elements
+            .iter()
+            .zip(dz.iter_mut())
+            .enumerate()
+            .map(|(i, (e, d))| {
+                let zi = z.get(i).copied().unwrap_or(0.0);
+                *d = self.z_dot(e, v, zi, s);
+                Self::element_force(e, zi, *d)
+            })
+            .sum();
+        elements + self.viscous * v
+    }
+    /// Every element fully loaded: z_i = sgn(v) w_i s(v) / k_i (rho_i = 1, where its rate is
+    /// stiffest); an element without stiffness stays at 0.
+    fn sliding_states(&self, v: f64, normal: f64, out: &mut [f64]) -> bool {
+        let s = self.s(v, normal);
+        for (e, z) in self.elements.iter().zip(out.iter_mut()) {
+            *z = if e.stiffness > 0.0 {
+                sgn(v) * e.weight * s / e.stiffness
+            } else {
+                0.0
+            };
+        }
+        true
+    }
+    fn stored_energy(&self, z: &[f64], _normal: f64) -> f64 {
+        self.elements
+            .iter()
+            .zip(z)
+            .map(|(e, zi)| 0.5 * e.stiffness * zi * zi)
+            .sum()
+    }
+    /// Rigid elements: each saturates at once at its share of the Stribeck curve, and the
+    /// model slides at s(v) + viscous v, a Stribeck law with GMS's shape exponent (free, as
+    /// in GMS) and no dynamics: the elements' weights (only their sum scales the curve), their
+    /// damping (it acts only while they deflect) and the sharpness of their saturation vanish.
+    fn rigid_limit(&self) -> Option<RigidLimit> {
+        // The vector order of `params`: ELEMENT_PARAMS kind by kind (stiffnesses, weights,
+        // dampings), one entry per element, then SHARED_PARAMS.
+        let n = self.elements.len();
+        let kind = |k: usize| k * n..(k + 1) * n;
+        let shared = |name: &str| {
+            SHARED_PARAMS
+                .iter()
+                .position(|p| p.name == name)
+                .map(|i| ELEMENT_PARAMS.len() * n + i)
+        };
+        Some(RigidLimit {
+            law: Box::new(Stribeck::default()),
+            stiffnesses: kind(0).collect(),
+            presliding: kind(1).chain(kind(2)).chain(shared("sharpness")).collect(),
+            also_free: vec!["delta"],
+        })
+    }
+    crate::law_groups!(jacobians);
+}
+
+impl Jacobians for Gms {
     /// Diagonal: each element's rate depends on its own deflection only (see
     /// `Gms::z_dot_slope`).
     fn state_jacobian(&self, v: f64, z: &[f64], normal: f64, jac: &mut [f64]) {
@@ -667,63 +773,9 @@ impl FrictionModel for Gms {
             finite_difference_velocity_derivative(self, v, z, normal, out);
         }
     }
-    fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
-        let s = self.s(v, normal);
-        let elements: f64 = self
-            .elements
-            .iter()
-            .enumerate()
-            .map(|(i, e)| {
-                let zi = z.get(i).copied().unwrap_or(0.0);
-                if e.damping == 0.0 {
-                    e.stiffness * zi
-                } else {
-                    Self::element_force(e, zi, self.z_dot(e, v, zi, s))
-                }
-            })
-            .sum();
-        elements + self.viscous * v
-    }
-    /// The Stribeck curve once, and each element's rate once for its derivative and force.
-    fn state_derivative_and_force(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) -> f64 {
-        let s = self.s(v, normal);
-        let elements: f64 = self
-            .elements
-            .iter()
-            .zip(dz.iter_mut())
-            .enumerate()
-            .map(|(i, (e, d))| {
-                let zi = z.get(i).copied().unwrap_or(0.0);
-                *d = self.z_dot(e, v, zi, s);
-                Self::element_force(e, zi, *d)
-            })
-            .sum();
-        elements + self.viscous * v
-    }
-    /// Every element fully loaded: z_i = sgn(v) w_i s(v) / k_i (rho_i = 1, where its rate is
-    /// stiffest); an element without stiffness stays at 0.
-    fn sliding_states(&self, v: f64, normal: f64, out: &mut [f64]) -> bool {
-        let s = self.s(v, normal);
-        for (e, z) in self.elements.iter().zip(out.iter_mut()) {
-            *z = if e.stiffness > 0.0 {
-                sgn(v) * e.weight * s / e.stiffness
-            } else {
-                0.0
-            };
-        }
-        true
-    }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        let total_weight: f64 = self.elements.iter().map(|e| e.weight).sum();
-        total_weight * self.s(v, normal) * sgn(v) + self.viscous * v
-    }
-    fn stored_energy(&self, z: &[f64], _normal: f64) -> f64 {
-        self.elements
-            .iter()
-            .zip(z)
-            .map(|(e, zi)| 0.5 * e.stiffness * zi * zi)
-            .sum()
-    }
+}
+
+impl Staging for Gms {
     fn apply_guess(&mut self, hint: &GuessHint) {
         let levels = StribeckLevels::guess(hint);
         self.set_levels(&levels);
@@ -752,44 +804,5 @@ impl FrictionModel for Gms {
         }
         self.scale_stiffness(ctx.stiffness_for(levels.mu_c * ctx.normal_force));
         true
-    }
-    /// Rigid elements: each saturates at once at its share of the Stribeck curve, and the
-    /// model slides at s(v) + viscous v, a Stribeck law with GMS's shape exponent (free, as
-    /// in GMS) and no dynamics: the elements' weights (only their sum scales the curve), their
-    /// damping (it acts only while they deflect) and the sharpness of their saturation vanish.
-    fn rigid_limit(&self) -> Option<RigidLimit> {
-        // The vector order of `params`: ELEMENT_PARAMS kind by kind (stiffnesses, weights,
-        // dampings), one entry per element, then SHARED_PARAMS.
-        let n = self.elements.len();
-        let kind = |k: usize| k * n..(k + 1) * n;
-        let shared = |name: &str| {
-            SHARED_PARAMS
-                .iter()
-                .position(|p| p.name == name)
-                .map(|i| ELEMENT_PARAMS.len() * n + i)
-        };
-        Some(RigidLimit {
-            law: Box::new(Stribeck::default()),
-            stiffnesses: kind(0).collect(),
-            presliding: kind(1).chain(kind(2)).chain(shared("sharpness")).collect(),
-            also_free: vec!["delta"],
-        })
-    }
-    fn validate(&self) -> Result<Vec<String>, ModelError> {
-        if self.elements.is_empty() {
-            return Err(bad_key(
-                "elements",
-                "the model needs at least one element".into(),
-            ));
-        }
-        check_bounds(self.name(), &self.param_info(), &self.params())?;
-        let mut warnings = mu_s_warning(self.name(), self.mu_s, self.mu_c);
-        let total: f64 = self.elements.iter().map(|e| e.weight).sum();
-        if (total - 1.0).abs() > 1e-9 {
-            warnings.push(format!(
-                "model `gms`: the weights sum to {total}, so the sliding force is {total} times the Stribeck curve"
-            ));
-        }
-        Ok(warnings)
     }
 }

@@ -19,7 +19,10 @@
 
 use crate::builtin::stribeck::{mu_s_warning, Stribeck};
 use crate::error::ModelError;
-use crate::model::{check_bounds, decay, sgn, FrictionModel, GuessHint, Linearisation, RigidLimit};
+use crate::hints::GuessHint;
+use crate::linearisation::Linearisation;
+use crate::model::{decay, sgn, FrictionModel, InternalStates, Jacobians, RigidLimit, Staging};
+use crate::param_info::check_bounds;
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
 crate::declare_params! {
@@ -86,7 +89,21 @@ impl FrictionModel for LuGre {
         name: "lugre",
         equation: "dz/dt = v - sigma0 |v| z / g(v), g(v) = N (mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)), F = sigma0 z + sigma1 dz/dt + sigma2 v",
     );
+    fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
+        let z0 = z.first().copied().unwrap_or(0.0);
+        self.force_at(v, z0, self.z_dot(v, z0, normal))
+    }
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        self.g(v, normal) * sgn(v) + self.sigma2 * v
+    }
+    crate::law_groups!(states, staging);
+    fn validate(&self) -> Result<Vec<String>, ModelError> {
+        check_bounds(self.name(), &self.param_info(), &self.params())?;
+        Ok(mu_s_warning(self.name(), self.mu_s, self.mu_c))
+    }
+}
 
+impl InternalStates for LuGre {
     fn n_states(&self) -> usize {
         1
     }
@@ -99,6 +116,33 @@ impl FrictionModel for LuGre {
     fn force_only_params(&self) -> Vec<usize> {
         vec![1, 2]
     }
+    /// dz/dt once for both (it holds the Stribeck level's exponential).
+    fn state_derivative_and_force(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) -> f64 {
+        let z0 = z.first().copied().unwrap_or(0.0);
+        let z_dot = self.z_dot(v, z0, normal);
+        if let Some(d) = dz.first_mut() {
+            *d = z_dot;
+        }
+        self.force_at(v, z0, z_dot)
+    }
+    fn stored_energy(&self, z: &[f64], _normal: f64) -> f64 {
+        let z0 = z.first().copied().unwrap_or(0.0);
+        0.5 * self.sigma0 * z0 * z0
+    }
+    /// Rigid, critically damped bristles: the force follows the steady-state curve, a
+    /// Stribeck law with delta = 2 and sigma2 as its viscous term.
+    fn rigid_limit(&self) -> Option<RigidLimit> {
+        Some(RigidLimit {
+            law: Box::new(Stribeck::default()),
+            stiffnesses: vec![0],
+            presliding: Vec::new(),
+            also_free: Vec::new(),
+        })
+    }
+    crate::law_groups!(jacobians);
+}
+
+impl Jacobians for LuGre {
     /// d(dz/dt)/dz = -sigma0 |v| / g(v) (0 without normal load).
     fn state_jacobian(&self, v: f64, _z: &[f64], normal: f64, jac: &mut [f64]) {
         if let Some(j) = jac.first_mut() {
@@ -116,10 +160,6 @@ impl FrictionModel for LuGre {
             *o = self.z_dot_partials(v, z0, normal).1;
         }
     }
-    fn force(&self, v: f64, z: &[f64], normal: f64) -> f64 {
-        let z0 = z.first().copied().unwrap_or(0.0);
-        self.force_at(v, z0, self.z_dot(v, z0, normal))
-    }
     /// The Stribeck exponential once for the three derivatives (the three calls take it three
     /// times).
     fn linearisation(&self, v: f64, z: &[f64], normal: f64, out: Linearisation<'_>) -> f64 {
@@ -133,22 +173,9 @@ impl FrictionModel for LuGre {
         }
         self.force_partials(partials, out.df_dz)
     }
-    /// dz/dt once for both (it holds the Stribeck level's exponential).
-    fn state_derivative_and_force(&self, v: f64, z: &[f64], normal: f64, dz: &mut [f64]) -> f64 {
-        let z0 = z.first().copied().unwrap_or(0.0);
-        let z_dot = self.z_dot(v, z0, normal);
-        if let Some(d) = dz.first_mut() {
-            *d = z_dot;
-        }
-        self.force_at(v, z0, z_dot)
-    }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.g(v, normal) * sgn(v) + self.sigma2 * v
-    }
-    fn stored_energy(&self, z: &[f64], _normal: f64) -> f64 {
-        let z0 = z.first().copied().unwrap_or(0.0);
-        0.5 * self.sigma0 * z0 * z0
-    }
+}
+
+impl Staging for LuGre {
     fn apply_guess(&mut self, hint: &GuessHint) {
         let levels = StribeckLevels::guess(hint);
         self.mu_c = levels.mu_c;
@@ -174,19 +201,5 @@ impl FrictionModel for LuGre {
         self.sigma0 = ctx.stiffness_for(levels.mu_c * ctx.normal_force);
         self.sigma1 = ctx.critical_damping(self.sigma0);
         true
-    }
-    /// Rigid, critically damped bristles: the force follows the steady-state curve, a
-    /// Stribeck law with delta = 2 and sigma2 as its viscous term.
-    fn rigid_limit(&self) -> Option<RigidLimit> {
-        Some(RigidLimit {
-            law: Box::new(Stribeck::default()),
-            stiffnesses: vec![0],
-            presliding: Vec::new(),
-            also_free: Vec::new(),
-        })
-    }
-    fn validate(&self) -> Result<Vec<String>, ModelError> {
-        check_bounds(self.name(), &self.param_info(), &self.params())?;
-        Ok(mu_s_warning(self.name(), self.mu_s, self.mu_c))
     }
 }

@@ -26,7 +26,9 @@
 //! Intelligent Mechatronics (AIM), Monterey, 2005, pp. 600-605.
 
 use crate::error::ModelError;
-use crate::model::{check_bounds, FrictionModel, GuessHint};
+use crate::hints::GuessHint;
+use crate::model::{FrictionModel, Staging};
+use crate::param_info::check_bounds;
 
 crate::declare_params! {
     /// Makkar et al.'s smooth friction law with Stribeck, Coulomb and viscous terms.
@@ -46,7 +48,6 @@ impl FrictionModel for Makkar {
         name: "makkar",
         equation: "F = g1 (tanh(g2 v) - tanh(g3 v)) + g4 tanh(g5 v) + g6 v",
     );
-
     fn force(&self, v: f64, _z: &[f64], _normal: f64) -> f64 {
         self.g1 * ((self.g2 * v).tanh() - (self.g3 * v).tanh())
             + self.g4 * (self.g5 * v).tanh()
@@ -55,6 +56,21 @@ impl FrictionModel for Makkar {
     fn steady_state(&self, v: f64, normal: f64) -> f64 {
         self.force(v, &[], normal)
     }
+    crate::law_groups!(staging);
+    fn validate(&self) -> Result<Vec<String>, ModelError> {
+        check_bounds(self.name(), &self.param_info(), &self.params())?;
+        let mut warnings = Vec::new();
+        if self.g1 > 0.0 && self.g3 > self.g2 {
+            warnings.push(format!(
+                "model `makkar`: g3 = {} exceeds g2 = {} (the Stribeck term is a dip, not a bump)",
+                self.g3, self.g2
+            ));
+        }
+        Ok(warnings)
+    }
+}
+
+impl Staging for Makkar {
     fn apply_guess(&mut self, hint: &GuessHint) {
         // Coulomb level from the energy estimate, a bump of a third of it peaking near a
         // fifth of the typical speed (tanh(a x) - tanh(a x / 10) peaks at a x = 1.84).
@@ -66,16 +82,5 @@ impl FrictionModel for Makkar {
         self.g2 = 1.84 / (0.2 * v);
         self.g3 = 0.1 * self.g2;
         self.g6 = 0.05 * level / v;
-    }
-    fn validate(&self) -> Result<Vec<String>, ModelError> {
-        check_bounds(self.name(), &self.param_info(), &self.params())?;
-        let mut warnings = Vec::new();
-        if self.g1 > 0.0 && self.g3 > self.g2 {
-            warnings.push(format!(
-                "model `makkar`: g3 = {} exceeds g2 = {} (the Stribeck term is a dip, not a bump)",
-                self.g3, self.g2
-            ));
-        }
-        Ok(warnings)
     }
 }

@@ -1,7 +1,7 @@
 //! No friction (F = 0), for identifying the oscillator itself from a free vibration without
 //! friction contact (as the paper does for m, c and k).
 
-use crate::model::FrictionModel;
+use crate::model::{FrictionModel, SwitchedLaw};
 
 crate::declare_params! {
     /// The zero friction force.
@@ -14,14 +14,17 @@ impl FrictionModel for NoFriction {
         name: "none",
         equation: "F = 0 (no friction contact)",
     );
-
     fn force(&self, _v: f64, _z: &[f64], _normal: f64) -> f64 {
         0.0
     }
-    fn affine_slip(&self, _direction: f64, _normal: f64) -> Option<(f64, f64)> {
-        Some((0.0, 0.0))
-    }
     fn steady_state(&self, _v: f64, _normal: f64) -> f64 {
         0.0
+    }
+    crate::law_groups!(switching);
+}
+
+impl SwitchedLaw for NoFriction {
+    fn affine_slip(&self, _direction: f64, _normal: f64) -> Option<(f64, f64)> {
+        Some((0.0, 0.0))
     }
 }

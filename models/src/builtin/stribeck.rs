@@ -17,7 +17,9 @@
 //! Z. VDI 46, 1902; the exponential form as in Armstrong-Hélouvry et al., Automatica 30(7), 1994.
 
 use crate::error::ModelError;
-use crate::model::{check_bounds, decay, sgn, FrictionModel, GuessHint};
+use crate::hints::GuessHint;
+use crate::model::{decay, sgn, FrictionModel, Staging, SwitchedLaw};
+use crate::param_info::check_bounds;
 use crate::start::{StartContext, StribeckLevels};
 
 crate::declare_params! {
@@ -59,19 +61,29 @@ impl FrictionModel for Stribeck {
         name: "stribeck",
         equation: "F = N (mu_c + (mu_s - mu_c) exp(-|v/v_s|^delta)) sgn(v) + viscous v",
     );
-
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         normal * self.coefficient(v) * sgn(v) + self.viscous * v
     }
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        self.force(v, &[], normal)
+    }
+    crate::law_groups!(switching, staging);
+    fn validate(&self) -> Result<Vec<String>, ModelError> {
+        check_bounds(self.name(), &self.param_info(), &self.params())?;
+        Ok(mu_s_warning(self.name(), self.mu_s, self.mu_c))
+    }
+}
+
+impl SwitchedLaw for Stribeck {
     fn static_limit(&self, normal: f64) -> Option<f64> {
         Some(self.mu_s * normal)
     }
     fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
         normal * self.coefficient(v) * direction + self.viscous * v
     }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.force(v, &[], normal)
-    }
+}
+
+impl Staging for Stribeck {
     fn apply_guess(&mut self, hint: &GuessHint) {
         self.set_levels(&StribeckLevels::guess(hint));
     }
@@ -81,10 +93,6 @@ impl FrictionModel for Stribeck {
         };
         self.set_levels(&levels);
         true
-    }
-    fn validate(&self) -> Result<Vec<String>, ModelError> {
-        check_bounds(self.name(), &self.param_info(), &self.params())?;
-        Ok(mu_s_warning(self.name(), self.mu_s, self.mu_c))
     }
 }
 

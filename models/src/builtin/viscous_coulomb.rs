@@ -11,7 +11,8 @@
 //! P. Dupont, C. Canudas de Wit, "A survey of models, analysis tools and compensation methods
 //! for the control of machines with friction", Automatica 30(7), 1994.
 
-use crate::model::{sgn, FrictionModel, GuessHint};
+use crate::hints::GuessHint;
+use crate::model::{sgn, FrictionModel, Staging, SwitchedLaw};
 
 crate::declare_params! {
     /// Coulomb friction with a viscous term proportional to the sliding velocity.
@@ -27,10 +28,16 @@ impl FrictionModel for ViscousCoulomb {
         name: "viscous_coulomb",
         equation: "F = mu N sgn(v) + viscous v",
     );
-
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         self.mu * normal * sgn(v) + self.viscous * v
     }
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        self.force(v, &[], normal)
+    }
+    crate::law_groups!(switching, staging);
+}
+
+impl SwitchedLaw for ViscousCoulomb {
     fn static_limit(&self, normal: f64) -> Option<f64> {
         Some(self.mu * normal)
     }
@@ -40,9 +47,9 @@ impl FrictionModel for ViscousCoulomb {
     fn affine_slip(&self, direction: f64, normal: f64) -> Option<(f64, f64)> {
         Some((self.mu * normal * direction, self.viscous))
     }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.force(v, &[], normal)
-    }
+}
+
+impl Staging for ViscousCoulomb {
     fn apply_guess(&mut self, hint: &GuessHint) {
         self.mu = 0.9 * hint.mu;
         self.viscous = 0.1 * hint.mu * hint.normal_force / hint.typical_velocity.max(1e-6);

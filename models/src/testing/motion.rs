@@ -23,6 +23,28 @@ pub enum Integration {
     },
 }
 
+/// A release of the mass from rest: from where, for how long, with which integrator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Release {
+    /// The initial displacement \[m\].
+    pub x0: f64,
+    /// The end of the simulation \[s\].
+    pub t_end: f64,
+    /// The integrator.
+    pub integration: Integration,
+}
+
+impl Release {
+    /// A release from `x0` until `t_end` with the engine's adaptive solver.
+    pub fn adaptive(x0: f64, t_end: f64) -> Self {
+        Self {
+            x0,
+            t_end,
+            integration: Integration::Adaptive,
+        }
+    }
+}
+
 /// A simulated release, sampled at common times (every release of one check uses the same
 /// sampling).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -51,28 +73,23 @@ pub trait Simulator {
     fn normal_force(&self) -> f64;
     /// Releases the mass from rest at `x0` and simulates until `t_end`, sampled at fixed
     /// times (the same for every call with the same `t_end`).
-    fn release(
-        &self,
-        model: &Model,
-        x0: f64,
-        t_end: f64,
-        integration: Integration,
-    ) -> Result<Motion, String>;
+    fn release(&self, model: &Model, release: Release) -> Result<Motion, String>;
 }
 
-fn release(
+/// `sim`'s release of `model`, its failure a [`Check::Simulates`] violation.
+fn released(
     sim: &dyn Simulator,
     model: &Model,
-    x0: f64,
-    t_end: f64,
-    integration: Integration,
+    release: Release,
 ) -> Result<Motion, super::Violation> {
-    sim.release(model, x0, t_end, integration)
-        .map_err(|e| super::Violation {
-            model: model.name().to_string(),
-            check: Check::Simulates,
-            message: format!("release from {x0} m with {integration:?}: {e}"),
-        })
+    let Release {
+        x0, integration, ..
+    } = release;
+    sim.release(model, release).map_err(|e| super::Violation {
+        model: model.name().to_string(),
+        check: Check::Simulates,
+        message: format!("release from {x0} m with {integration:?}: {e}"),
+    })
 }
 
 /// The first rise of a total-energy series by more than `tolerance` \[J\] from one sample to
@@ -97,7 +114,7 @@ pub fn check_energy_never_increases(
     t_end: f64,
 ) -> Outcome {
     for &x0 in releases {
-        let m = release(sim, model, x0, t_end, Integration::Adaptive)?;
+        let m = released(sim, model, Release::adaptive(x0, t_end))?;
         let scale = m.total_energy.first().copied().unwrap_or(0.0);
         if let Some((i, rise)) = first_energy_rise(&m.total_energy, 1e-9 * scale) {
             let t = m.time.get(i).copied().unwrap_or(f64::NAN);
@@ -113,7 +130,10 @@ pub fn check_energy_never_increases(
 }
 
 fn check_rest_within_limit(sim: &dyn Simulator, model: &Model, x0: f64, m: &Motion) -> Outcome {
-    let Some(limit) = model.static_limit(sim.normal_force()) else {
+    let Some(limit) = model
+        .switching()
+        .and_then(|law| law.static_limit(sim.normal_force()))
+    else {
         return Ok(());
     };
     let Some(rest) = m.rest_displacement else {
@@ -159,8 +179,8 @@ pub fn first_unmirrored(a: &[f64], b: &[f64], tolerance: f64) -> Option<usize> {
 /// The release from -x0 mirrors the release from x0: x and v to 1e-12, the friction force to
 /// 1e-9, the same number of events and the same rest (or none).
 pub fn check_mirror_symmetry(sim: &dyn Simulator, model: &Model, x0: f64, t_end: f64) -> Outcome {
-    let a = release(sim, model, x0, t_end, Integration::Adaptive)?;
-    let b = release(sim, model, -x0, t_end, Integration::Adaptive)?;
+    let a = released(sim, model, Release::adaptive(x0, t_end))?;
+    let b = released(sim, model, Release::adaptive(-x0, t_end))?;
     let unmirrored = [
         first_unmirrored(&a.x, &b.x, 1e-12),
         first_unmirrored(&a.v, &b.v, 1e-12),
@@ -195,15 +215,13 @@ pub fn check_mirror_symmetry(sim: &dyn Simulator, model: &Model, x0: f64, t_end:
 /// Fixed-step Euler with 1e4 and 1e5 steps per period converges to the adaptive solution at
 /// first order: the larger error is below 2e-5 m and below a fifth of the smaller one's.
 pub fn check_integrators_agree(sim: &dyn Simulator, model: &Model, x0: f64, t_end: f64) -> Outcome {
-    let reference = release(sim, model, x0, t_end, Integration::Adaptive)?;
+    let reference = released(sim, model, Release::adaptive(x0, t_end))?;
     let error = |steps_per_period: f64| -> Result<f64, super::Violation> {
-        let euler = release(
-            sim,
-            model,
-            x0,
-            t_end,
-            Integration::Euler { steps_per_period },
-        )?;
+        let euler = Release {
+            integration: Integration::Euler { steps_per_period },
+            ..Release::adaptive(x0, t_end)
+        };
+        let euler = released(sim, model, euler)?;
         Ok(euler
             .x
             .iter()

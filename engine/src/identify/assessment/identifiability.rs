@@ -203,7 +203,7 @@ fn profile_all<R: Residuals + 'static>(
     Ok(Profiled::Standings(standings))
 }
 
-/// The rigid-contact limit of the fitted model (`FrictionModel::rigid_limit`) fitted to the
+/// The rigid-contact limit of the fitted model (`InternalStates::rigid_limit`) fitted to the
 /// same records. The records resolve the contact's stiffness only when they reject the limit:
 /// a likelihood-ratio test of the nested limit law, whose cost must lie more than
 /// chi²(d, 95 %) / 2 residual variances above the best, d the parameters the limit removes.
@@ -354,7 +354,7 @@ fn rigid_limit<R: Residuals + 'static>(
     best: &StartRun,
     opts: &FitOptions,
 ) -> Option<Limit> {
-    let declared = reference.model.rigid_limit()?;
+    let declared = reference.model.states()?.rigid_limit()?;
     let slots_of = |indices: &[usize]| -> Vec<usize> {
         (0..reference.layout.len())
             .filter(|&j| matches!(reference.layout[j].kind, ParamKind::Model(i) if indices.contains(&i)))

@@ -31,7 +31,7 @@ use super::residuals::STEPS_PER_SAMPLE;
 use super::residuals::{Evaluation, RecordCase, Residuals, Segment};
 use super::state_cache::StateCache;
 use crate::energy::forces_at;
-use crate::energy::model_force::{check_motion, states_along_checked};
+use crate::energy::model_force::{check_motion, states_along_checked, CheckedMotion};
 use crate::energy::{analyze_record, record_motion};
 use crate::error::EngineError;
 use crate::identify::values::levels::{FrictionLevels, UNIT_NORMAL_FORCE};
@@ -259,13 +259,12 @@ impl ForceAlongMotion {
         let budget = STEPS_PER_SAMPLE * (track.time.len() as u64).max(100);
         self.states.states(index, at.model, || {
             at.count_simulation();
-            states_along_checked(
-                at.model,
-                &track.time,
-                &track.velocity,
-                &track.normal,
-                budget,
-            )
+            let motion = CheckedMotion {
+                time: &track.time,
+                v: &track.velocity,
+                normal: &track.normal,
+            };
+            states_along_checked(at.model, motion, budget)
         })
     }
 

@@ -2,7 +2,7 @@
 //!
 //! Along a given motion a model's states depend only on the parameters of its states'
 //! equation: the finite-difference column of a force-only parameter
-//! ([`FrictionModel::force_only_params`]: a damping on the rate, a viscous drag) needs the
+//! ([`InternalStates::force_only_params`](frictionid_models::InternalStates::force_only_params): a damping on the rate, a viscous drag) needs the
 //! states of the point it differs from, and only a new force. The cache keys states by record
 //! and by the exact values of the other parameters, so a hit returns what the integration
 //! would, bit for bit.
@@ -28,7 +28,9 @@ impl Key {
     /// The key of `model` on record `record`: its name and the bits of every parameter that
     /// is not force-only.
     fn of(record: usize, model: &dyn FrictionModel) -> Self {
-        let force_only = model.force_only_params();
+        let force_only = model
+            .states()
+            .map_or_else(Vec::new, |s| s.force_only_params());
         let state_params = model
             .params()
             .iter()

@@ -138,7 +138,9 @@ fn starting_model(
     let mut start_model = frictionid_models::clone_model(model);
     if opts.guess && !free.is_empty() {
         let given = model.params();
-        start_model.apply_guess(&hint());
+        if let Some(staging) = start_model.staging() {
+            staging.apply_guess(&hint());
+        }
         let mut values = start_model.params();
         for (i, p) in model.param_info().iter().enumerate() {
             if !free.contains(&i) || opts.keep_initial.contains(&p.name) {

@@ -4,7 +4,7 @@
 //! - `local`: the data-driven guess and points spread around it ([`super::starts`]).
 //! - `staged`: first the static laws along the model hierarchy (coulomb, then stribeck when
 //!   the target has Stribeck levels), each one start, one run; their optima are mapped onto
-//!   the target through `FrictionModel::start_from` (presliding stiffness from the typical
+//!   the target through `Staging::start_from` (presliding stiffness from the typical
 //!   presliding displacement and a tenth of it) and start the target alongside the local
 //!   starts.
 //! - `global`: the staged starts, plus a seeded Latin hypercube over the physical box in the
@@ -114,7 +114,7 @@ pub fn plan_starts<R: Residuals + 'static>(
 pub struct Planned {
     /// Every starting point, staged ones first.
     pub seeded: Vec<Seeded>,
-    /// The cost of the stage that is the target's rigid limit (`FrictionModel::rigid_limit`):
+    /// The cost of the stage that is the target's rigid limit (`InternalStates::rigid_limit`):
     /// the target reaches it as its stiffness grows, so a screened start left far above it
     /// is abandoned.
     pub reachable: Option<f64>,
@@ -122,7 +122,7 @@ pub struct Planned {
 
 /// The cost of the fitted stage that is `model`'s rigid-limit law, if any.
 fn nested_limit_cost(model: &dyn FrictionModel, fitted: &[SimplerFit]) -> Option<f64> {
-    let law = model.rigid_limit()?.law;
+    let law = model.states()?.rigid_limit()?.law;
     fitted
         .iter()
         .find(|f| f.model.name() == law.name())
@@ -314,7 +314,7 @@ impl Onto<'_> {
     /// from `fitted`.
     pub fn started_from(&self, fitted: &dyn FrictionModel, ctx: &StartContext) -> Option<Vec<f64>> {
         let mut started = clone_model(self.model);
-        if !started.start_from(fitted, ctx) {
+        if !started.staging().is_some_and(|s| s.start_from(fitted, ctx)) {
             return None;
         }
         let values = started.params();
