@@ -1,7 +1,8 @@
 //! Identifier benchmarks: the Coulomb mu fit on the three FMM records, the
 //! five-model comparison, and LuGre fits from the default start and from the truth of stiff
 //! (sigma0 = 1e7) records. Records: the acceptance set-up of the tests (releases of 10, 14
-//! and 22 mm, 2 s at 1 kHz, 0.2 mm/s noise).
+//! and 22 mm, 2 s at 1 kHz, 0.2 mm/s noise). And the inverse-dynamics fit of a driven axis
+//! (25 000 samples; `benches/scipy_inverse_dynamics.py` is SciPy's counterpart).
 
 /// mimalloc, as the `frictionid` binary and the Python module use (glibc's malloc returned
 /// and refaulted the fits' buffers, a sixth of a Coulomb fit's time).
@@ -14,9 +15,12 @@ mod common;
 use common::{lugre_truth, records, stiff_lugre_truth, stribeck_truth, NOISE};
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use frictionid_engine::data::RecordSource;
-use frictionid_engine::identify::{compare, fit, FitDomain, FitOptions, Search};
+use frictionid_engine::identify::{compare, fit, FitDomain, FitOptions, ForceTarget};
+use frictionid_engine::identify::{OscillatorParam, Search};
+use frictionid_engine::oscillator::OscillatorInput;
+use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::{Oscillator, Record};
-use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre};
+use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre, ViscousCoulomb};
 use std::hint::black_box;
 use std::path::Path;
 
@@ -154,5 +158,62 @@ fn force_route(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, coulomb_and_compare, lugre, force_route);
+/// The driven axis of `benches/scipy_inverse_dynamics.py`, the same record: 25 000 samples at
+/// 1 kHz of a prescribed three-tone velocity, the input u = M a + Fv v + Fc sgn(v) + offset
+/// (M 8 kg, Fv 200 N s/m, Fc 20 N, offset 1.5 N) plus two high tones standing for noise.
+fn driven_axis_record() -> Record {
+    use std::f64::consts::TAU;
+    const TONES: [(f64, f64, f64); 3] = [(0.2, 0.4, 0.0), (0.1, 1.1, 1.0), (0.05, 2.3, 2.0)];
+    let time: Vec<f64> = (0..25_000).map(|i| i as f64 * 1e-3).collect();
+    let tones = |t: f64, derivative: bool| -> f64 {
+        TONES
+            .iter()
+            .map(|&(a, f, p)| match derivative {
+                false => a * (TAU * f * t + p).sin(),
+                true => a * TAU * f * (TAU * f * t + p).cos(),
+            })
+            .sum()
+    };
+    let v: Vec<f64> = time.iter().map(|&t| tones(t, false)).collect();
+    let u: Vec<f64> = time
+        .iter()
+        .zip(&v)
+        .map(|(&t, &v)| {
+            let disturbance = 0.1 * (TAU * 123.4 * t + 0.7).sin() + 0.07 * (TAU * 211.1 * t).sin();
+            8.0 * tones(t, true) + 200.0 * v + 20.0 * v.signum() + 1.5 + disturbance
+        })
+        .collect();
+    Record::from_time_base("drive", TimeBase::new(time).expect("time"))
+        .with_channel(Channel::Velocity, v)
+        .with_channel(Channel::InputForce, u)
+}
+
+/// Inverse dynamics (`force_target = "inverse_dynamics"`): the mass, a viscous+Coulomb law
+/// (its level a force: no normal force given) and an offset, on 25 000 samples.
+fn inverse_dynamics(c: &mut Criterion) {
+    let (osc, unknown) = OscillatorInput::default().resolve();
+    let opts = FitOptions {
+        domain: FitDomain::Force,
+        force_target: ForceTarget::InverseDynamics,
+        force_offset: true,
+        oscillator: vec![OscillatorParam::Mass],
+        unknown_oscillator: unknown,
+        ..FitOptions::default()
+    };
+    let record = [driven_axis_record()];
+    let mut group = c.benchmark_group("inverse dynamics");
+    group.sample_size(20);
+    group.bench_function("mass, viscous_coulomb and offset, 25 000 samples", |b| {
+        b.iter(|| fit(&osc, black_box(&ViscousCoulomb::default()), &record, &opts).expect("fit"))
+    });
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    coulomb_and_compare,
+    lugre,
+    force_route,
+    inverse_dynamics
+);
 criterion_main!(benches);

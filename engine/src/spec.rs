@@ -488,7 +488,8 @@ pub struct FitSpec {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FitOptionsSpec {
-    /// Oscillator properties to fit with the model: any of "mass", "damping", "stiffness".
+    /// Oscillator properties to fit with the model: any of "mass", "damping", "stiffness"
+    /// (velocity fits, and force fits with `force_target = "inverse_dynamics"`).
     pub oscillator: Vec<OscillatorParam>,
     /// Fit a velocity offset per record.
     pub velocity_offset: bool,
@@ -507,9 +508,11 @@ pub struct FitOptionsSpec {
     pub models: Option<Vec<String>>,
     /// What the fit compares: "velocity" (default) or "force".
     pub domain: FitDomain,
-    /// Force domain: "auto" (default: the force channel, else Eq. 7), "measured" or "energy".
+    /// Force domain: "auto" (default: the force channel, else Eq. 7), "measured", "energy" or
+    /// "inverse_dynamics" (the input force against J a + c v + R(q) + F).
     pub force_target: ForceTarget,
-    /// Force domain: fit a constant force offset per record (a load cell's zero).
+    /// Force domain: fit a constant force offset per record (a load cell's zero, a drive's
+    /// force offset).
     pub force_offset: bool,
     /// Velocity fits of dynamic models start also from a force-domain prefit (default false).
     pub prefit: Option<bool>,

@@ -2,7 +2,7 @@
 //! form) plus numpy arrays for the series report.json leaves out.
 
 use crate::convert::{serialized, set_array};
-use frictionid_engine::identify::{FitResult, FitSeries};
+use frictionid_engine::identify::{FitResult, FitSeries, ForceBalance};
 use frictionid_engine::report::{
     CompareReport, EnergyRecord, EnergyReport, FitReport, SimulateReport,
 };
@@ -61,7 +61,7 @@ pub fn simulate_dict<'py>(
 }
 
 /// Adds each record's series (`time`, `measured`, `fitted`, `energy_based_force`,
-/// `model_force`) to the record dicts of one fit.
+/// `model_force`, and an inverse-dynamics fit's force balance) to the record dicts of one fit.
 fn add_record_series(fit_dict: &Bound<'_, PyDict>, fit: &FitResult) -> PyResult<()> {
     let records = list_at(fit_dict, "records")?;
     for (item, r) in records.iter().zip(&fit.records) {
@@ -71,6 +71,7 @@ fn add_record_series(fit_dict: &Bound<'_, PyDict>, fit: &FitResult) -> PyResult<
             fitted,
             energy_based_force,
             model_force,
+            balance,
         } = &r.series;
         for (key, values) in [
             ("time", &r.axes.time),
@@ -81,8 +82,28 @@ fn add_record_series(fit_dict: &Bound<'_, PyDict>, fit: &FitResult) -> PyResult<
         ] {
             set_array(&d, key, values)?;
         }
+        if let Some(b) = balance {
+            add_force_balance(&d, b)?;
+        }
     }
     Ok(())
+}
+
+/// An inverse-dynamics record's force balance: `input_force`, `inertia_force`,
+/// `damping_force`, `restoring_force`, `friction_fitted`, `friction_balance` (arrays at the
+/// compared samples) and `force_offset`.
+fn add_force_balance(d: &Bound<'_, PyDict>, b: &ForceBalance) -> PyResult<()> {
+    for (key, values) in [
+        ("input_force", &b.input),
+        ("inertia_force", &b.inertia),
+        ("damping_force", &b.damping),
+        ("restoring_force", &b.restoring),
+        ("friction_fitted", &b.friction_fitted),
+        ("friction_balance", &b.friction_balance),
+    ] {
+        set_array(d, key, values)?;
+    }
+    d.set_item("force_offset", b.offset)
 }
 
 /// `fit`: report.json's structure with the fitted series per record.

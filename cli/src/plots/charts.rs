@@ -2,6 +2,7 @@
 
 use super::{draw, Figure, Panel, Series, XTicks};
 use crate::error::CliError;
+use frictionid_engine::identify::ForceBalance;
 use frictionid_models::FrictionModel;
 use std::path::Path;
 
@@ -117,6 +118,44 @@ pub fn friction_force(
         panel = panel.with_reference(label, r).with_reference("", -r);
     }
     draw(path, &Figure::over_time(title, vec![panel]))
+}
+
+/// The force balance of an inverse-dynamics fit over time: in the upper panel the input u
+/// with the inertial force J a and the restoring force R(q); in the lower panel the friction
+/// force the balance leaves (u - J a - c v - R(q) - offset) and the fitted law's. Lines break
+/// across the samples left out (at rest).
+pub fn force_balance(
+    path: &Path,
+    title: &str,
+    time: &[f64],
+    balance: &ForceBalance,
+    model: &str,
+) -> Result<(), CliError> {
+    let gap = |y: &[f64]| super::sets::break_at_gaps(time, y);
+    let (input, inertia, restoring) = (
+        gap(&balance.input),
+        gap(&balance.inertia),
+        gap(&balance.restoring),
+    );
+    let (from_balance, fitted) = (
+        gap(&balance.friction_balance),
+        gap(&balance.friction_fitted),
+    );
+    let forces = Panel::new("force", "N")
+        .with(Series::solid("input u", time, &input).color(super::MEASURED))
+        .with(Series::solid("inertia J a", time, &inertia).width(1))
+        .with(Series::dashed("restoring R(q)", time, &restoring).width(1));
+    let friction = Panel::new("friction force", "N")
+        .with(
+            Series::solid("from the balance", time, &from_balance)
+                .width(1)
+                .color(super::MEASURED),
+        )
+        .with(
+            Series::dashed(format!("fitted ({model})"), time, &fitted)
+                .color(super::model_color(model)),
+        );
+    draw(path, &Figure::over_time(title, vec![forces, friction]))
 }
 
 /// The motion axis of a force-against-motion chart: quantity, unit and the factor from SI.

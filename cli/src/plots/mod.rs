@@ -10,8 +10,8 @@ mod panel;
 pub mod sets;
 
 pub use charts::{
-    force_against_motion, friction_force, over_time, response_fit, steady_state_curves, MotionAxis,
-    Quantity,
+    force_against_motion, force_balance, friction_force, over_time, response_fit,
+    steady_state_curves, MotionAxis, Quantity,
 };
 
 use crate::error::CliError;

@@ -189,22 +189,37 @@ pub fn break_at_gaps(time: &[f64], values: &[f64]) -> Vec<f64> {
     out
 }
 
-/// A force-domain fit of one record: measured (or energy-based) and fitted friction force
-/// against displacement (hysteresis loops) and against velocity; `stem` starts the names.
+/// A force-domain fit of one record: measured (or energy-based, or from the inverse-dynamics
+/// balance) and fitted friction force against displacement (hysteresis loops) and against
+/// velocity, and for inverse dynamics the force balance over time; `stem` starts the names.
 fn force_record_plots(
     out: &OutputDir,
     fit: &FitResult,
     r: &RecordFit,
     stem: &str,
 ) -> Result<Vec<String>, CliError> {
-    let measured = break_at_gaps(&r.axes.time, &r.series.measured);
-    let fitted = break_at_gaps(&r.axes.time, &r.series.fitted);
-    let label = if r.channel == "energy_based_force" {
-        "energy-based (Eq. 7)"
-    } else {
-        "measured"
+    // Inverse dynamics compares the input force; its plots show the friction forces.
+    let (measured, fitted, label) = match &r.series.balance {
+        Some(b) => (&b.friction_balance, &b.friction_fitted, "from the balance"),
+        None if r.channel == "energy_based_force" => {
+            (&r.series.measured, &r.series.fitted, "energy-based (Eq. 7)")
+        }
+        None => (&r.series.measured, &r.series.fitted, "measured"),
     };
+    let measured = break_at_gaps(&r.axes.time, measured);
+    let fitted = break_at_gaps(&r.axes.time, fitted);
     let mut files = Vec::new();
+    if let Some(balance) = &r.series.balance {
+        let file = format!("{stem}_force_balance.svg");
+        super::force_balance(
+            &out.path(&file),
+            &format!("{}: force balance", r.file),
+            &r.axes.time,
+            balance,
+            &fit.model,
+        )?;
+        files.push(file);
+    }
     for (name, what, motion, axis) in [
         (
             "force_displacement",

@@ -14,11 +14,12 @@
 //! time_column = "time"        # and time_scale (1e-3 for milliseconds)
 //! velocity_column = "velocity"
 //! velocity_scale = 1e-3       # the file's velocity unit in m/s (here mm/s)
-//! # displacement_, acceleration_, force_ and normal_force_ column and scale alike: a channel
+//! # displacement_, acceleration_, force_, normal_force_ and input_force_ column and scale
+//! # alike (input_force: the force driving the axis, a drive's motor force): a channel
 //! # is read when its column is found (default: the channel's own name); a negative scale
 //! # flips a sign convention
 //! velocity_noise = 2e-4       # m/s, the channel's noise level (default: estimated from it);
-//! # displacement_, acceleration_ and force_noise alike, in the channel's SI unit
+//! # displacement_, acceleration_, force_ and input_force_noise alike, in the channel's SI unit
 //! normal_force = 14.5         # N, this record's constant normal force (else the oscillator's)
 //! release = "auto"            # or a time in s: drop the pre-trigger rest (default: none)
 //! min_samples = 10
@@ -91,6 +92,8 @@ pub struct RecordSource {
     pub acceleration_noise: Option<f64>,
     /// Noise level of the force channel \[N\] (default: estimated).
     pub force_noise: Option<f64>,
+    /// Noise level of the input-force channel \[N\] (default: estimated).
+    pub input_force_noise: Option<f64>,
     /// Where the free vibration starts (default: at the first sample).
     pub release: Option<Release>,
     /// Fewest samples accepted (default 10).
@@ -171,6 +174,7 @@ macro_rules! record_keys {
             displacement_noise,
             acceleration_noise,
             force_noise,
+            input_force_noise,
             release,
             min_samples,
             sampling_tolerance
@@ -378,6 +382,7 @@ impl RecordSource {
             (Channel::Displacement, self.displacement_noise),
             (Channel::Acceleration, self.acceleration_noise),
             (Channel::Force, self.force_noise),
+            (Channel::InputForce, self.input_force_noise),
         ];
         given
             .into_iter()

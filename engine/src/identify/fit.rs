@@ -75,7 +75,8 @@ pub fn fit_with<R: Residuals + 'static>(
 }
 
 /// Fits `model`'s force along the measured motion of `records` to their target forces (see
-/// [`ForceAlongMotion`]). The result's residuals are in N.
+/// [`ForceAlongMotion`]; for inverse dynamics with the oscillator properties in
+/// `opts.oscillator`, started at the linear estimate). The result's residuals are in N.
 pub fn fit_force(
     osc: &Oscillator,
     model: &(dyn FrictionModel + 'static),
@@ -85,7 +86,9 @@ pub fn fit_force(
     check_force_domain(opts)?;
     let producer = ForceAlongMotion::new(records, osc, opts)?;
     let mean_normal = producer.mean_normal_force();
-    let mut result = fit_with(Arc::new(producer), osc, model, records, opts)?;
+    // Inverse dynamics starts its oscillator properties at the linear estimate.
+    let start = producer.starting_oscillator(osc, &opts.oscillator);
+    let mut result = fit_with(Arc::new(producer), &start, model, records, opts)?;
     if opts.unknown_oscillator.iter().any(|k| k == "normal_force") {
         // The records carry the normal force; the result's oscillator shows their mean.
         result.oscillator.normal_force = mean_normal;

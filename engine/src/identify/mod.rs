@@ -32,7 +32,8 @@ pub use problem::{Evaluation, Residuals, Segment, SimulatedResponse};
 pub use search::LevenbergMarquardt;
 pub use values::{
     non_model_bound_keys, worst_status, Check, Derived, EnergyForce, Finding, FitDomain,
-    FitOptions, FitResult, FitSeries, FittedParam, ForceTarget, Identifiability, NuisanceKind,
-    NuisanceValues, OscillatorParam, Progress, ProgressFn, PropertyUncertainty, Rank, RecordFit,
-    Search, StartOutcome, Status, StdErrorComponents, TerminationReason, Verdict,
+    FitOptions, FitResult, FitSeries, FittedParam, ForceBalance, ForceTarget, FrictionLevels,
+    Identifiability, NuisanceKind, NuisanceValues, OscillatorParam, Progress, ProgressFn,
+    PropertyUncertainty, Rank, RecordFit, Search, StartOutcome, Status, StdErrorComponents,
+    TerminationReason, Verdict,
 };

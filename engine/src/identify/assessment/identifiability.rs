@@ -23,11 +23,12 @@ use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::{run_start, MultiStart, RunSlot, StartRun};
 use crate::identify::search::strategy::{fit_simpler, stage_options, FitTarget, Onto};
 use crate::identify::values::layout::ParamKind;
+use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::options::FitOptions;
 use crate::identify::values::outcome::{Check, Finding, TerminationReason};
 use crate::identify::values::result::Identifiability;
 use frictionid_models::start::TYPICAL_PRESLIDING_DISPLACEMENT;
-use frictionid_models::{FrictionModel, StartContext, StribeckLevels};
+use frictionid_models::{FrictionModel, ModelError, StartContext, StribeckLevels};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
@@ -897,12 +898,23 @@ pub fn findings(names: &[(String, String)], standings: &[Standing]) -> Vec<Findi
 }
 
 /// A warning for each physical inconsistency the fitted model reports (e.g. mu_s < mu_c).
-pub fn consistency_findings(model: &dyn FrictionModel) -> Vec<Finding> {
+/// A level read as a force (`levels`) beyond the declared bound of its coefficient is no
+/// inconsistency: its bounds are the data's.
+pub fn consistency_findings(model: &dyn FrictionModel, levels: FrictionLevels) -> Vec<Finding> {
     match model.validate() {
         Ok(warnings) => warnings
             .into_iter()
             .map(|w| Finding::warn(Check::PhysicalConsistency, None, w))
             .collect(),
+        Err(ModelError::OutOfBounds { param, .. })
+            if levels.are_forces()
+                && model
+                    .param_info()
+                    .iter()
+                    .any(|p| p.name == param && FrictionLevels::is_level(p)) =>
+        {
+            Vec::new()
+        }
         Err(e) => vec![Finding::warn(
             Check::PhysicalConsistency,
             None,

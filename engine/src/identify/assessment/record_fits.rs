@@ -5,7 +5,9 @@ use super::diagnostics;
 use super::energy_check::{energy_force_check, ForceReference};
 use crate::energy::{analyze_record, forces_from_states, states_along};
 use crate::error::EngineError;
-use crate::identify::problem::{FitProblem, Realised, Residuals, Segment, STEPS_PER_SAMPLE};
+use crate::identify::problem::{
+    FitProblem, Realised, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
+};
 use crate::identify::values::{
     ChannelFit, Check, EnergyForce, Finding, FitOptions, FitSeries, NuisanceValues, RecordFit,
 };
@@ -83,6 +85,14 @@ fn record_fit<R: Residuals>(
         (None, Vec::new(), Vec::new(), None)
     };
     let axes = problem.residuals.sample_axes(ri, rec);
+    let case = RecordCase {
+        index: ri,
+        record: rec,
+        nuisance,
+    };
+    let balance = problem
+        .residuals
+        .force_balance(&problem.evaluation(world), case)?;
     let record = RecordFit {
         file: rec.name.clone(),
         x0: nuisance.x0_of(rec),
@@ -98,6 +108,7 @@ fn record_fit<R: Residuals>(
             fitted,
             energy_based_force: ebf,
             model_force: mf,
+            balance,
         },
     };
     Ok((record, sum_sq, finding))

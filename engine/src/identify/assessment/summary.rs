@@ -11,8 +11,8 @@ use crate::identify::problem::{FitProblem, Realised, Residuals};
 use crate::identify::search::starts::{MultiStart, StartRun};
 use crate::identify::search::Layout;
 use crate::identify::values::{
-    Check, Derived, Finding, FitOptions, FitResult, FittedParam, FreeParam, OscillatorParam,
-    ParamKind, Search, StartOutcome, Status,
+    Check, Derived, Finding, FitOptions, FitResult, FittedParam, FreeParam, FrictionLevels,
+    OscillatorParam, ParamKind, Search, StartOutcome, Status,
 };
 use crate::oscillator::Oscillator;
 use nalgebra::DMatrix;
@@ -146,7 +146,8 @@ pub fn summarise<R: Residuals>(
     let mut simulations = runs.simulations + ctx.reference.simulations();
     let fits = record_fits(ctx.reference, &stats.world, ctx.opts)?;
     simulations += ctx.reference.records.len() as u64;
-    let parameters = parameter_entries(&stats, params, ctx.standings);
+    let levels = ctx.reference.residuals.friction_levels();
+    let parameters = parameter_entries(&stats, params, ctx.standings, levels);
     let findings = diagnose(ctx, &runs, &stats, &parameters, &fits);
     let n_free = params.len();
     let samples = ctx.reference.n_residuals();
@@ -163,7 +164,12 @@ pub fn summarise<R: Residuals>(
         correlation: (0..k)
             .map(|a| (0..k).map(|b| stats.cov.correlation[(a, b)]).collect())
             .collect(),
-        derived: derived_ratios(&stats.world.oscillator, params, &stats.cov.matrix, ctx.opts),
+        derived: if ctx.reference.residuals.simulates_response() {
+            derived_ratios(&stats.world.oscillator, params, &stats.cov.matrix, ctx.opts)
+        } else {
+            // The ratios a free response fixes; a force balance fixes the properties.
+            Vec::new()
+        },
         records: fits.records,
         rms_residual: (fits.sum_sq / fits.n_total.max(1) as f64).sqrt(),
         compared: ctx.reference.residuals.channel().to_string(),
@@ -223,10 +229,12 @@ fn diagnose<R: Residuals>(
     findings.extend(correlation_findings(params, &stats.cov));
     findings.push(diagnostics::standard_errors(parameters, stats.cov.singular));
     findings.extend(stats.widening.clone());
-    findings.extend(identifiability_findings(
-        ctx.opts,
-        ctx.layout.n_model_free(),
-    ));
+    if ctx.reference.residuals.simulates_response() {
+        findings.extend(identifiability_findings(
+            ctx.opts,
+            ctx.layout.n_model_free(),
+        ));
+    }
     let names: Vec<(String, String)> = params
         .iter()
         .map(|f| (f.name.clone(), f.unit.clone()))
@@ -234,6 +242,7 @@ fn diagnose<R: Residuals>(
     findings.extend(identifiability::findings(&names, ctx.standings));
     findings.extend(identifiability::consistency_findings(
         stats.world.model.as_ref(),
+        ctx.reference.residuals.friction_levels(),
     ));
     findings.extend(diagnostics::parameters_at_bounds(params, &stats.p_best));
     findings.extend(fits.findings.iter().cloned());
@@ -263,6 +272,7 @@ fn parameter_entries(
     stats: &Statistics,
     params: &[FreeParam],
     standings: &[Standing],
+    levels: FrictionLevels,
 ) -> Vec<FittedParam> {
     let se = &stats.cov.std_errors;
     let tq = stats.t_quantile;
@@ -281,7 +291,8 @@ fn parameter_entries(
         .enumerate()
         .map(|(i, (p, v))| {
             let slot = params.iter().position(|f| f.kind == ParamKind::Model(i));
-            stand(param_entry(&p.name, &p.unit, v, slot, se, tq), slot)
+            let unit = levels.unit(p);
+            stand(param_entry(&p.name, &unit, v, slot, se, tq), slot)
         })
         .collect();
     for (slot, f) in params.iter().enumerate() {
@@ -339,7 +350,8 @@ fn correlation_findings(params: &[FreeParam], cov: &Covariance) -> Vec<Finding> 
     out
 }
 
-/// A warning for a free mass with anything that scales with it.
+/// A warning for a free mass with anything that scales with it (a fit of the free response:
+/// a measured input force fixes the scale).
 fn identifiability_findings(opts: &FitOptions, n_model_free: usize) -> Vec<Finding> {
     let mut out = Vec::new();
     let osc_free = |q: OscillatorParam| opts.oscillator.contains(&q);

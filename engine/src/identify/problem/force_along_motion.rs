@@ -10,7 +10,13 @@
 //!   offset per record (a load cell's zero, [`NuisanceKind::ForceOffset`]); or
 //! - the energy-based force of Eq. 7 ([`crate::energy::analyze_record`]), masked near v = 0
 //!   and after the final stop: the paper's own route, with no force sensor. It needs m, c
-//!   and k; a measured force needs none of them.
+//!   and k; a measured force needs none of them; or
+//! - the measured input force u of a driven axis (inverse dynamics, [`super::inverse_dynamics`]):
+//!   the prediction is then J a + c v + R(q) + F + offset, with the oscillator properties
+//!   named in `[fit.options] oscillator` fitted with the law.
+//!
+//! Without a normal force (neither `[oscillator] normal_force` nor a record's), the levels
+//! are forces ([`FrictionLevels`]): N = 1 and their bounds from the largest force compared.
 //!
 //! Residuals are `sqrt(weight) (model + offset - target) / sigma`, with sigma the record's
 //! noise level estimated from the target ([`crate::record::noise::noise_floor_level`] of its first differences), so records of different noise
@@ -18,6 +24,9 @@
 //! few milliseconds per evaluation and has no phase errors to trap the optimiser: it is also
 //! the prefit of velocity fits of dynamic models (run by [`crate::identify::fit::fit`]).
 
+use super::inverse_dynamics::{
+    linear_start, sliding_samples, Balance, BalanceSamples, LinearStart,
+};
 use super::residuals::STEPS_PER_SAMPLE;
 use super::residuals::{Evaluation, RecordCase, Residuals, Segment};
 use super::state_cache::StateCache;
@@ -25,9 +34,10 @@ use crate::energy::forces_at;
 use crate::energy::model_force::{check_motion, states_along_checked, CheckedMotion};
 use crate::energy::{analyze_record, record_motion};
 use crate::error::EngineError;
+use crate::identify::values::levels::{FrictionLevels, UNIT_NORMAL_FORCE};
 use crate::identify::values::nuisance::NuisanceKind;
-use crate::identify::values::options::{FitDomain, FitOptions, ForceTarget};
-use crate::identify::values::result::SampleAxes;
+use crate::identify::values::options::{FitDomain, FitOptions, ForceTarget, OscillatorParam};
+use crate::identify::values::result::{ForceBalance, SampleAxes};
 use crate::oscillator::Oscillator;
 use crate::record::noise::noise_floor_level;
 use crate::record::{channel_list, Channel, NormalForce, Record};
@@ -41,6 +51,8 @@ pub enum TargetSource {
     Measured,
     /// The energy-based force of Eq. 7.
     EnergyBased,
+    /// The measured input force, against the balance of inverse dynamics.
+    InverseDynamics,
 }
 
 /// One record's motion, normal force and target, prepared once per fit.
@@ -58,6 +70,8 @@ pub struct ForceTrack {
     target: Vec<f64>,
     /// Noise level of the target \[N\].
     pub noise: f64,
+    /// The oscillator's terms of an inverse-dynamics target.
+    balance: Option<Balance>,
 }
 
 /// The force-domain residual producer.
@@ -65,6 +79,10 @@ pub struct ForceTrack {
 pub struct ForceAlongMotion {
     tracks: Vec<ForceTrack>,
     nuisance: Vec<NuisanceKind>,
+    /// Whether the law's levels are coefficients or forces (no normal force given).
+    levels: FrictionLevels,
+    /// The linear inverse-dynamics estimate (inverse dynamics only).
+    start: Option<LinearStart>,
     /// States of recent predictions: a force-only parameter's column reuses them.
     states: StateCache,
 }
@@ -119,39 +137,54 @@ fn require_properties(
 
 impl ForceAlongMotion {
     /// The producer for `records` under `opts` (`force_target`, `force_offset`, the energy
-    /// options for Eq. 7, the oscillator keys not given).
+    /// options for Eq. 7, the oscillator keys not given and, for inverse dynamics, the
+    /// oscillator properties fitted).
     pub fn new(
         records: &[Record],
         osc: &Oscillator,
         opts: &FitOptions,
     ) -> Result<Self, EngineError> {
+        let unit_normal = opts.unknown_oscillator.iter().any(|k| k == "normal_force")
+            && records.iter().all(|r| r.normal_force().is_none());
         let mut tracks = Vec::with_capacity(records.len());
         for record in records {
-            let source =
-                target_source(record, opts.force_target).map_err(|reason| EngineError::Record {
-                    record: record.name.clone(),
-                    reason,
-                })?;
-            if opts.force_offset && source != TargetSource::Measured {
-                return Err(EngineError::Record {
-                    record: record.name.clone(),
-                    reason: "[fit.options] force_offset = true needs a measured force channel \
-                             (this record is fitted to the energy-based force)"
+            let err = |reason: String| EngineError::Record {
+                record: record.name.clone(),
+                reason,
+            };
+            let source = target_source(record, opts.force_target).map_err(err)?;
+            if opts.force_offset && source == TargetSource::EnergyBased {
+                return Err(err(
+                    "[fit.options] force_offset = true needs a measured force channel or \
+                     force_target = \"inverse_dynamics\" (this record is fitted to the \
+                     energy-based force)"
                         .into(),
-                });
+                ));
             }
-            tracks.push(ForceTrack::new(record, source, osc, opts)?);
+            tracks.push(ForceTrack::new(record, source, osc, opts, unit_normal)?);
         }
         let nuisance = if opts.force_offset {
             vec![NuisanceKind::ForceOffset]
         } else {
             Vec::new()
         };
-        Ok(Self {
+        let mut producer = Self {
             tracks,
             nuisance,
+            levels: FrictionLevels::Coefficients,
+            start: None,
             states: StateCache::default(),
-        })
+        };
+        if opts.force_target == ForceTarget::InverseDynamics {
+            producer.start = producer.linear_start(osc, &opts.oscillator);
+        }
+        if unit_normal {
+            let at = producer.start.as_ref().map_or(osc, |s| &s.oscillator);
+            producer.levels = FrictionLevels::Forces {
+                largest: producer.largest_friction(at),
+            };
+        }
+        Ok(producer)
     }
 
     /// The prepared record `index`.
@@ -163,6 +196,58 @@ impl ForceAlongMotion {
     pub fn mean_normal_force(&self) -> f64 {
         let sum: f64 = self.tracks.iter().map(|t| t.normal.mean()).sum();
         sum / self.tracks.len().max(1) as f64
+    }
+
+    /// Whether the law's levels are coefficients or forces.
+    pub fn levels(&self) -> FrictionLevels {
+        self.levels
+    }
+
+    /// The oscillator an inverse-dynamics fit starts from: `osc` with the properties in
+    /// `fitted` at the linear estimate (`osc` itself without one).
+    pub fn starting_oscillator(&self, osc: &Oscillator, fitted: &[OscillatorParam]) -> Oscillator {
+        let Some(start) = &self.start else {
+            return *osc;
+        };
+        let mut out = *osc;
+        for p in fitted {
+            match p {
+                OscillatorParam::Mass => out.mass = start.oscillator.mass,
+                OscillatorParam::Damping => out.damping = start.oscillator.damping,
+                OscillatorParam::Stiffness => out.stiffness = start.oscillator.stiffness,
+                OscillatorParam::GravityMoment => out.restoring = start.oscillator.restoring,
+                OscillatorParam::InputOffset => out.input_offset = start.oscillator.input_offset,
+            }
+        }
+        out
+    }
+
+    /// The linear inverse-dynamics estimate over every record (see
+    /// [`super::inverse_dynamics::linear_start`]).
+    fn linear_start(&self, osc: &Oscillator, fitted: &[OscillatorParam]) -> Option<LinearStart> {
+        let samples: Vec<BalanceSamples<'_>> = self
+            .tracks
+            .iter()
+            .filter_map(|t| {
+                let balance = t.balance.as_ref()?;
+                Some(BalanceSamples {
+                    used: &t.used,
+                    input: &t.target,
+                    motion: [&balance.acceleration, &t.velocity, &t.displacement],
+                    restoring: balance.restoring,
+                })
+            })
+            .collect();
+        linear_start(&samples, osc, fitted)
+    }
+
+    /// The largest |friction force| compared: the target, less the oscillator's terms at
+    /// `osc` for inverse dynamics.
+    fn largest_friction(&self, osc: &Oscillator) -> f64 {
+        self.tracks
+            .iter()
+            .flat_map(|t| t.friction_target(osc))
+            .fold(0.0, |m, f| m.max(f.abs()))
     }
 
     /// The model's states along track `index` (a dynamic model), from the cache when the
@@ -191,15 +276,44 @@ impl ForceAlongMotion {
             reason: format!("no prepared force track {index}"),
         })
     }
+
+    /// The friction law's force at the compared samples of track `index`.
+    fn friction_at(
+        &self,
+        at: &Evaluation<'_>,
+        index: usize,
+        record: &Record,
+    ) -> Result<Vec<f64>, EngineError> {
+        let track = self.track_of(index, record)?;
+        let states = if at.model.n_states() == 0 {
+            at.count_simulation();
+            Arc::new(Vec::new())
+        } else {
+            self.states_of(index, at, track)
+                .map_err(|e| EngineError::Record {
+                    record: record.name.clone(),
+                    reason: e.to_string(),
+                })?
+        };
+        Ok(forces_at(
+            at.model,
+            &track.velocity,
+            &track.normal,
+            &states,
+            track.used.iter().copied(),
+        ))
+    }
 }
 
 impl ForceTrack {
-    /// Prepares `record`: its motion, its normal force and its target from `source`.
+    /// Prepares `record`: its motion, its normal force (1 N when `unit_normal`: no normal
+    /// force given anywhere) and its target from `source`.
     fn new(
         record: &Record,
         source: TargetSource,
         osc: &Oscillator,
         opts: &FitOptions,
+        unit_normal: bool,
     ) -> Result<Self, EngineError> {
         let err = |reason: String| EngineError::Record {
             record: record.name.clone(),
@@ -209,11 +323,14 @@ impl ForceTrack {
         let motion = record_motion(record).ok_or_else(|| {
             err(format!(
                 "a force-domain fit needs the motion: a velocity or displacement channel (the \
-                 record has: {})",
+                 record has: {}); name its column with `velocity_column` or \
+                 `displacement_column`",
                 channel_list(&record.channels())
             ))
         })?;
-        let normal = normal_force(record, osc, &opts.unknown_oscillator).map_err(err)?;
+        let normal =
+            normal_force(record, osc, &opts.unknown_oscillator, unit_normal).map_err(err)?;
+        let mut balance = None;
         let (used, target) = match source {
             TargetSource::Measured => {
                 let f = record.channel(Channel::Force).unwrap_or_default().to_vec();
@@ -223,43 +340,93 @@ impl ForceTrack {
                 require_mechanics(&opts.unknown_oscillator, "the energy-based force (Eq. 7)")?;
                 energy_target(record, osc, opts)?
             }
+            TargetSource::InverseDynamics => {
+                let threshold = opts.energy.velocity_threshold;
+                balance = Some(
+                    Balance::new(record, &motion.v, threshold, has_restoring(osc, opts))
+                        .map_err(|e| err(e.to_string()))?,
+                );
+                let u = record.channel(Channel::InputForce).unwrap_or_default();
+                let used = sliding_samples(&motion.v, threshold);
+                let target = used.iter().map(|&i| u[i]).collect();
+                (used, target)
+            }
         };
         check_motion(record.time(), &motion.v, &normal).map_err(|e| err(e.to_string()))?;
         if target.len() < 2 {
             return Err(err(format!(
-                "{} samples to compare the model force with (Eq. 7 is masked where |v| <= \
-                 [energy] velocity_threshold = {} m/s)",
+                "{} samples to compare the model force with (Eq. 7 and the inverse-dynamics \
+                 force are masked where |v| <= [energy] velocity_threshold = {} m/s)",
                 target.len(),
                 opts.energy.velocity_threshold
             )));
         }
+        let noise_channel = match source {
+            TargetSource::Measured => Some(Channel::Force),
+            TargetSource::InverseDynamics => Some(Channel::InputForce),
+            TargetSource::EnergyBased => None,
+        };
         Ok(Self {
             source,
             time: record.time().to_vec(),
             velocity: motion.v,
             displacement: motion.x,
             normal,
-            noise: record
-                .given_noise(Channel::Force)
-                .filter(|_| source == TargetSource::Measured)
+            noise: noise_channel
+                .and_then(|c| record.given_noise(c))
                 .unwrap_or_else(|| noise_floor_level(&target, 1)),
             used,
             target,
+            balance,
         })
+    }
+
+    /// The oscillator's terms J a + c v + R(q) at the compared samples (inverse dynamics;
+    /// empty otherwise).
+    fn axis_forces(&self, osc: &Oscillator) -> Vec<f64> {
+        let Some(balance) = &self.balance else {
+            return Vec::new();
+        };
+        self.used
+            .iter()
+            .map(|&i| balance.axis_force(osc, i, self.velocity[i], self.displacement[i]))
+            .collect()
+    }
+
+    /// The friction force the target implies at `osc`: the target itself, or for inverse
+    /// dynamics u - J a - c v - R(q).
+    fn friction_target(&self, osc: &Oscillator) -> Vec<f64> {
+        let axis = self.axis_forces(osc);
+        if axis.is_empty() {
+            return self.target.clone();
+        }
+        self.target.iter().zip(&axis).map(|(u, a)| u - a).collect()
     }
 }
 
-/// The record's normal force, or its absence explained.
+/// Whether an inverse-dynamics balance has a restoring force: a restoring law other than the
+/// linear spring carries its own parameters; the spring needs its stiffness given or fitted
+/// (an axis without a spring gives no `stiffness`).
+fn has_restoring(osc: &Oscillator, opts: &FitOptions) -> bool {
+    !osc.restoring.is_linear_spring()
+        || opts.oscillator.contains(&OscillatorParam::Stiffness)
+        || !opts.unknown_oscillator.iter().any(|k| k == "stiffness")
+}
+
+/// The record's normal force, [`UNIT_NORMAL_FORCE`] when `unit_normal` (none given anywhere:
+/// the levels are forces), or its absence explained (given for some records, not this one).
 fn normal_force(
     record: &Record,
     osc: &Oscillator,
     unknown: &[String],
+    unit_normal: bool,
 ) -> Result<NormalForce, String> {
     match record.normal_force() {
         Some(n) => Ok(n.clone()),
+        None if unit_normal => Ok(NormalForce::Constant(UNIT_NORMAL_FORCE)),
         None if unknown.iter().any(|k| k == "normal_force") => Err(
             "no normal force: give [oscillator] normal_force, the record's `normal_force` or a \
-             normal_force channel"
+             normal_force channel (other records have one)"
                 .into(),
         ),
         None => Ok(NormalForce::Constant(osc.normal_force)),
@@ -277,11 +444,17 @@ fn target_source(record: &Record, wanted: ForceTarget) -> Result<TargetSource, S
         )),
         (ForceTarget::Measured, true) | (ForceTarget::Auto, true) => Ok(TargetSource::Measured),
         (ForceTarget::Energy, _) | (ForceTarget::Auto, false) => Ok(TargetSource::EnergyBased),
+        (ForceTarget::InverseDynamics, _) if record.channel(Channel::InputForce).is_none() => {
+            Err(format!(
+                "[fit.options] force_target = \"inverse_dynamics\" but the record has no input \
+                 force channel (it has: {}; name its column with `input_force_column`)",
+                channel_list(&record.channels())
+            ))
+        }
+        (ForceTarget::InverseDynamics, _) => Ok(TargetSource::InverseDynamics),
     }
 }
 
-/// The energy-based force of Eq. 7 along `record` (from its measured channels, see
-/// [`crate::energy::record_motion`]), at the samples where it is defined.
 fn energy_target(
     record: &Record,
     osc: &Oscillator,
@@ -302,10 +475,12 @@ impl Residuals for ForceAlongMotion {
         "force"
     }
 
-    /// `force` for a measured force, `energy_based_force` for Eq. 7.
+    /// `force` for a measured force, `energy_based_force` for Eq. 7, `input_force` for
+    /// inverse dynamics.
     fn record_channel(&self, index: usize) -> &'static str {
         match self.tracks.get(index).map(|t| t.source) {
             Some(TargetSource::EnergyBased) => "energy_based_force",
+            Some(TargetSource::InverseDynamics) => "input_force",
             _ => "force",
         }
     }
@@ -325,30 +500,56 @@ impl Residuals for ForceAlongMotion {
             .unwrap_or_default()
     }
 
+    /// The law's force plus the offset; for inverse dynamics plus J a + c v + R(q) at the
+    /// evaluated oscillator, so that the oscillator properties' columns are the balance's.
     fn predict(&self, at: &Evaluation<'_>, case: RecordCase<'_>) -> Result<Vec<f64>, EngineError> {
         let (index, record, nuisance) = (case.index, case.record, case.nuisance);
+        let mut force = self.friction_at(at, index, record)?;
         let track = self.track_of(index, record)?;
-        let states = if at.model.n_states() == 0 {
-            at.count_simulation();
-            Arc::new(Vec::new())
-        } else {
-            self.states_of(index, at, track)
-                .map_err(|e| EngineError::Record {
-                    record: record.name.clone(),
-                    reason: e.to_string(),
-                })?
-        };
-        let mut force = forces_at(
-            at.model,
-            &track.velocity,
-            &track.normal,
-            &states,
-            track.used.iter().copied(),
-        );
+        if let Some(balance) = &track.balance {
+            for (f, &i) in force.iter_mut().zip(&track.used) {
+                *f +=
+                    balance.axis_force(at.oscillator, i, track.velocity[i], track.displacement[i]);
+            }
+        }
         if nuisance.force_offset != 0.0 {
             force.iter_mut().for_each(|f| *f += nuisance.force_offset);
         }
         Ok(force)
+    }
+
+    fn friction_levels(&self) -> FrictionLevels {
+        self.levels
+    }
+
+    /// The balance's terms at the fitted values (inverse dynamics only).
+    fn force_balance(
+        &self,
+        at: &Evaluation<'_>,
+        case: RecordCase<'_>,
+    ) -> Result<Option<ForceBalance>, EngineError> {
+        let track = self.track_of(case.index, case.record)?;
+        let Some(balance) = &track.balance else {
+            return Ok(None);
+        };
+        let osc = at.oscillator;
+        let offset = case.nuisance.force_offset;
+        let pick = |f: &dyn Fn(usize) -> f64| track.used.iter().map(|&i| f(i)).collect();
+        let inertia: Vec<f64> = pick(&|i| osc.mass * balance.acceleration[i]);
+        let damping: Vec<f64> = pick(&|i| osc.damping * track.velocity[i]);
+        let restoring: Vec<f64> = pick(&|i| balance.restoring_at(osc, track.displacement[i]));
+        let friction_balance = (0..track.used.len())
+            .map(|k| track.target[k] - inertia[k] - damping[k] - restoring[k] - offset)
+            .collect();
+        Ok(Some(ForceBalance {
+            input: track.target.clone(),
+            inertia,
+            damping,
+            restoring,
+            offset,
+            friction_fitted: self.friction_at(at, case.index, case.record)?,
+            friction_balance,
+        }))
     }
 
     /// One segment, weighted by the target's noise level: records of different noise weigh
@@ -369,14 +570,18 @@ impl Residuals for ForceAlongMotion {
     }
 
     /// The friction level from the target (mean |F| over the compared samples over the mean
-    /// normal force), the typical speed from the motion.
+    /// normal force; for inverse dynamics the linear estimate's Coulomb level), the typical
+    /// speed from the motion.
     fn hint(&self, osc: &Oscillator, _records: &[Record], _opts: &FitOptions) -> GuessHint {
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-        let levels: Vec<f64> = self
-            .tracks
-            .iter()
-            .map(|t| mean(&t.target.iter().map(|f| f.abs()).collect::<Vec<_>>()))
-            .collect();
+        let levels: Vec<f64> = match &self.start {
+            Some(start) => vec![start.coulomb],
+            None => self
+                .tracks
+                .iter()
+                .map(|t| mean(&t.target.iter().map(|f| f.abs()).collect::<Vec<_>>()))
+                .collect(),
+        };
         let speeds: Vec<f64> = self
             .tracks
             .iter()
@@ -386,7 +591,7 @@ impl Residuals for ForceAlongMotion {
         let mu = mean(&levels) / n;
         GuessHint {
             mu: if mu.is_finite() && mu > 0.0 {
-                mu.clamp(1e-4, 5.0)
+                self.levels.clamp_guess(mu)
             } else {
                 0.2
             },
@@ -424,7 +629,10 @@ fn velocity_only_options(opts: &FitOptions) -> Vec<&'static str> {
         (opts.velocity_offset, "velocity_offset"),
         (opts.time_shift, "time_shift"),
         (opts.x0, "x0"),
-        (!opts.oscillator.is_empty(), "oscillator"),
+        (
+            !opts.oscillator.is_empty() && opts.force_target != ForceTarget::InverseDynamics,
+            "oscillator",
+        ),
     ] {
         if on {
             keys.push(key);
@@ -434,7 +642,8 @@ fn velocity_only_options(opts: &FitOptions) -> Vec<&'static str> {
 }
 
 /// The options fit the force domain: `domain = "force"`, and none of the options only a
-/// velocity fit has.
+/// velocity fit has (the oscillator properties are fitted in the force domain by inverse
+/// dynamics only).
 pub fn check_force_domain(opts: &FitOptions) -> Result<(), EngineError> {
     let velocity_keys = velocity_only_options(opts);
     if !velocity_keys.is_empty() {
@@ -446,6 +655,20 @@ pub fn check_force_domain(opts: &FitOptions) -> Result<(), EngineError> {
     if opts.domain != FitDomain::Force {
         return Err(EngineError::InvalidInput(
             "fit_force needs [fit.options] domain = \"force\"".into(),
+        ));
+    }
+    check_inverse_dynamics(opts)
+}
+
+/// Inverse dynamics knows the mass (the inertia): given in `[oscillator]` or fitted.
+fn check_inverse_dynamics(opts: &FitOptions) -> Result<(), EngineError> {
+    let mass_unknown = opts.unknown_oscillator.iter().any(|k| k == "mass")
+        && !opts.oscillator.contains(&OscillatorParam::Mass);
+    if opts.force_target == ForceTarget::InverseDynamics && mass_unknown {
+        return Err(EngineError::InvalidInput(
+            "[oscillator]: force_target = \"inverse_dynamics\" needs the mass (the inertia): \
+             give `mass`, or fit it with [fit.options] oscillator = [\"mass\"]"
+                .into(),
         ));
     }
     Ok(())

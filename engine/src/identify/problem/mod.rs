@@ -7,6 +7,7 @@
 pub mod analysis_cache;
 pub mod force_along_motion;
 pub mod guess;
+pub mod inverse_dynamics;
 pub mod least_squares;
 pub mod residuals;
 pub mod simulated_response;

@@ -15,7 +15,9 @@ use super::step_allowance::StepAllowance;
 use crate::energy::{analyze_record, EnergyAnalysis, EnergyOptions};
 use crate::error::EngineError;
 use crate::identify::values::options::FitOptions;
-use crate::identify::values::{NuisanceKind, NuisanceValues, SampleAxes};
+use crate::identify::values::{
+    ForceBalance, FrictionLevels, NuisanceKind, NuisanceValues, SampleAxes,
+};
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use crate::simulate::{SimOptions, SimStats};
@@ -172,6 +174,22 @@ pub trait Residuals: Send + Sync {
             Some(cache) => cache.analysis(index, record, osc, options),
             None => Ok(Arc::new(analyze_record(record, osc, options)?)),
         }
+    }
+
+    /// Whether the law's levels are coefficients of a normal force or forces (default:
+    /// coefficients).
+    fn friction_levels(&self) -> FrictionLevels {
+        FrictionLevels::Coefficients
+    }
+
+    /// The terms of record `index`'s force balance at the evaluated values, for an
+    /// inverse-dynamics producer (default: none).
+    fn force_balance(
+        &self,
+        _at: &Evaluation<'_>,
+        _case: RecordCase<'_>,
+    ) -> Result<Option<ForceBalance>, EngineError> {
+        Ok(None)
     }
 
     /// Whether the prediction is the oscillator's simulated response: then the energy-balance

@@ -5,6 +5,7 @@
 use crate::error::EngineError;
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::values::layout::{FreeParam, ParamKind};
+use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::nuisance::{non_model_bound_keys, NuisanceKind};
 use crate::identify::values::options::{FitOptions, OscillatorParam};
 use crate::oscillator::Oscillator;
@@ -66,8 +67,9 @@ pub fn build_layout<R: Residuals + ?Sized>(
         start: Vec::new(),
     };
     let values = layout.start_model.params();
+    let levels = residuals.friction_levels();
     for &i in &free {
-        let (param, x) = model_param(&info[i], i, values[i], opts);
+        let (param, x) = model_param(&info[i], i, values[i], opts, levels);
         layout.push(param, x);
     }
     for &q in &opts.oscillator {
@@ -151,13 +153,20 @@ fn starting_model(
 }
 
 /// A free model parameter: log coordinates for a strictly positive one, its bounds from the
-/// options or the model; the start clipped into them.
-fn model_param(p: &ParamInfo, index: usize, value: f64, opts: &FitOptions) -> (FreeParam, f64) {
+/// options, else the model's (a level read as a force: from the data, see
+/// [`FrictionLevels`]); the start clipped into them.
+fn model_param(
+    p: &ParamInfo,
+    index: usize,
+    value: f64,
+    opts: &FitOptions,
+    levels: FrictionLevels,
+) -> (FreeParam, f64) {
     let (lo, hi) = opts
         .bounds
         .get(&p.name)
         .copied()
-        .unwrap_or((p.lower, p.upper));
+        .unwrap_or_else(|| levels.bounds(p));
     let log = p.lower_exclusive && p.lower == 0.0 && lo >= 0.0;
     let (lo_eff, hi_eff) = if log { (lo.max(0.0), hi) } else { (lo, hi) };
     let mut x = value;
@@ -167,7 +176,7 @@ fn model_param(p: &ParamInfo, index: usize, value: f64, opts: &FitOptions) -> (F
     x = x.clamp(lo_eff, hi_eff);
     let mut f = FreeParam::linear(
         p.name.clone(),
-        &p.unit,
+        &levels.unit(p),
         ParamKind::Model(index),
         (lo_eff, hi_eff),
         x,

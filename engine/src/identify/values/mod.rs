@@ -5,6 +5,7 @@
 //! floors above (problem, search, assessment).
 
 pub mod layout;
+pub mod levels;
 pub mod nuisance;
 pub mod options;
 pub mod outcome;
@@ -13,14 +14,15 @@ pub mod search;
 pub mod uncertainty;
 
 pub use layout::{BoundSide, FreeParam, ParamKind};
+pub use levels::FrictionLevels;
 pub use nuisance::{non_model_bound_keys, NuisanceKind, NuisanceValues, X0_RELATIVE_BOUND};
 pub use options::{
     FitDomain, FitOptions, ForceTarget, OscillatorParam, Progress, ProgressFn, FIT_MAX_STEPS,
 };
 pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
 pub use result::{
-    ChannelFit, Derived, EnergyForce, FitResult, FitSeries, FittedParam, Identifiability, Rank,
-    RecordFit, SampleAxes, Verdict,
+    ChannelFit, Derived, EnergyForce, FitResult, FitSeries, FittedParam, ForceBalance,
+    Identifiability, Rank, RecordFit, SampleAxes, Verdict,
 };
 pub use search::{fits_directly, Search, PROMOTED_STARTS};
 pub use uncertainty::{PropertyUncertainty, StdErrorComponents};

@@ -81,6 +81,10 @@ pub enum ForceTarget {
     Measured,
     /// The energy-based force of Eq. 7 (needs m, c and k).
     Energy,
+    /// Inverse dynamics: the measured input force u against J a + c v + R(q) + F along the
+    /// measured motion, with the oscillator properties named in `oscillator` fitted jointly
+    /// (the inverse-dynamics identification of drives and robot joints).
+    InverseDynamics,
 }
 
 /// Progress of a running fit, reported after every solver iteration.
@@ -137,7 +141,8 @@ pub struct FitOptions {
     pub domain: FitDomain,
     /// The target force of a force-domain fit.
     pub force_target: ForceTarget,
-    /// Fit a constant force offset per record (force domain, measured force).
+    /// Fit a constant force offset per record (force domain: a measured force or inverse
+    /// dynamics).
     pub force_offset: bool,
     /// Velocity fits of models with internal states start also from the optimum of a
     /// force-domain fit to the energy-based force (the prefit).

@@ -77,6 +77,28 @@ pub struct FitSeries {
     pub energy_based_force: Vec<f64>,
     /// The model's force along the measured motion (empty without the energy check).
     pub model_force: Vec<f64>,
+    /// The force balance of an inverse-dynamics fit at the compared samples.
+    pub balance: Option<ForceBalance>,
+}
+
+/// The terms of J a + c v + R(q) + F + offset = u at a record's compared samples, at the
+/// fitted values (an inverse-dynamics fit) \[N, or N m on a rotary axis\].
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ForceBalance {
+    /// The measured input force u.
+    pub input: Vec<f64>,
+    /// The inertial force J a.
+    pub inertia: Vec<f64>,
+    /// The damping force c v.
+    pub damping: Vec<f64>,
+    /// The restoring force R(q).
+    pub restoring: Vec<f64>,
+    /// The fitted force offset (0 when not fitted).
+    pub offset: f64,
+    /// The fitted friction law's force F along the motion.
+    pub friction_fitted: Vec<f64>,
+    /// The friction force the balance leaves: u - J a - c v - R(q) - offset.
+    pub friction_balance: Vec<f64>,
 }
 
 /// The fit of one compared channel of a record.
