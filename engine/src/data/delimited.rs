@@ -440,8 +440,7 @@ mod tests {
         assert_eq!(
             e.to_string(),
             "r.csv: line 1: no channel column found (looked for `velocity`, `displacement`, \
-             `acceleration`, `force`, `normal_force`, `input_force`); the header has: time, \
-             pressure"
+             `acceleration`, `force`, `normal_force`); the header has: time, pressure"
         );
     }
 }
