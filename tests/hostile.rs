@@ -351,3 +351,150 @@ fn an_absurd_number_of_starts_is_refused_before_allocating() {
     let e = fit(&Oscillator::fmm(), &Coulomb::default(), &[rec], &opts).unwrap_err();
     assert!(one_line(&e).contains("multistart"), "{e}");
 }
+
+/// A driven axis along 5 mm at 2 Hz (velocity, displacement and a friction force of 3 N
+/// Coulomb plus 0.05 N noise), 2 s at 1 kHz.
+fn driven_record() -> Record {
+    use frictionid_engine::record::{Channel, TimeBase};
+    let time = uniform_times(2.0, 1000.0);
+    let w = 4.0 * std::f64::consts::PI;
+    let x: Vec<f64> = time.iter().map(|t| 5e-3 * (w * t).sin()).collect();
+    let v: Vec<f64> = time.iter().map(|t| 5e-3 * w * (w * t).cos()).collect();
+    let mut f: Vec<f64> = v.iter().map(|v| 3.0 * v.signum()).collect();
+    frictionid_engine::synthetic::add_gaussian_noise(&mut f, 0.05, 9);
+    Record::from_time_base("driven", TimeBase::new(time).expect("time base"))
+        .with_channel(Channel::Displacement, x)
+        .with_channel(Channel::Velocity, v)
+        .with_channel(Channel::Force, f)
+}
+
+/// A run at constant speed `v` (1 s at 100 Hz): 3 N Coulomb and 2 N s/m viscous friction
+/// plus 0.05 N noise (seed `seed`).
+fn constant_velocity_run(v: f64, seed: u64) -> Record {
+    use frictionid_engine::record::{Channel, TimeBase};
+    let time = uniform_times(1.0, 100.0);
+    let x: Vec<f64> = time.iter().map(|t| v * t).collect();
+    let mut f = vec![3.0 * v.signum() + 2.0 * v; time.len()];
+    frictionid_engine::synthetic::add_gaussian_noise(&mut f, 0.05, seed);
+    let n = time.len();
+    Record::from_time_base(
+        format!("run{seed}"),
+        TimeBase::new(time).expect("time base"),
+    )
+    .with_channel(Channel::Displacement, x)
+    .with_channel(Channel::Velocity, vec![v; n])
+    .with_channel(Channel::Force, f)
+}
+
+fn force_domain() -> FitOptions {
+    FitOptions {
+        domain: frictionid_engine::identify::FitDomain::Force,
+        parallel: false,
+        ..FitOptions::default()
+    }
+}
+
+fn expression(force: &str, params: serde_json::Value) -> Box<dyn frictionid_models::FrictionModel> {
+    build_json(&serde_json::json!({ "type": "expression", "force": force, "params": params }))
+        .expect("a valid formula")
+        .model
+}
+
+/// The verdict a fit of degenerate input must not reach: converged with no failed finding.
+fn failed_checks(r: &frictionid_engine::identify::FitResult) -> Vec<String> {
+    r.diagnostics
+        .iter()
+        .filter(|d| d.status == frictionid_engine::identify::Status::Fail)
+        .map(|d| d.message.clone())
+        .collect()
+}
+
+#[test]
+fn a_law_that_is_not_finite_over_part_of_the_data_is_an_error_or_a_failure() {
+    // ln(v) is not a number wherever the axis moves backwards: half of every cycle.
+    let model = expression("mu * N * ln(v)", serde_json::json!({ "mu": 0.2 }));
+    let osc = Oscillator::fmm();
+    for opts in [
+        force_domain(),
+        FitOptions {
+            parallel: false,
+            ..FitOptions::default()
+        },
+    ] {
+        match fit(&osc, model.as_ref(), &[driven_record()], &opts) {
+            Ok(r) => assert!(
+                !failed_checks(&r).is_empty() || !r.converged,
+                "fitted a law that is NaN on half the record: cost {}",
+                r.cost
+            ),
+            Err(e) => {
+                one_line(&e);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_record_without_motion_is_refused_with_one_line() {
+    use frictionid_engine::record::Channel;
+    let osc = Oscillator::fmm();
+    let still = |v: Vec<f64>| {
+        let time = uniform_times(1.0, 1000.0);
+        Record::new("still", time, v, 0.0)
+    };
+    let n = uniform_times(1.0, 1000.0).len();
+    let mut noise = vec![0.0; n];
+    frictionid_engine::synthetic::add_gaussian_noise(&mut noise, 2e-4, 5);
+    for (rec, says) in [
+        (still(vec![0.0; n]), "every velocity sample is 0"),
+        (still(noise), "no motion above the noise"),
+    ] {
+        let opts = FitOptions {
+            parallel: false,
+            ..FitOptions::default()
+        };
+        let e = fit(&osc, &Coulomb::default(), std::slice::from_ref(&rec), &opts).unwrap_err();
+        let msg = one_line(&e);
+        assert!(msg.contains("still") && msg.contains(says), "{msg}");
+        // In the force domain too (a force record of a stage that never moved).
+        let forced = rec.with_channel(Channel::Force, vec![0.1; n]);
+        let e = fit(&osc, &Coulomb::default(), &[forced], &force_domain()).unwrap_err();
+        assert!(one_line(&e).contains(says), "{e}");
+    }
+}
+
+#[test]
+fn a_parameter_without_effect_on_the_residuals_fails_a_finding() {
+    let osc = Oscillator::fmm();
+    // `b` enters the formula but not the force.
+    let model = expression(
+        "mu * N * sign(v) + 0 * b * v",
+        serde_json::json!({ "mu": 0.2, "b": 1.0 }),
+    );
+    let r = fit(&osc, model.as_ref(), &[driven_record()], &force_domain()).unwrap();
+    let failed = failed_checks(&r);
+    assert!(
+        failed
+            .iter()
+            .any(|m| m.contains("`b`") && m.contains("changes no residual")),
+        "{failed:?}"
+    );
+    // A Stribeck velocity of 0.1 mm/s held fixed under constant-velocity runs of 10 to
+    // 100 mm/s: exp(-(v/v_s)^2) is 0 at every sample, so mu_s changes nothing.
+    let stribeck = frictionid_models::Stribeck {
+        v_s: 1e-4,
+        ..frictionid_models::Stribeck::default()
+    };
+    let runs: Vec<Record> = [0.01, -0.01, 0.1, -0.1]
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| constant_velocity_run(v, i as u64))
+        .collect();
+    let opts = FitOptions {
+        free: Some(vec!["mu_c".into(), "mu_s".into(), "viscous".into()]),
+        ..force_domain()
+    };
+    let r = fit(&osc, &stribeck, &runs, &opts).unwrap();
+    let failed = failed_checks(&r);
+    assert!(failed.iter().any(|m| m.contains("`mu_s`")), "{failed:?}");
+}

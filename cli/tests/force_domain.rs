@@ -123,3 +123,61 @@ fn bad_force_domain_configurations_are_named() {
     ];
     assert_bad_inputs(Path::new(env!("CARGO_BIN_EXE_frictionid")), "force", &cases);
 }
+
+/// A drive's friction record: 20 N Coulomb friction (plus 0.2 N of deterministic ripple as
+/// noise) along a 2 Hz sinusoid, with no normal-force channel.
+fn coulomb_20n_csv() -> String {
+    let mut s = String::from("time,velocity,force\n");
+    for i in 0..1000 {
+        let t = i as f64 * 1e-3;
+        let v = 0.05 * (4.0 * std::f64::consts::PI * t).sin();
+        let ripple = 0.2 * (1.7e3 * t).sin() * (0.37e3 * t).cos();
+        s.push_str(&format!("{t},{v},{}\n", 20.0 * v.signum() + ripple));
+    }
+    s
+}
+
+/// With N = 1 a 20 N level needs mu = 20, above mu's bound 10: the fit stops on the bound,
+/// and compare says so on stderr and in its verdict (the bound named, and what to do)
+/// instead of ranking a pinned law as if it were fitted.
+#[test]
+fn compare_names_a_level_pinned_at_its_bound_on_stderr_and_in_the_verdict() {
+    let dir = scratch_dir("force", "pinned-level");
+    std::fs::write(dir.join("r.csv"), coulomb_20n_csv()).unwrap();
+    let cfg = dir.join("c.toml");
+    std::fs::write(
+        &cfg,
+        "[oscillator]\nnormal_force = 1.0\n[fit.options]\ndomain = \"force\"\n\
+         models = [\"coulomb\", \"stribeck\"]\n[[records]]\nfile = \"r.csv\"\nx0 = 0.0\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = frictionid()
+        .args(["compare", cfg.to_str().unwrap(), "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(
+        stderr.contains("model `coulomb`: `mu` = 1e1 1 is at its upper bound 1e1")
+            && stderr.contains("normal force"),
+        "{stderr}"
+    );
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let verdict = r["verdict"]["message"].as_str().unwrap();
+    let best = r["verdict"]["best"].as_str().unwrap();
+    assert!(
+        verdict.contains(&format!("`{best}` has `"))
+            && verdict.contains("= 10 at a bound")
+            && verdict.contains("widen its [fit] bounds or set the normal force"),
+        "{verdict}"
+    );
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("at a bound, so its rank is not reliable"),
+        "{md}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,7 +1,7 @@
 //! Criterion benchmarks of the simulation engine: one run per registered model for the FMM case
 //! (N = 14.5 N, x0 = 22 mm, 2 s sampled at 1 kHz, default Dopri5), the paper's 140 mm Coulomb case (N = m g, mu = 0.24)
 //! with Dopri5, the closed form and the paper's Euler (T_n / 1e6), and the stiff bristle models
-//! (sigma0 = 1e7 N/m). The RHS counts are printed once per case (stderr) for the
+//! (sigma0 = 1e7 N/m), among them the `simulate` command's default (`auto`). The RHS counts are printed once per case (stderr) for the
 //! table in benches/README.md.
 
 /// mimalloc, as the `frictionid` binary and the Python module use (glibc's malloc returned
@@ -105,7 +105,29 @@ fn fmm_stiff(c: &mut Criterion) {
         }
     }
     saturating_dahl(&mut group, &osc, &times);
+    simulate_default(&mut group, &osc, &times);
     group.finish();
+}
+
+/// Stiff LuGre (sigma0 = 1e7 N/m, the default sigma1 = 300 N s/m, and sigma1 = 5000 N s/m)
+/// on the `simulate` command's default path: `[simulation.integrator]` left out, so the
+/// spec's default options (`auto`, the engine's tolerances). SciPy's `lugre sigma0=1e7` rows
+/// of benches/scipy_reference.py are the same cases.
+fn simulate_default(group: &mut BenchmarkGroup<'_, WallTime>, osc: &Oscillator, times: &[f64]) {
+    let opts = frictionid_engine::spec::IntegratorSpec::default().sim_options();
+    for sigma1 in [300.0, 5000.0] {
+        let json = serde_json::json!({ "type": "lugre", "sigma0": 1e7, "sigma1": sigma1 });
+        let Ok(built) = frictionid_models::build_json(&json) else {
+            continue;
+        };
+        let model = built.model;
+        let label = format!("lugre_1e7_sigma1_{sigma1}_simulate_default");
+        let rhs = run(osc, model.as_ref(), 0.022, 2.0, times, &opts);
+        eprintln!("fmm_22mm_2s_1kHz_stiff/{label}: {rhs} RHS evaluations");
+        group.bench_function(label, |b| {
+            b.iter(|| run(osc, model.as_ref(), black_box(0.022), 2.0, times, &opts))
+        });
+    }
 }
 
 fn paper_140mm(c: &mut Criterion) {

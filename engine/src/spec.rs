@@ -578,11 +578,13 @@ impl FitSpec {
 #[serde(rename_all = "snake_case")]
 pub enum IntegratorMethod {
     /// Adaptive Dormand-Prince 5(4) with dense output and event location.
-    #[default]
     Dopri5,
     /// Fixed-step explicit Euler (for comparison only).
     Euler,
-    /// Closed form for laws affine in v, Dopri5 otherwise.
+    /// The fits' choice, and `simulate`'s default: the exact propagator for laws affine in v,
+    /// Rodas4 where the motion is stiff (bristle contacts of sigma0 >= 1e6 N/m), Dopri5
+    /// otherwise.
+    #[default]
     Auto,
     /// The exact closed-form propagator (coulomb, viscous_coulomb, none).
     Exact,
@@ -590,7 +592,8 @@ pub enum IntegratorMethod {
     Rodas,
 }
 
-/// `[simulation.integrator]`: integrator choice and tolerances (engine defaults when absent).
+/// `[simulation.integrator]`: integrator choice (default `auto`, as the fits) and tolerances
+/// (the engine's defaults when absent).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct IntegratorSpec {
@@ -852,7 +855,13 @@ mod tests {
     #[test]
     fn integrator_spec_maps_onto_engine_options() {
         let d = SimOptions::default();
-        assert_eq!(IntegratorSpec::default().sim_options(), d);
+        // `simulate` integrates as the fits do by default: `auto`, with the engine's
+        // tolerances and limits.
+        let auto = SimOptions {
+            integrator: Integrator::Auto,
+            ..d
+        };
+        assert_eq!(IntegratorSpec::default().sim_options(), auto);
         let o = IntegratorSpec {
             method: IntegratorMethod::Euler,
             steps_per_period: Some(1e5),

@@ -2,8 +2,10 @@
 
 use super::fit::fit;
 use crate::error::EngineError;
+use crate::identify::values::layout::is_friction_level;
 use crate::identify::values::nuisance::non_model_bound_keys;
 use crate::identify::values::options::FitOptions;
+use crate::identify::values::outcome::{Check, Finding};
 use crate::identify::values::result::FitResult;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -187,6 +189,16 @@ fn verdict(ranking: &[FitResult]) -> Option<ComparisonVerdict> {
             .unwrap_or_default();
         format!("best: `{}`{margin}", best.model)
     };
+    let mut named = vec![best];
+    if simplest.model != best.model {
+        named.push(simplest);
+    }
+    let caveats: Vec<String> = named.into_iter().filter_map(pinned_caveat).collect();
+    let message = if caveats.is_empty() {
+        message
+    } else {
+        format!("{message}; but {}", caveats.join("; "))
+    };
     Some(ComparisonVerdict {
         best: best.model.clone(),
         indistinguishable: names,
@@ -195,7 +207,40 @@ fn verdict(ranking: &[FitResult]) -> Option<ComparisonVerdict> {
     })
 }
 
-/// A warning per model that did not converge.
+/// The findings of `fit` that say a friction level is at its bound (a viscous coefficient at
+/// 0 is an answer; a level at its bound is a level the bounds or a missing normal force set).
+fn at_bounds(fit: &FitResult) -> impl Iterator<Item = &Finding> {
+    fit.diagnostics.iter().filter(|d| {
+        d.check == Check::ParameterAtBound
+            && d.parameter.as_deref().is_some_and(|name| {
+                fit.parameters
+                    .iter()
+                    .any(|p| p.name == name && is_friction_level(&p.name, &p.unit))
+            })
+    })
+}
+
+/// What the verdict adds about a model it names with friction levels at their bounds:
+/// which, at what value, and what to do (`None` when none is).
+fn pinned_caveat(fit: &FitResult) -> Option<String> {
+    let pinned: Vec<String> = at_bounds(fit)
+        .map(|d| {
+            let name = d.parameter.as_deref().unwrap_or("a parameter");
+            let value = d.value.map(|v| format!(" = {v}")).unwrap_or_default();
+            format!("`{name}`{value}")
+        })
+        .collect();
+    (!pinned.is_empty()).then(|| {
+        format!(
+            "`{}` has {} at a bound, so its rank is not reliable: widen its [fit] bounds or set the normal force",
+            fit.model,
+            pinned.join(", ")
+        )
+    })
+}
+
+/// A warning per model that did not converge, and per friction level of a ranked model at
+/// its bound.
 fn comparison_warnings(ranking: &[FitResult], failed: &[FailedFit]) -> Vec<String> {
     let unconverged = ranking.iter().filter(|f| !f.converged).map(|f| {
         format!(
@@ -206,7 +251,10 @@ fn comparison_warnings(ranking: &[FitResult], failed: &[FailedFit]) -> Vec<Strin
     let failures = failed
         .iter()
         .map(|f| format!("model `{}` could not be fitted: {}", f.model, f.error));
-    unconverged.chain(failures).collect()
+    let pinned = ranking
+        .iter()
+        .flat_map(|f| at_bounds(f).map(move |d| format!("model `{}`: {}", f.model, d.message)));
+    unconverged.chain(failures).chain(pinned).collect()
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@
 use super::assessment::identifiability;
 use super::assessment::property_refits::add_property_uncertainty;
 use super::assessment::summary::{summarise, FinishContext};
-use super::problem::{check_force_domain, require_mechanics, ForceAlongMotion};
+use super::problem::{check_force_domain, check_moves, require_mechanics, ForceAlongMotion};
 use super::problem::{FitProblem, ProblemParts, Residuals, SimulatedResponse};
 use super::search::prefit::{prefit_finding, prefit_options, Prefit, PREFIT_ORIGIN};
 use super::search::starts::{run_starts, start_count, MultiStart, StartRun};
@@ -207,8 +207,8 @@ fn seeded_point(layout: &Layout, seeded: &dyn FrictionModel) -> Vec<f64> {
         .collect()
 }
 
-/// The model, the oscillator and every record are valid (as `residuals` needs them), and
-/// there is a record.
+/// The model, the oscillator and every record are valid (as `residuals` needs them), every
+/// record moves ([`check_moves`]), and there is a record.
 fn check_inputs<R: Residuals + ?Sized>(
     osc: &Oscillator,
     model: &dyn FrictionModel,
@@ -222,9 +222,10 @@ fn check_inputs<R: Residuals + ?Sized>(
             "a fit needs at least one record".into(),
         ));
     }
-    records
-        .iter()
-        .try_for_each(|rec| residuals.check_record(rec))
+    records.iter().try_for_each(|rec| {
+        residuals.check_record(rec)?;
+        check_moves(rec)
+    })
 }
 
 /// Nothing to vary: the model evaluated as it is, as a converged run.

@@ -14,7 +14,7 @@
 
 use super::identifiability::PROFILE_DELTA;
 use crate::energy::cumulative_trapezoid;
-use crate::identify::values::layout::FreeParam;
+use crate::identify::values::layout::{is_friction_level, FreeParam, ParamKind};
 use crate::identify::values::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
 use crate::identify::values::result::EnergyForce;
 use crate::identify::values::result::{FittedParam, RecordFit};
@@ -283,25 +283,78 @@ fn structure_finding(stats: &[Statistic]) -> Finding {
     Finding::new(Check::ResidualStructure, status, Some(value), message)
 }
 
-/// A warning per free parameter that ended at one of its (finite) bounds.
+/// A warning per free parameter that ended at one of its (finite) bounds, or collapsed onto
+/// its open lower bound 0 (reported as 0, never as a fitted 2.2e-308), saying what to do.
 pub fn parameters_at_bounds(layout: &[FreeParam], values: &[f64]) -> Vec<Finding> {
     let mut out = Vec::new();
     for (f, &p) in layout.iter().zip(values) {
         let Some(side) = f.bound_side(p) else {
             continue;
         };
-        out.push(Finding::warn(
-            Check::ParameterAtBound,
-            Some(p),
-            format!(
-                "`{}` = {p:e} {} is at its {} bound: the data push it further (check the units, the model and the bounds)",
-                f.name,
-                f.unit,
-                side.name()
-            ),
-        ));
+        let bound = f.bound(side);
+        let shown = f.reported(p);
+        out.push(
+            Finding::warn(
+                Check::ParameterAtBound,
+                Some(shown),
+                format!(
+                    "`{}` = {shown:e} {} is at its {} bound {bound:e}: the data push it further; {}",
+                    f.name,
+                    f.unit,
+                    side.name(),
+                    at_bound_advice(f)
+                ),
+            )
+            .about(&f.name),
+        );
     }
     out
+}
+
+/// The largest change of any weighted residual (in units of its noise) that a change of a
+/// free parameter by its own magnitude may make for the parameter to count as without effect.
+pub const NO_EFFECT: f64 = 1e-8;
+
+/// A failure naming the free parameters whose Jacobian column `jac` (physical coordinates,
+/// weighted residuals) is zero everywhere at `values`: changed by their own magnitude (or
+/// scale, when zero), none moves a residual by [`NO_EFFECT`] of its noise. `None` when every
+/// parameter acts on the records.
+pub fn parameters_without_effect(
+    layout: &[FreeParam],
+    values: &[f64],
+    jac: &nalgebra::DMatrix<f64>,
+) -> Option<Finding> {
+    let dead: Vec<String> = layout
+        .iter()
+        .zip(values)
+        .enumerate()
+        .filter(|&(j, (f, &p))| {
+            let step = if p != 0.0 { p.abs() } else { f.scale.abs() };
+            j < jac.ncols() && jac.column(j).iter().all(|d| (d * step).abs() <= NO_EFFECT)
+        })
+        .map(|(_, (f, p))| format!("`{}` = {p:e} {}", f.name, f.unit))
+        .collect();
+    (!dead.is_empty()).then(|| {
+        Finding::new(
+            Check::ParameterWithoutEffect,
+            Status::Fail,
+            Some(dead.len() as f64),
+            format!(
+                "{} changes no residual at the optimum: the records say nothing about it (speeds outside the range where it acts, or a formula it does not enter); fix it at a known value or fit records that exercise it",
+                dead.join(", ")
+            ),
+        )
+    })
+}
+
+/// What to do about a parameter at its bound.
+fn at_bound_advice(f: &FreeParam) -> String {
+    let widen = format!("widen it in [fit] bounds = {{ {} = [lo, hi] }}", f.name);
+    if matches!(f.kind, ParamKind::Model(_)) && is_friction_level(&f.name, &f.unit) {
+        format!("{widen} or set the normal force (a friction coefficient is the level over N)")
+    } else {
+        format!("{widen}, or check the units and the model")
+    }
 }
 
 /// Whether every free parameter has a standard error; a rank-deficient Jacobian is named as
@@ -585,9 +638,20 @@ mod tests {
             lower: 1e-3,
             ..mu
         };
-        assert!(parameters_at_bounds(&[log], &[1e-3])[0]
+        assert!(parameters_at_bounds(std::slice::from_ref(&log), &[1e-3])[0]
             .message
             .contains("lower"));
+        // Collapsed onto the open lower bound 0: reported as 0, with the way out.
+        let open = FreeParam { lower: 0.0, ..log };
+        let collapsed = parameters_at_bounds(&[open], &[f64::MIN_POSITIVE]);
+        assert_eq!(collapsed[0].value, Some(0.0));
+        assert_eq!(collapsed[0].parameter.as_deref(), Some("mu"));
+        assert!(
+            !collapsed[0].message.contains("e-308"),
+            "{}",
+            collapsed[0].message
+        );
+        assert!(collapsed[0].message.contains("normal force"));
     }
 
     #[test]

@@ -12,8 +12,9 @@
 
 use super::stats::t_quantile_975;
 use crate::error::EngineError;
-use crate::identify::values::options::FitOptions;
+use crate::identify::values::options::{FitDomain, FitOptions};
 use crate::identify::values::result::{FitResult, FittedParam};
+use crate::identify::values::search::{fits_directly, Search};
 use crate::identify::values::uncertainty::{PropertyUncertainty, StdErrorComponents};
 use crate::oscillator::Oscillator;
 use frictionid_models::FrictionModel;
@@ -40,6 +41,12 @@ pub(crate) fn add_property_uncertainty(
     opts.uncertainty = PropertyUncertainty::default();
     opts.guess = false;
     opts.multistart = Some(1);
+    // A refit starts at the optimum: a static law along the measured motion needs no global
+    // search from there (its default, see `Search::resolve`).
+    let simulated = opts.domain != FitDomain::Force;
+    if opts.search.is_none() && fits_directly(result.fitted_model.as_ref(), simulated) {
+        opts.search = Some(Search::Local);
+    }
     opts.progress = None;
     let fitted: Vec<&str> = opts_in.oscillator.iter().map(|q| q.name()).collect();
     let mut components: Vec<StdErrorComponents> = result

@@ -48,6 +48,8 @@ struct Statistics {
     t_quantile: f64,
     /// Says how the standard errors were widened for autocorrelated residuals.
     widening: Option<Finding>,
+    /// Names the free parameters that change no residual.
+    without_effect: Option<Finding>,
 }
 
 fn statistics<R: Residuals>(
@@ -59,6 +61,7 @@ fn statistics<R: Residuals>(
     let p_best = reference.physical(&best.u);
     let (jac, r) = reference.jacobian_physical(&p_best)?;
     let ssr = r.norm_squared();
+    let without_effect = diagnostics::parameters_without_effect(&reference.layout, &p_best, &jac);
     let mut cov = covariance_of_determined(&jac, ssr, standings);
     let segments: Vec<usize> = reference
         .records
@@ -76,6 +79,7 @@ fn statistics<R: Residuals>(
         ssr,
         t_quantile,
         widening,
+        without_effect,
     })
 }
 
@@ -245,6 +249,7 @@ fn diagnose<R: Residuals>(
         ctx.reference.residuals.friction_levels(),
     ));
     findings.extend(diagnostics::parameters_at_bounds(params, &stats.p_best));
+    findings.extend(stats.without_effect.clone());
     findings.extend(fits.findings.iter().cloned());
     if ctx.reference.residuals.simulates_response() {
         findings.push(diagnostics::residual_structure(
@@ -292,6 +297,8 @@ fn parameter_entries(
         .map(|(i, (p, v))| {
             let slot = params.iter().position(|f| f.kind == ParamKind::Model(i));
             let unit = levels.unit(p);
+            // A value collapsed onto its open lower bound is reported as that bound.
+            let v = slot.map_or(v, |s| params[s].reported(v));
             stand(param_entry(&p.name, &unit, v, slot, se, tq), slot)
         })
         .collect();

@@ -9,6 +9,7 @@ pub mod force_along_motion;
 pub mod guess;
 pub mod inverse_dynamics;
 pub mod least_squares;
+pub mod motion_check;
 pub mod residuals;
 pub mod simulated_response;
 pub mod state_cache;
@@ -19,6 +20,7 @@ pub use force_along_motion::{
 };
 pub use guess::guess_hint;
 pub use least_squares::{FitProblem, ProblemParts, Realised};
+pub use motion_check::check_moves;
 pub use residuals::{Evaluation, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE};
 pub use simulated_response::SimulatedResponse;
 pub use step_allowance::StepAllowance;

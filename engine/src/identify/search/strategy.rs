@@ -451,8 +451,14 @@ mod tests {
             assert_eq!(global, Search::Global);
         }
         assert_eq!(Search::resolve(None, &stribeck, 4, true), Search::Staged);
-        // Along the measured motion a static law has no phase to trap the solver.
-        assert_eq!(Search::resolve(None, &stribeck, 4, false), Search::Local);
+        // Along the measured motion a static law's evaluations are cheap: a wide one searches
+        // globally (the Stribeck velocity's plateaus trap a single start).
+        assert_eq!(Search::resolve(None, &stribeck, 4, false), Search::Global);
+        let viscous_coulomb = frictionid_models::ViscousCoulomb::default();
+        assert_eq!(
+            Search::resolve(None, &viscous_coulomb, 2, false),
+            Search::Local
+        );
     }
 
     #[test]

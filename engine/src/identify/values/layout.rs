@@ -136,8 +136,13 @@ impl FreeParam {
 
     /// The bound the physical value `p` sits at: within 1e-6 (relative, at least absolute)
     /// of it in internal coordinates, so that a value a rounding short of its bound (1e12
-    /// read back as 999999999999.999) counts as at the bound.
+    /// read back as 999999999999.999) counts as at the bound; a log-coordinate parameter
+    /// whose value collapsed to the smallest normal double or below ([`Self::collapsed`])
+    /// sits at its lower bound 0.
     pub fn bound_side(&self, p: f64) -> Option<BoundSide> {
+        if self.collapsed(p) {
+            return Some(BoundSide::Lower);
+        }
         let u = self.to_internal(p);
         let (lo, hi) = self.internal_bounds();
         let near = |b: f64| b.is_finite() && (u - b).abs() <= 1e-6 * b.abs().max(1.0);
@@ -149,6 +154,39 @@ impl FreeParam {
             None
         }
     }
+}
+
+impl FreeParam {
+    /// Whether `p` is a log-coordinate parameter that ran down to its open lower bound 0:
+    /// at or below the smallest normal double (where [`Self::to_internal`] clips it), the
+    /// value is 0 in all but name.
+    pub fn collapsed(&self, p: f64) -> bool {
+        self.log && self.lower <= 0.0 && p <= f64::MIN_POSITIVE
+    }
+
+    /// The value to report for `p`: its lower bound when it collapsed onto it, else `p`.
+    pub fn reported(&self, p: f64) -> f64 {
+        if self.collapsed(p) {
+            self.lower.max(0.0)
+        } else {
+            p
+        }
+    }
+
+    /// The bound on `side`.
+    pub fn bound(&self, side: BoundSide) -> f64 {
+        match side {
+            BoundSide::Lower => self.lower,
+            BoundSide::Upper => self.upper,
+        }
+    }
+}
+
+/// Whether a model parameter named `name` in `unit` is a friction level: a coefficient
+/// (`mu`, `mu_c`, `mu_s`, ...) that the normal force turns into a force, so that a level at
+/// its bound may be a missing normal force. The one place of this rule.
+pub fn is_friction_level(name: &str, unit: &str) -> bool {
+    unit == "1" && (name == "mu" || name.starts_with("mu_"))
 }
 
 /// Which bound a parameter sits at.

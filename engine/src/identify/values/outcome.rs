@@ -192,6 +192,9 @@ pub enum Check {
     ResidualStructure,
     /// A fitted parameter sits at one of its bounds.
     ParameterAtBound,
+    /// A free parameter that changes no residual at the optimum (its Jacobian column is zero
+    /// everywhere): the records say nothing about it.
+    ParameterWithoutEffect,
     /// Whether standard errors could be computed.
     StandardErrors,
     /// Two free parameters are strongly correlated.
@@ -223,6 +226,9 @@ pub struct Finding {
     pub value: Option<f64>,
     /// What it means, for a person.
     pub message: String,
+    /// The parameter it is about, when it is about one (a parameter at its bound).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parameter: Option<String>,
 }
 
 impl Finding {
@@ -233,7 +239,14 @@ impl Finding {
             status,
             value,
             message,
+            parameter: None,
         }
+    }
+
+    /// The finding, about the parameter `name`.
+    pub fn about(mut self, name: &str) -> Self {
+        self.parameter = Some(name.to_string());
+        self
     }
 
     /// A warning.

@@ -31,10 +31,12 @@ impl Search {
         }
     }
 
-    /// The strategy asked for, else `staged` for a model with internal states or more than
-    /// two free parameters and `local` otherwise (a Coulomb fit stays one start, one run),
-    /// and `local` for a static law fitted along the measured motion
-    /// ([`fits_directly`]).
+    /// The strategy asked for, else, for a model with internal states or more than two free
+    /// parameters, `staged` (fitted by simulating the response or a dynamic law along the
+    /// measured motion) or `global` (a static law along the measured motion,
+    /// [`fits_directly`]: its evaluations cost microseconds, and the Stribeck velocity's
+    /// plateaus trap a single start); `local` otherwise (a Coulomb fit stays one start, one
+    /// run).
     pub fn resolve(
         asked: Option<Self>,
         model: &dyn FrictionModel,
@@ -42,10 +44,10 @@ impl Search {
         simulated: bool,
     ) -> Self {
         let wide = model.n_states() > 0 || n_model_free > 2;
-        asked.unwrap_or(if wide && !fits_directly(model, simulated) {
-            Self::Staged
-        } else {
-            Self::Local
+        asked.unwrap_or(match (wide, fits_directly(model, simulated)) {
+            (false, _) => Self::Local,
+            (true, false) => Self::Staged,
+            (true, true) => Self::Global,
         })
     }
 
@@ -60,10 +62,9 @@ impl Search {
 }
 
 /// Whether `model` is a static law fitted without simulating the response (`simulated`
-/// false: the force domain). Its residuals are the law itself at the measured velocities:
-/// no phase error traps the solver and the data-driven guess puts the levels at the target
-/// force's, so the default is one start from the guess (the force route's speed; `search`
-/// and `multistart` still ask for more).
+/// false: the force domain). Its residuals are the law itself at the measured velocities,
+/// cheap to evaluate, so its default is one local run from the data-driven guess (no screening)
+/// and, with more than two free parameters, a `global` search ([`Search::resolve`]).
 pub fn fits_directly(model: &dyn FrictionModel, simulated: bool) -> bool {
     !simulated && model.n_states() == 0
 }
