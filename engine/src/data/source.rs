@@ -10,7 +10,8 @@
 //! x0 = 0.014                  # m, the release displacement
 //! v0 = 0.0                    # m/s, optional
 //! weight = 1.0                # optional, in a joint fit
-//! format = "auto"             # auto | csv | whitespace | uff58
+//! format = "auto"             # auto | csv | whitespace | uff58 | mat (a MAT-file: each
+//!                             # *_column names a variable)
 //! time_column = "time"        # and time_scale (1e-3 for milliseconds)
 //! velocity_column = "velocity"
 //! velocity_scale = 1e-3       # the file's velocity unit in m/s (here mm/s)
