@@ -15,7 +15,7 @@ use super::step_allowance::StepAllowance;
 use crate::energy::{analyze_record, EnergyAnalysis, EnergyOptions};
 use crate::error::EngineError;
 use crate::identify::values::options::FitOptions;
-use crate::identify::values::{NuisanceKind, NuisanceValues, SampleAxes};
+use crate::identify::values::{NuisanceKind, NuisanceValues, SampleAxes, SlidingSamples};
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use crate::simulate::{SimOptions, SimStats};
@@ -187,6 +187,12 @@ pub trait Residuals: Send + Sync {
             time: record.time().to_vec(),
             ..SampleAxes::default()
         }
+    }
+
+    /// The sliding samples record `index` compares, when only those are (`None`: every
+    /// sample the residuals define).
+    fn sliding_samples(&self, _index: usize) -> Option<SlidingSamples> {
+        None
     }
 
     /// Number of residuals record `index` contributes.
