@@ -10,7 +10,7 @@
 //! The measured records are not part of this value yet: front ends read them and hand them
 //! to the jobs in [`crate::jobs`].
 
-use crate::data::MAX_SAMPLES;
+use crate::data::{RecordUse, MAX_SAMPLES};
 use crate::energy::{Differentiator, EnergyOptions};
 use crate::identify::{
     check_min_speed, non_model_bound_keys, FitDomain, FitOptions, ForceTarget, OscillatorParam,
@@ -312,6 +312,15 @@ impl Spec {
             energy,
             unknown_oscillator: oscillator.unknown,
         })
+    }
+
+    /// How the fit uses its records: simulated (velocity domain) or replayed as measured
+    /// (force domain), which decides whether a `[[records]]` entry needs `x0`.
+    pub fn record_use(&self) -> RecordUse {
+        match self.fit.options.domain {
+            FitDomain::Velocity => RecordUse::Simulated,
+            FitDomain::Force => RecordUse::Replayed,
+        }
     }
 
     /// The model, or an error naming the command that needs it.

@@ -14,7 +14,7 @@ mod uff58;
 
 pub use delimited::read_delimited;
 pub use mat5::read_mat;
-pub use source::{RecordSource, RecordSourceError, ResolvedSource};
+pub use source::{RecordSource, RecordSourceError, RecordUse, ResolvedSource};
 pub use uff58::read_uff58;
 
 pub use crate::record::Channel;
