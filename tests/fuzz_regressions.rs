@@ -3,7 +3,7 @@
 //! which must return (Ok or a clean one-line Err) without panicking.
 
 use frictionid_cli::config::Config;
-use frictionid_engine::data::{read_delimited, read_uff58, DataFormat, ReadOptions};
+use frictionid_engine::data::{read_delimited, read_mat, read_uff58, DataFormat, ReadOptions};
 use frictionid_models::formula;
 use std::path::{Path, PathBuf};
 
@@ -66,6 +66,22 @@ fn uff58_regressions() {
         match read_uff58(Path::new("fuzz.uff"), &text, &opts()) {
             Ok(r) => assert!(
                 r.time().iter().chain(r.velocity()).all(|v| v.is_finite()),
+                "{}: non-finite samples accepted",
+                path.display()
+            ),
+            Err(e) => check_message(&path, &e.to_string()),
+        }
+    }
+}
+
+#[test]
+fn mat_regressions() {
+    let files = inputs("mat");
+    assert!(!files.is_empty());
+    for (path, data) in files {
+        match read_mat(Path::new("fuzz.mat"), &data, &opts()) {
+            Ok(r) => assert!(
+                r.time().iter().all(|v| v.is_finite()),
                 "{}: non-finite samples accepted",
                 path.display()
             ),

@@ -271,7 +271,7 @@ impl Config {
             .enumerate()
             .map(|(i, r)| {
                 r.with_defaults(&record_defaults)
-                    .resolve(i + 1, &base_dir)
+                    .resolve_for(i + 1, &base_dir, spec.record_use())
                     .map_err(|e| cfg_err(e.to_string()))
             })
             .collect::<Result<Vec<_>, _>>()?;

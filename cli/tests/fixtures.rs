@@ -1,10 +1,11 @@
 //! The bundled fixtures end to end: `simulate` on the paper's configs against the exact
 //! Coulomb solution, the synthetic FMM records against their documented truth, and the UFF
-//! dataset 58 twins (written by pyuff) against their CSV record.
+//! dataset 58 twins (written by pyuff) and the MAT-file twins (written by SciPy's `savemat`)
+//! against their CSV record.
 
 use assert_cmd::Command;
 use frictionid_cli::testing::{fixtures_dir, read_report, scratch_dir};
-use frictionid_engine::data::{read_record, Channel, ReadOptions};
+use frictionid_engine::data::{read_record, Channel, DataFormat, ReadOptions};
 use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::Oscillator;
 use std::path::PathBuf;
@@ -182,6 +183,89 @@ fn uff_record_in_a_config_reads_like_its_csv_twin() {
     assert_eq!(recs[1].x0, 0.014);
     assert_eq!(recs[0].len(), recs[1].len());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `velocity` of `mat` against the CSV twin's, within `rel` of each value plus `abs`.
+fn assert_twin(file: &str, mat: &frictionid_engine::Record, rel: f64, abs: f64) {
+    let csv = read_record(&fixtures_dir().join("x14mm.csv"), &ReadOptions::default()).unwrap();
+    assert_eq!(mat.len(), csv.len(), "{file}");
+    assert_eq!(mat.time(), csv.time(), "{file}: time");
+    for (a, b) in mat.velocity().iter().zip(csv.velocity()) {
+        assert!((a - b).abs() <= rel * b.abs() + abs, "{file}: v {a} vs {b}");
+    }
+    assert_eq!((mat.x0, mat.v0, mat.weight), (csv.x0, csv.v0, csv.weight));
+}
+
+/// SciPy's `savemat` output (fixtures/make_mat.py) reads to the CSV record: a 1xN time and an
+/// Nx1 velocity uncompressed and in double precision (exact); compressed, a single-precision
+/// velocity (to its 24-bit mantissa) and an int32 velocity in um/s (to its rounding).
+#[test]
+fn mat_twins_read_to_the_csv_record() {
+    let read = |file: &str, opts: ReadOptions| {
+        read_record(&fixtures_dir().join(file), &opts).unwrap_or_else(|e| panic!("{e}"))
+    };
+    assert_twin(
+        "x14mm.mat",
+        &read("x14mm.mat", ReadOptions::default()),
+        0.0,
+        0.0,
+    );
+    let compressed = "x14mm-compressed.mat";
+    let single = read(compressed, ReadOptions::default());
+    assert_twin(compressed, &single, 2f64.powi(-24), 0.0);
+    let counts = ReadOptions::default()
+        .with_column(Channel::Velocity, "velocity_um_s")
+        .with_scale(Channel::Velocity, 1e-6);
+    assert_twin(compressed, &read(compressed, counts), 0.0, 0.5e-6);
+    let by_format = ReadOptions {
+        format: DataFormat::Mat,
+        ..ReadOptions::default()
+    };
+    let copy = scratch_dir("fx", "matfmt").join("x14mm.bin");
+    std::fs::copy(fixtures_dir().join("x14mm.mat"), &copy).unwrap();
+    let record = read_record(&copy, &by_format).unwrap();
+    assert_twin("x14mm.bin", &record, 0.0, 0.0);
+}
+
+/// A variable missing or unusable is one line naming the file, the variable and the key; a
+/// near name is suggested.
+#[test]
+fn mat_errors_name_the_file_variable_and_key() {
+    let path = fixtures_dir().join("x14mm-compressed.mat");
+    let file = path.display().to_string();
+    for (column, says) in [
+        (
+            "velocty",
+            "velocity_column: no variable `velocty` (did you mean `velocity`?); the file has: \
+             time, velocity, velocity_um_s, note, rig, both",
+        ),
+        (
+            "rig",
+            "velocity_column: variable `rig` is a struct; save each channel as its own \
+             numeric variable",
+        ),
+        (
+            "both",
+            "velocity_column: variable `both` is a 2001x2 matrix; store each channel as a 1xN \
+             or Nx1 vector",
+        ),
+        (
+            "note",
+            "velocity_column: variable `note` is text (a char array), not a numeric vector",
+        ),
+    ] {
+        let opts = ReadOptions::default().with_column(Channel::Velocity, column);
+        let e = read_record(&path, &opts).unwrap_err().to_string();
+        assert_eq!(e, format!("{file}: {says}"));
+    }
+    let csv_as_mat = ReadOptions {
+        format: DataFormat::Mat,
+        ..ReadOptions::default()
+    };
+    let e = read_record(&fixtures_dir().join("x14mm.csv"), &csv_as_mat)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("x14mm.csv: not a MAT-file of level 5"), "{e}");
 }
 
 /// `energy` on the FMM records recovers the true Coulomb force mu N = 3.48 N (the records'

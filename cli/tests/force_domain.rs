@@ -42,6 +42,9 @@ fn tribometer_compare_ranks_dynamic_models_ahead_of_static_ones() {
             assert!(rms(d) < rms(s), "{d}: {} N, {s}: {} N", rms(d), rms(s));
         }
     }
+    // The config gives no x0: the record starts at its first position sample, -110.0353 mm.
+    let x0 = ranking[0]["records"][0]["x0"].as_f64().unwrap();
+    assert!((x0 + 0.1100353).abs() < 1e-12, "x0 = {x0}");
     // Static laws cannot hold the ~2.3 N of the dwells: their RMS is far above 0.5 N.
     for s in STATIC {
         assert!(rms(s) > 0.5, "{s}: {} N", rms(s));
@@ -120,6 +123,13 @@ fn bad_force_domain_configurations_are_named() {
             config(FULL, "domain = \"force\"\nforce_offset = true", ""),
         )
         .says(Contains("force_offset = true needs a measured force channel")),
+        // Eq. 7 integrates a velocity-only record from x0: without it, the record is named.
+        case(
+            "no-x0-energy",
+            "fit",
+            config(FULL, "domain = \"force\"", "").replace("x0 = 0.0138\n", ""),
+        )
+        .says(Contains("c.toml: record `r.csv`: missing `x0` (the release displacement, m): the energy analysis (it integrates the velocity from x0) needs it for a record without a displacement channel")),
     ];
     assert_bad_inputs(Path::new(env!("CARGO_BIN_EXE_frictionid")), "force", &cases);
 }

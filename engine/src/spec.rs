@@ -11,11 +11,11 @@
 //! to the jobs in [`crate::jobs`].
 
 use crate::axis::{Axis, Restoring};
-use crate::data::MAX_SAMPLES;
+use crate::data::{RecordUse, MAX_SAMPLES};
 use crate::energy::{Differentiator, EnergyOptions};
 use crate::identify::{
-    non_model_bound_keys, FitDomain, FitOptions, ForceTarget, OscillatorParam, ProgressFn,
-    PropertyUncertainty, Search,
+    check_min_speed, non_model_bound_keys, FitDomain, FitOptions, ForceTarget, OscillatorParam,
+    ProgressFn, PropertyUncertainty, Search,
 };
 use crate::oscillator::Oscillator;
 use crate::simulate::{Integrator, SimOptions};
@@ -66,6 +66,9 @@ pub enum SpecError {
         /// Upper bound as written.
         upper: f64,
     },
+    /// A `[fit.options]` value that cannot be used.
+    #[error("{0}")]
+    FitOption(String),
     /// A value out of range or a key missing in `[simulation]`.
     #[error("[simulation]: {0}")]
     Simulation(String),
@@ -359,6 +362,7 @@ impl Spec {
         if let Some(m) = &model {
             fit.check_against(m.model.as_ref())?;
         }
+        check_min_speed(fit.options.min_speed, fit.options.domain).map_err(SpecError::FitOption)?;
         Ok(Self {
             oscillator: oscillator.oscillator,
             uncertainty: oscillator.uncertainty,
@@ -368,6 +372,15 @@ impl Spec {
             energy,
             unknown_oscillator: oscillator.unknown,
         })
+    }
+
+    /// How the fit uses its records: simulated (velocity domain) or replayed as measured
+    /// (force domain), which decides whether a `[[records]]` entry needs `x0`.
+    pub fn record_use(&self) -> RecordUse {
+        match self.fit.options.domain {
+            FitDomain::Velocity => RecordUse::Simulated,
+            FitDomain::Force => RecordUse::Replayed,
+        }
     }
 
     /// The model, or an error naming the command that needs it.
@@ -410,6 +423,7 @@ impl Spec {
             domain: given.domain,
             force_target: given.force_target,
             force_offset: given.force_offset,
+            min_speed: given.min_speed,
             prefit: given.prefit.unwrap_or(defaults.prefit),
             unknown_oscillator: self.unknown_oscillator.clone(),
             multistart: given.multistart,
@@ -514,6 +528,9 @@ pub struct FitOptionsSpec {
     /// Force domain: fit a constant force offset per record (a load cell's zero, a drive's
     /// force offset).
     pub force_offset: bool,
+    /// Force domain: compare only the samples with |v| >= min_speed \[m/s\] (the sliding
+    /// ones; default: every sample).
+    pub min_speed: Option<f64>,
     /// Velocity fits of dynamic models start also from a force-domain prefit (default false).
     pub prefit: Option<bool>,
     /// The integrator of the fit's simulations (default `auto`: exact, rodas or dopri5 by the

@@ -238,3 +238,118 @@ fn the_energy_based_route_gives_the_stribeck_curve() {
     let mu_c = noisy.value("mu_c").unwrap();
     assert!(rel(mu_c, truth.mu_c) < 1e-2, "noisy mu_c = {mu_c}");
 }
+
+/// A reciprocating record whose reversals stick: the table slides at up to 20 mm/s for two
+/// thirds of each 1 s cycle (v = 0.02 (|sin| - 1/2) / (1/2) sgn(sin), zero while |sin| < 1/2)
+/// and dwells for the rest, where the measured velocity is a dither of +-1e-5 m/s (encoder
+/// noise) and the force reverses with the drive from +-F to -+F (F = 2 F_s sin: the contact's
+/// static load). The sliding force is Coulomb, F_s = mu N = 0.3 x 10 N = 3 N: the oracle.
+fn sticking_reversals() -> Record {
+    let (sliding, normal) = (3.0, 10.0);
+    let n = 4000;
+    let dt = 1e-3;
+    let omega = 2.0 * PI;
+    let mut time = Vec::with_capacity(n);
+    let (mut v, mut f) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for i in 0..n {
+        let t = i as f64 * dt;
+        let s = (omega * t).sin();
+        time.push(t);
+        if s.abs() >= 0.5 {
+            v.push(0.02 * (s.abs() - 0.5) / 0.5 * s.signum());
+            f.push(sliding * s.signum());
+        } else {
+            v.push(if i % 2 == 0 { 1e-5 } else { -1e-5 });
+            f.push(2.0 * sliding * s);
+        }
+    }
+    Record::from_time_base("reversals", TimeBase::new(time).expect("time base"))
+        .with_channel(Channel::Velocity, v)
+        .with_channel(Channel::Force, f)
+        .with_channel(Channel::NormalForce, vec![normal; n])
+}
+
+#[test]
+fn min_speed_recovers_the_sliding_level_that_stick_phases_drag_down() {
+    let record = sticking_reversals();
+    let osc = Oscillator::fmm();
+    let all = fit(
+        &osc,
+        &Coulomb::default(),
+        std::slice::from_ref(&record),
+        &force_options(),
+    )
+    .unwrap();
+    let dragged = all.value("mu").unwrap();
+    assert!(dragged < 0.8 * 0.3, "every sample: mu = {dragged}");
+    assert!(all.records[0].sliding.is_none());
+    let sliding = FitOptions {
+        min_speed: Some(1e-3),
+        ..force_options()
+    };
+    let r = fit(&osc, &Coulomb::default(), &[record], &sliding).unwrap();
+    let mu = r.value("mu").unwrap();
+    assert!(rel(mu, 0.3) < 1e-9, "sliding samples: mu = {mu}");
+    let kept = r.records[0].sliding.expect("the kept samples are reported");
+    assert_eq!((kept.min_speed, kept.of), (1e-3, 4000));
+    // |v| >= 1 mm/s where |sin| >= 0.525: 1 - (2/pi) asin(0.525) = 64.8 % of the samples.
+    assert!(
+        (2400..2667).contains(&kept.kept),
+        "kept {} of {}",
+        kept.kept,
+        kept.of
+    );
+    // Every writer shows the record table: its last column holds the count.
+    let table = frictionid_engine::report::fit::record_table(&r);
+    assert_eq!(
+        table.headers.last().map(String::as_str),
+        Some("samples with |v| >= 0.001 m/s")
+    );
+    assert_eq!(
+        table.rows[0].last(),
+        Some(&format!("{} of 4000", kept.kept))
+    );
+    let json = serde_json::to_value(&r.records[0]).unwrap();
+    assert_eq!(json["sliding"]["kept"].as_u64(), Some(kept.kept as u64));
+    let plain = frictionid_engine::report::fit::record_table(&all);
+    assert!(!plain.headers.iter().any(|h| h.contains("|v|")));
+}
+
+#[test]
+fn min_speed_is_a_force_domain_option_and_a_speed() {
+    let record = sticking_reversals();
+    let osc = Oscillator::fmm();
+    for (opts, says) in [
+        (
+            FitOptions {
+                min_speed: Some(1e-3),
+                ..FitOptions::default()
+            },
+            "min_speed applies to force-domain fits only",
+        ),
+        (
+            FitOptions {
+                min_speed: Some(-1.0),
+                ..force_options()
+            },
+            "min_speed must be a speed >= 0 (m/s), got -1",
+        ),
+        (
+            FitOptions {
+                min_speed: Some(1.0),
+                ..force_options()
+            },
+            "0 samples slide with |v| >= [fit.options] min_speed = 1 m/s; lower it",
+        ),
+    ] {
+        let e = fit(
+            &osc,
+            &Coulomb::default(),
+            std::slice::from_ref(&record),
+            &opts,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains(says), "{e}");
+    }
+}

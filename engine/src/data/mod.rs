@@ -1,6 +1,6 @@
-//! Readers for measured velocity records: delimited text (CSV, whitespace-separated) and the
-//! universal file format's dataset 58 (ASCII), as exported by laser vibrometers and modal-test
-//! software.
+//! Readers for measured records: delimited text (CSV, whitespace-separated), the universal
+//! file format's dataset 58 (ASCII), as exported by laser vibrometers and modal-test software,
+//! and MATLAB MAT-files of level 5, as drive, robot and benchmark data come.
 //!
 //! Every reader returns an engine [`Record`] released from rest at x0 = 0 with unit weight; the
 //! caller sets `x0`, `v0` and `weight` from its configuration: [`RecordSource`] (one
@@ -8,11 +8,13 @@
 //! message is one line naming the file and, where there is one, the line and the reason.
 
 mod delimited;
+mod mat5;
 pub mod source;
 mod uff58;
 
 pub use delimited::read_delimited;
-pub use source::{RecordSource, RecordSourceError, ResolvedSource};
+pub use mat5::read_mat;
+pub use source::{RecordSource, RecordSourceError, RecordUse, ResolvedSource};
 pub use uff58::read_uff58;
 
 pub use crate::record::Channel;
@@ -48,8 +50,8 @@ pub(crate) fn quoted(text: &str) -> String {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum DataFormat {
-    /// Chosen from the file extension (`.uff`, `.unv`, `.58` are UFF; anything else is
-    /// delimited text with the delimiter taken from the header row).
+    /// Chosen from the file extension (`.uff`, `.unv`, `.58` are UFF; `.mat` is a MAT-file;
+    /// anything else is delimited text with the delimiter taken from the header row).
     #[default]
     Auto,
     /// Comma-, semicolon- or tab-separated text with a header row.
@@ -58,13 +60,16 @@ pub enum DataFormat {
     Whitespace,
     /// Universal file format, dataset 58, ASCII.
     Uff58,
+    /// MATLAB MAT-file, level 5 (`save -v7` or -v6, SciPy's `savemat`), compressed or not:
+    /// each column names a numeric vector variable.
+    Mat,
 }
 
 /// Where one quantity is in a file and the factor that turns the file's unit into SI.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ColumnSpec {
-    /// Header name of the column (delimited text only).
+    /// Header name of the column (delimited text), or the variable's name (MAT-file).
     pub column: String,
     /// Factor from the file's unit to SI (1e-3 for mm/s; negative to flip a sign convention).
     pub scale: f64,
@@ -281,6 +286,9 @@ pub enum DataError {
         line: usize,
         reason: String,
     },
+    /// A malformed or unsupported MAT-file, or a variable missing or unusable.
+    #[error("{file}: {reason}")]
+    Mat { file: PathBuf, reason: String },
     /// The file or record exceeds a size limit ([`MAX_FILE_BYTES`], [`MAX_SAMPLES`]).
     #[error("{file}: {reason}")]
     TooLarge { file: PathBuf, reason: String },
@@ -301,10 +309,11 @@ pub fn read_record(path: &Path, opts: &ReadOptions) -> Result<Record, DataError>
         file: path.to_path_buf(),
         reason,
     })?;
-    let text = read_text(path)?;
+    let bytes = read_bytes(path)?;
     match resolve_format(path, opts.format) {
-        DataFormat::Uff58 => read_uff58(path, &text, opts),
-        fmt => read_delimited(path, &text, fmt, opts),
+        DataFormat::Mat => read_mat(path, &bytes, opts),
+        DataFormat::Uff58 => read_uff58(path, &as_text(&bytes), opts),
+        fmt => read_delimited(path, &as_text(&bytes), fmt, opts),
     }
 }
 
@@ -320,11 +329,13 @@ pub fn resolve_format(path: &Path, format: DataFormat) -> DataFormat {
         .unwrap_or_default();
     match ext.as_str() {
         "uff" | "unv" | "58" => DataFormat::Uff58,
+        "mat" => DataFormat::Mat,
         _ => DataFormat::Auto,
     }
 }
 
-fn read_text(path: &Path) -> Result<String, DataError> {
+/// The bytes of the file at `path`, refused beyond [`MAX_FILE_BYTES`].
+fn read_bytes(path: &Path) -> Result<Vec<u8>, DataError> {
     use std::io::Read;
     let io = |e: std::io::Error| DataError::Io {
         file: path.to_path_buf(),
@@ -350,11 +361,15 @@ fn read_text(path: &Path) -> Result<String, DataError> {
     if bytes.len() as u64 > MAX_FILE_BYTES {
         return Err(too_large(format!("over {MAX_FILE_BYTES} bytes")));
     }
-    let text = String::from_utf8_lossy(&bytes).into_owned();
-    Ok(text
-        .strip_prefix('\u{feff}')
+    Ok(bytes)
+}
+
+/// The text of a file's bytes, invalid UTF-8 replaced and a byte-order mark dropped.
+fn as_text(bytes: &[u8]) -> String {
+    let text = String::from_utf8_lossy(bytes).into_owned();
+    text.strip_prefix('\u{feff}')
         .map(str::to_string)
-        .unwrap_or(text))
+        .unwrap_or(text)
 }
 
 /// The error for a record with more than [`MAX_SAMPLES`] samples.
@@ -482,6 +497,10 @@ mod tests {
         assert_eq!(
             resolve_format(Path::new("a/b.UFF"), DataFormat::Auto),
             DataFormat::Uff58
+        );
+        assert_eq!(
+            resolve_format(Path::new("a/b.MAT"), DataFormat::Auto),
+            DataFormat::Mat
         );
         assert_eq!(
             resolve_format(Path::new("a/b.csv"), DataFormat::Auto),

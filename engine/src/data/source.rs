@@ -7,10 +7,11 @@
 //!
 //! [[records]]
 //! file = "x14mm.csv"          # relative to the configuration file
-//! x0 = 0.014                  # m, the release displacement
+//! x0 = 0.014                  # m, the release displacement (see below when it may be left out)
 //! v0 = 0.0                    # m/s, optional
 //! weight = 1.0                # optional, in a joint fit
-//! format = "auto"             # auto | csv | whitespace | uff58
+//! format = "auto"             # auto | csv | whitespace | uff58 | mat (a MAT-file: each
+//!                             # *_column names a variable)
 //! time_column = "time"        # and time_scale (1e-3 for milliseconds)
 //! velocity_column = "velocity"
 //! velocity_scale = 1e-3       # the file's velocity unit in m/s (here mm/s)
@@ -25,9 +26,19 @@
 //! min_samples = 10
 //! sampling_tolerance = 0.01
 //! ```
+//!
+//! `x0` is needed only where a record without a displacement channel is simulated from rest
+//! or has its velocity integrated (velocity fits, the energy analysis, the energy-based force
+//! of Eq. 7). A record with a displacement channel starts at its first sample (relative to
+//! the equilibrium); a force-domain fit on a measured force uses no x0. Where the entry is
+//! checked ([`RecordSource::resolve_for`]) an entry without `x0` or `displacement_column` is
+//! refused for a velocity fit; once read, [`crate::record::Record::require_x0`] refuses a
+//! record whose x0 is unknown wherever one is needed.
 
 use super::{read_record, DataError, DataFormat, ReadOptions};
-use crate::record::{check_scales, detect_release, Channel, NormalForce, Record, Release};
+use crate::record::{
+    check_scales, detect_release, Channel, NormalForce, Record, Release, X0Source,
+};
 use crate::Oscillator;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -44,7 +55,8 @@ use thiserror::Error;
 pub struct RecordSource {
     /// The data file, relative to the base directory (the configuration file's) or absolute.
     pub file: Option<String>,
-    /// Release displacement \[m\] (required).
+    /// Release displacement \[m\] (default: the first displacement sample; required for a
+    /// velocity fit of a record without a displacement channel).
     pub x0: Option<f64>,
     /// Release velocity [m/s] (default 0).
     pub v0: Option<f64>,
@@ -146,6 +158,16 @@ pub enum RecordSourceError {
     NormalForceTwice { index: usize, file: String },
 }
 
+/// How the records of a run are used: what decides whether an entry needs `x0`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RecordUse {
+    /// Simulated from rest at x0 (a velocity fit): x0 given or measured.
+    Simulated,
+    /// Replayed as measured (a force-domain fit): x0 only where the energy analysis or Eq. 7
+    /// integrates a velocity ([`crate::record::Record::require_x0`]).
+    Replayed,
+}
+
 /// Every key of [`RecordSource`], for the merge with `[record_defaults]`.
 macro_rules! record_keys {
     ($m:ident) => {
@@ -189,8 +211,8 @@ pub struct ResolvedSource {
     pub file: PathBuf,
     /// The file as written (the record's name in messages and reports).
     pub file_as_written: String,
-    /// Release displacement \[m\].
-    pub x0: f64,
+    /// Release displacement \[m\] (`None`: the first displacement sample, else unknown).
+    pub x0: Option<f64>,
     /// Release velocity [m/s].
     pub v0: f64,
     /// Weight in a joint fit.
@@ -211,7 +233,6 @@ impl ResolvedSource {
     pub fn load(&self) -> Result<Record, DataError> {
         let mut record = read_record(&self.file, &self.read)?;
         record.name = self.file_as_written.clone();
-        record.x0 = self.x0;
         record.v0 = self.v0;
         record.weight = self.weight;
         if let Some(n) = self.normal_force {
@@ -220,7 +241,22 @@ impl ResolvedSource {
         for &(channel, sigma) in &self.noise {
             record = record.with_noise(channel, sigma);
         }
-        self.start_at_release(record)
+        let mut record = self.start_at_release(record)?;
+        (record.x0, record.x0_source) = self.release_displacement(&record);
+        Ok(record)
+    }
+
+    /// The record's x0 and where it comes from: given, else its first displacement sample,
+    /// else unknown (0).
+    fn release_displacement(&self, record: &Record) -> (f64, X0Source) {
+        let first = record
+            .channel(Channel::Displacement)
+            .and_then(|x| x.first().copied());
+        match (self.x0, first) {
+            (Some(x0), _) => (x0, X0Source::Given),
+            (None, Some(x0)) => (x0, X0Source::FirstDisplacement),
+            (None, None) => (0.0, X0Source::Unknown),
+        }
     }
 
     /// [`ResolvedSource::load`], then the units checked against `osc`
@@ -287,20 +323,32 @@ impl RecordSource {
         record_keys!(merge)
     }
 
-    /// Checks the entry (the `index`-th, 1-based, for messages) and resolves its file against
-    /// `base_dir`.
+    /// Checks the entry (the `index`-th, 1-based, for messages) for a simulated record and
+    /// resolves its file against `base_dir` ([`RecordSource::resolve_for`]).
     pub fn resolve(
         &self,
         index: usize,
         base_dir: &Path,
     ) -> Result<ResolvedSource, RecordSourceError> {
+        self.resolve_for(index, base_dir, RecordUse::Simulated)
+    }
+
+    /// Checks the entry (the `index`-th, 1-based, for messages) for `used` and resolves its
+    /// file against `base_dir`. A simulated record needs `x0` unless the entry names a
+    /// displacement column (then x0 is its first sample).
+    pub fn resolve_for(
+        &self,
+        index: usize,
+        base_dir: &Path,
+        used: RecordUse,
+    ) -> Result<ResolvedSource, RecordSourceError> {
         let Some(file) = self.file.clone() else {
             return Err(RecordSourceError::MissingFile { index });
         };
-        let x0 = self.x0.ok_or_else(|| RecordSourceError::MissingX0 {
-            index,
-            file: file.clone(),
-        })?;
+        let measured_x0 = self.displacement_column.is_some();
+        if self.x0.is_none() && !measured_x0 && used == RecordUse::Simulated {
+            return Err(RecordSourceError::MissingX0 { index, file });
+        }
         let finite = |key: &'static str, value: f64| {
             if value.is_finite() {
                 Ok(value)
@@ -321,7 +369,7 @@ impl RecordSource {
                 value: weight,
             });
         }
-        let x0 = finite("x0", x0)?;
+        let x0 = self.x0.map(|x0| finite("x0", x0)).transpose()?;
         let v0 = finite("v0", self.v0.unwrap_or(0.0))?;
         if let Some(Release::At(t)) = self.release {
             finite("release", t)?;
@@ -500,7 +548,7 @@ mod tests {
         let r = s.resolve(1, Path::new("dir")).unwrap();
         assert_eq!(r.file, Path::new("dir/a.csv"));
         assert_eq!(r.file_as_written, "a.csv");
-        assert_eq!((r.x0, r.v0, r.weight), (0.014, 0.0, 1.0));
+        assert_eq!((r.x0, r.v0, r.weight), (Some(0.014), 0.0, 1.0));
         assert_eq!(r.read.scale(Channel::Velocity), 1e-3);
         assert_eq!(r.read.time.column, "time");
         assert_eq!(r.read.column(Channel::Velocity), "velocity");
@@ -550,6 +598,34 @@ mod tests {
             e.to_string().starts_with("unknown field `velocity_colum`"),
             "{e}"
         );
+    }
+
+    /// x0 is required of a simulated record without a displacement column; otherwise it is the
+    /// first displacement sample, or unknown (for a force-domain fit on a measured force).
+    #[test]
+    fn x0_comes_from_the_entry_the_displacement_or_nowhere() {
+        let dir = std::env::temp_dir().join(format!("frictionid-x0-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let rows: String = (0..12)
+            .map(|i| format!("{},{},{}\n", i as f64 * 1e-3, 0.5 - i as f64 * 1e-3, i))
+            .collect();
+        std::fs::write(dir.join("r.csv"), format!("time,x,velocity\n{rows}")).unwrap();
+        let with_x = source("file = \"r.csv\"\ndisplacement_column = \"x\"").unwrap();
+        let r = with_x.resolve(1, &dir).unwrap().load().unwrap();
+        assert_eq!((r.x0, r.x0_source), (0.5, X0Source::FirstDisplacement));
+        let bare = source("file = \"r.csv\"").unwrap();
+        let e = bare.resolve(1, &dir).unwrap_err();
+        assert!(matches!(e, RecordSourceError::MissingX0 { .. }), "{e}");
+        let replayed = bare.resolve_for(1, &dir, RecordUse::Replayed).unwrap();
+        let r = replayed.load().unwrap();
+        assert_eq!((r.x0, r.x0_source), (0.0, X0Source::Unknown));
+        let e = r.require_x0("a test").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "record `r.csv`: missing `x0` (the release displacement, m): a test needs it for a \
+             record without a displacement channel"
+        );
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]

@@ -302,6 +302,7 @@ pub fn analyze_record(
     osc: &Oscillator,
     opts: &EnergyOptions,
 ) -> Result<EnergyAnalysis, EngineError> {
+    record.require_x0("the energy analysis (it integrates the velocity from x0)")?;
     let (measured, motion) = measured_motion(record, osc, opts)?;
     let time = record.time();
     let (a, acceleration) = match record.channel(Channel::Acceleration) {

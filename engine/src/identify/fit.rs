@@ -18,7 +18,8 @@ use super::search::starts::{run_starts, start_count, MultiStart, StartRun};
 use super::search::strategy::{plan_starts, Planned, Seeded, StartPlan};
 use super::search::{build_layout, Layout};
 use super::values::{
-    fits_directly, FitDomain, FitOptions, FitResult, ParamKind, Search, TerminationReason,
+    check_min_speed, fits_directly, FitDomain, FitOptions, FitResult, ParamKind, Search,
+    TerminationReason,
 };
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
@@ -41,6 +42,7 @@ pub fn fit(
     records: &[Record],
     opts: &FitOptions,
 ) -> Result<FitResult, EngineError> {
+    check_min_speed(opts.min_speed, opts.domain).map_err(EngineError::InvalidInput)?;
     if opts.domain == FitDomain::Force {
         return fit_force(osc, model, records, opts);
     }

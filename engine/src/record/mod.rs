@@ -39,6 +39,9 @@ pub struct Record {
     noise: BTreeMap<Channel, f64>,
     /// Displacement at the first time stamp (release) [m].
     pub x0: f64,
+    /// Where `x0` comes from: given, the first displacement sample, or unknown (0 stands in).
+    #[serde(default, skip_serializing_if = "X0Source::is_given")]
+    pub x0_source: X0Source,
     /// Velocity at release [m/s] (0 for a release from rest).
     pub v0: f64,
     /// Weight of this record in a joint fit.
@@ -51,6 +54,26 @@ pub struct Record {
     /// What was worked out from the samples (noise levels, checks), kept until they change.
     #[serde(skip)]
     derived: SampleFacts,
+}
+
+/// Where a record's release displacement `x0` comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum X0Source {
+    /// Given (a configuration's `x0`, or the record's maker).
+    #[default]
+    Given,
+    /// The first sample of the displacement channel (relative to the equilibrium).
+    FirstDisplacement,
+    /// Neither given nor measured: `x0` is 0 in its place, and what needs it refuses the
+    /// record ([`Record::require_x0`]).
+    Unknown,
+}
+
+impl X0Source {
+    fn is_given(&self) -> bool {
+        *self == X0Source::Given
+    }
 }
 
 /// What is worked out from a record's samples and kept until they change: clones carry it
@@ -97,6 +120,7 @@ impl Record {
             normal_force: None,
             noise: BTreeMap::new(),
             x0: 0.0,
+            x0_source: X0Source::Given,
             v0: 0.0,
             weight: 1.0,
             release_time: None,
@@ -120,6 +144,22 @@ impl Record {
     fn with_x0(mut self, x0: f64) -> Self {
         self.x0 = x0;
         self
+    }
+
+    /// The record's x0 is known (given or measured), as `purpose` needs it: a velocity-only
+    /// record is simulated from rest at x0 or has its velocity integrated from it. A record
+    /// read without `x0` and without a displacement channel is refused, with the key to give.
+    pub fn require_x0(&self, purpose: &str) -> Result<(), EngineError> {
+        if self.x0_source != X0Source::Unknown {
+            return Ok(());
+        }
+        Err(EngineError::Record {
+            record: self.name.clone(),
+            reason: format!(
+                "missing `x0` (the release displacement, m): {purpose} needs it for a record \
+                 without a displacement channel"
+            ),
+        })
     }
 
     /// The time stamps \[s\].
@@ -211,6 +251,7 @@ impl Record {
             }),
             noise: self.noise.clone(),
             x0: self.x0,
+            x0_source: self.x0_source,
             v0: self.v0,
             weight: self.weight,
             release_time: self.release_time,

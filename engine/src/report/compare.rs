@@ -1,6 +1,6 @@
 //! The report of `compare`: several models fitted to the same records, ranked by AIC.
 
-use super::fit::{fit_json, parameter_table, verdict_line};
+use super::fit::{fit_json, parameter_table, sliding_column, verdict_line};
 use super::format::{fmt_criterion, fmt_num, fmt_opt};
 use super::{render_files, render_opening, Render, Role, Sink, Status, Table};
 use crate::identify::{Check, Comparison, FitResult};
@@ -105,6 +105,19 @@ impl CompareReport {
     }
 }
 
+/// The sliding samples each record compared (the same for every model), when
+/// `[fit.options] min_speed` selected them.
+fn sliding_table(fit: &FitResult) -> Option<Table> {
+    let (header, cells) = sliding_column(fit)?;
+    let rows = fit
+        .records
+        .iter()
+        .zip(cells)
+        .map(|(r, cell)| vec![r.file.clone(), cell])
+        .collect();
+    Some(Table::new(&["record", &header], rows))
+}
+
 /// `yes`, `no`, or `yes, no model parameter settled` when the convergence finding warns.
 fn converged_cell(fit: &FitResult) -> String {
     let warned = fit
@@ -131,6 +144,9 @@ impl Render for CompareReport {
             sink.verdict(status, &text);
         }
         sink.table(&self.ranking_table(), Role::Summary);
+        if let Some(table) = self.best().and_then(sliding_table) {
+            sink.table(&table, Role::Summary);
+        }
         if let Some(best) = self.best() {
             sink.paragraph(
                 &format!(

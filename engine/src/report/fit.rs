@@ -215,8 +215,35 @@ pub fn diagnostics_table(fit: &FitResult) -> Table {
     Table::new(&["check", "status", "value", "message"], rows)
 }
 
-/// The per-record table of a fit: residual and the energy-based force check.
+/// The per-record table of a fit: residual and the energy-based force check, and the sliding
+/// samples compared when `min_speed` selected them.
 pub fn record_table(fit: &FitResult) -> Table {
+    let table = energy_record_table(fit);
+    match sliding_column(fit) {
+        Some((header, cells)) => table.with_column(&header, cells),
+        None => table,
+    }
+}
+
+/// The header and cells (`kept of defined`) of the sliding samples each record compared,
+/// when `[fit.options] min_speed` selected them.
+pub fn sliding_column(fit: &FitResult) -> Option<(String, Vec<String>)> {
+    let min_speed = fit.records.iter().find_map(|r| r.sliding)?.min_speed;
+    let cells = fit
+        .records
+        .iter()
+        .map(|r| {
+            r.sliding
+                .map_or("-".into(), |s| format!("{} of {}", s.kept, s.of))
+        })
+        .collect();
+    Some((
+        format!("samples with |v| >= {} m/s", fmt_num(min_speed)),
+        cells,
+    ))
+}
+
+fn energy_record_table(fit: &FitResult) -> Table {
     let rows = fit
         .records
         .iter()

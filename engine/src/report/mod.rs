@@ -57,6 +57,17 @@ impl Table {
             rows,
         }
     }
+
+    /// The table with one more column, `header`, holding `cells` (one per row; a missing
+    /// cell is `-`).
+    pub fn with_column(mut self, header: &str, cells: Vec<String>) -> Self {
+        self.headers.push(header.to_string());
+        let mut cells = cells.into_iter();
+        for row in &mut self.rows {
+            row.push(cells.next().unwrap_or_else(|| "-".into()));
+        }
+        self
+    }
 }
 
 /// A writer: receives a report's document block by block.

@@ -546,6 +546,7 @@ mod tests {
             x0: 0.014,
             release_time: None,
             samples: time.len(),
+            sliding: None,
             channel: "velocity".into(),
             rms_residual: 0.0,
             channels: Vec::new(),

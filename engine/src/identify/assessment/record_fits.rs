@@ -98,6 +98,7 @@ fn record_fit<R: Residuals>(
         x0: nuisance.x0_of(rec),
         release_time: rec.release_time,
         samples: rec.len(),
+        sliding: problem.residuals.sliding_samples(ri),
         channel: problem.residuals.record_channel(ri).to_string(),
         rms_residual: (sum_sq / measured.len() as f64).sqrt(),
         channels,

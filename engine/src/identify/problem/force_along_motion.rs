@@ -18,6 +18,10 @@
 //! Without a normal force (neither `[oscillator] normal_force` nor a record's), the levels
 //! are forces ([`FrictionLevels`]): N = 1 and their bounds from the largest force compared.
 //!
+//! With `[fit.options] min_speed`, only the samples where the motion slides (|v| >=
+//! min_speed) are compared: the stick phases at reversals hold a force below the sliding
+//! level that a static law cannot follow, and would drag its level down.
+//!
 //! Residuals are `sqrt(weight) (model + offset - target) / sigma`, with sigma the record's
 //! noise level estimated from the target ([`crate::record::noise::noise_floor_level`] of its first differences), so records of different noise
 //! weigh as they should in a joint fit. Nothing is simulated, so a force-domain fit costs a
@@ -37,7 +41,7 @@ use crate::error::EngineError;
 use crate::identify::values::levels::{FrictionLevels, UNIT_NORMAL_FORCE};
 use crate::identify::values::nuisance::NuisanceKind;
 use crate::identify::values::options::{FitDomain, FitOptions, ForceTarget, OscillatorParam};
-use crate::identify::values::result::{ForceBalance, SampleAxes};
+use crate::identify::values::result::{ForceBalance, SampleAxes, SlidingSamples};
 use crate::oscillator::Oscillator;
 use crate::record::noise::noise_floor_level;
 use crate::record::{channel_list, Channel, NormalForce, Record};
@@ -68,6 +72,8 @@ pub struct ForceTrack {
     used: Vec<usize>,
     /// The target force at the compared samples \[N\].
     target: Vec<f64>,
+    /// The samples kept by `min_speed`, when it is given.
+    sliding: Option<SlidingSamples>,
     /// Noise level of the target \[N\].
     pub noise: f64,
     /// The oscillator's terms of an inverse-dynamics target.
@@ -353,6 +359,14 @@ impl ForceTrack {
             }
         };
         check_motion(record.time(), &motion.v, &normal).map_err(|e| err(e.to_string()))?;
+        let (used, target, sliding) = keep_sliding(used, target, &motion.v, opts.min_speed);
+        if sliding.is_some_and(|s| s.kept < 2) {
+            return Err(err(format!(
+                "{} samples slide with |v| >= [fit.options] min_speed = {} m/s; lower it",
+                target.len(),
+                opts.min_speed.unwrap_or_default()
+            )));
+        }
         if target.len() < 2 {
             return Err(err(format!(
                 "{} samples to compare the model force with (Eq. 7 and the inverse-dynamics \
@@ -378,6 +392,7 @@ impl ForceTrack {
             used,
             target,
             balance,
+            sliding,
         })
     }
 
@@ -402,6 +417,31 @@ impl ForceTrack {
         }
         self.target.iter().zip(&axis).map(|(u, a)| u - a).collect()
     }
+}
+
+/// The compared samples `used` (with their `target`) where |v| >= `min_speed`, and how many
+/// were kept; all of them without a `min_speed`.
+fn keep_sliding(
+    used: Vec<usize>,
+    target: Vec<f64>,
+    velocity: &[f64],
+    min_speed: Option<f64>,
+) -> (Vec<usize>, Vec<f64>, Option<SlidingSamples>) {
+    let Some(min_speed) = min_speed else {
+        return (used, target, None);
+    };
+    let of = used.len();
+    let (used, target): (Vec<usize>, Vec<f64>) = used
+        .into_iter()
+        .zip(target)
+        .filter(|&(i, _)| velocity.get(i).is_some_and(|v| v.abs() >= min_speed))
+        .unzip();
+    let sliding = SlidingSamples {
+        min_speed,
+        kept: used.len(),
+        of,
+    };
+    (used, target, Some(sliding))
 }
 
 /// Whether an inverse-dynamics balance has a restoring force: a restoring law other than the
@@ -604,6 +644,10 @@ impl Residuals for ForceAlongMotion {
 
     fn simulates_response(&self) -> bool {
         false
+    }
+
+    fn sliding_samples(&self, index: usize) -> Option<SlidingSamples> {
+        self.tracks.get(index).and_then(|t| t.sliding)
     }
 
     fn sample_axes(&self, index: usize, record: &Record) -> SampleAxes {

@@ -16,7 +16,7 @@ use crate::energy::{analyze_record, EnergyAnalysis, EnergyOptions};
 use crate::error::EngineError;
 use crate::identify::values::options::FitOptions;
 use crate::identify::values::{
-    ForceBalance, FrictionLevels, NuisanceKind, NuisanceValues, SampleAxes,
+    ForceBalance, FrictionLevels, NuisanceKind, NuisanceValues, SampleAxes, SlidingSamples,
 };
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -205,6 +205,12 @@ pub trait Residuals: Send + Sync {
             time: record.time().to_vec(),
             ..SampleAxes::default()
         }
+    }
+
+    /// The sliding samples record `index` compares, when only those are (`None`: every
+    /// sample the residuals define).
+    fn sliding_samples(&self, _index: usize) -> Option<SlidingSamples> {
+        None
     }
 
     /// Number of residuals record `index` contributes.

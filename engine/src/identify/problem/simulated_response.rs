@@ -100,6 +100,7 @@ impl SimulatedResponse {
             .unwrap_or(Channel::Velocity);
         let reference = median_noise(records, out.primary);
         for record in records {
+            record.require_x0("a velocity-domain fit (it simulates the record from rest)")?;
             check_response_channels(record, velocity_offset)?;
             out.tracks.push(track(record, out.primary, reference));
         }

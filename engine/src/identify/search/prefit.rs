@@ -46,6 +46,7 @@ pub fn prefit_options(model: &dyn FrictionModel, opts: &FitOptions) -> Option<Fi
         domain: FitDomain::Force,
         force_target: ForceTarget::Energy,
         force_offset: false,
+        min_speed: None,
         velocity_offset: false,
         time_shift: false,
         x0: false,

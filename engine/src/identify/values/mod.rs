@@ -17,12 +17,13 @@ pub use layout::{BoundSide, FreeParam, ParamKind};
 pub use levels::FrictionLevels;
 pub use nuisance::{non_model_bound_keys, NuisanceKind, NuisanceValues, X0_RELATIVE_BOUND};
 pub use options::{
-    FitDomain, FitOptions, ForceTarget, OscillatorParam, Progress, ProgressFn, FIT_MAX_STEPS,
+    check_min_speed, FitDomain, FitOptions, ForceTarget, OscillatorParam, Progress, ProgressFn,
+    FIT_MAX_STEPS,
 };
 pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
 pub use result::{
     ChannelFit, Derived, EnergyForce, FitResult, FitSeries, FittedParam, ForceBalance,
-    Identifiability, Rank, RecordFit, SampleAxes, Verdict,
+    Identifiability, Rank, RecordFit, SampleAxes, SlidingSamples, Verdict,
 };
 pub use search::{fits_directly, Search, PROMOTED_STARTS};
 pub use uncertainty::{PropertyUncertainty, StdErrorComponents};

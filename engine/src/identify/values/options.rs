@@ -87,6 +87,25 @@ pub enum ForceTarget {
     InverseDynamics,
 }
 
+/// `[fit.options] min_speed` is a speed >= 0 given for a force-domain fit (only it compares
+/// samples one by one); the message otherwise. The one place of this rule.
+pub fn check_min_speed(min_speed: Option<f64>, domain: FitDomain) -> Result<(), String> {
+    let Some(speed) = min_speed else {
+        return Ok(());
+    };
+    if !(speed.is_finite() && speed >= 0.0) {
+        return Err(format!(
+            "[fit.options] min_speed must be a speed >= 0 (m/s), got {speed}"
+        ));
+    }
+    if domain != FitDomain::Force {
+        return Err(
+            "[fit.options] min_speed applies to force-domain fits only (domain = \"force\")".into(),
+        );
+    }
+    Ok(())
+}
+
 /// Progress of a running fit, reported after every solver iteration.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Progress {
@@ -144,6 +163,10 @@ pub struct FitOptions {
     /// Fit a constant force offset per record (force domain: a measured force or inverse
     /// dynamics).
     pub force_offset: bool,
+    /// Force domain: compare only the samples where the measured motion slides, |v| >=
+    /// `min_speed` \[m/s\] (stick phases at reversals hold a force below the sliding level
+    /// that a static law cannot follow); `None`: every sample.
+    pub min_speed: Option<f64>,
     /// Velocity fits of models with internal states start also from the optimum of a
     /// force-domain fit to the energy-based force (the prefit).
     pub prefit: bool,
@@ -188,6 +211,7 @@ impl Default for FitOptions {
             domain: FitDomain::Velocity,
             force_target: ForceTarget::Auto,
             force_offset: false,
+            min_speed: None,
             prefit: false,
             unknown_oscillator: Vec::new(),
             multistart: None,
@@ -221,6 +245,7 @@ impl std::fmt::Debug for FitOptions {
             .field("domain", &self.domain)
             .field("force_target", &self.force_target)
             .field("force_offset", &self.force_offset)
+            .field("min_speed", &self.min_speed)
             .field("prefit", &self.prefit)
             .field("unknown_oscillator", &self.unknown_oscillator)
             .field("multistart", &self.multistart)

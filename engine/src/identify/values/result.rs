@@ -50,6 +50,10 @@ pub struct RecordFit {
     pub release_time: Option<f64>,
     /// Samples.
     pub samples: usize,
+    /// The sliding samples compared, when `[fit.options] min_speed` selects them (force
+    /// domain).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sliding: Option<SlidingSamples>,
     /// The quantity compared (`velocity`, `force`, `energy_based_force`).
     pub channel: String,
     /// RMS of fitted - measured, in the unit of the compared quantity (m/s for velocity).
@@ -64,6 +68,18 @@ pub struct RecordFit {
     /// The measured and fitted series and the forces along the motion (for plots).
     #[serde(skip)]
     pub series: FitSeries,
+}
+
+/// The samples of a force-domain record compared under `[fit.options] min_speed`: those
+/// where the measured motion slides, |v| >= `min_speed`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SlidingSamples {
+    /// The least speed compared \[m/s\].
+    pub min_speed: f64,
+    /// Samples kept.
+    pub kept: usize,
+    /// Samples the target defines (all of a measured force; Eq. 7's unmasked ones).
+    pub of: usize,
 }
 
 /// A record's series at the compared samples, for plots and the Python package.
