@@ -19,8 +19,8 @@ pub use options::{
 };
 pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
 pub use result::{
-    ChannelFit, Derived, EnergyForce, FitResult, FitSeries, FittedParam, Identifiability, Rank,
-    RecordFit, SampleAxes, Verdict,
+    ChannelFit, Derived, EnergyForce, EnergySkip, FitResult, FitSeries, FittedParam,
+    Identifiability, Rank, RecordFit, SampleAxes, Verdict,
 };
 pub use search::{fits_directly, Search, PROMOTED_STARTS};
 pub use uncertainty::{PropertyUncertainty, StdErrorComponents};
