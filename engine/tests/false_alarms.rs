@@ -391,3 +391,62 @@ fn correct_fits_raise_no_failed_diagnostic() {
     );
     assert_eq!(false_alarms, 0);
 }
+
+/// The other side of the alarm: Coulomb friction fitted to records of laws it cannot follow
+/// exactly (a viscous term, a Stribeck dip, Makkar's smooth bump, LuGre's and Dahl's
+/// presliding) at 1 kHz with white noise. Every fit whose misfit shows in its residuals (an
+/// RMS more than 1 % above the noise level: with 3000 samples the RMS of the noise alone is
+/// within 0.3 % of it) is flagged by at least one warning or failure; a wrong law that fits
+/// within the noise leaves nothing to see, and is listed.
+#[test]
+fn a_wrong_law_is_flagged() {
+    use rayon::prelude::*;
+    let wrong: Vec<Box<dyn FrictionModel>> = truths()
+        .into_iter()
+        .filter(|m| ["viscous_coulomb", "stribeck", "makkar", "dahl", "lugre"].contains(&m.name()))
+        .collect();
+    let outcomes: Vec<(String, f64, Vec<String>)> = wrong
+        .par_iter()
+        .enumerate()
+        .map(|(k, truth)| {
+            let recs = records(
+                truth.as_ref(),
+                1e3,
+                Noise::White,
+                Sensor::Vibrometer,
+                500 + 10 * k as u64,
+            );
+            let osc = Oscillator::fmm();
+            let result = fit(&osc, &Coulomb { mu: 0.2 }, &recs, &FitOptions::default())
+                .unwrap_or_else(|e| panic!("coulomb on {}: {e}", truth.name()));
+            let flagged = result
+                .diagnostics
+                .iter()
+                .filter(|d| matches!(d.status, Status::Warn | Status::Fail))
+                .map(|d| format!("{:?} {:?}", d.check, d.status))
+                .collect();
+            let label = format!("coulomb on {}", truth.name());
+            (label, result.rms_residual / V_NOISE, flagged)
+        })
+        .collect();
+    for (label, excess, flagged) in &outcomes {
+        eprintln!("{label}: rms / noise {excess:.4}, {flagged:?}");
+    }
+    let visible: Vec<&(String, f64, Vec<String>)> = outcomes
+        .iter()
+        .filter(|(_, excess, _)| *excess > 1.01)
+        .collect();
+    let missed: Vec<&String> = visible
+        .iter()
+        .filter(|(_, _, f)| f.is_empty())
+        .map(|(l, _, _)| l)
+        .collect();
+    let flagged = outcomes.iter().filter(|(_, _, f)| !f.is_empty()).count();
+    eprintln!(
+        "{flagged} of {} wrong fits flagged; {} with a visible misfit, {} of them missed",
+        outcomes.len(),
+        visible.len(),
+        missed.len()
+    );
+    assert!(missed.is_empty(), "not flagged: {missed:?}");
+}
