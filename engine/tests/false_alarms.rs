@@ -16,13 +16,13 @@
 //! - Dahl, whose presliding the old half-cycle comparison misjudged: clean and AR(1) at
 //!   1 kHz, white at 100 kHz, an interferometer's and an encoder's records (5).
 
+mod common;
+
 use frictionid_engine::identify::{fit, FitOptions, FitResult, Status};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::{add_coloured_noise, add_gaussian_noise, uniform_times};
 use frictionid_engine::{Oscillator, Record};
-use frictionid_models::{
-    Coulomb, Dahl, Expression, FrictionModel, Gms, LuGre, Makkar, Stribeck, ViscousCoulomb,
-};
+use frictionid_models::{Coulomb, Dahl, Expression, FrictionModel, Gms, Makkar, ViscousCoulomb};
 
 /// The simulator's step [s]: a divisor of every sample interval of the matrix.
 const STEP: f64 = 1e-6;
@@ -270,22 +270,9 @@ fn truths() -> Vec<Box<dyn FrictionModel>> {
             mu: 0.2,
             viscous: 2.0,
         }),
-        Box::new(Stribeck {
-            mu_c: 0.20,
-            mu_s: 0.28,
-            v_s: 0.02,
-            delta: 2.0,
-            viscous: 3.0,
-        }),
+        Box::new(common::stribeck_truth()),
         Box::new(Makkar::default()),
-        Box::new(LuGre {
-            sigma0: 1e5,
-            sigma1: 500.0,
-            sigma2: 1.0,
-            mu_c: 0.22,
-            mu_s: 0.30,
-            v_s: 0.01,
-        }),
+        Box::new(common::lugre_truth()),
         Box::new(dahl()),
         Box::new(Gms::default()),
         Box::new(

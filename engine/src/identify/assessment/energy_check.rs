@@ -8,7 +8,11 @@
 //!
 //! # Like with like
 //! Eq. 7's force is compared sample by sample and by its time mean with the model's force
-//! over the same samples. The half-cycle energy balance needs no derivative: between two
+//! over the same samples, each mean taken of the force against the motion, F sgn(v): the
+//! mean |F| where the force opposes the motion (a sliding contact's), and unbiased by noise
+//! where |F| is not (stiff bristles replayed along a noisy velocity give a model force whose
+//! noise alone would add to a mean |F|; presliding just after a reversal pushes with the
+//! motion on both sides alike). The half-cycle energy balance needs no derivative: between two
 //! turning points the drop of the mechanical energy less the viscous work is the energy the
 //! friction dissipated, and the model's is int F v dt over the same interval of the measured
 //! motion. Both are energies, summed over the complete half-cycles; a force that depends on
@@ -22,9 +26,10 @@
 //! dissipated (the energies), an Eq. 7 force whose noise exceeds [`MAX_NOISE_SHARE`] of the
 //! friction level (Eq. 7).
 
-use crate::energy::{mean_abs_where_defined, percent_difference, EnergyAnalysis, HalfCycle};
+use crate::energy::{percent_difference, EnergyAnalysis, HalfCycle};
 use crate::error::EngineError;
 use crate::identify::values::{EnergyForce, EnergySkip};
+use crate::record::noise::difference_noise;
 
 /// The fewest samples in the median half-cycle for either part of the check: a 31-sample
 /// derivative window needs a few windows per half-cycle, and the trapezoidal work of a
@@ -63,6 +68,7 @@ pub fn energy_force_check(
     reference: ForceReference<'_>,
 ) -> Result<EnergyForce, EngineError> {
     let energy = &analysis.friction;
+    let eq7_mean = mean_against_motion(energy, energy, &analysis.v);
     let (level, residual_rms, samples) = match reference {
         ForceReference::ModelForce(model) => {
             if model.len() != energy.len() {
@@ -73,7 +79,7 @@ pub fn energy_force_check(
                 )));
             }
             let (rms, used) = residual_rms(energy, model)?;
-            (mean_abs_where_defined(model, energy), rms, used)
+            (mean_against_motion(model, energy, &analysis.v), rms, used)
         }
         ForceReference::Level(level) => (
             level,
@@ -91,10 +97,14 @@ pub fn energy_force_check(
         })
         .sum();
     let (eq7_skipped, dissipation_skipped) = skips(analysis, dissipated);
+    let eq7_skipped = eq7_skipped.or_else(|| match reference {
+        ForceReference::ModelForce(model) => noisy_replay(model, level),
+        ForceReference::Level(_) => None,
+    });
     Ok(EnergyForce {
-        mean_abs: analysis.mean_abs_force,
+        mean_abs: eq7_mean,
         reference: level,
-        percent_difference: percent_difference(analysis.mean_abs_force, level),
+        percent_difference: percent_difference(eq7_mean, level),
         residual_rms,
         samples,
         force_noise: analysis.force_noise,
@@ -110,6 +120,24 @@ pub fn energy_force_check(
         eq7_skipped,
         dissipation_skipped,
     })
+}
+
+/// The mean of `force` sgn(v) over the samples where the energy-based force `energy` is
+/// defined (NaN when none is): the mean force against the motion.
+fn mean_against_motion(force: &[f64], energy: &[f64], v: &[f64]) -> f64 {
+    let (sum, n) = force
+        .iter()
+        .zip(energy)
+        .zip(v)
+        .filter(|((f, e), _)| e.is_finite() && f.is_finite())
+        .fold((0.0, 0usize), |(s, n), ((f, _), v)| {
+            (s + f * v.signum(), n + 1)
+        });
+    if n > 0 {
+        sum / n as f64
+    } else {
+        f64::NAN
+    }
 }
 
 /// Why each part (Eq. 7, the dissipated energies) cannot judge the analysis, if it cannot.
@@ -144,6 +172,14 @@ fn skips(analysis: &EnergyAnalysis, dissipated: f64) -> (Option<EnergySkip>, Opt
         few.clone().or(quantised)
     };
     (few.or(noisy), energies)
+}
+
+/// The skip for a model force whose own noise (white-noise level of its second differences)
+/// exceeds [`MAX_NOISE_SHARE`] of `level`: its mean then measures the replayed noise.
+fn noisy_replay(model: &[f64], level: f64) -> Option<EnergySkip> {
+    let force_noise = difference_noise(model, 2);
+    (force_noise > MAX_NOISE_SHARE * level.abs())
+        .then_some(EnergySkip::NoisyReplay { force_noise, level })
 }
 
 /// Samples in the median complete half-cycle (`None` without one).

@@ -193,10 +193,11 @@ pub struct SampleAxes {
 /// (energies against energies).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EnergyForce {
-    /// Mean |F_f| from Eq. 7 over the unmasked oscillating samples [N].
+    /// Mean of the Eq. 7 force against the motion, F sgn(v), over the unmasked oscillating
+    /// samples (its mean |F| where it opposes the motion) [N].
     pub mean_abs: f64,
-    /// The reference level [N]: the model's mean |F| along the measured motion over the same
-    /// samples (mu N for Coulomb), or the given level.
+    /// The reference level [N]: the model's mean force against the motion along the measured
+    /// motion over the same samples (mu N for Coulomb), or the given level.
     pub reference: f64,
     /// 100 (mean_abs - reference) / reference.
     pub percent_difference: f64,
@@ -248,6 +249,14 @@ pub enum EnergySkip {
         /// k |x| step / 2 at both ends of every half-cycle over the energy dissipated.
         share: f64,
     },
+    /// The model's force replayed along the measured velocity follows its noise more than
+    /// the friction level (stiff, strongly damped bristles: sigma1 times the noise's rate).
+    NoisyReplay {
+        /// The replayed force's noise level [N].
+        force_noise: f64,
+        /// The friction level [N].
+        level: f64,
+    },
     /// The noise of the Eq. 7 force dominates the friction level.
     NoisyDerivative {
         /// Its standard deviation [N].
@@ -272,6 +281,10 @@ impl std::fmt::Display for EnergySkip {
                 f,
                 "the displacement's quantisation step {step:.3e} m makes the energies at the turning points uncertain by {:.1} % of the energy dissipated",
                 100.0 * share
+            ),
+            Self::NoisyReplay { force_noise, level } => write!(
+                f,
+                "the model's force replayed along the measured velocity carries {force_noise:.3} N of its noise, more than a third of the friction level ({level:.3} N)"
             ),
             Self::NoisyDerivative { force_noise, level } => write!(
                 f,
