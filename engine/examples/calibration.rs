@@ -9,11 +9,17 @@
 //! with those drawn values and fresh velocity noise, and fits mu with the *nominal* values and
 //! the standard deviations stated (`FitOptions::uncertainty`), as a user of the rig would.
 //!
+//! Then under coloured noise: the nominal rig's three releases from the exact piecewise
+//! Coulomb solution (`exact::coulomb_free_vibration`, independent of the fitted simulation)
+//! with stationary AR(1) velocity noise of lag-1 correlation 0.6 and 0.9, where the standard
+//! errors come from the Newey-West estimate after AR(1) prewhitening.
+//!
 //! Run: `cargo run --release -p frictionid-engine --example calibration [-- REALISATIONS]`
 
+use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::identify::{fit, FitOptions, PropertyUncertainty};
 use frictionid_engine::simulate::{simulate, Initial, SimOptions};
-use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
+use frictionid_engine::synthetic::{add_coloured_noise, add_gaussian_noise, uniform_times};
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::Coulomb;
 use rand::rngs::StdRng;
@@ -55,8 +61,49 @@ fn draw_rig(
     })
 }
 
-/// The three noisy records of `rig` (realisation `k`).
+/// The velocity noise of a calibration run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum NoiseModel {
+    /// White Gaussian, on the engine's simulation of the drawn rig.
+    White,
+    /// Stationary AR(1) of this lag-1 correlation, on the exact Coulomb solution.
+    Coloured(f64),
+}
+
+/// The three noisy records of `rig` (realisation `k`) with `noise`.
 fn records(
+    rig: &Oscillator,
+    times: &[f64],
+    k: usize,
+    noise: NoiseModel,
+) -> Result<Vec<Record>, Box<dyn std::error::Error>> {
+    match noise {
+        NoiseModel::White => simulated_records(rig, times, k),
+        NoiseModel::Coloured(phi) => exact_records(rig, times, k, phi),
+    }
+}
+
+/// The exact Coulomb motions of `rig` with AR(1) noise of lag-1 correlation `phi`.
+fn exact_records(
+    rig: &Oscillator,
+    times: &[f64],
+    k: usize,
+    phi: f64,
+) -> Result<Vec<Record>, Box<dyn std::error::Error>> {
+    RELEASES
+        .iter()
+        .enumerate()
+        .map(|(i, &x0)| {
+            let exact = coulomb_free_vibration(rig, MU * rig.normal_force, x0, times)?;
+            let mut v = exact.v;
+            add_coloured_noise(&mut v, NOISE, phi, 20_000 + 3 * k as u64 + i as u64);
+            Ok(Record::new(format!("r{i}"), times.to_vec(), v, x0))
+        })
+        .collect()
+}
+
+/// The three records of `rig` simulated by the engine with white noise (realisation `k`).
+fn simulated_records(
     rig: &Oscillator,
     times: &[f64],
     k: usize,
@@ -98,11 +145,12 @@ struct Calibration {
 }
 
 /// `n` realisations with the rig's properties drawn with standard deviations `sigma` (all 0:
-/// the nominal rig, only the noise varies), each fitted with the nominal values and `sigma`
-/// stated.
+/// the nominal rig, only the noise varies) and velocity noise `noise`, each fitted with the
+/// nominal values and `sigma` stated.
 fn calibrate(
     n: usize,
     sigma: PropertyUncertainty,
+    noise: NoiseModel,
 ) -> Result<Calibration, Box<dyn std::error::Error>> {
     let nominal = Oscillator::fmm();
     let opts = FitOptions {
@@ -117,7 +165,7 @@ fn calibrate(
         let r = fit(
             &nominal,
             &Coulomb::default(),
-            &records(&rig, &times, k)?,
+            &records(&rig, &times, k, noise)?,
             &opts,
         )?;
         let p = r.param("mu").ok_or("no mu")?;
@@ -161,14 +209,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("realisations: {n}, velocity noise {NOISE} m/s");
     print(
         "properties known exactly (noise only):",
-        &calibrate(n, PropertyUncertainty::default())?,
+        &calibrate(n, PropertyUncertainty::default(), NoiseModel::White)?,
     );
     print(
         &format!(
             "m, k, N drawn per realisation (std {} kg, {} N/m, {} N) and stated:",
             sigma.mass, sigma.stiffness, sigma.normal_force
         ),
-        &calibrate(n, sigma)?,
+        &calibrate(n, sigma, NoiseModel::White)?,
     );
+    for phi in [0.6, 0.9] {
+        print(
+            &format!("exact Coulomb motion, AR(1) velocity noise of lag-1 correlation {phi}:"),
+            &calibrate(n, PropertyUncertainty::default(), NoiseModel::Coloured(phi))?,
+        );
+    }
     Ok(())
 }

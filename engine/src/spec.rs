@@ -783,6 +783,9 @@ impl SimulationSpec {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum DifferentiatorMethod {
+    /// Savitzky-Golay with a window chosen from the record (the default; see
+    /// [`Differentiator::Auto`]).
+    Auto,
     /// The paper's differentiation (central differences and a moving average).
     Paper,
     /// Savitzky-Golay smoothing differentiator.
@@ -805,9 +808,11 @@ pub struct EnergySpec {
     pub reference_force: Option<f64>,
 }
 
-/// Savitzky-Golay window and order used when the engine's default differentiator is not a
-/// Savitzky-Golay one.
+/// Savitzky-Golay window and order used when the engine's default differentiator is the
+/// paper's and a window or an order is given.
 const FALLBACK_SAVITZKY_GOLAY: (usize, usize) = (21, 3);
+/// ... and when it is the automatic one: its choice on the FMM rig at 1 kHz.
+const AUTO_SAVITZKY_GOLAY: (usize, usize) = (31, crate::energy::AUTO_ORDER);
 
 impl EnergySpec {
     /// The engine's energy-analysis options (engine defaults where not given).
@@ -822,8 +827,10 @@ impl EnergySpec {
     }
 
     fn differentiator(&self, default: Differentiator) -> Differentiator {
-        if self.method == Some(DifferentiatorMethod::Paper) {
-            return Differentiator::Paper;
+        match self.method {
+            Some(DifferentiatorMethod::Paper) => return Differentiator::Paper,
+            Some(DifferentiatorMethod::Auto) => return Differentiator::Auto,
+            _ => {}
         }
         if self.method.is_none() && self.window.is_none() && self.order.is_none() {
             return default;
@@ -831,6 +838,7 @@ impl EnergySpec {
         let (window, order) = match default {
             Differentiator::SavitzkyGolay { window, order } => (window, order),
             Differentiator::Paper => FALLBACK_SAVITZKY_GOLAY,
+            Differentiator::Auto => AUTO_SAVITZKY_GOLAY,
         };
         Differentiator::SavitzkyGolay {
             window: self.window.unwrap_or(window),
@@ -860,13 +868,15 @@ mod tests {
             ..EnergySpec::default()
         }
         .options();
-        match (o.differentiator, d.differentiator) {
-            (
-                Differentiator::SavitzkyGolay { window, order },
-                Differentiator::SavitzkyGolay { order: order0, .. },
-            ) => assert_eq!((window, order), (41, order0)),
-            other => panic!("{other:?}"),
-        }
+        // A window without a method is Savitzky-Golay with the automatic choice's degree.
+        assert_eq!(d.differentiator, Differentiator::Auto);
+        assert_eq!(
+            o.differentiator,
+            Differentiator::SavitzkyGolay {
+                window: 41,
+                order: crate::energy::AUTO_ORDER
+            }
+        );
     }
 
     #[test]

@@ -403,9 +403,8 @@ fn savitzky_golay_on_a_sine() {
     let w = Oscillator::fmm().omega_n();
     let time = uniform_times(1.0, 1000.0);
     let v: Vec<f64> = time.iter().map(|&t| (w * t).sin()).collect();
-    let Differentiator::SavitzkyGolay { window, order } = Differentiator::default() else {
-        panic!("default is Savitzky-Golay");
-    };
+    // The automatic window's choice at 1 kHz on the FMM rig (a fifteenth of its period).
+    let (window, order) = (31, frictionid_engine::energy::AUTO_ORDER);
     let d = savitzky_golay_derivative(&time, &v, window, order, &[]).expect("sg");
     let (mut inner, mut edge) = (0.0_f64, 0.0_f64);
     for (i, &t) in time.iter().enumerate() {
@@ -973,4 +972,32 @@ fn measured_displacement_and_acceleration_replace_the_derived_ones() {
         let hc = measured.half_cycle_mean / mu_n() - 1.0;
         assert!(hc.abs() < 1e-3, "x0 = {x0}: half-cycle mean off by {hc}");
     }
+}
+
+/// The automatic window spans a fifteenth of the natural period: 31 samples on the FMM at
+/// 1 kHz, 303 at 10 kHz, the cap of 1001 at 100 kHz; a velocity noise that would make m a's
+/// noise exceed a quarter of the friction level widens it until it does not.
+#[test]
+fn the_automatic_window_follows_the_period_and_the_noise() {
+    use frictionid_engine::energy::{auto_window, centre_weight_norm, WindowInputs, AUTO_ORDER};
+    let osc = Oscillator::fmm();
+    let inputs = |rate: f64, noise: f64| WindowInputs {
+        dt: 1.0 / rate,
+        period: 2.0 * std::f64::consts::PI / osc.omega_n(),
+        velocity_noise: noise,
+        mass: osc.mass,
+        level: mu_n(),
+    };
+    assert_eq!(auto_window(&inputs(1e3, 0.0)).unwrap().0, 31);
+    assert_eq!(auto_window(&inputs(1e4, 0.0)).unwrap().0, 303);
+    assert_eq!(auto_window(&inputs(1e5, 0.0)).unwrap().0, 1001);
+    // At 1 kHz, 2e-4 m/s of noise leaves m a's noise far below the level: no widening.
+    let (window, noise) = auto_window(&inputs(1e3, 2e-4)).unwrap();
+    assert_eq!(window, 31);
+    assert!(noise < 0.25 * mu_n(), "{noise}");
+    // A hundred times more noise widens the window, up to a quarter period at most.
+    let (window, noise) = auto_window(&inputs(1e3, 2e-2)).unwrap();
+    assert!(window > 31 && window <= 113, "{window}");
+    let norm = centre_weight_norm(window, AUTO_ORDER).unwrap();
+    assert!((noise - osc.mass * 2e-2 * norm * 1e3).abs() < 1e-9 * noise);
 }

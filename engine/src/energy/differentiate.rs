@@ -17,6 +17,11 @@ pub const PAPER_SPAN: usize = 10;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(tag = "method", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Differentiator {
+    /// A quartic Savitzky-Golay derivative per half-cycle whose window is chosen from the
+    /// record ([`auto_window`]): a fifteenth of the natural period (31 samples for the FMM at
+    /// 1 kHz), at most [`MAX_AUTO_WINDOW`] samples, widened up to a quarter period when the
+    /// velocity's noise or quantisation would dominate the derivative.
+    Auto,
     /// The paper's recipe: central differences, then a centred moving average of span 10
     /// ([`paper_derivative`]). Applied to the whole record, as in the paper.
     Paper,
@@ -32,22 +37,112 @@ pub enum Differentiator {
 }
 
 impl Default for Differentiator {
-    /// Savitzky-Golay with a 31-sample window and a quartic: at 1 kHz the fit spans 30 ms,
-    /// about 1/15 of the FMM's 0.455 s period, so the quartic follows its sine to 4e-6
-    /// relative (3e-5 with the one-sided fits at the ends) while averaging white noise over
-    /// 31 samples (see the `energy` module docs for the measured figures behind this choice).
+    /// [`Differentiator::Auto`]: at 1 kHz on the FMM rig, Savitzky-Golay with a 31-sample
+    /// window and a quartic; the fit spans 30 ms, about 1/15 of the FMM's 0.455 s period, so
+    /// the quartic follows its sine to 4e-6 relative (3e-5 with the one-sided fits at the
+    /// ends) while averaging white noise over 31 samples (see the `energy` module docs for
+    /// the measured figures behind this choice). At other rates and periods the window keeps
+    /// that span.
     fn default() -> Self {
-        Differentiator::SavitzkyGolay {
-            window: 31,
-            order: 4,
-        }
+        Differentiator::Auto
     }
 }
+
+/// The polynomial degree of [`Differentiator::Auto`].
+pub const AUTO_ORDER: usize = 4;
+/// The share of the natural period [`Differentiator::Auto`]'s window spans before any
+/// widening.
+pub const AUTO_PERIOD_SHARE: f64 = 1.0 / 15.0;
+/// The largest share of the natural period the automatic window widens to (half a
+/// half-cycle: a quartic still follows a sine over it to 1e-3).
+pub const AUTO_MAX_PERIOD_SHARE: f64 = 0.25;
+/// The most samples in an automatic window (its weight table grows with the square).
+pub const MAX_AUTO_WINDOW: usize = 1001;
+/// The share of the friction level the derivative's noise (times the mass) may reach before
+/// the automatic window widens: below a quarter of the level, the mean |F| of Eq. 7 is
+/// biased by less than 0.01 % by the noise's absolute value.
+pub const AUTO_NOISE_SHARE: f64 = 0.25;
+
+/// What [`auto_window`] chooses from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindowInputs {
+    /// Sample spacing \[s\].
+    pub dt: f64,
+    /// The oscillator's natural period \[s\].
+    pub period: f64,
+    /// The velocity's noise standard deviation, quantisation included \[m/s\].
+    pub velocity_noise: f64,
+    /// The mass that turns the acceleration into a force \[kg\].
+    pub mass: f64,
+    /// The friction level the derivative's noise is held against \[N\] (the half-cycle
+    /// mean; NaN or 0 when unknown: no widening).
+    pub level: f64,
+}
+
+/// The automatic Savitzky-Golay window (odd, at least `AUTO_ORDER + 3` samples) and the
+/// standard deviation of the force m a it leaves from the velocity's noise \[N\]: a
+/// fifteenth of the natural period, bounded by [`MAX_AUTO_WINDOW`] and a quarter period,
+/// widened by half at a time while that force noise exceeds [`AUTO_NOISE_SHARE`] of the
+/// friction level.
+pub fn auto_window(inputs: &WindowInputs) -> Result<(usize, f64), EngineError> {
+    let samples = |share: f64| inputs.period * share / inputs.dt;
+    let cap = nearest_odd(samples(AUTO_MAX_PERIOD_SHARE).floor() - 1.0)
+        .clamp(AUTO_ORDER + 3, MAX_AUTO_WINDOW);
+    let mut window = auto_base_window(inputs.dt, inputs.period).min(cap);
+    let noise = |w: usize| -> Result<f64, EngineError> {
+        Ok(inputs.mass * inputs.velocity_noise * centre_weight_norm(w, AUTO_ORDER)? / inputs.dt)
+    };
+    let allowed = AUTO_NOISE_SHARE * inputs.level;
+    let mut force_noise = noise(window)?;
+    while allowed > 0.0 && force_noise > allowed && window < cap {
+        window = nearest_odd(window as f64 * 1.5).clamp(window + 2, cap);
+        force_noise = noise(window)?;
+    }
+    Ok((window, force_noise))
+}
+
+/// The automatic window before any widening: the odd sample count nearest to
+/// [`AUTO_PERIOD_SHARE`] of the natural `period` at spacing `dt`, within `AUTO_ORDER + 3`
+/// and [`MAX_AUTO_WINDOW`]; also the fewest samples a record needs for it.
+pub fn auto_base_window(dt: f64, period: f64) -> usize {
+    nearest_odd(period * AUTO_PERIOD_SHARE / dt).clamp(AUTO_ORDER + 3, MAX_AUTO_WINDOW)
+}
+
+/// The odd number nearest to `x` (1 at least; an even `x` rounds up).
+fn nearest_odd(x: f64) -> usize {
+    if !x.is_finite() || x < 1.0 {
+        return 1;
+    }
+    let below = ((x - 1.0) / 2.0).floor() as usize * 2 + 1;
+    if x - below as f64 >= 1.0 {
+        below + 2
+    } else {
+        below
+    }
+}
+
+/// The Euclidean norm of the centred Savitzky-Golay derivative weights (unit spacing) of
+/// `window` samples and degree `order`: the derivative's noise is the samples' white noise
+/// times it, over the spacing.
+pub fn centre_weight_norm(window: usize, order: usize) -> Result<f64, EngineError> {
+    let h = (window / 2) as f64;
+    let offsets: Vec<f64> = (0..window).map(|j| j as f64 - h).collect();
+    Ok(derivative_weights(&offsets, order)?
+        .iter()
+        .map(|w| w * w)
+        .sum::<f64>()
+        .sqrt())
+}
+
+/// The norm of the paper's derivative weights (unit spacing): a central difference averaged
+/// over 9 samples telescopes to (v\[i+5\] + v\[i+4\] - v\[i-4\] - v\[i-5\]) / 18.
+pub const PAPER_WEIGHT_NORM: f64 = 2.0 / 18.0;
 
 impl Differentiator {
     /// The fewest samples a record needs for this method.
     pub fn min_samples(&self) -> usize {
         match *self {
+            Differentiator::Auto => AUTO_ORDER + 3,
             Differentiator::Paper => PAPER_SPAN,
             Differentiator::SavitzkyGolay { window, .. } => window,
         }

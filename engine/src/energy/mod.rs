@@ -72,18 +72,19 @@ pub mod model_force;
 
 pub use crate::simulate::MechanicalEnergy;
 pub use differentiate::{
-    central_difference, derivative_weights, moving_average, paper_derivative,
-    savitzky_golay_derivative, Differentiator, PAPER_SPAN,
+    auto_window, central_difference, centre_weight_norm, derivative_weights, moving_average,
+    paper_derivative, savitzky_golay_derivative, Differentiator, WindowInputs, AUTO_ORDER,
+    PAPER_SPAN,
 };
 pub use halfcycle::{HalfCycle, MIN_RUN};
 pub use model_force::{
     force_residuals, forces_at, forces_from_states, model_force_along, model_force_with_normal,
-    states_along, ForceResiduals,
+    states_along, states_along_stiff, ForceResiduals,
 };
 
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
-use crate::record::noise::difference_noise;
+use crate::record::noise::{difference_noise, quantisation_step, RESPONSE_ORDER};
 use crate::record::{Channel, Record};
 use halfcycle::{detect_motion, half_cycles, Interp, Motion, Samples, VELOCITY_NOISE_ORDER};
 use serde::{Deserialize, Serialize};
@@ -100,8 +101,9 @@ pub struct EnergyOptions {
 }
 
 impl Default for EnergyOptions {
-    /// Savitzky-Golay (31 samples, quartic) and a 1 mm/s threshold: 1 % of the paper's
-    /// smallest peak speed, 5x its vibrometer-like noise of 2e-4 m/s.
+    /// The automatic Savitzky-Golay window (31 samples, quartic, on the FMM at 1 kHz) and a
+    /// 1 mm/s threshold: 1 % of the paper's smallest peak speed, 5x its vibrometer-like noise
+    /// of 2e-4 m/s.
     fn default() -> Self {
         Self {
             differentiator: Differentiator::default(),
@@ -153,6 +155,15 @@ pub struct EnergyAnalysis {
     pub half_cycle_std: f64,
     /// Where the displacement, velocity and acceleration series came from.
     pub sources: SeriesSources,
+    /// The Savitzky-Golay window the acceleration was differentiated with (`None` when it
+    /// was measured, exact, or from the paper's recipe).
+    pub window: Option<usize>,
+    /// Standard deviation of Eq. 7's force from the measurement noise and quantisation
+    /// (m times the derivative's noise, k times the displacement's quantisation) \[N\]; 0
+    /// for exact states.
+    pub force_noise: f64,
+    /// The quantisation step of a measured displacement (an encoder's count) \[m\].
+    pub displacement_step: Option<f64>,
 }
 
 /// How a series of the energy analysis was obtained.
@@ -303,14 +314,34 @@ pub fn analyze_record(
     opts: &EnergyOptions,
 ) -> Result<EnergyAnalysis, EngineError> {
     record.require_x0("the energy analysis (it integrates the velocity from x0)")?;
-    let (measured, motion) = measured_motion(record, osc, opts)?;
+    let (measured, motion, velocity_noise) = measured_motion(record, osc, opts)?;
     let time = record.time();
-    let (a, acceleration) = match record.channel(Channel::Acceleration) {
-        Some(channel) => (channel.to_vec(), SeriesSource::Measured),
-        None => (
-            differentiate_velocity(time, &measured.v, opts, &motion)?,
-            SeriesSource::Differentiated,
-        ),
+    let displacement_step = match measured.displacement {
+        SeriesSource::Measured => record
+            .channel(Channel::Displacement)
+            .and_then(quantisation_step),
+        _ => None,
+    };
+    let (a, acceleration, derivative) = match record.channel(Channel::Acceleration) {
+        Some(channel) => {
+            let noise = osc.mass * difference_noise(channel, RESPONSE_ORDER);
+            let measured_a = Derivative {
+                window: None,
+                force_noise: noise,
+            };
+            (channel.to_vec(), SeriesSource::Measured, measured_a)
+        }
+        None => {
+            let level = half_cycles(&measured.samples(time), &motion, osc).1;
+            let context = DerivativeContext {
+                osc,
+                velocity_noise,
+                level,
+            };
+            let (a, derivative) =
+                differentiate_velocity(time, &measured.v, opts, &motion, &context)?;
+            (a, SeriesSource::Differentiated, derivative)
+        }
     };
     let sources = SeriesSources {
         displacement: measured.displacement,
@@ -324,7 +355,28 @@ pub fn analyze_record(
         a,
         interp: Interp::Linear,
     };
-    Ok(assemble(osc, series, &motion, opts, sources))
+    let mut analysis = assemble(osc, series, &motion, opts, sources);
+    let spring_noise = displacement_step.map_or(0.0, |q| osc.stiffness * q / 12f64.sqrt());
+    analysis.window = derivative.window;
+    analysis.force_noise = derivative.force_noise.hypot(spring_noise);
+    analysis.displacement_step = displacement_step;
+    Ok(analysis)
+}
+
+/// How the acceleration of an analysis was obtained: the Savitzky-Golay window, and the
+/// standard deviation of m a from the velocity's noise \[N\].
+struct Derivative {
+    window: Option<usize>,
+    force_noise: f64,
+}
+
+/// What the automatic differentiator chooses its window from.
+struct DerivativeContext<'a> {
+    osc: &'a Oscillator,
+    /// The velocity's noise, quantisation included \[m/s\].
+    velocity_noise: f64,
+    /// The half-cycle mean friction force \[N\] (NaN without a complete half-cycle).
+    level: f64,
 }
 
 /// The samples an analysis keeps (owned: the measured motion and the derivative are moved
@@ -358,21 +410,33 @@ pub fn half_cycle_force(
     osc: &Oscillator,
     opts: &EnergyOptions,
 ) -> Result<Option<f64>, EngineError> {
-    let (measured, motion) = measured_motion(record, osc, opts)?;
+    let (measured, motion, _) = measured_motion(record, osc, opts)?;
     let (_, mean, _) = half_cycles(&measured.samples(record.time()), &motion, osc);
     Ok(mean.is_finite().then_some(mean))
 }
 
-/// The checked inputs of an energy analysis: the record's displacement and velocity and its
-/// motion (release, turning points, end).
+/// The checked inputs of an energy analysis: the record's displacement and velocity, its
+/// motion (release, turning points, end) and the velocity's noise level (white noise from
+/// its second differences, or the quantisation of its values, step / sqrt(12), when larger:
+/// a quantised velocity's differences are mostly zero).
 fn measured_motion(
     record: &Record,
     osc: &Oscillator,
     opts: &EnergyOptions,
-) -> Result<(RecordMotion, Motion), EngineError> {
+) -> Result<(RecordMotion, Motion, f64), EngineError> {
     opts.validate()?;
     osc.validate()?;
-    record.validate_channels(opts.differentiator.min_samples().max(MIN_RUN + 1))?;
+    let window = match opts.differentiator {
+        // The automatic window's own size on this record.
+        Differentiator::Auto => {
+            let time = record.time();
+            let span = time.last().zip(time.first()).map(|(b, a)| b - a);
+            let dt = span.unwrap_or(f64::NAN) / time.len().saturating_sub(1).max(1) as f64;
+            differentiate::auto_base_window(dt, 2.0 * std::f64::consts::PI / osc.omega_n())
+        }
+        other => other.min_samples(),
+    };
+    record.validate_channels(window.max(MIN_RUN + 1))?;
     let Some(measured) = record_motion(record) else {
         // The velocity check names what the record has instead.
         record.validate(0)?;
@@ -394,23 +458,48 @@ fn measured_motion(
         record.v0,
         &record.name,
     )?;
-    Ok((measured, motion))
+    let quantised = quantisation_step(&measured.v).map_or(0.0, |q| q / 12f64.sqrt());
+    Ok((measured, motion, noise.max(quantised)))
 }
 
 /// The acceleration from the velocity by the configured differentiator (Savitzky-Golay
-/// windows do not straddle the breaks of the motion).
+/// windows do not straddle the breaks of the motion; the automatic one takes its window from
+/// the record, [`auto_window`]), and how it was obtained.
 fn differentiate_velocity(
     time: &[f64],
     v: &[f64],
     opts: &EnergyOptions,
     motion: &Motion,
-) -> Result<Vec<f64>, EngineError> {
-    match opts.differentiator {
-        Differentiator::Paper => Ok(paper_derivative(time, v)),
-        Differentiator::SavitzkyGolay { window, order } => {
-            savitzky_golay_derivative(time, v, window, order, &motion.break_indices(time))
+    context: &DerivativeContext<'_>,
+) -> Result<(Vec<f64>, Derivative), EngineError> {
+    let dt = (time[time.len() - 1] - time[0]) / (time.len() - 1).max(1) as f64;
+    let force_noise = |norm: f64| context.osc.mass * context.velocity_noise * norm / dt;
+    let (window, order) = match opts.differentiator {
+        Differentiator::Paper => {
+            let derivative = Derivative {
+                window: None,
+                force_noise: force_noise(differentiate::PAPER_WEIGHT_NORM),
+            };
+            return Ok((paper_derivative(time, v), derivative));
         }
-    }
+        Differentiator::SavitzkyGolay { window, order } => (window, order),
+        Differentiator::Auto => {
+            let inputs = WindowInputs {
+                dt,
+                period: 2.0 * std::f64::consts::PI / context.osc.omega_n(),
+                velocity_noise: context.velocity_noise,
+                mass: context.osc.mass,
+                level: context.level,
+            };
+            (auto_window(&inputs)?.0, AUTO_ORDER)
+        }
+    };
+    let a = savitzky_golay_derivative(time, v, window, order, &motion.break_indices(time))?;
+    let derivative = Derivative {
+        window: Some(window),
+        force_noise: force_noise(centre_weight_norm(window, order)?),
+    };
+    Ok((a, derivative))
 }
 
 /// The energy analysis from exact states (e.g. a simulated trajectory): no integration, no
@@ -515,6 +604,7 @@ fn assemble(
     };
     let (cycles, half_cycle_mean, half_cycle_std) = half_cycles(s, motion, osc);
     let Series { time, x, v, a, .. } = series;
+    // Exact states carry no noise; a record's analysis overwrites these.
     EnergyAnalysis {
         time,
         x,
@@ -529,5 +619,8 @@ fn assemble(
         half_cycle_mean,
         half_cycle_std,
         sources,
+        window: None,
+        force_noise: 0.0,
+        displacement_step: None,
     }
 }

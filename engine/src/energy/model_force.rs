@@ -18,12 +18,18 @@
 //! odd in v, has a kink there that a step's error estimate would not see. It
 //! needs nothing of the model beyond
 //! `state_derivative`, so every registered model works unchanged.
+//!
+//! Bristles far stiffer than that (sigma0 = 1e7 N/m: lambda ~ 4e5 1/s) hold Dopri5 at its
+//! stability limit, hundreds of sub-steps per sample; [`states_along_stiff`] integrates the
+//! same intervals with Rodas4 (linearly implicit, no stability bound, the states' Jacobian by
+//! forward differences), which the energy check falls back on when the explicit replay runs
+//! out of its step budget.
 
 use super::EnergyAnalysis;
 use crate::error::{EngineError, IntegrationFailure};
 use crate::oscillator::Oscillator;
 use crate::record::NormalForce;
-use crate::simulate::{Dopri5, OdeSystem, StepOutcome, Stepper};
+use crate::simulate::{Dopri5, OdeSystem, Rodas4, StepOutcome, Stepper};
 use frictionid_models::{FrictionModel, InternalStates};
 use serde::Serialize;
 
@@ -101,6 +107,29 @@ pub(crate) struct CheckedMotion<'a> {
     pub normal: &'a NormalForce,
 }
 
+/// [`states_along`] integrated with the stiff Rodas4 (see the module docs): for bristles
+/// so stiff that the explicit replay would need many sub-steps per sample.
+pub fn states_along_stiff(
+    model: &dyn FrictionModel,
+    time: &[f64],
+    v: &[f64],
+    normal: &NormalForce,
+    max_substeps: u64,
+) -> Result<Vec<f64>, EngineError> {
+    check_motion(time, v, normal)?;
+    let Some(states) = model.states() else {
+        return Ok(Vec::new());
+    };
+    let stepper = Rodas4::new(states.n_states(), RTOL, ATOL, f64::INFINITY);
+    replay(
+        stepper,
+        model,
+        states,
+        CheckedMotion { time, v, normal },
+        max_substeps,
+    )
+}
+
 /// [`states_along`] of a motion already checked by [`check_motion`] (a fit checks it once,
 /// not at every evaluation).
 pub(crate) fn states_along_checked(
@@ -108,17 +137,45 @@ pub(crate) fn states_along_checked(
     motion: CheckedMotion<'_>,
     max_substeps: u64,
 ) -> Result<Vec<f64>, EngineError> {
-    let CheckedMotion { time, v, normal } = motion;
     let Some(states) = model.states() else {
         return Ok(Vec::new());
     };
+    let stepper = Dopri5::new(states.n_states(), RTOL, ATOL, f64::INFINITY);
+    replay(stepper, model, states, motion, max_substeps)
+}
+
+/// A stepper that can run on from one sample interval into the next (see the module docs).
+trait ReplayStepper: Stepper {
+    fn extend_to(&mut self, t_end: f64);
+}
+
+impl ReplayStepper for Dopri5 {
+    fn extend_to(&mut self, t_end: f64) {
+        Dopri5::extend_to(self, t_end);
+    }
+}
+
+impl ReplayStepper for Rodas4 {
+    fn extend_to(&mut self, t_end: f64) {
+        Rodas4::extend_to(self, t_end);
+    }
+}
+
+/// The states at every sample, integrated interval after interval with `stepper`.
+fn replay<S: ReplayStepper>(
+    mut stepper: S,
+    model: &dyn FrictionModel,
+    states: &dyn InternalStates,
+    motion: CheckedMotion<'_>,
+    max_substeps: u64,
+) -> Result<Vec<f64>, EngineError> {
+    let CheckedMotion { time, v, normal } = motion;
     let ns = states.n_states();
     let mut z = vec![0.0; ns];
     let mut out = Vec::with_capacity(v.len() * ns);
     if ns == 0 {
         return Ok(out);
     }
-    let mut stepper = Dopri5::new(ns, RTOL, ATOL, f64::INFINITY);
     for i in 0..time.len() {
         if i > 0 {
             let along = AlongMotion {
@@ -306,8 +363,8 @@ enum Start {
 
 /// Integrates the states `z` over one sample interval (the stepper keeps its step size
 /// across intervals).
-fn integrate_interval(
-    stepper: &mut Dopri5,
+fn integrate_interval<S: ReplayStepper>(
+    stepper: &mut S,
     along: &AlongMotion<'_>,
     z: &mut [f64],
     start: Start,
@@ -326,8 +383,8 @@ fn integrate_interval(
 }
 
 /// Steps to the stepper's end time within the sub-step budget, refusing non-finite states.
-fn run_to_stop(
-    stepper: &mut Dopri5,
+fn run_to_stop<S: ReplayStepper>(
+    stepper: &mut S,
     along: &AlongMotion<'_>,
     max_substeps: u64,
 ) -> Result<(), IntegrationFailure> {

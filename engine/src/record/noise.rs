@@ -51,6 +51,31 @@ pub fn noise_floor(values: &[f64]) -> f64 {
     }
 }
 
+/// The quantisation step of `values` when they sit on a uniform grid (an encoder's counts, an
+/// ADC's levels): the smallest non-zero difference between successive samples, kept when at
+/// least 99 % of the samples lie within 5 % of a step of the grid through the first sample.
+/// `None` for values that are not quantised (their smallest difference is a grazing one that
+/// the other samples do not share), and for fewer than 10 non-zero differences.
+pub fn quantisation_step(values: &[f64]) -> Option<f64> {
+    let step = values
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .filter(|d| *d > 0.0 && d.is_finite());
+    let (count, smallest) = step.fold((0usize, f64::INFINITY), |(n, m), d| (n + 1, m.min(d)));
+    if count < 10 || !smallest.is_finite() {
+        return None;
+    }
+    let origin = values.first().copied()?;
+    let off_grid = values
+        .iter()
+        .filter(|&&x| {
+            let steps = (x - origin) / smallest;
+            !(steps.abs() < 1e7 && (steps - steps.round()).abs() <= 0.05)
+        })
+        .count();
+    (off_grid * 100 <= values.len()).then_some(smallest)
+}
+
 /// C(2k, k): the variance gain of the k-th difference of white noise.
 fn central_binomial(k: usize) -> f64 {
     (1..=k).fold(1.0, |c, i| c * (k + i) as f64 / i as f64)
@@ -133,6 +158,21 @@ impl Clone for NoiseCache {
 mod tests {
     use super::*;
     use crate::synthetic::add_gaussian_noise;
+
+    /// An encoder's counts of a sinusoid give back the count; the sinusoid itself, sampled
+    /// finely enough to pass close to some values, has no step.
+    #[test]
+    fn the_step_of_quantised_values_is_found_and_smooth_values_have_none() {
+        let q = 1.5e-6;
+        let smooth: Vec<f64> = (0..5000)
+            .map(|i| 0.01 * (i as f64 * 1e-3 * 13.8).sin() + 3e-4)
+            .collect();
+        let counts: Vec<f64> = smooth.iter().map(|x| (x / q).round() * q).collect();
+        let step = quantisation_step(&counts).unwrap();
+        assert!((step / q - 1.0).abs() < 1e-6, "{step}");
+        assert_eq!(quantisation_step(&smooth), None);
+        assert_eq!(quantisation_step(&counts[..5]), None);
+    }
 
     /// White noise on a sinusoid sampled like the FMM records: every order from 1 (on a slow
     /// ramp) to 3 (on the oscillation) returns the noise's sigma within a few per cent.

@@ -5,6 +5,7 @@ use super::format::{
     serialized_name,
 };
 use super::{render_files, render_opening, Render, Role, Sink, Status, Table, Verdict};
+use crate::identify::values::EnergyForce;
 use crate::identify::{FitResult, FittedParam};
 use serde::{Serialize, Serializer};
 
@@ -186,11 +187,18 @@ pub fn verdict_line(fit: &FitResult) -> (Status, String) {
                 problems(Status::Fail).join(", ")
             ),
         ),
-        Verdict::Ok => match problems(Status::Warn) {
-            warned if warned.is_empty() => {
+        Verdict::Ok => match (problems(Status::Warn), problems(Status::Skipped)) {
+            (warned, skipped) if warned.is_empty() && skipped.is_empty() => {
                 (Status::Pass, "converged; every diagnostic passed.".into())
             }
-            warned => (
+            (warned, skipped) if warned.is_empty() => (
+                Status::Pass,
+                format!(
+                    "converged; every diagnostic that could judge passed ({} skipped: read why).",
+                    skipped.join(", ")
+                ),
+            ),
+            (warned, _) => (
                 Status::Warn,
                 format!("converged, with warnings ({}).", warned.join(", ")),
             ),
@@ -248,22 +256,9 @@ fn energy_record_table(fit: &FitResult) -> Table {
         .records
         .iter()
         .map(|r| {
-            let (m, re, pd) = match &r.energy_force {
-                Some(e) => (
-                    fmt_num(e.mean_abs),
-                    fmt_num(e.reference),
-                    fmt_percent(e.percent_difference),
-                ),
-                None => ("-".into(), "-".into(), "-".into()),
-            };
-            vec![
-                r.file.clone(),
-                fmt_num(r.x0),
-                fmt_num(r.rms_residual),
-                m,
-                re,
-                pd,
-            ]
+            let mut row = vec![r.file.clone(), fmt_num(r.x0), fmt_num(r.rms_residual)];
+            row.extend(energy_cells(r.energy_force.as_ref()));
+            row
         })
         .collect();
     let rms = format!("rms residual [{}]", fit.residual_unit);
@@ -275,9 +270,38 @@ fn energy_record_table(fit: &FitResult) -> Table {
             "mean |F| Eq. 7 [N]",
             "model mean |F| [N]",
             "difference [%]",
+            "dissipated [J]",
+            "model dissipated [J]",
+            "difference [%]",
         ],
         rows,
     )
+}
+
+/// The energy check's cells of a record: Eq. 7's mean against the model's, the dissipated
+/// energy against the model's, each difference `skipped` where that part could not judge.
+fn energy_cells(ef: Option<&EnergyForce>) -> [String; 6] {
+    let Some(e) = ef else {
+        return std::array::from_fn(|_| "-".into());
+    };
+    let judged = |skip: bool, percent: f64| {
+        if skip {
+            "skipped".to_string()
+        } else {
+            fmt_percent(percent)
+        }
+    };
+    [
+        fmt_num(e.mean_abs),
+        fmt_num(e.reference),
+        judged(e.eq7_skipped.is_some(), e.percent_difference),
+        fmt_num(e.dissipated),
+        fmt_num(e.model_dissipated),
+        judged(
+            e.dissipation_skipped.is_some(),
+            e.dissipation_percent_difference,
+        ),
+    ]
 }
 
 /// Every compared channel of every record: its RMS residual against the noise level its

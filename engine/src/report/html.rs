@@ -142,7 +142,8 @@ impl Sink for HtmlWriter<'_> {
     }
 }
 
-/// An HTML table; cells that are a check status (`pass`, `warn`, `fail`) carry it as class.
+/// An HTML table; cells that are a check status (`pass`, `skipped`, `warn`, `fail`) carry it
+/// as class.
 fn html_table(table: &Table) -> String {
     let mut out = String::from("<div class=\"scroll\"><table>\n<thead><tr>");
     for h in &table.headers {
@@ -153,7 +154,7 @@ fn html_table(table: &Table) -> String {
         out.push_str("<tr>");
         for cell in row {
             match cell.as_str() {
-                "pass" | "warn" | "fail" => {
+                "pass" | "skipped" | "warn" | "fail" => {
                     let _ = write!(out, "<td class=\"status {cell}\">{cell}</td>");
                 }
                 _ => {
@@ -232,6 +233,7 @@ td.status { font-weight: 600; text-transform: uppercase; font-size: .85em; }
 td.status.pass { color: var(--ok); }
 td.status.warn { color: var(--warn); }
 td.status.fail { color: var(--fail); }
+td.status.skipped { color: var(--muted); }
 figure { margin: 1rem 0 1.5rem; }
 figure svg { display: block; width: 100%; height: auto; }
 figcaption { color: var(--muted); font-size: .9rem; }

@@ -1,9 +1,11 @@
 //! Diagnostics on every fit: each check turns part of a fit into a [`Finding`] with a pass,
 //! warn or fail status, so that a result that cannot be trusted says so.
 //!
-//! - Energy balance: the model's mean force against the energy-based estimates (Eq. 7, time
-//!   mean, and the half-cycle estimate, a distance mean): warn above
-//!   [`ENERGY_WARN_PERCENT`], fail above [`ENERGY_FAIL_PERCENT`].
+//! - Energy balance: the model's mean force against Eq. 7's over the same samples, and the
+//!   energy the model dissipates over the half-cycles along the measured motion against the
+//!   energy the record loses there: warn above [`ENERGY_WARN_PERCENT`], fail above
+//!   [`ENERGY_FAIL_PERCENT`]; a part the record cannot support is skipped with its reason
+//!   (both skipped: the finding is `skipped`).
 //! - Residual structure: residuals locked to the motion (correlated with sgn v or x, repeating
 //!   with the oscillation period, or with a mean) betray a wrong model, an offset or a missed
 //!   release. Significance is judged with the effective sample size of autocorrelated
@@ -45,35 +47,66 @@ fn status_of(value: f64, warn: f64, fail: f64) -> Status {
     }
 }
 
-/// The energy-balance finding of one record: the larger of the Eq. 7 and the half-cycle
-/// differences (in percent) decides.
+/// The energy-balance finding of one record: the larger of the Eq. 7 and the dissipated
+/// energy differences (in percent) decides among the parts that can judge; with neither,
+/// the finding is skipped with the reasons.
 pub fn energy_balance(record: &str, ef: &EnergyForce) -> Finding {
     let eq7 = ef.percent_difference.abs();
-    let half = ef.half_cycle_percent_difference.abs();
-    let worst = [eq7, half]
-        .into_iter()
-        .filter(|d| !d.is_nan())
+    let energies = ef.dissipation_percent_difference.abs();
+    let judged = [
+        (eq7, ef.eq7_skipped.is_none()),
+        (energies, ef.dissipation_skipped.is_none()),
+    ];
+    let worst = judged
+        .iter()
+        .filter(|(d, judged)| *judged && !d.is_nan())
+        .map(|(d, _)| *d)
         .fold(f64::NAN, f64::max);
-    let status = if worst.is_nan() {
-        Status::Warn
+    let skipped = energy_skips(ef);
+    if worst.is_nan() {
+        let why = if skipped.is_empty() {
+            "neither comparison is defined".to_string()
+        } else {
+            skipped.join("; ")
+        };
+        return Finding::skipped(
+            Check::EnergyBalance,
+            format!("record `{record}`: the energy balance cannot judge this record: {why}"),
+        );
+    }
+    let status = status_of(worst, ENERGY_WARN_PERCENT, ENERGY_FAIL_PERCENT);
+    let not_judged = if skipped.is_empty() {
+        String::new()
     } else {
-        status_of(worst, ENERGY_WARN_PERCENT, ENERGY_FAIL_PERCENT)
+        format!(" (not judged: {})", skipped.join("; "))
     };
     let message = format!(
-        "record `{record}`: energy-based friction force differs from the model's by {:.1} % (Eq. 7 mean {:.4} N vs {:.4} N) and {:.1} % (half-cycle mean {:.4} N vs {:.4} N){}",
+        "record `{record}`: energy-based friction differs from the model's by {:.1} % (Eq. 7 mean {:.4} N vs {:.4} N) and {:.1} % (energy dissipated over {} half-cycles {:.4e} J vs {:.4e} J){not_judged}{}",
         ef.percent_difference,
         ef.mean_abs,
         ef.reference,
-        ef.half_cycle_percent_difference,
-        ef.half_cycle_mean,
-        ef.half_cycle_reference,
+        ef.dissipation_percent_difference,
+        ef.half_cycles,
+        ef.dissipated,
+        ef.model_dissipated,
         match status {
-            Status::Pass => "",
+            Status::Pass | Status::Skipped => "",
             Status::Warn => ": the fitted law does not quite dissipate the energy the record loses",
             Status::Fail => ": the fitted law does not explain the energy the record loses (wrong units, model, offset or release?)",
         }
     );
     Finding::new(Check::EnergyBalance, status, Some(worst), message)
+}
+
+/// The parts of an energy check that could not judge, each with its reason.
+fn energy_skips(ef: &EnergyForce) -> Vec<String> {
+    [
+        ("Eq. 7", &ef.eq7_skipped),
+        ("dissipated energy", &ef.dissipation_skipped),
+    ]
+    .into_iter()
+    .filter_map(|(part, skip)| skip.as_ref().map(|s| format!("{part}: {s}")))
+    .collect()
 }
 
 /// Lag-`lag` autocorrelation of the residual segments (pairs within a segment only).
@@ -99,11 +132,24 @@ fn autocorrelation<S: AsRef<[f64]>>(segments: &[S], lag: usize) -> f64 {
 /// Differencing removes the slow, motion-locked part, which would otherwise pass for
 /// strongly coloured noise and hide itself.
 pub(crate) fn noise_correlation<S: AsRef<[f64]>>(segments: &[S]) -> f64 {
+    residual_smoothness(segments).clamp(0.0, 0.999)
+}
+
+/// 1 + 2 times the lag-1 autocorrelation of the residuals' first differences: the lag-1
+/// correlation of AR(1) noise ([`noise_correlation`] unclamped). Above 1 (differences
+/// positively correlated) no AR(1) noise can explain the residuals: they are smoother than
+/// noise at the sample scale.
+pub(crate) fn residual_smoothness<S: AsRef<[f64]>>(segments: &[S]) -> f64 {
     let differences: Vec<Vec<f64>> = segments
         .iter()
         .map(|s| s.as_ref().windows(2).map(|w| w[1] - w[0]).collect())
         .collect();
-    (1.0 + 2.0 * autocorrelation(&differences, 1)).clamp(0.0, 0.999)
+    1.0 + 2.0 * autocorrelation(&differences, 1)
+}
+
+/// The lag-1 autocorrelation of residual segments (pairs within a segment only).
+pub(crate) fn lag_one_correlation<S: AsRef<[f64]>>(segments: &[S]) -> f64 {
+    autocorrelation(segments, 1)
 }
 
 /// Pearson correlation of already demeaned series `a` and `b` of the moving parts, pooled
@@ -199,6 +245,16 @@ pub fn residual_structure(records: &[RecordFit], osc: &Oscillator, threshold: f6
             "too few moving samples to judge the residual structure".into(),
         );
     }
+    if let Some(share) = at_numerical_floor(&moving, records) {
+        return Finding::new(
+            Check::ResidualStructure,
+            Status::Pass,
+            Some(0.0),
+            format!(
+                "residuals are {share:.1e} of the response, at the simulations' numerical floor: no structure to judge (a noise-free record)"
+            ),
+        );
+    }
     // AR(1) effective sample sizes: for a correlation with a smooth regressor and for an
     // autocorrelation coefficient.
     let phi = noise_correlation(&residuals);
@@ -230,6 +286,24 @@ pub fn residual_structure(records: &[RecordFit], osc: &Oscillator, threshold: f6
     }
     stats.push(mean_statistic(records, phi));
     structure_finding(&stats)
+}
+
+/// The largest residual RMS, as a share of the fitted response's RMS, that is the
+/// simulations' own round-off and tolerance (the noise floor of a noise-free record):
+/// residuals that small are locked to the motion by construction.
+pub const NUMERICAL_FLOOR: f64 = 1e-6;
+
+/// The residuals' RMS over the fitted response's on the moving parts, when at most
+/// [`NUMERICAL_FLOOR`].
+fn at_numerical_floor(moving: &[Moving], records: &[RecordFit]) -> Option<f64> {
+    let residual: f64 = moving.iter().flat_map(|m| &m.residual).map(|r| r * r).sum();
+    let response: f64 = records
+        .iter()
+        .flat_map(|r| &r.series.fitted)
+        .map(|f| f * f)
+        .sum();
+    let share = (residual / response).sqrt();
+    (share <= NUMERICAL_FLOOR).then_some(share)
 }
 
 /// The residual mean over whole records, relative to the residual RMS.
@@ -501,6 +575,7 @@ mod tests {
     use super::*;
     use crate::exact::coulomb_free_vibration;
     use crate::identify::values::layout::ParamKind;
+    use crate::identify::values::result::EnergySkip;
     use crate::identify::values::result::FitSeries;
     use crate::identify::values::result::SampleAxes;
     use rand::rngs::StdRng;
@@ -597,22 +672,27 @@ mod tests {
         assert!(offset.message.contains("mean"), "{}", offset.message);
     }
 
-    fn energy_force(eq7: f64, half: f64) -> EnergyForce {
+    fn energy_force(eq7: f64, energies: f64) -> EnergyForce {
         EnergyForce {
             mean_abs: 3.48 * (1.0 + eq7 / 100.0),
             reference: 3.48,
             percent_difference: eq7,
             residual_rms: 0.1,
             samples: 100,
-            half_cycle_mean: 3.48 * (1.0 + half / 100.0),
-            half_cycle_reference: 3.48,
-            half_cycle_percent_difference: half,
+            force_noise: 0.05,
+            half_cycle_mean: 3.48,
+            half_cycles: 4,
+            dissipated: 0.1 * (1.0 + energies / 100.0),
+            model_dissipated: 0.1,
+            dissipation_percent_difference: energies,
+            eq7_skipped: None,
+            dissipation_skipped: None,
         }
     }
 
     #[test]
     fn energy_balance_thresholds_are_five_and_twenty_percent() {
-        let status = |eq7, half| energy_balance("r", &energy_force(eq7, half)).status;
+        let status = |eq7, energies| energy_balance("r", &energy_force(eq7, energies)).status;
         assert_eq!(status(1.0, -2.0), Status::Pass);
         assert_eq!(status(-6.0, 1.0), Status::Warn);
         assert_eq!(status(1.0, 12.0), Status::Warn);
@@ -621,6 +701,31 @@ mod tests {
         let f = energy_balance("x14.csv", &energy_force(-25.0, 3.0));
         assert_eq!(f.value, Some(25.0));
         assert!(f.message.contains("x14.csv"));
+    }
+
+    /// A part that cannot judge is left out of the status and named; with both left out the
+    /// finding is skipped, never failed.
+    #[test]
+    fn an_energy_part_that_cannot_judge_is_skipped_with_its_reason() {
+        let mut ef = energy_force(150.0, 1.0);
+        ef.eq7_skipped = Some(EnergySkip::NoisyDerivative {
+            force_noise: 2.0,
+            level: 3.48,
+        });
+        let f = energy_balance("r", &ef);
+        assert_eq!(f.status, Status::Pass, "{}", f.message);
+        assert!(f.message.contains("not judged: Eq. 7"), "{}", f.message);
+        ef.dissipation_skipped = Some(EnergySkip::FewSamples {
+            per_half_cycle: 8,
+            needed: 20,
+        });
+        let f = energy_balance("r", &ef);
+        assert_eq!(f.status, Status::Skipped, "{}", f.message);
+        assert!(
+            f.message.contains("8 samples per half-cycle"),
+            "{}",
+            f.message
+        );
     }
 
     #[test]

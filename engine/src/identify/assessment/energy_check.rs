@@ -1,12 +1,46 @@
 //! The energy-balance check (the paper's cross-check): the friction force from the energy
-//! balance, Eq. 7, held against the force of a fitted model or a given reference force.
+//! balance, Eq. 7, held against the force of a fitted model or a given reference force, and
+//! the energy the friction dissipates over each half-cycle, measured, against the model's
+//! along the measured motion.
 //!
 //! One function, [`energy_force_check`], serves the identifier (after every fit) and the
 //! `energy` command (against `[model]`, `reference_force` or a Coulomb fit).
+//!
+//! # Like with like
+//! Eq. 7's force is compared sample by sample and by its time mean with the model's force
+//! over the same samples, each mean taken of the force against the motion, F sgn(v): the
+//! mean |F| where the force opposes the motion (a sliding contact's), and unbiased by noise
+//! where |F| is not (stiff bristles replayed along a noisy velocity give a model force whose
+//! noise alone would add to a mean |F|; presliding just after a reversal pushes with the
+//! motion on both sides alike). The half-cycle energy balance needs no derivative: between two
+//! turning points the drop of the mechanical energy less the viscous work is the energy the
+//! friction dissipated, and the model's is int F v dt over the same interval of the measured
+//! motion. Both are energies, summed over the complete half-cycles; a force that depends on
+//! the speed or on presliding changes neither side's weighting.
+//!
+//! # When it cannot judge
+//! A part is skipped, with its reason ([`EnergySkip`]), where its figure would measure the
+//! record rather than the model: fewer than [`MIN_HALF_CYCLE_SAMPLES`] samples in the median
+//! half-cycle (both parts), a displacement quantised so coarsely that the energies at the
+//! turning points are uncertain by more than [`MAX_QUANTISATION_SHARE`] of the energy
+//! dissipated (the energies), an Eq. 7 force whose noise exceeds [`MAX_NOISE_SHARE`] of the
+//! friction level (Eq. 7).
 
-use crate::energy::{mean_abs_where_defined, percent_difference, EnergyAnalysis};
+use crate::energy::{percent_difference, EnergyAnalysis, HalfCycle};
 use crate::error::EngineError;
-use crate::identify::values::EnergyForce;
+use crate::identify::values::{EnergyForce, EnergySkip};
+use crate::record::noise::difference_noise;
+
+/// The fewest samples in the median half-cycle for either part of the check: a 31-sample
+/// derivative window needs a few windows per half-cycle, and the trapezoidal work of a
+/// half-sine over 20 samples is within 0.5 %.
+pub const MIN_HALF_CYCLE_SAMPLES: usize = 20;
+/// The largest uncertainty of the dissipated energy from the displacement's quantisation,
+/// as a share of it, that the energies are judged with: half the warning threshold.
+pub const MAX_QUANTISATION_SHARE: f64 = 0.025;
+/// The largest noise of the Eq. 7 force, as a share of the friction level, that its mean is
+/// judged with: E|F + e| exceeds F by under 0.1 % while sd(e) <= F / 3.
+pub const MAX_NOISE_SHARE: f64 = 1.0 / 3.0;
 
 /// What the energy-based force is compared with.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -14,13 +48,16 @@ pub enum ForceReference<'a> {
     /// A model's friction force along the analysed motion, one value per sample of the
     /// analysis (e.g. from [`crate::energy::model_force_along`] on `analysis.time`,
     /// `analysis.v`). The reference level is its mean |F| over the samples where the
-    /// energy-based force is defined (exactly mu N for Coulomb friction).
+    /// energy-based force is defined (exactly mu N for Coulomb friction); its dissipated
+    /// energy is int F v dt over each half-cycle.
     ModelForce(&'a [f64]),
-    /// A constant force level [N] (e.g. a measured mu N).
+    /// A constant force level [N] (e.g. a measured mu N): its dissipated energy is the level
+    /// times the distance travelled.
     Level(f64),
 }
 
-/// Holds the energy-based force of `analysis` against `reference`.
+/// Holds the energy-based force of `analysis` against `reference`, and the energy dissipated
+/// over its half-cycles against the reference's.
 ///
 /// With a model force, the residual is the energy-based minus the model force on the samples
 /// where both are defined; an error when there are none, or when the model force is not
@@ -31,7 +68,8 @@ pub fn energy_force_check(
     reference: ForceReference<'_>,
 ) -> Result<EnergyForce, EngineError> {
     let energy = &analysis.friction;
-    let (level, distance_level, residual_rms, samples) = match reference {
+    let eq7_mean = mean_against_motion(energy, energy, &analysis.v);
+    let (level, residual_rms, samples) = match reference {
         ForceReference::ModelForce(model) => {
             if model.len() != energy.len() {
                 return Err(EngineError::InvalidInput(format!(
@@ -41,44 +79,182 @@ pub fn energy_force_check(
                 )));
             }
             let (rms, used) = residual_rms(energy, model)?;
-            let distance = distance_mean(model, energy, &analysis.v);
-            (mean_abs_where_defined(model, energy), distance, rms, used)
+            (mean_against_motion(model, energy, &analysis.v), rms, used)
         }
         ForceReference::Level(level) => (
-            level,
             level,
             f64::NAN,
             energy.iter().filter(|f| f.is_finite()).count(),
         ),
     };
+    let cycles = &analysis.half_cycles;
+    let dissipated: f64 = cycles.iter().map(|c| c.energy_lost - c.viscous_loss).sum();
+    let model_dissipated: f64 = cycles
+        .iter()
+        .map(|c| match reference {
+            ForceReference::ModelForce(model) => work_over(analysis, model, c),
+            ForceReference::Level(level) => level * c.distance,
+        })
+        .sum();
+    let (eq7_skipped, dissipation_skipped) = skips(analysis, dissipated);
+    let eq7_skipped = eq7_skipped.or_else(|| match reference {
+        ForceReference::ModelForce(model) => noisy_replay(model, level),
+        ForceReference::Level(_) => None,
+    });
     Ok(EnergyForce {
-        mean_abs: analysis.mean_abs_force,
+        mean_abs: eq7_mean,
         reference: level,
-        percent_difference: percent_difference(analysis.mean_abs_force, level),
+        percent_difference: percent_difference(eq7_mean, level),
         residual_rms,
         samples,
+        force_noise: analysis.force_noise,
         half_cycle_mean: analysis.half_cycle_mean,
-        half_cycle_reference: distance_level,
-        half_cycle_percent_difference: percent_difference(analysis.half_cycle_mean, distance_level),
+        half_cycles: cycles.len(),
+        dissipated,
+        model_dissipated,
+        dissipation_percent_difference: if cycles.is_empty() {
+            f64::NAN
+        } else {
+            percent_difference(dissipated, model_dissipated)
+        },
+        eq7_skipped,
+        dissipation_skipped,
     })
 }
 
-/// The distance mean sum |F| |v| / sum |v| of a model force over the samples where the
-/// energy-based force is defined (NaN when none is).
-fn distance_mean(model: &[f64], energy: &[f64], v: &[f64]) -> f64 {
-    let (work, distance) = model
+/// The mean of `force` sgn(v) over the samples where the energy-based force `energy` is
+/// defined (NaN when none is): the mean force against the motion.
+fn mean_against_motion(force: &[f64], energy: &[f64], v: &[f64]) -> f64 {
+    let (sum, n) = force
         .iter()
         .zip(energy)
         .zip(v)
-        .filter(|((m, e), _)| e.is_finite() && m.is_finite())
-        .fold((0.0, 0.0), |(w, d), ((m, _), v)| {
-            (w + m.abs() * v.abs(), d + v.abs())
+        .filter(|((f, e), _)| e.is_finite() && f.is_finite())
+        .fold((0.0, 0usize), |(s, n), ((f, _), v)| {
+            (s + f * v.signum(), n + 1)
         });
-    if distance > 0.0 {
-        work / distance
+    if n > 0 {
+        sum / n as f64
     } else {
         f64::NAN
     }
+}
+
+/// Why each part (Eq. 7, the dissipated energies) cannot judge the analysis, if it cannot.
+fn skips(analysis: &EnergyAnalysis, dissipated: f64) -> (Option<EnergySkip>, Option<EnergySkip>) {
+    let cycles = &analysis.half_cycles;
+    let per_half_cycle = median_samples(analysis);
+    let few = per_half_cycle
+        .filter(|&n| n < MIN_HALF_CYCLE_SAMPLES)
+        .map(|n| EnergySkip::FewSamples {
+            per_half_cycle: n,
+            needed: MIN_HALF_CYCLE_SAMPLES,
+        });
+    let level = if analysis.half_cycle_mean.is_finite() {
+        analysis.half_cycle_mean
+    } else {
+        analysis.mean_abs_force
+    };
+    let noisy = (analysis.force_noise > MAX_NOISE_SHARE * level.abs()).then_some(
+        EnergySkip::NoisyDerivative {
+            force_noise: analysis.force_noise,
+            level,
+        },
+    );
+    let quantised = analysis.displacement_step.and_then(|step| {
+        let share = turning_point_uncertainty(analysis, step) / dissipated.abs();
+        (share > MAX_QUANTISATION_SHARE || !share.is_finite())
+            .then_some(EnergySkip::Quantised { step, share })
+    });
+    let energies = if cycles.is_empty() {
+        Some(EnergySkip::NoHalfCycle)
+    } else {
+        few.clone().or(quantised)
+    };
+    (few.or(noisy), energies)
+}
+
+/// The skip for a model force whose own noise (white-noise level of its second differences)
+/// exceeds [`MAX_NOISE_SHARE`] of `level`: its mean then measures the replayed noise.
+fn noisy_replay(model: &[f64], level: f64) -> Option<EnergySkip> {
+    let force_noise = difference_noise(model, 2);
+    (force_noise > MAX_NOISE_SHARE * level.abs())
+        .then_some(EnergySkip::NoisyReplay { force_noise, level })
+}
+
+/// Samples in the median complete half-cycle (`None` without one).
+fn median_samples(analysis: &EnergyAnalysis) -> Option<usize> {
+    let dt = mean_spacing(&analysis.time)?;
+    let mut counts: Vec<usize> = analysis
+        .half_cycles
+        .iter()
+        .map(|c| ((c.t_end - c.t_start) / dt).round() as usize)
+        .collect();
+    counts.sort_unstable();
+    counts.get(counts.len() / 2).copied()
+}
+
+fn mean_spacing(time: &[f64]) -> Option<f64> {
+    let n = time.len();
+    (n >= 2).then(|| (time[n - 1] - time[0]) / (n - 1) as f64)
+}
+
+/// The uncertainty of the dissipated energy from a displacement quantised to `step`: k |x|
+/// step / 2 at both turning points of every half-cycle.
+fn turning_point_uncertainty(analysis: &EnergyAnalysis, step: f64) -> f64 {
+    let k = stiffness_of(analysis);
+    analysis
+        .half_cycles
+        .iter()
+        .map(|c| {
+            let x = |t| interpolate(&analysis.time, &analysis.x, t).abs();
+            k * (x(c.t_start) + x(c.t_end)) * step / 2.0
+        })
+        .sum()
+}
+
+/// The spring stiffness of the analysis, from its potential energy k x^2 / 2 at the sample
+/// farthest from equilibrium (the analysis keeps energies, not the oscillator).
+fn stiffness_of(analysis: &EnergyAnalysis) -> f64 {
+    let pe = &analysis.mechanical.potential;
+    let far =
+        (0..analysis.x.len()).max_by(|&a, &b| analysis.x[a].abs().total_cmp(&analysis.x[b].abs()));
+    far.map_or(f64::NAN, |i| 2.0 * pe[i] / (analysis.x[i] * analysis.x[i]))
+}
+
+/// `values` at `t`, linear between samples (the end values outside).
+fn interpolate(time: &[f64], values: &[f64], t: f64) -> f64 {
+    let i = time.partition_point(|&s| s <= t);
+    match (i.checked_sub(1), values.get(i)) {
+        (Some(lo), Some(&hi)) => {
+            let share = (t - time[lo]) / (time[i] - time[lo]);
+            values[lo] + (hi - values[lo]) * share
+        }
+        (Some(lo), None) => values[lo],
+        (None, _) => values.first().copied().unwrap_or(f64::NAN),
+    }
+}
+
+/// int F v dt of the model force `force` over the half-cycle `c` of the analysed motion, with
+/// the power F v linear between samples (the pieces at both ends cut at the turning points).
+fn work_over(analysis: &EnergyAnalysis, force: &[f64], c: &HalfCycle) -> f64 {
+    let (time, v) = (&analysis.time, &analysis.v);
+    let power = |i: usize| force[i] * v[i];
+    let power_at = |t: f64| {
+        let i = time.partition_point(|&s| s <= t).clamp(1, time.len() - 1);
+        let share = (t - time[i - 1]) / (time[i] - time[i - 1]);
+        power(i - 1) + (power(i) - power(i - 1)) * share
+    };
+    let first = time.partition_point(|&s| s <= c.t_start);
+    let last = time.partition_point(|&s| s < c.t_end);
+    if first >= last {
+        return 0.5 * (power_at(c.t_start) + power_at(c.t_end)) * (c.t_end - c.t_start);
+    }
+    let mut work = 0.5 * (power_at(c.t_start) + power(first)) * (time[first] - c.t_start);
+    for i in first + 1..last {
+        work += 0.5 * (power(i - 1) + power(i)) * (time[i] - time[i - 1]);
+    }
+    work + 0.5 * (power(last - 1) + power_at(c.t_end)) * (c.t_end - time[last - 1])
 }
 
 /// RMS of energy minus model force over the samples where both are defined, and their count.
@@ -126,10 +302,13 @@ mod tests {
         let ef = energy_force_check(&a, ForceReference::ModelForce(&fr.model_force)).unwrap();
         let mu_n = 0.24 * osc.normal_force;
         assert!((ef.reference - mu_n).abs() < 1e-12);
-        // Coulomb friction is the same at every speed: its distance mean is mu N too, and
-        // the half-cycle estimate (energy per distance) finds it.
-        assert!((ef.half_cycle_reference - mu_n).abs() < 1e-12);
-        assert!(ef.half_cycle_percent_difference.abs() < 0.5);
+        // The energy the model dissipates along the exact motion is the energy it loses.
+        assert!(
+            ef.dissipation_percent_difference.abs() < 0.05,
+            "{}",
+            ef.dissipation_percent_difference
+        );
+        assert!(ef.eq7_skipped.is_none() && ef.dissipation_skipped.is_none());
         assert!(
             ef.percent_difference.abs() < 1e-6,
             "{}",

@@ -3,8 +3,8 @@
 
 use super::diagnostics;
 use super::energy_check::{energy_force_check, ForceReference};
-use crate::energy::{analyze_record, forces_from_states, states_along};
-use crate::error::EngineError;
+use crate::energy::{analyze_record, forces_from_states, states_along, states_along_stiff};
+use crate::error::{EngineError, IntegrationFailure};
 use crate::identify::problem::{
     FitProblem, Realised, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
 };
@@ -73,11 +73,15 @@ fn record_fit<R: Residuals>(
                 (Some(ef), ebf, mf, Some(finding))
             }
             Err(e) => {
-                let finding = Finding::warn(
-                    Check::EnergyBalance,
-                    None,
-                    format!("record `{}`: no energy-based force check: {e}", rec.name),
-                );
+                let message = format!("record `{}`: no energy-based force check: {e}", rec.name);
+                let finding = match e {
+                    // The model's force along the measured motion could not be computed:
+                    // the check has nothing to judge the fit with.
+                    EngineError::StateIntegration { .. } => {
+                        Finding::skipped(Check::EnergyBalance, message)
+                    }
+                    _ => Finding::warn(Check::EnergyBalance, None, message),
+                };
                 (None, Vec::new(), Vec::new(), Some(finding))
             }
         }
@@ -167,12 +171,18 @@ fn energy_check<R: Residuals + ?Sized>(
         }
         Arc::new(analyze_record(&corrected, osc, &opts.energy)?)
     };
-    // The fit's step budget: bristles too stiff to replay cheaply (sigma0 far inside a
-    // one-sided bound) leave the check out, with a warning, instead of taking seconds.
+    // The fit's step budget, for the explicit replay and then, for bristles too stiff for
+    // it, for the stiff one; a replay that fails both leaves the check skipped.
     let budget = STEPS_PER_SAMPLE * (analysis.time.len() as u64).max(100);
     let model = world.model.as_ref();
     let normal = NormalForce::Constant(osc.normal_force);
-    let states = states_along(model, &analysis.time, &analysis.v, &normal, budget)?;
+    let states = match states_along(model, &analysis.time, &analysis.v, &normal, budget) {
+        Err(EngineError::StateIntegration {
+            failure: IntegrationFailure::StepBudgetExceeded { .. },
+            ..
+        }) => states_along_stiff(model, &analysis.time, &analysis.v, &normal, budget)?,
+        other => other?,
+    };
     let model_force = forces_from_states(model, &analysis.v, &normal, &states);
     let ef = energy_force_check(&analysis, ForceReference::ModelForce(&model_force))?;
     Ok((ef, analysis.friction.clone(), model_force))

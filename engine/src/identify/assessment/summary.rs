@@ -87,24 +87,28 @@ fn statistics<R: Residuals>(
 /// noise gives about 1/sqrt(n), far below).
 pub const AUTOCORRELATION_THRESHOLD: f64 = 0.1;
 
-/// Widens the covariance when the residuals are autocorrelated: each standard error becomes
-/// the larger of the classical and the Newey-West one (Bartlett lags covering the noise's
-/// correlation time), keeping the correlations. Returns the finding that says so.
+/// Lag-1 correlation (from the residuals' differences, [`diagnostics::residual_smoothness`])
+/// at or above which the residuals are smoother than measurement noise: a model error (or
+/// low-pass filtered data), reported as such instead of corrected for.
+pub const SMOOTH_RESIDUALS: f64 = 0.98;
+
+/// Widens the covariance when the residuals are autocorrelated noise: each standard error
+/// becomes the larger of the classical and the Newey-West one, after AR(1) prewhitening with
+/// the noise's lag-1 correlation and with Bartlett lags by Andrews' plug-in rule on what the
+/// prewhitening leaves (bounded: [`stats::andrews_lags`], at most a quarter of the shortest
+/// record), keeping the correlations. Residuals smooth enough to correlate near 1 at lag 1
+/// are not noise: a warning says so and nothing is widened. Returns the finding.
 fn widen_for_autocorrelation(
     cov: &mut Covariance,
     jac: &DMatrix<f64>,
     r: &[f64],
     segments: &[usize],
 ) -> Option<Finding> {
-    let mut start = 0;
-    let parts: Vec<Vec<f64>> = segments
-        .iter()
-        .map(|&len| {
-            let part = r[start..(start + len).min(r.len())].to_vec();
-            start += len;
-            part
-        })
-        .collect();
+    let parts = split(r, segments);
+    let smoothness = diagnostics::residual_smoothness(&parts);
+    if smoothness >= SMOOTH_RESIDUALS {
+        return Some(smooth_residuals_finding(smoothness));
+    }
     let phi = diagnostics::noise_correlation(&parts);
     if phi <= AUTOCORRELATION_THRESHOLD
         || cov.singular
@@ -113,10 +117,16 @@ fn widen_for_autocorrelation(
     {
         return None;
     }
+    let phi = phi.min(stats::MAX_PLUG_IN_CORRELATION);
+    let filtered: Vec<Vec<f64>> = parts
+        .iter()
+        .map(|p| p.windows(2).map(|w| w[1] - phi * w[0]).collect())
+        .collect();
+    let rho = diagnostics::lag_one_correlation(&filtered);
     let shortest = segments.iter().copied().min().unwrap_or(0);
-    let lags = ((5.0 * (1.0 + phi) / (1.0 - phi)).ceil() as usize).clamp(1, shortest / 4 + 1);
+    let lags = stats::andrews_lags(rho, r.len(), shortest / 4 + 1);
     let bread = &cov.matrix / cov.residual_variance;
-    let hac = stats::newey_west(jac, r, segments, lags, &bread);
+    let hac = stats::newey_west_prewhitened(jac, r, segments, lags, &bread, phi);
     let p = cov.std_errors.len();
     let factors: Vec<f64> = (0..p)
         .map(|i| (hac[(i, i)] / cov.matrix[(i, i)]).sqrt())
@@ -134,9 +144,34 @@ fn widen_for_autocorrelation(
         Status::Pass,
         Some(widest),
         format!(
-            "residuals are autocorrelated (noise lag-1 correlation {phi:.2}): standard errors widened by up to {widest:.2}x (Newey-West, {lags} lags)"
+            "residuals are autocorrelated (noise lag-1 correlation {phi:.2}): standard errors widened by up to {widest:.2}x (Newey-West after AR(1) prewhitening, {lags} Bartlett lags by Andrews' plug-in rule)"
         ),
     ))
+}
+
+/// `r` cut into its records' parts.
+fn split(r: &[f64], segments: &[usize]) -> Vec<Vec<f64>> {
+    let mut start = 0;
+    segments
+        .iter()
+        .map(|&len| {
+            let part = r[start.min(r.len())..(start + len).min(r.len())].to_vec();
+            start += len;
+            part
+        })
+        .collect()
+}
+
+/// The warning for residuals smoother than any measurement noise.
+fn smooth_residuals_finding(smoothness: f64) -> Finding {
+    Finding::warn(
+        Check::NoiseCorrelation,
+        Some(smoothness),
+        format!(
+            "the residuals correlate {:.3} at lag 1 (from their differences): smoother than measurement noise, so a misfit the law cannot follow (or low-pass filtered data), not noise to correct for; the standard errors are not widened and understate the uncertainty (look at the residual plot, try another model)",
+            smoothness.min(1.0)
+        ),
+    )
 }
 
 /// Statistics, per-record fits, the energy check and the findings at the best start.

@@ -22,7 +22,7 @@ pub use options::{
 };
 pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
 pub use result::{
-    ChannelFit, Derived, EnergyForce, FitResult, FitSeries, FittedParam, ForceBalance,
+    ChannelFit, Derived, EnergyForce, EnergySkip, FitResult, FitSeries, FittedParam, ForceBalance,
     Identifiability, Rank, RecordFit, SampleAxes, SlidingSamples, Verdict,
 };
 pub use search::{fits_directly, Search, PROMOTED_STARTS};

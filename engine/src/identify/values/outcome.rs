@@ -176,6 +176,9 @@ impl StartOutcome {
 pub enum Status {
     /// The check passed.
     Pass,
+    /// The check could not judge (the message says why): neither a pass nor a problem
+    /// with the result, but a check the reader does not have.
+    Skipped,
     /// The result may be doubtful: read the message.
     Warn,
     /// The result cannot be trusted.
@@ -252,6 +255,11 @@ impl Finding {
     /// A warning.
     pub fn warn(check: Check, value: Option<f64>, message: String) -> Self {
         Self::new(check, Status::Warn, value, message)
+    }
+
+    /// A check that could not judge, and why.
+    pub fn skipped(check: Check, message: String) -> Self {
+        Self::new(check, Status::Skipped, None, message)
     }
 }
 

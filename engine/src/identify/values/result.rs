@@ -225,13 +225,17 @@ pub struct SampleAxes {
     pub velocity: Vec<f64>,
 }
 
-/// The energy-based force check of one record.
+/// The energy-based force check of one record: the Eq. 7 force's time mean against the
+/// model's over the same samples, and the energy the friction dissipates over the complete
+/// half-cycles as the record measures it against the model's along the measured motion
+/// (energies against energies).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EnergyForce {
-    /// Mean |F_f| from Eq. 7 over the unmasked oscillating samples [N].
+    /// Mean of the Eq. 7 force against the motion, F sgn(v), over the unmasked oscillating
+    /// samples (its mean |F| where it opposes the motion) [N].
     pub mean_abs: f64,
-    /// The reference level [N]: the model's mean |F| along the measured motion over the same
-    /// samples (mu N for Coulomb), or the given level.
+    /// The reference level [N]: the model's mean force against the motion along the measured
+    /// motion over the same samples (mu N for Coulomb), or the given level.
     pub reference: f64,
     /// 100 (mean_abs - reference) / reference.
     pub percent_difference: f64,
@@ -239,15 +243,93 @@ pub struct EnergyForce {
     pub residual_rms: f64,
     /// Samples compared (where the energy-based force is defined).
     pub samples: usize,
+    /// Standard deviation of the Eq. 7 force from the record's noise and quantisation [N].
+    pub force_noise: f64,
     /// Mean friction force of the half-cycles (energy balance, no differentiation) [N].
     pub half_cycle_mean: f64,
-    /// The reference as a distance mean, comparable with the half-cycle estimate (energy
-    /// per distance): the model's sum |F| |v| / sum |v| over the samples compared, or the
-    /// given level [N].
-    pub half_cycle_reference: f64,
-    /// 100 (half_cycle_mean - half_cycle_reference) / half_cycle_reference (NaN without a
-    /// complete half-cycle).
-    pub half_cycle_percent_difference: f64,
+    /// Complete half-cycles compared.
+    pub half_cycles: usize,
+    /// Energy the friction dissipated over them, as measured: the drop of m v^2 / 2 +
+    /// k x^2 / 2 between turning points less the viscous work c int v^2 dt [J].
+    pub dissipated: f64,
+    /// Energy the model dissipates over the same half-cycles along the measured motion,
+    /// int F v dt (the level times the distance for a given level) [J].
+    pub model_dissipated: f64,
+    /// 100 (dissipated - model_dissipated) / model_dissipated (NaN without a complete
+    /// half-cycle).
+    pub dissipation_percent_difference: f64,
+    /// Why the Eq. 7 comparison was not judged, when it was not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub eq7_skipped: Option<EnergySkip>,
+    /// Why the dissipated energies were not judged, when they were not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dissipation_skipped: Option<EnergySkip>,
+}
+
+/// Why a part of the energy check cannot judge a record.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "reason", rename_all = "snake_case")]
+pub enum EnergySkip {
+    /// No complete half-cycle between two turning points.
+    NoHalfCycle,
+    /// Too few samples per half-cycle (the median) to differentiate or integrate over it.
+    FewSamples {
+        /// Samples in the median half-cycle.
+        per_half_cycle: usize,
+        /// The fewest the check needs.
+        needed: usize,
+    },
+    /// The displacement's quantisation step makes the energies at the turning points
+    /// uncertain by this share of the dissipated energy.
+    Quantised {
+        /// The step [m].
+        step: f64,
+        /// k |x| step / 2 at both ends of every half-cycle over the energy dissipated.
+        share: f64,
+    },
+    /// The model's force replayed along the measured velocity follows its noise more than
+    /// the friction level (stiff, strongly damped bristles: sigma1 times the noise's rate).
+    NoisyReplay {
+        /// The replayed force's noise level [N].
+        force_noise: f64,
+        /// The friction level [N].
+        level: f64,
+    },
+    /// The noise of the Eq. 7 force dominates the friction level.
+    NoisyDerivative {
+        /// Its standard deviation [N].
+        force_noise: f64,
+        /// The friction level [N].
+        level: f64,
+    },
+}
+
+impl std::fmt::Display for EnergySkip {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::NoHalfCycle => write!(f, "no complete half-cycle"),
+            Self::FewSamples {
+                per_half_cycle,
+                needed,
+            } => write!(
+                f,
+                "{per_half_cycle} samples per half-cycle, at least {needed} needed"
+            ),
+            Self::Quantised { step, share } => write!(
+                f,
+                "the displacement's quantisation step {step:.3e} m makes the energies at the turning points uncertain by {:.1} % of the energy dissipated",
+                100.0 * share
+            ),
+            Self::NoisyReplay { force_noise, level } => write!(
+                f,
+                "the model's force replayed along the measured velocity carries {force_noise:.3} N of its noise, more than a third of the friction level ({level:.3} N)"
+            ),
+            Self::NoisyDerivative { force_noise, level } => write!(
+                f,
+                "the noise of the Eq. 7 force ({force_noise:.3} N) is more than a third of the friction level ({level:.3} N)"
+            ),
+        }
+    }
 }
 
 /// What the records say about a fitted parameter.
