@@ -19,7 +19,17 @@ pub const RESPONSE_ORDER: usize = 3;
 /// Robust white-noise standard deviation of `values` from their `order`-th differences (see
 /// the module docs); 0 when there are too few samples.
 pub fn difference_noise(values: &[f64], order: usize) -> f64 {
-    // The k-th differences in place, one order after the other.
+    let d = differences(values, order);
+    if d.is_empty() {
+        return 0.0;
+    }
+    let centre = median(&d);
+    let dev: Vec<f64> = d.iter().map(|x| (x - centre).abs()).collect();
+    1.4826 * median(&dev) / central_binomial(order).sqrt()
+}
+
+/// The `order`-th differences of `values`, computed in place one order after the other.
+fn differences(values: &[f64], order: usize) -> Vec<f64> {
     let mut d = values.to_vec();
     for _ in 0..order.min(d.len()) {
         for i in 0..d.len() - 1 {
@@ -27,12 +37,20 @@ pub fn difference_noise(values: &[f64], order: usize) -> f64 {
         }
         d.pop();
     }
+    d
+}
+
+/// The RMS counterpart of [`difference_noise`]: the root mean square of the `order`-th
+/// differences over sqrt(C(2k, k)). Where the median-based level ignores bursts (a force that
+/// chatters on a few stretches of a record), this one counts them; 0 when there are too few
+/// samples.
+pub fn rms_difference_noise(values: &[f64], order: usize) -> f64 {
+    let d = differences(values, order);
     if d.is_empty() {
         return 0.0;
     }
-    let centre = median(&d);
-    let dev: Vec<f64> = d.iter().map(|x| (x - centre).abs()).collect();
-    1.4826 * median(&dev) / central_binomial(order).sqrt()
+    let mean_square = d.iter().map(|x| x * x).sum::<f64>() / d.len() as f64;
+    (mean_square / central_binomial(order)).sqrt()
 }
 
 /// [`difference_noise`], never below 1e-6 of the values' RMS (noise-free records) nor zero:

@@ -29,7 +29,7 @@
 use crate::energy::{percent_difference, EnergyAnalysis, HalfCycle};
 use crate::error::EngineError;
 use crate::identify::values::{EnergyForce, EnergySkip};
-use crate::record::noise::difference_noise;
+use crate::record::noise::{difference_noise, rms_difference_noise};
 
 /// The fewest samples in the median half-cycle for either part of the check: a 31-sample
 /// derivative window needs a few windows per half-cycle, and the trapezoidal work of a
@@ -174,10 +174,12 @@ fn skips(analysis: &EnergyAnalysis, dissipated: f64) -> (Option<EnergySkip>, Opt
     (few.or(noisy), energies)
 }
 
-/// The skip for a model force whose own noise (white-noise level of its second differences)
-/// exceeds [`MAX_NOISE_SHARE`] of `level`: its mean then measures the replayed noise.
+/// The skip for a model force whose own noise (white-noise level of its second differences,
+/// the larger of the median-based and the RMS level, so that a force chattering on a few
+/// stretches of the motion counts) exceeds [`MAX_NOISE_SHARE`] of `level`: its mean then
+/// measures the replayed noise.
 fn noisy_replay(model: &[f64], level: f64) -> Option<EnergySkip> {
-    let force_noise = difference_noise(model, 2);
+    let force_noise = difference_noise(model, 2).max(rms_difference_noise(model, 2));
     (force_noise > MAX_NOISE_SHARE * level.abs())
         .then_some(EnergySkip::NoisyReplay { force_noise, level })
 }
