@@ -3,6 +3,7 @@
 //!
 //! Library code: values in, values out; no printing.
 
+pub mod campaign;
 pub mod data;
 pub mod energy;
 pub mod error;
