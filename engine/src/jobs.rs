@@ -305,6 +305,18 @@ pub fn campaign_models(
     }
 }
 
+/// The names of the models a campaign fits in each group (see [`campaign_models`]).
+pub fn campaign_model_names(spec: &Spec, models: Option<&[Box<dyn FrictionModel>]>) -> Vec<String> {
+    match models {
+        Some(list) => list.iter().map(|m| m.name().to_string()).collect(),
+        None => spec
+            .model
+            .iter()
+            .map(|m| m.model.name().to_string())
+            .collect(),
+    }
+}
+
 /// What fitting one group gave: its result (rows and summaries) and the report `fit` or
 /// `compare` gives for its records (`None` when they could not be read or nothing fitted).
 #[derive(Debug, Clone)]

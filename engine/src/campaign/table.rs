@@ -214,6 +214,22 @@ pub struct GroupResult {
     pub fits: Vec<FitSummary>,
 }
 
+impl GroupResult {
+    /// The result of a group that gave no fit: a failed row per model in `models`, `error`
+    /// the reason.
+    pub fn failed(task: &GroupTask, models: &[String], error: &str) -> Self {
+        Self {
+            task: task.clone(),
+            verdict: RowVerdict::Failed,
+            rows: models
+                .iter()
+                .map(|m| CampaignRow::failed(task, m, error))
+                .collect(),
+            fits: Vec::new(),
+        }
+    }
+}
+
 /// The fixed columns between the conditions and the parameters.
 const FIXED_COLUMNS: [&str; 9] = [
     "file",
