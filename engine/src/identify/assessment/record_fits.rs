@@ -159,7 +159,7 @@ fn energy_check<R: Residuals + ?Sized>(
     // one-sided bound) leave the check out, with a warning, instead of taking seconds.
     let budget = STEPS_PER_SAMPLE * (analysis.time.len() as u64).max(100);
     let model = world.model.as_ref();
-    let normal = NormalForce::Constant(osc.normal_force);
+    let normal = NormalForce::Constant(rec.oscillator_for(osc).normal_force);
     let states = states_along(model, &analysis.time, &analysis.v, &normal, budget)?;
     let model_force = forces_from_states(model, &analysis.v, &normal, &states);
     let ef = energy_force_check(&analysis, ForceReference::ModelForce(&model_force))?;

@@ -128,8 +128,8 @@ impl SimulatedResponse {
                 v_out: &mut sim,
                 watch: &mut superseded,
             };
-            let stats =
-                simulate_velocity_watched(at.oscillator, at.model, &init, t_end, &opts, run)?;
+            let osc = record.oscillator_for(at.oscillator);
+            let stats = simulate_velocity_watched(&osc, at.model, &init, t_end, &opts, run)?;
             at.record_work(index, &stats, clock.times.len());
             if v.is_empty() {
                 return Ok(sim);
@@ -155,8 +155,8 @@ impl SimulatedResponse {
                 at.count_simulation();
                 let opts = within_allowance(at, index, record, clock.times.len());
                 let init = initial(record, nuisance);
-                let trajectory =
-                    simulate(at.oscillator, at.model, &init, t_end, &clock.times, &opts)?;
+                let osc = record.oscillator_for(at.oscillator);
+                let trajectory = simulate(&osc, at.model, &init, t_end, &clock.times, &opts)?;
                 at.record_work(index, &trajectory.stats, clock.times.len());
                 Some(trajectory)
             }
