@@ -336,24 +336,9 @@ pub fn campaign_group_job(
     task: &GroupTask,
     hooks: &Hooks,
 ) -> GroupRun {
-    let names: Vec<String> = match models {
-        Some(list) => list.iter().map(|m| m.name().to_string()).collect(),
-        None => spec
-            .model
-            .iter()
-            .map(|m| m.model.name().to_string())
-            .collect(),
-    };
+    let names = campaign_model_names(spec, models);
     let failed = |error: String| GroupRun {
-        result: GroupResult {
-            task: task.clone(),
-            verdict: RowVerdict::Failed,
-            rows: names
-                .iter()
-                .map(|n| CampaignRow::failed(task, n, &error))
-                .collect(),
-            fits: Vec::new(),
-        },
+        result: GroupResult::failed(task, &names, &error),
         report: None,
     };
     let records = match load_group(spec, task) {

@@ -28,11 +28,15 @@ use std::time::Instant;
 pub const RESULT_FILE: &str = "result.json";
 
 /// Everything a campaign runs on, checked before any fit.
-struct Plan {
-    cfg: Config,
-    campaign: CampaignSpec,
-    models: Option<Vec<Box<dyn FrictionModel>>>,
-    tasks: Vec<GroupTask>,
+pub struct Plan {
+    /// The configuration.
+    pub cfg: Config,
+    /// Its `[campaign]` table (or the one a front end gave).
+    pub campaign: CampaignSpec,
+    /// The models compared in each group (`None`: the `[model]` fitted alone).
+    pub models: Option<Vec<Box<dyn FrictionModel>>>,
+    /// The groups, in manifest order.
+    pub tasks: Vec<GroupTask>,
 }
 
 /// Runs `frictionid campaign`.
@@ -43,22 +47,10 @@ pub fn run(
     output: &OutputArgs,
 ) -> anyhow::Result<Outcome> {
     let started = Instant::now();
-    let plan = plan(config)?;
+    let plan = plan(load_config(config)?, None)?;
     let out = OutputDir::create(&output.dir_for(config, "campaign"))?;
     let results = run_groups(&plan, &out, jobs, resume, output, config)?;
-    let name = config.display().to_string();
-    let mut report = CampaignReport::new(
-        &name,
-        &plan.campaign,
-        &results,
-        started.elapsed().as_secs_f64(),
-    );
-    out.write_text("campaign.csv", &report.csv())?;
-    let mut files = vec!["campaign.csv".to_string()];
-    files.extend(trend_plots(&out, &report)?);
-    files.extend(REPORT_FILES.map(String::from));
-    report.files = files;
-    publish(&out, &report, output, config)?;
+    let report = write_campaign(&plan, &results, started, &out, output)?;
     for group in results
         .iter()
         .filter(|g| g.rows.iter().any(|r| r.error.is_some()))
@@ -70,13 +62,36 @@ pub fn run(
     Ok(Outcome::from(report.exit_verdict()))
 }
 
-/// The configuration, its `[campaign]` table, the models and the groups: every error a
-/// user can fix before a fit runs.
-fn plan(config: &Path) -> anyhow::Result<Plan> {
-    let cfg = load_config(config)?;
-    let campaign = cfg
-        .campaign
-        .clone()
+/// campaign.csv, the trend plots and the reports of the groups' `results` (in group order)
+/// in `out`; returns the report.
+pub fn write_campaign(
+    plan: &Plan,
+    results: &[GroupResult],
+    started: Instant,
+    out: &OutputDir,
+    output: &OutputArgs,
+) -> anyhow::Result<CampaignReport> {
+    let config = &plan.cfg.path;
+    let mut report = CampaignReport::new(
+        &config.display().to_string(),
+        &plan.campaign,
+        results,
+        started.elapsed().as_secs_f64(),
+    );
+    out.write_text("campaign.csv", &report.csv())?;
+    let mut files = vec!["campaign.csv".to_string()];
+    files.extend(trend_plots(out, &report)?);
+    files.extend(REPORT_FILES.map(String::from));
+    report.files = files;
+    publish(out, &report, output, config)?;
+    Ok(report)
+}
+
+/// The configuration `cfg`, its `[campaign]` table (or `campaign`, given by a front end),
+/// the models and the groups: every error a user can fix before a fit runs.
+pub fn plan(cfg: Config, campaign: Option<CampaignSpec>) -> anyhow::Result<Plan> {
+    let campaign = campaign
+        .or_else(|| cfg.campaign.clone())
         .ok_or_else(|| cfg.error("campaign needs a [campaign] table (manifest = \"runs.csv\")"))?;
     let models = campaign_models(&cfg.spec, &campaign).map_err(|e| cfg.error(e))?;
     let manifest = Manifest::load(&campaign.manifest, &cfg.base_dir).map_err(|e| cfg.error(e))?;
@@ -107,10 +122,15 @@ fn run_groups(
     config: &Path,
 ) -> anyhow::Result<Vec<GroupResult>> {
     let groups_dir = out.dir().join("groups");
+    let models = campaign_model_names(&plan.cfg.spec, plan.models.as_deref());
     let mut results: Vec<Option<GroupResult>> = plan
         .tasks
         .iter()
-        .map(|t| resume.then(|| written_result(&groups_dir, t)).flatten())
+        .map(|t| {
+            resume
+                .then(|| written_result(&groups_dir, t, &models))
+                .flatten()
+        })
         .collect();
     let pending: Vec<usize> = (0..plan.tasks.len())
         .filter(|&i| results[i].is_none())
@@ -140,11 +160,17 @@ fn run_groups(
     Ok(results.into_iter().flatten().collect())
 }
 
-/// The result an earlier run wrote for `task`, if it is there, readable and of the same task.
-pub fn written_result(groups_dir: &Path, task: &GroupTask) -> Option<GroupResult> {
+/// The result an earlier run wrote for `task`, if it is there, readable, of the same task
+/// (its manifest rows and `[record_defaults]`) and of the same `models`.
+pub fn written_result(
+    groups_dir: &Path,
+    task: &GroupTask,
+    models: &[String],
+) -> Option<GroupResult> {
     let text = std::fs::read_to_string(group_dir(groups_dir, task).join(RESULT_FILE)).ok()?;
     let result: GroupResult = serde_json::from_str(&text).ok()?;
-    (result.task == *task).then_some(result)
+    let same_models = result.rows.iter().map(|r| &r.model).eq(models.iter());
+    (result.task == *task && same_models).then_some(result)
 }
 
 fn group_dir(groups_dir: &Path, task: &GroupTask) -> PathBuf {
