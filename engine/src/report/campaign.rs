@@ -12,6 +12,9 @@ use crate::campaign::{
 };
 use serde::Serialize;
 
+/// Most rows of the results table a terminal summary shows.
+const TERMINAL_ROWS: usize = 30;
+
 /// The report `fit` or `compare` gives for one group's records.
 #[derive(Debug, Clone)]
 pub enum GroupReport {
@@ -270,7 +273,17 @@ impl Render for CampaignReport {
         sink.verdict(status, &text);
         sink.paragraph(&format!("verdict: {text}"), Role::Brief);
         sink.heading(2, "Results", Role::Detail);
-        sink.table(&self.results_table(), Role::Summary);
+        // A terminal shows the table of a small campaign; a large one's is in the files.
+        let role = if self.rows.len() <= TERMINAL_ROWS {
+            Role::Summary
+        } else {
+            sink.paragraph(
+                &format!("{} rows: see campaign.csv and report.html", self.rows.len()),
+                Role::Brief,
+            );
+            Role::Detail
+        };
+        sink.table(&self.results_table(), role);
         let failures: Vec<String> = self
             .rows
             .iter()
@@ -293,5 +306,69 @@ impl Render for CampaignReport {
             sink.table(&self.trends_table(), Role::Detail);
         }
         render_files(sink, &self.files);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::campaign::{CellValue, GroupTask, ParamCell};
+    use crate::report::markdown::MarkdownWriter;
+
+    fn group(id: &str, load: f64, lube: &str, verdict: RowVerdict, mu: f64) -> GroupResult {
+        let task = GroupTask {
+            id: id.into(),
+            conditions: vec![
+                ("load".into(), Some(CellValue::Number(load))),
+                ("lube".into(), Some(CellValue::Text(lube.into()))),
+            ],
+            sources: Vec::new(),
+            lines: vec![2],
+            base_dir: ".".into(),
+        };
+        let mut row = CampaignRow::failed(&task, "coulomb", "");
+        row.error = None;
+        row.verdict = verdict;
+        row.converged = verdict != RowVerdict::NotConverged;
+        row.parameters = vec![ParamCell {
+            name: "mu".into(),
+            value: Some(mu),
+            std_error: Some(0.001),
+            status: "determined".into(),
+        }];
+        GroupResult {
+            task,
+            verdict,
+            rows: vec![row],
+            fits: Vec::new(),
+        }
+    }
+
+    /// The worst group decides the verdict; a group without a converged fit leaves the
+    /// trend; the text condition is no abscissa.
+    #[test]
+    fn verdict_numeric_conditions_and_trends_of_a_campaign() {
+        let results = [
+            group("001", 1.0, "oil", RowVerdict::Ok, 0.30),
+            group("002", 2.0, "oil", RowVerdict::DiagnosticFailed, 0.28),
+            group("003", 3.0, "dry", RowVerdict::Ok, 0.26),
+            group("004", 4.0, "dry", RowVerdict::NotConverged, 9.0),
+        ];
+        let spec = CampaignSpec::default();
+        let report = CampaignReport::new("c.toml", &spec, &results, 0.0);
+        assert_eq!(report.verdict, RowVerdict::NotConverged);
+        assert_eq!(report.exit_verdict(), Verdict::NotConverged);
+        assert_eq!(report.numeric_conditions, ["load"]);
+        assert_eq!(report.trends.len(), 1);
+        let line = report.trends[0].linear.as_ref().unwrap();
+        assert!((line.b + 0.02).abs() < 1e-12 && (line.a - 0.32).abs() < 1e-12);
+        let flagged = CampaignReport::new("c.toml", &spec, &results[..3], 0.0);
+        assert_eq!(flagged.exit_verdict(), Verdict::DiagnosticFailed);
+        let md = MarkdownWriter::render(&report);
+        assert!(
+            md.contains("1 did not converge and 1 failed a diagnostic"),
+            "{md}"
+        );
+        assert!(report.csv().starts_with("group,load,lube,file,model,"));
     }
 }
