@@ -105,6 +105,28 @@ pub enum Command {
         #[command(flatten)]
         output: OutputArgs,
     },
+    /// Fit every group of a campaign manifest, tabulate the parameters against the
+    /// conditions and fit their trends.
+    #[command(
+        after_help = "Example:\n  frictionid campaign fixtures/campaign/campaign.toml --out campaign/\n\n\
+                      Writes campaign.csv (one row per group and model), report.json, report.md,\n\
+                      report.html with trend plots, and each group's reports under groups/<id>/.\n\
+                      Exit codes: 0 every group fitted cleanly, 1 error before any fit, 2 a group\n\
+                      could not be fitted or did not converge, 3 a group's fit failed a diagnostic."
+    )]
+    Campaign {
+        /// The TOML configuration file, with a [campaign] table.
+        config: PathBuf,
+        /// Groups fitted at the same time [default: one per core].
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+        jobs: Option<u16>,
+        /// Keep the groups whose results an earlier run wrote (groups/<id>/result.json) and
+        /// fit only the others.
+        #[arg(long)]
+        resume: bool,
+        #[command(flatten)]
+        output: OutputArgs,
+    },
     /// Energy-based friction force of each record (the paper's Eq. 7) against the reference.
     #[command(after_help = "Example:\n  frictionid energy fixtures/fmm-energy.toml --out energy/")]
     Energy {

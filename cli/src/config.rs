@@ -30,6 +30,9 @@
 //! [record_defaults]             # optional: any [[records]] key, for every record
 //! velocity_scale = 1e-3         # (a record's own key wins)
 //!
+//! [campaign]                    # for campaign (see docs/config.md)
+//! manifest = "runs.csv"         # one row per record; group_by, models optional
+//!
 //! [[records]]                   # for fit, compare and energy
 //! file = "x14mm.csv"            # relative to this file
 //! x0 = 0.014                    # m
@@ -40,6 +43,7 @@
 //! syntax errors name the line and column.
 
 use crate::error::CliError;
+use frictionid_engine::campaign::CampaignSpec;
 use frictionid_engine::data::RecordSource;
 use frictionid_engine::spec::{
     EnergySpec, FitSpec, ModelSpec, OscillatorSpec, SimulationSpec, Spec, SpecError,
@@ -66,6 +70,11 @@ pub struct Config {
     pub spec: Spec,
     /// The measured records (`[[records]]`), not yet read.
     pub records: Vec<RecordConfig>,
+    /// `[record_defaults]`: keys every record takes unless it gives its own (also a
+    /// campaign manifest's rows).
+    pub record_defaults: RecordSource,
+    /// The `[campaign]` table, if given.
+    pub campaign: Option<CampaignSpec>,
 }
 
 /// One `[[records]]` entry, checked and resolved (the engine's shared record source).
@@ -85,6 +94,7 @@ struct RawConfig {
     record_defaults: Option<RecordSource>,
     #[serde(default)]
     records: Vec<RecordSource>,
+    campaign: Option<CampaignSpec>,
 }
 
 use frictionid_models::suggest::did_you_mean as hint;
@@ -280,6 +290,8 @@ impl Config {
             base_dir,
             spec,
             records,
+            record_defaults,
+            campaign: raw.campaign,
         })
     }
 

@@ -60,6 +60,12 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
             models,
             output,
         } => commands::compare::run(&config, models.as_deref(), &output),
+        Command::Campaign {
+            config,
+            jobs,
+            resume,
+            output,
+        } => commands::campaign::run(&config, jobs.map(usize::from), resume, &output),
     }
 }
 

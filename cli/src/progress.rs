@@ -74,6 +74,32 @@ impl Progress {
         }
     }
 
+    /// Progress over `total` items of work of comparable size (the groups of a campaign):
+    /// the bar estimates the time left; without a terminal, [`Progress::item_done`] prints a
+    /// line per item.
+    pub fn items(total: u64, message: impl Into<String>, enabled: bool) -> Self {
+        let progress = Self::new(total, message, enabled);
+        let style =
+            ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} ({elapsed}, ~{eta} left)")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> ");
+        progress.bar.set_style(style);
+        progress
+    }
+
+    /// One item done: the bar advances; without a terminal, a line names the item.
+    pub fn item_done(&self, label: &str) {
+        self.inc(1);
+        if self.mode == Mode::Lines {
+            let elapsed = self.started.elapsed().as_secs_f64();
+            let (done, total) = (self.bar.position(), self.bar.length().unwrap_or(0));
+            let _ = writeln!(
+                std::io::stderr(),
+                "[{elapsed:6.1} s] {label} ({done}/{total})"
+            );
+        }
+    }
+
     /// Records `n` more units done; shows the bar once the work has run for [`SHOW_AFTER`].
     pub fn inc(&self, n: u64) {
         self.bar.inc(n);

@@ -4,6 +4,8 @@
 //! `energy`); the front end then names the source (`config`), writes plots and files, lists
 //! them in the report's `files`, and hands the report to its writers.
 
+use crate::campaign::table::FitSummary;
+use crate::campaign::{CampaignRow, CampaignSpec, GroupResult, GroupTask, RowVerdict};
 use crate::energy::{
     analyze_record, mean_abs_where_defined, model_force_along, percent_difference, EnergyAnalysis,
     EnergyOptions,
@@ -14,7 +16,9 @@ use crate::identify::{
 };
 use crate::oscillator::Oscillator;
 use crate::record::Record;
-use crate::report::{CompareReport, EnergyRecord, EnergyReport, FitReport, SimulateReport};
+use crate::report::{
+    CompareReport, EnergyRecord, EnergyReport, FitReport, GroupReport, SimulateReport,
+};
 use crate::simulate::{simulate, Initial, Trajectory};
 use crate::spec::{Hooks, SimulationSpec, Spec, SpecError};
 use crate::synthetic::{add_gaussian_noise, uniform_times};
@@ -287,6 +291,129 @@ pub fn energy_job(
         files: Vec::new(),
         reference_model: model.map(|m| m.name().to_string()),
     })
+}
+
+/// The models a campaign fits in each group: `Some` models compared (`[campaign] models`),
+/// or `None` for the `[model]` fitted alone (an error when there is none).
+pub fn campaign_models(
+    spec: &Spec,
+    campaign: &CampaignSpec,
+) -> Result<Option<Vec<Box<dyn FrictionModel>>>, SpecError> {
+    match &campaign.models {
+        Some(names) => spec.models_to_compare(Some(names)).map(Some),
+        None => spec.require_model("campaign").map(|_| None),
+    }
+}
+
+/// The names of the models a campaign fits in each group (see [`campaign_models`]).
+pub fn campaign_model_names(spec: &Spec, models: Option<&[Box<dyn FrictionModel>]>) -> Vec<String> {
+    match models {
+        Some(list) => list.iter().map(|m| m.name().to_string()).collect(),
+        None => spec
+            .model
+            .iter()
+            .map(|m| m.model.name().to_string())
+            .collect(),
+    }
+}
+
+/// What fitting one group gave: its result (rows and summaries) and the report `fit` or
+/// `compare` gives for its records (`None` when they could not be read or nothing fitted).
+#[derive(Debug, Clone)]
+pub struct GroupRun {
+    /// The group's rows.
+    pub result: GroupResult,
+    /// Its own report.
+    pub report: Option<GroupReport>,
+}
+
+/// One group of a campaign: its records read as `fit` reads a configuration's, then
+/// [`fit_job`] (no `models`) or [`compare_job`] on them. A record that cannot be read or a
+/// fit that fails gives rows with the reason, never an error.
+pub fn campaign_group_job(
+    spec: &Spec,
+    models: Option<&[Box<dyn FrictionModel>]>,
+    task: &GroupTask,
+    hooks: &Hooks,
+) -> GroupRun {
+    let names = campaign_model_names(spec, models);
+    let failed = |error: String| GroupRun {
+        result: GroupResult::failed(task, &names, &error),
+        report: None,
+    };
+    let records = match load_group(spec, task) {
+        Ok(records) => records,
+        Err(e) => return failed(e),
+    };
+    let report = match models {
+        Some(list) => {
+            compare_job(spec, list, &records, hooks).map(|r| GroupReport::Compare(Box::new(r)))
+        }
+        None => fit_job(spec, &records, hooks).map(|r| GroupReport::Fit(Box::new(r))),
+    };
+    match report {
+        Ok(report) => GroupRun {
+            result: group_result(task, &names, &report),
+            report: Some(report),
+        },
+        Err(e) => failed(e.to_string()),
+    }
+}
+
+/// A group's records, read and checked as a configuration's `[[records]]` are.
+fn load_group(spec: &Spec, task: &GroupTask) -> Result<Vec<Record>, String> {
+    task.sources
+        .iter()
+        .zip(&task.lines)
+        .map(|(source, &line)| {
+            let resolved = source
+                .resolve(line, &task.base_dir)
+                .map_err(|e| e.to_string())?;
+            // Units are checked against k/m only when the oscillator is known.
+            if spec.unknown_oscillator.is_empty() {
+                resolved.load_checked(&spec.oscillator)
+            } else {
+                resolved.load()
+            }
+            .map_err(|e| e.to_string())
+        })
+        .collect()
+}
+
+/// The rows of a group's report, one per model in `names` order.
+fn group_result(task: &GroupTask, names: &[String], report: &GroupReport) -> GroupResult {
+    let (fits, failures, best): (Vec<&FitResult>, Vec<(String, String)>, Option<&FitResult>) =
+        match report {
+            GroupReport::Fit(r) => (vec![&r.fit], Vec::new(), Some(&r.fit)),
+            GroupReport::Compare(r) => (
+                r.comparison.ranking.iter().collect(),
+                r.comparison
+                    .failed
+                    .iter()
+                    .map(|f| (f.model.clone(), f.error.clone()))
+                    .collect(),
+                r.best(),
+            ),
+        };
+    let rows = names
+        .iter()
+        .map(|name| match fits.iter().find(|f| &f.model == name) {
+            Some(fit) => CampaignRow::from_fit(task, fit),
+            None => {
+                let why = failures
+                    .iter()
+                    .find(|(m, _)| m == name)
+                    .map_or("not fitted", |(_, e)| e);
+                CampaignRow::failed(task, name, why)
+            }
+        })
+        .collect();
+    GroupResult {
+        task: task.clone(),
+        verdict: best.map_or(RowVerdict::Failed, |b| b.verdict().into()),
+        rows,
+        fits: fits.into_iter().map(FitSummary::of).collect(),
+    }
 }
 
 #[cfg(test)]

@@ -4,6 +4,7 @@
 //! Library code: values in, values out; no printing.
 
 pub mod axis;
+pub mod campaign;
 pub mod data;
 pub mod energy;
 pub mod error;

@@ -13,10 +13,14 @@ every fitted parameter then reports ``std_error_components`` and a total ``std_e
 - ``compare(oscillator, models, records, fit=None)``: several models ranked by AIC.
 - ``energy(oscillator, records, model=None, options=None)``: the energy-based force (Eq. 7).
 - ``run(config_path, command="fit", out=None)``: a configuration file, as the CLI runs it.
+- ``campaign(config, manifest=None, executor=None, out=None)``: every group of a campaign
+  (one task per group on any ``concurrent.futures`` executor), campaign.csv as a pandas
+  DataFrame (pandas: ``pip install frictionid[campaign]``).
 
 Bad input raises ``ValueError``; a fit that failed raises ``FitError``. Ctrl-C stops a fit.
 """
 
 from ._native import FitError, compare, energy, fit, models, run, simulate
+from .campaign import campaign
 
-__all__ = ["FitError", "compare", "energy", "fit", "models", "run", "simulate"]
+__all__ = ["FitError", "campaign", "compare", "energy", "fit", "models", "run", "simulate"]

@@ -10,6 +10,7 @@
 //! - [`outputs`]: report values to dicts with arrays.
 //! - [`errors`]: `ValueError` for bad input, `frictionid.FitError` for a failed fit.
 //! - [`api`]: the module's functions.
+//! - [`campaign`]: campaigns, one group a task for any executor.
 
 /// mimalloc, as the `frictionid` binary uses: glibc's malloc gave the fits' buffers back to
 /// the system and faulted them in again at every evaluation (a sixth of a Coulomb fit).
@@ -17,6 +18,7 @@
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 pub mod api;
+pub mod campaign;
 pub mod convert;
 pub mod errors;
 pub mod inputs;
@@ -34,5 +36,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(api::compare, m)?)?;
     m.add_function(wrap_pyfunction!(api::energy, m)?)?;
     m.add_function(wrap_pyfunction!(api::run, m)?)?;
+    m.add_function(wrap_pyfunction!(campaign::campaign_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(campaign::campaign_group, m)?)?;
+    m.add_function(wrap_pyfunction!(campaign::campaign_assemble, m)?)?;
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! The subcommands: each loads its inputs, runs the engine's job and writes the report.
 //! Errors propagate as `anyhow` to the edge ([`crate::main_with_args`] decides exit codes).
 
+pub mod campaign;
 pub mod compare;
 pub mod energy;
 pub mod fit;

@@ -8,11 +8,13 @@
 mod charts;
 mod panel;
 pub mod sets;
+mod trends;
 
 pub use charts::{
     force_against_motion, force_balance, friction_force, over_time, response_fit,
     steady_state_curves, MotionAxis, Quantity,
 };
+pub use trends::trend_plots;
 
 use crate::error::CliError;
 use crate::report::write_atomic;

@@ -232,6 +232,18 @@ impl Record {
             .unwrap_or(NormalForce::Constant(osc.normal_force))
     }
 
+    /// `osc` under this record's own constant normal force (`[[records]] normal_force`), as
+    /// a free-vibration simulation of the record needs it; `osc` itself otherwise.
+    pub fn oscillator_for(&self, osc: &crate::Oscillator) -> crate::Oscillator {
+        match self.normal_force {
+            Some(NormalForce::Constant(n)) => crate::Oscillator {
+                normal_force: n,
+                ..*osc
+            },
+            _ => *osc,
+        }
+    }
+
     /// Sets (or with `None` removes) the record's own normal force.
     pub fn set_normal_force(&mut self, normal_force: Option<NormalForce>) {
         self.samples_changed();

@@ -11,6 +11,7 @@
 //! Inline code in text is written between backticks (`` `x14mm.csv` ``); writers render it
 //! in their own syntax.
 
+pub mod campaign;
 pub mod compare;
 pub mod energy;
 pub mod fit;
@@ -21,6 +22,7 @@ pub mod markdown;
 pub mod models;
 pub mod simulate;
 
+pub use campaign::{CampaignReport, GroupReport};
 pub use compare::CompareReport;
 pub use energy::{EnergyRecord, EnergyReport};
 pub use fit::FitReport;

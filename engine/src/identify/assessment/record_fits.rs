@@ -175,7 +175,7 @@ fn energy_check<R: Residuals + ?Sized>(
     // it, for the stiff one; a replay that fails both leaves the check skipped.
     let budget = STEPS_PER_SAMPLE * (analysis.time.len() as u64).max(100);
     let model = world.model.as_ref();
-    let normal = NormalForce::Constant(osc.normal_force);
+    let normal = NormalForce::Constant(rec.oscillator_for(osc).normal_force);
     let states = match states_along(model, &analysis.time, &analysis.v, &normal, budget) {
         Err(EngineError::StateIntegration {
             failure: IntegrationFailure::StepBudgetExceeded { .. },

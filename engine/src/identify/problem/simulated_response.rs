@@ -133,8 +133,8 @@ impl SimulatedResponse {
                 watch: &mut superseded,
                 input: input.as_ref(),
             };
-            let stats =
-                simulate_velocity_watched(at.oscillator, at.model, &init, t_end, &opts, run)?;
+            let osc = record.oscillator_for(at.oscillator);
+            let stats = simulate_velocity_watched(&osc, at.model, &init, t_end, &opts, run)?;
             at.record_work(index, &stats, clock.times.len());
             if v.is_empty() {
                 return Ok(sim);
@@ -165,8 +165,9 @@ impl SimulatedResponse {
                     t_end,
                     sample_times: &clock.times,
                 };
+                let osc = record.oscillator_for(at.oscillator);
                 let trajectory =
-                    simulate_driven(at.oscillator, at.model, &init, input.as_ref(), grid, &opts)?;
+                    simulate_driven(&osc, at.model, &init, input.as_ref(), grid, &opts)?;
                 at.record_work(index, &trajectory.stats, clock.times.len());
                 Some(trajectory)
             }
