@@ -13,6 +13,7 @@
 //!   non-convergence.
 
 use super::identifiability::PROFILE_DELTA;
+use crate::axis::Axis;
 use crate::energy::cumulative_trapezoid;
 use crate::identify::values::layout::{is_friction_level, FreeParam, ParamKind};
 use crate::identify::values::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
@@ -46,8 +47,8 @@ fn status_of(value: f64, warn: f64, fail: f64) -> Status {
 }
 
 /// The energy-balance finding of one record: the larger of the Eq. 7 and the half-cycle
-/// differences (in percent) decides.
-pub fn energy_balance(record: &str, ef: &EnergyForce) -> Finding {
+/// differences (in percent) decides; forces in the units of `axis`.
+pub fn energy_balance(record: &str, ef: &EnergyForce, axis: Axis) -> Finding {
     let eq7 = ef.percent_difference.abs();
     let half = ef.half_cycle_percent_difference.abs();
     let worst = [eq7, half]
@@ -59,8 +60,9 @@ pub fn energy_balance(record: &str, ef: &EnergyForce) -> Finding {
     } else {
         status_of(worst, ENERGY_WARN_PERCENT, ENERGY_FAIL_PERCENT)
     };
+    let n = axis.unit("N");
     let message = format!(
-        "record `{record}`: energy-based friction force differs from the model's by {:.1} % (Eq. 7 mean {:.4} N vs {:.4} N) and {:.1} % (half-cycle mean {:.4} N vs {:.4} N){}",
+        "record `{record}`: energy-based friction force differs from the model's by {:.1} % (Eq. 7 mean {:.4} {n} vs {:.4} {n}) and {:.1} % (half-cycle mean {:.4} {n} vs {:.4} {n}){}",
         ef.percent_difference,
         ef.mean_abs,
         ef.reference,
@@ -611,13 +613,13 @@ mod tests {
 
     #[test]
     fn energy_balance_thresholds_are_five_and_twenty_percent() {
-        let status = |eq7, half| energy_balance("r", &energy_force(eq7, half)).status;
+        let status = |eq7, half| energy_balance("r", &energy_force(eq7, half), Axis::Linear).status;
         assert_eq!(status(1.0, -2.0), Status::Pass);
         assert_eq!(status(-6.0, 1.0), Status::Warn);
         assert_eq!(status(1.0, 12.0), Status::Warn);
         assert_eq!(status(38112.0, 1.0), Status::Fail);
         assert_eq!(status(1.0, f64::NAN), Status::Pass);
-        let f = energy_balance("x14.csv", &energy_force(-25.0, 3.0));
+        let f = energy_balance("x14.csv", &energy_force(-25.0, 3.0), Axis::Linear);
         assert_eq!(f.value, Some(25.0));
         assert!(f.message.contains("x14.csv"));
     }
