@@ -122,6 +122,15 @@ pub enum Command {
     },
 }
 
+/// An axis as `[oscillator] axis` spells it: `linear` or `rotary`.
+fn parse_axis(text: &str) -> Result<Axis, String> {
+    match text {
+        "linear" => Ok(Axis::Linear),
+        "rotary" => Ok(Axis::Rotary),
+        other => Err(format!("unknown axis `{other}`: `linear` or `rotary`")),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -144,14 +153,5 @@ mod tests {
             ..args
         };
         assert_eq!(explicit.dir_for(cfg, "fit"), Path::new("results"));
-    }
-}
-
-/// An axis as `[oscillator] axis` spells it: `linear` or `rotary`.
-fn parse_axis(text: &str) -> Result<Axis, String> {
-    match text {
-        "linear" => Ok(Axis::Linear),
-        "rotary" => Ok(Axis::Rotary),
-        other => Err(format!("unknown axis `{other}`: `linear` or `rotary`")),
     }
 }

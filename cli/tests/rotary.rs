@@ -151,3 +151,20 @@ fn a_driven_pendulum_reports_rotary_units_and_plots_its_input() {
     assert!(read(&fit_out.join("report.md")).contains("driven_input.svg"));
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// `models --axis rotary` lists the viscous coefficients in N m s/rad, none in N s/m; the
+/// default listing keeps N s/m.
+#[test]
+fn models_list_rotary_units_on_request() {
+    let listing = |args: &[&str]| {
+        let o = frictionid().args(args).output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let rotary = listing(&["models", "--json", "--axis", "rotary"]);
+    assert!(rotary.contains("\"N m s/rad\""), "{rotary}");
+    assert!(!rotary.contains("\"N s/m\""), "{rotary}");
+    let linear = listing(&["models", "--json"]);
+    assert!(linear.contains("\"N s/m\""));
+    assert!(!linear.contains("rad"));
+}
