@@ -1,6 +1,7 @@
 //! Command-line arguments (clap derive).
 
 use clap::{Args, Parser, Subcommand};
+use frictionid_engine::Axis;
 use std::path::{Path, PathBuf};
 
 /// Identify friction models from the measured free vibration of an oscillator.
@@ -60,11 +61,17 @@ impl OutputArgs {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// List every registered friction model with its parameters and equation.
-    #[command(after_help = "Examples:\n  frictionid models\n  frictionid models --json")]
+    #[command(
+        after_help = "Examples:\n  frictionid models\n  frictionid models --json\n  frictionid models --axis rotary"
+    )]
     Models {
         /// Print the listing as JSON.
         #[arg(long)]
         json: bool,
+        /// The axis whose units the parameters are listed in: `linear` (m, N, kg) or
+        /// `rotary` (rad, N m, kg m^2).
+        #[arg(long, default_value = "linear", value_parser = parse_axis)]
+        axis: Axis,
         /// Print nothing (accepted for symmetry with the other commands).
         #[arg(long, short)]
         quiet: bool,
@@ -135,6 +142,15 @@ pub enum Command {
         #[command(flatten)]
         output: OutputArgs,
     },
+}
+
+/// An axis as `[oscillator] axis` spells it: `linear` or `rotary`.
+fn parse_axis(text: &str) -> Result<Axis, String> {
+    match text {
+        "linear" => Ok(Axis::Linear),
+        "rotary" => Ok(Axis::Rotary),
+        other => Err(format!("unknown axis `{other}`: `linear` or `rotary`")),
+    }
 }
 
 #[cfg(test)]

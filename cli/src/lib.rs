@@ -49,8 +49,8 @@ pub const EXIT_ERROR: u8 = 1;
 /// Runs parsed arguments.
 pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
-        Command::Models { json, quiet } => {
-            commands::models::run(json, quiet).map(|_| Outcome::Done)
+        Command::Models { json, quiet, axis } => {
+            commands::models::run(json, quiet, axis).map(|_| Outcome::Done)
         }
         Command::Simulate { config, output } => commands::simulate::run(&config, &output),
         Command::Energy { config, output } => commands::energy::run(&config, &output),

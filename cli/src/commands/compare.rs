@@ -3,7 +3,7 @@
 
 use super::{hooks, load_inputs, progress_bar, publish, warn, Outcome, REPORT_FILES};
 use crate::args::OutputArgs;
-use crate::plots::sets::{fit_record_plots, steady_state_plot};
+use crate::plots::sets::{fit_record_plots, input_plots, steady_state_plot};
 use crate::report::OutputDir;
 use frictionid_engine::jobs::compare_job;
 use std::collections::BTreeSet;
@@ -51,6 +51,11 @@ pub fn run(
         Some(best) => fit_record_plots(&out, best, "best_")?,
         None => Vec::new(),
     };
+    files.extend(input_plots(
+        &out,
+        &inputs.records,
+        cfg.spec.oscillator.axis,
+    )?);
     files.extend(steady_state_plot(&out, "steady_state_curves.svg", ranking)?);
     files.extend(REPORT_FILES.map(String::from));
     report.files = files;

@@ -3,7 +3,7 @@
 
 use super::{load_inputs, publish, Outcome, REPORT_FILES};
 use crate::args::OutputArgs;
-use crate::plots::sets::energy_plots;
+use crate::plots::sets::{energy_plots, input_plots};
 use crate::report::OutputDir;
 use frictionid_engine::jobs::energy_job;
 use frictionid_engine::spec::Hooks;
@@ -18,6 +18,11 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
     report.config = config.display().to_string();
     let out = OutputDir::create(&output.dir_for(config, "energy"))?;
     let mut files = energy_plots(&out, &report)?;
+    files.extend(input_plots(
+        &out,
+        &inputs.records,
+        cfg.spec.oscillator.axis,
+    )?);
     files.extend(REPORT_FILES.map(String::from));
     report.files = files;
     publish(&out, &report, output, config)?;

@@ -3,7 +3,7 @@
 
 use super::{hooks, load_inputs, progress_bar, publish, warn, Outcome, REPORT_FILES};
 use crate::args::OutputArgs;
-use crate::plots::sets::{fit_record_plots, steady_state_plot};
+use crate::plots::sets::{fit_record_plots, input_plots, steady_state_plot};
 use crate::report::OutputDir;
 use frictionid_engine::identify::FitOptions;
 use frictionid_engine::jobs::fit_job;
@@ -39,6 +39,11 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
 
     let out = OutputDir::create(&output.dir_for(config, "fit"))?;
     let mut files = fit_record_plots(&out, &report.fit, "")?;
+    files.extend(input_plots(
+        &out,
+        &inputs.records,
+        cfg.spec.oscillator.axis,
+    )?);
     files.extend(steady_state_plot(
         &out,
         "steady_state.svg",

@@ -3,14 +3,15 @@
 use crate::terminal::TerminalWriter;
 use frictionid_engine::report::json::to_json_text;
 use frictionid_engine::report::ModelsReport;
+use frictionid_engine::Axis;
 use std::io::Write;
 
-/// Runs `frictionid models [--json] [--quiet]`.
-pub fn run(json: bool, quiet: bool) -> anyhow::Result<()> {
+/// Runs `frictionid models [--json] [--quiet] [--axis rotary]`.
+pub fn run(json: bool, quiet: bool, axis: Axis) -> anyhow::Result<()> {
     if quiet && !json {
         return Ok(());
     }
-    let report = ModelsReport::registered();
+    let report = ModelsReport::on_axis(axis);
     let text = if json {
         to_json_text(&report)?
     } else {

@@ -3,12 +3,13 @@
 use super::{draw, Figure, Panel, Series, XTicks};
 use crate::error::CliError;
 use frictionid_engine::identify::ForceBalance;
+use frictionid_engine::Axis;
 use frictionid_models::FrictionModel;
 use std::path::Path;
 
 /// The measured and fitted response of one record over time, and their difference:
-/// `quantity` is the compared channel and its unit (velocity in m/s, or displacement in m
-/// for interferometer records).
+/// `quantity` is the compared channel and its unit as shown (velocity in m/s, or
+/// displacement in m for interferometer records; a fit's units are on its axis already).
 pub fn response_fit(
     path: &Path,
     record: &str,
@@ -81,11 +82,13 @@ fn displacement_panel<'a>(time: &'a [f64], x: &'a [f64], scaled: &'a mut Vec<f64
 /// Quantities against time in stacked panels, in the order given: displacement and velocity
 /// (simulations), displacement and the acceleration derived from a measured velocity (the
 /// paper's Figs. 9-10), mechanical energy and its rate of change (Figs. 4-5, 11).
+/// Units are shown on `axis`.
 pub fn over_time(
     path: &Path,
     title: &str,
     time: &[f64],
     quantities: &[Quantity<'_>],
+    axis: Axis,
 ) -> Result<(), CliError> {
     let mut scaled = vec![Vec::new(); quantities.len()];
     let panels = quantities
@@ -93,11 +96,11 @@ pub fn over_time(
         .zip(scaled.iter_mut())
         .map(|(q, s)| q.panel(time, s))
         .collect();
-    draw(path, &Figure::over_time(title, panels))
+    draw(path, &Figure::over_time(title, panels).on(axis))
 }
 
 /// Energy-based friction force against the model's force, with dashed levels at +-reference
-/// (the paper's Figs. 6, 12).
+/// (the paper's Figs. 6, 12), in the units of `axis`.
 pub fn friction_force(
     path: &Path,
     title: &str,
@@ -105,6 +108,7 @@ pub fn friction_force(
     energy_force: &[f64],
     model_force: Option<(&str, &[f64])>,
     reference: Option<(&str, f64)>,
+    axis: Axis,
 ) -> Result<(), CliError> {
     let mut panel = Panel::new("friction force", "N").with(Series::solid(
         "energy-based (Eq. 7)",
@@ -117,19 +121,20 @@ pub fn friction_force(
     if let Some((label, r)) = reference {
         panel = panel.with_reference(label, r).with_reference("", -r);
     }
-    draw(path, &Figure::over_time(title, vec![panel]))
+    draw(path, &Figure::over_time(title, vec![panel]).on(axis))
 }
 
 /// The force balance of an inverse-dynamics fit over time: in the upper panel the input u
 /// with the inertial force J a and the restoring force R(q); in the lower panel the friction
 /// force the balance leaves (u - J a - c v - R(q) - offset) and the fitted law's. Lines break
-/// across the samples left out (at rest).
+/// across the samples left out (at rest). Units are shown on `axis`.
 pub fn force_balance(
     path: &Path,
     title: &str,
     time: &[f64],
     balance: &ForceBalance,
     model: &str,
+    axis: Axis,
 ) -> Result<(), CliError> {
     let gap = |y: &[f64]| super::sets::break_at_gaps(time, y);
     let (input, inertia, restoring) = (
@@ -155,7 +160,25 @@ pub fn force_balance(
             Series::dashed(format!("fitted ({model})"), time, &fitted)
                 .color(super::model_color(model)),
         );
-    draw(path, &Figure::over_time(title, vec![forces, friction]))
+    draw(
+        path,
+        &Figure::over_time(title, vec![forces, friction]).on(axis),
+    )
+}
+
+/// The measured input u of a driven record over time (a force, a torque on a rotary axis),
+/// its units shown on `axis`.
+pub fn input_force(
+    path: &Path,
+    record: &str,
+    time: &[f64],
+    input: &[f64],
+    axis: Axis,
+) -> Result<(), CliError> {
+    let panel = Panel::new("input u", "N")
+        .with(Series::solid("measured input", time, input).color(super::MEASURED));
+    let title = format!("{record}: measured input");
+    draw(path, &Figure::over_time(title, vec![panel]).on(axis))
 }
 
 /// The motion axis of a force-against-motion chart: quantity, unit and the factor from SI.
@@ -171,15 +194,16 @@ pub struct MotionAxis {
 
 /// Measured and fitted friction force against a motion quantity of one record (force-domain
 /// fits): against the displacement these are the hysteresis loops, against the velocity the
-/// friction curve. Lines break where samples are missing (masked samples of Eq. 7).
+/// friction curve. Lines break where samples are missing (masked samples of Eq. 7). `motion`
+/// is the motion axis and its values; units are shown on `rig`.
 pub fn force_against_motion(
     path: &Path,
     title: &str,
-    axis: MotionAxis,
-    motion: &[f64],
+    (axis, motion): (MotionAxis, &[f64]),
     measured: (&str, &[f64]),
     fitted: &[f64],
     model: &str,
+    rig: Axis,
 ) -> Result<(), CliError> {
     let x: Vec<f64> = motion.iter().map(|m| m * axis.factor).collect();
     let panel = Panel::new("friction force", "N")
@@ -194,6 +218,7 @@ pub fn force_against_motion(
         x_unit: axis.unit.into(),
         x_ticks: XTicks::Linear,
         panels: vec![panel],
+        axis: rig,
     };
     draw(path, &fig)
 }
@@ -205,12 +230,13 @@ pub const STEADY_STATE_LINEAR_WIDTH: f64 = 1e-4;
 /// The steady-state friction curves F_ss(v) of several models on one chart, for
 /// v in [-v_max, v_max] on a symmetric-log axis (linear within +-1e-4 m/s, then one decade
 /// per unit), so that Stribeck regions (1e-3 to 1e-2 m/s) are as wide as the sliding range.
-/// Each model keeps its colour ([`super::model_color`]).
+/// Each model keeps its colour ([`super::model_color`]); units are shown on `axis`.
 pub fn steady_state_curves(
     path: &Path,
     models: &[(&str, &dyn FrictionModel)],
     normal_force: f64,
     v_max: f64,
+    axis: Axis,
 ) -> Result<(), CliError> {
     let n = 1601;
     let w = STEADY_STATE_LINEAR_WIDTH;
@@ -253,6 +279,7 @@ pub fn steady_state_curves(
         x_unit: "m/s".into(),
         x_ticks: XTicks::SymLog { linear_width: w },
         panels: vec![panel],
+        axis,
     };
     draw(path, &fig)
 }

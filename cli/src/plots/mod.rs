@@ -11,13 +11,14 @@ pub mod sets;
 mod trends;
 
 pub use charts::{
-    force_against_motion, force_balance, friction_force, over_time, response_fit,
+    force_against_motion, force_balance, friction_force, input_force, over_time, response_fit,
     steady_state_curves, MotionAxis, Quantity,
 };
 pub use trends::trend_plots;
 
 use crate::error::CliError;
 use crate::report::write_atomic;
+use frictionid_engine::Axis;
 use panel::{draw_panel, range};
 use plotters::prelude::*;
 use std::path::Path;
@@ -202,10 +203,13 @@ pub struct Figure<'a> {
     pub x_ticks: XTicks,
     /// The panels, top to bottom.
     pub panels: Vec<Panel<'a>>,
+    /// The axis whose units the labels show: the figure's units are written for a linear
+    /// axis and drawn on this one ([`Axis::unit`]: m/s is rad/s on a rotary axis).
+    pub axis: Axis,
 }
 
 impl<'a> Figure<'a> {
-    /// A figure of `panels` against time in seconds.
+    /// A figure of `panels` against time in seconds, its units shown as written.
     pub fn over_time(title: impl Into<String>, panels: Vec<Panel<'a>>) -> Self {
         Self {
             title: title.into(),
@@ -213,7 +217,13 @@ impl<'a> Figure<'a> {
             x_unit: "s".into(),
             x_ticks: XTicks::Linear,
             panels,
+            axis: Axis::Linear,
         }
+    }
+
+    /// The same figure with its units shown on `axis`.
+    pub fn on(self, axis: Axis) -> Self {
+        Self { axis, ..self }
     }
 }
 
@@ -324,6 +334,7 @@ mod tests {
             x_label: "time".into(),
             x_unit: "s".into(),
             x_ticks: XTicks::Linear,
+            axis: Axis::Linear,
             panels: vec![Panel::new("velocity", "m/s")
                 .with(Series::solid("measured", &t, &y1))
                 .with(Series::dashed("fitted", &t, &y2))
@@ -340,5 +351,23 @@ mod tests {
         ] {
             assert!(svg.contains(text), "missing {text}");
         }
+    }
+    /// A figure drawn on a rotary axis labels its velocity in rad/s and its force in N m.
+    #[test]
+    fn rotary_figures_label_angles_and_torques() {
+        let t = [0.0, 0.5, 1.0];
+        let y = [0.0, 1.0, 0.0];
+        let fig = Figure::over_time(
+            "T",
+            vec![
+                Panel::new("velocity", "m/s").with(Series::solid("v", &t, &y)),
+                Panel::new("friction force", "N").with(Series::solid("F", &t, &y)),
+            ],
+        )
+        .on(Axis::Rotary);
+        let svg = render(&fig).unwrap();
+        assert!(svg.contains("velocity [rad/s]"));
+        assert!(svg.contains("friction force [N m]"));
+        assert!(!svg.contains("[m/s]"));
     }
 }

@@ -5,11 +5,13 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-fn axis_text(label: &str, unit: &str) -> String {
+/// An axis's description `label [unit]`, the unit (written for a linear axis) shown on the
+/// figure's axis: the one place a plot's units pass through [`frictionid_engine::Axis::unit`].
+fn axis_text(fig: &Figure<'_>, label: &str, unit: &str) -> String {
     if unit.is_empty() {
         label.to_string()
     } else {
-        format!("{label} [{unit}]")
+        format!("{label} [{}]", fig.axis.unit(unit))
     }
 }
 
@@ -146,14 +148,14 @@ fn draw_mesh(
         // One label per decade: integer coordinates only.
         mesh.x_labels(spans.0.ceil() as usize + 1);
     }
-    mesh.y_desc(axis_text(&panel.y_label, &panel.y_unit))
+    mesh.y_desc(axis_text(fig, &panel.y_label, &panel.y_unit))
         .x_label_formatter(&x_fmt)
         .y_label_formatter(&y_fmt)
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 16))
         .light_line_style(RGBColor(235, 235, 235));
     if is_last {
-        mesh.x_desc(axis_text(&fig.x_label, &fig.x_unit));
+        mesh.x_desc(axis_text(fig, &fig.x_label, &fig.x_unit));
     }
     mesh.draw().map_err(|e| e.to_string())
 }

@@ -5,7 +5,9 @@ use super::{draw, Figure, Panel, Quantity, Series};
 use crate::error::CliError;
 use crate::report::{fmt_num, OutputDir};
 use frictionid_engine::identify::{FitResult, RecordFit};
+use frictionid_engine::record::{Channel, Record};
 use frictionid_engine::report::{EnergyRecord, EnergyReport, SimulateReport};
+use frictionid_engine::Axis;
 use frictionid_models::FrictionModel;
 use std::path::Path;
 
@@ -80,12 +82,19 @@ pub fn break_at_reversals(force: &[f64], v: &[f64]) -> Vec<f64> {
 /// `simulate`: displacement and velocity; energies and the dissipation rate.
 pub fn simulate_plots(out: &OutputDir, report: &SimulateReport) -> Result<Vec<String>, CliError> {
     let traj = &report.trajectory;
-    let title = format!("{} from x0 = {} m", report.model.name(), fmt_num(report.x0));
+    let axis = report.oscillator.axis;
+    let title = format!(
+        "{} from x0 = {} {}",
+        report.model.name(),
+        fmt_num(report.x0),
+        axis.unit("m")
+    );
     super::over_time(
         &out.path("displacement_velocity.svg"),
         &format!("Free vibration: {title}"),
         &traj.time,
         &[Quantity::Displacement(&traj.x), Quantity::Velocity(&traj.v)],
+        axis,
     )?;
     let t = &traj.time;
     draw(
@@ -122,8 +131,9 @@ fn fit_force_plot(
     let shown = where_defined(&r.series.model_force, &energy);
     let label = format!("model ({})", fit.model);
     let reference = r.energy_force.as_ref().map(|e| e.reference);
+    let axis = fit.oscillator.axis;
     let ref_label = reference
-        .map(|x| format!("model mean |F| ±{} N", fmt_num(x)))
+        .map(|x| format!("model mean |F| ±{} {}", fmt_num(x), axis.unit("N")))
         .unwrap_or_default();
     super::friction_force(
         &out.path(name),
@@ -134,6 +144,7 @@ fn fit_force_plot(
         reference
             .filter(|x| x.is_finite())
             .map(|x| (ref_label.as_str(), x)),
+        axis,
     )
 }
 
@@ -217,6 +228,7 @@ fn force_record_plots(
             &r.axes.time,
             balance,
             &fit.model,
+            fit.oscillator.axis,
         )?;
         files.push(file);
     }
@@ -246,11 +258,11 @@ fn force_record_plots(
         super::force_against_motion(
             &out.path(&file),
             &format!("{}: {what}", r.file),
-            axis,
-            motion,
+            (axis, motion),
             (label, &measured),
             &fitted,
             &fit.model,
+            fit.oscillator.axis,
         )?;
         files.push(file);
     }
@@ -291,6 +303,7 @@ pub fn steady_state_plot(
         &curves,
         first.oscillator.normal_force,
         peak_speed(first),
+        first.oscillator.axis,
     )?;
     Ok(vec![name.to_string()])
 }
@@ -304,6 +317,7 @@ fn energy_record_plots(
     stem: &str,
 ) -> Result<Vec<String>, CliError> {
     let a = &r.analysis;
+    let axis = report.oscillator.axis;
     let mut files = Vec::new();
     for (kind, what, quantities) in [
         (
@@ -322,7 +336,7 @@ fn energy_record_plots(
     ] {
         let file = format!("{stem}_{kind}.svg");
         let title = format!("{}: {what}", r.file);
-        super::over_time(&out.path(&file), &title, &a.time, &quantities)?;
+        super::over_time(&out.path(&file), &title, &a.time, &quantities, axis)?;
         files.push(file);
     }
     let ff = format!("{stem}_friction_force.svg");
@@ -332,7 +346,7 @@ fn energy_record_plots(
         .map(|m| format!("model ({m})"));
     let energy = break_at_reversals(&a.friction, &a.v);
     let model_shown = r.model_force.as_ref().map(|f| where_defined(f, &energy));
-    let ref_label = format!("reference ±{} N", fmt_num(r.reference));
+    let ref_label = format!("reference ±{} {}", fmt_num(r.reference), axis.unit("N"));
     super::friction_force(
         &out.path(&ff),
         &format!("{}: friction force", r.file),
@@ -340,8 +354,29 @@ fn energy_record_plots(
         &energy,
         model_label.as_deref().zip(model_shown.as_deref()),
         Some((ref_label.as_str(), r.reference)).filter(|(_, v)| v.is_finite()),
+        axis,
     )?;
     files.push(ff);
+    Ok(files)
+}
+
+/// The measured input of every record that has an `input_force` channel, against time:
+/// `<stem>_input.svg`, with the stems the records' other plots have ([`unique_stems`]).
+pub fn input_plots(
+    out: &OutputDir,
+    records: &[Record],
+    axis: Axis,
+) -> Result<Vec<String>, CliError> {
+    let names: Vec<&str> = records.iter().map(|r| r.name.as_str()).collect();
+    let mut files = Vec::new();
+    for (record, stem) in records.iter().zip(unique_stems(&names)) {
+        let Some(input) = record.channel(Channel::InputForce) else {
+            continue;
+        };
+        let file = format!("{stem}_input.svg");
+        super::input_force(&out.path(&file), &record.name, record.time(), input, axis)?;
+        files.push(file);
+    }
     Ok(files)
 }
 

@@ -54,7 +54,8 @@ impl Axis {
 
     /// `unit`, written for a linear axis (m, N, kg and their products and quotients), on
     /// this axis: on a rotary one m becomes rad, N becomes N m and kg becomes kg m^2
-    /// ("N s/m" -> "N m s/rad", "m/s^2" -> "rad/s^2"). A linear axis keeps it as it is.
+    /// ("N s/m" -> "N m s/rad", "m/s^2" -> "rad/s^2", "mm" -> "mrad"). A linear axis keeps it
+    /// as it is. Translate a unit once: "N m" is not a linear unit.
     pub fn unit(self, unit: &str) -> String {
         if self.is_linear() {
             return unit.to_string();
@@ -82,6 +83,7 @@ fn rotary_token(token: &str) -> String {
         "N" => "N m".into(),
         "kg" => "kg m^2".into(),
         "m" => "rad".into(),
+        "mm" => "mrad".into(),
         _ => match token.strip_prefix("m^") {
             Some(power) => format!("rad^{power}"),
             None => token.into(),
@@ -100,6 +102,9 @@ mod tests {
             ("m", "rad"),
             ("m/s", "rad/s"),
             ("m/s^2", "rad/s^2"),
+            ("mm", "mrad"),
+            ("mm/s", "mrad/s"),
+            ("m/s²", "rad/s²"),
             ("N", "N m"),
             ("N/m", "N m/rad"),
             ("N s/m", "N m s/rad"),

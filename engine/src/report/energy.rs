@@ -1,7 +1,7 @@
 //! The report of `energy`: the energy-based friction force of each record (the paper's
 //! Eq. 7) against a reference force.
 
-use super::format::{fmt_num, fmt_percent};
+use super::format::{column, fmt_num, fmt_percent};
 use super::{render_files, Render, Role, Sink, Table};
 use crate::energy::{EnergyAnalysis, EnergyOptions, HalfCycle, SeriesSources};
 use crate::oscillator::Oscillator;
@@ -89,12 +89,13 @@ impl EnergyReport {
                 ]
             })
             .collect();
+        let axis = self.oscillator.axis;
         Table::new(
             &[
                 "record",
-                "mean |F| [N]",
-                "half-cycle mean [N]",
-                "reference [N]",
+                &column(axis, "mean |F|", "N"),
+                &column(axis, "half-cycle mean", "N"),
+                &column(axis, "reference", "N"),
                 "difference [%]",
                 "half-cycles",
                 "x / v / a",

@@ -1,8 +1,8 @@
 //! The report of `fit`: one model fitted to the records, with the energy-based force check.
 
 use super::format::{
-    fmt_criterion, fmt_estimate, fmt_num, fmt_opt, fmt_percent, fmt_std_error, fmt_to_error,
-    serialized_name,
+    column, fmt_criterion, fmt_estimate, fmt_num, fmt_opt, fmt_percent, fmt_std_error,
+    fmt_to_error, serialized_name,
 };
 use super::{render_files, render_opening, Render, Role, Sink, Status, Table, Verdict};
 use crate::identify::values::EnergyForce;
@@ -261,14 +261,15 @@ fn energy_record_table(fit: &FitResult) -> Table {
             row
         })
         .collect();
+    let axis = fit.oscillator.axis;
     let rms = format!("rms residual [{}]", fit.residual_unit);
     Table::new(
         &[
             "record",
-            "x0 [m]",
+            &column(axis, "x0", "m"),
             &rms,
-            "mean |F| Eq. 7 [N]",
-            "model mean |F| [N]",
+            &column(axis, "mean |F| Eq. 7", "N"),
+            &column(axis, "model mean |F|", "N"),
             "difference [%]",
             "dissipated [J]",
             "model dissipated [J]",

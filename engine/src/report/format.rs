@@ -9,6 +9,12 @@
 //! - information criteria (AIC, BIC and their differences): one decimal ([`fmt_criterion`]);
 //! - percentages: two decimals ([`fmt_percent`]);
 //! - an undefined value (NaN, infinite, absent): `-`.
+//!
+//! A unit a report writes itself (a column header, a table's unit cell) is written for a
+//! linear axis and shown on the report's axis by [`on_axis`] and [`column`]; the units a fit
+//! carries (its parameters, residuals and channels) are on its axis already.
+
+use crate::axis::Axis;
 
 /// Significant digits of a figure.
 pub const SIGNIFICANT: i32 = 4;
@@ -171,6 +177,16 @@ pub fn fmt_estimate(x: f64, se: Option<f64>) -> String {
     }
 }
 
+/// `unit`, written for a linear axis, on `axis` (rad, N m, kg m^2 on a rotary one).
+pub fn on_axis(axis: Axis, unit: &str) -> String {
+    axis.unit(unit)
+}
+
+/// A column header `quantity [unit]`, the unit written for a linear axis and shown on `axis`.
+pub fn column(axis: Axis, quantity: &str, unit: &str) -> String {
+    format!("{quantity} [{}]", on_axis(axis, unit))
+}
+
 /// The name a unit-like enum value has in report.json (its serde name, e.g. `pass`,
 /// `energy_balance`), so every writer spells it the same way.
 pub fn serialized_name<T: serde::Serialize>(value: &T) -> String {
@@ -200,6 +216,13 @@ mod tests {
         assert_eq!(fmt_num(-1.25e-7), "-1.25e-7");
         assert_eq!(fmt_num(-0.009297), "-0.009297");
         assert_eq!(fmt_num(0.0), "0");
+    }
+
+    #[test]
+    fn columns_show_the_axis_units() {
+        assert_eq!(column(Axis::Linear, "x0", "m"), "x0 [m]");
+        assert_eq!(column(Axis::Rotary, "x0", "m"), "x0 [rad]");
+        assert_eq!(column(Axis::Rotary, "mean |F|", "N"), "mean |F| [N m]");
     }
 
     #[test]

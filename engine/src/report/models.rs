@@ -2,6 +2,7 @@
 
 use super::format::fmt_num;
 use super::{Render, Role, Sink, Table};
+use crate::axis::Axis;
 use frictionid_models::ModelListing;
 use serde::Serialize;
 
@@ -16,9 +17,17 @@ pub struct ModelsReport {
 impl ModelsReport {
     /// Every model registered in this program (built-in and linked plugins).
     pub fn registered() -> Self {
-        Self {
-            models: frictionid_models::listings(),
+        Self::on_axis(Axis::Linear)
+    }
+
+    /// Every registered model with its parameters' units on `axis` (a law declares them for
+    /// a linear axis: "N s/m" is "N m s/rad" on a rotary one).
+    pub fn on_axis(axis: Axis) -> Self {
+        let mut models = frictionid_models::listings();
+        for p in models.iter_mut().flat_map(|m| m.parameters.iter_mut()) {
+            p.unit = super::format::on_axis(axis, &p.unit);
         }
+        Self { models }
     }
 }
 

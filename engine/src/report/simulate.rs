@@ -1,6 +1,6 @@
 //! The report of `simulate`: one free vibration.
 
-use super::format::{fmt_num, fmt_opt};
+use super::format::{column, fmt_num, fmt_opt, on_axis};
 use super::{render_files, render_opening, Render, Role, Sink, Table};
 use crate::oscillator::Oscillator;
 use crate::simulate::{Event, SimStats, Trajectory};
@@ -65,7 +65,8 @@ impl SimulateReport {
     }
 
     fn summary_table(&self) -> Table {
-        let row = |q: &str, v: String, u: &str| vec![q.to_string(), v, u.to_string()];
+        let axis = self.oscillator.axis;
+        let row = |q: &str, v: String, u: &str| vec![q.to_string(), v, on_axis(axis, u)];
         let stats = &self.stats;
         Table::new(
             &["quantity", "value", "unit"],
@@ -103,7 +104,8 @@ impl SimulateReport {
                 vec![fmt_num(e.time), kind, fmt_num(e.displacement)]
             })
             .collect();
-        Table::new(&["time [s]", "kind", "displacement [m]"], rows)
+        let displacement = column(self.oscillator.axis, "displacement", "m");
+        Table::new(&["time [s]", "kind", &displacement], rows)
     }
 }
 

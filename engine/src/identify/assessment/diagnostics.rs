@@ -15,6 +15,7 @@
 //!   non-convergence.
 
 use super::identifiability::PROFILE_DELTA;
+use crate::axis::Axis;
 use crate::energy::cumulative_trapezoid;
 use crate::identify::values::layout::{is_friction_level, FreeParam, ParamKind};
 use crate::identify::values::outcome::{Check, Finding, StartOutcome, Status, TerminationReason};
@@ -49,8 +50,8 @@ fn status_of(value: f64, warn: f64, fail: f64) -> Status {
 
 /// The energy-balance finding of one record: the larger of the Eq. 7 and the dissipated
 /// energy differences (in percent) decides among the parts that can judge; with neither,
-/// the finding is skipped with the reasons.
-pub fn energy_balance(record: &str, ef: &EnergyForce) -> Finding {
+/// the finding is skipped with the reasons. Forces in the units of `axis`.
+pub fn energy_balance(record: &str, ef: &EnergyForce, axis: Axis) -> Finding {
     let eq7 = ef.percent_difference.abs();
     let energies = ef.dissipation_percent_difference.abs();
     let judged = [
@@ -80,8 +81,9 @@ pub fn energy_balance(record: &str, ef: &EnergyForce) -> Finding {
     } else {
         format!(" (not judged: {})", skipped.join("; "))
     };
+    let n = axis.unit("N");
     let message = format!(
-        "record `{record}`: energy-based friction differs from the model's by {:.1} % (Eq. 7 mean {:.4} N vs {:.4} N) and {:.1} % (energy dissipated over {} half-cycles {:.4e} J vs {:.4e} J){not_judged}{}",
+        "record `{record}`: energy-based friction differs from the model's by {:.1} % (Eq. 7 mean {:.4} {n} vs {:.4} {n}) and {:.1} % (energy dissipated over {} half-cycles {:.4e} J vs {:.4e} J){not_judged}{}",
         ef.percent_difference,
         ef.mean_abs,
         ef.reference,
@@ -692,13 +694,14 @@ mod tests {
 
     #[test]
     fn energy_balance_thresholds_are_five_and_twenty_percent() {
-        let status = |eq7, energies| energy_balance("r", &energy_force(eq7, energies)).status;
+        let status =
+            |eq7, energies| energy_balance("r", &energy_force(eq7, energies), Axis::Linear).status;
         assert_eq!(status(1.0, -2.0), Status::Pass);
         assert_eq!(status(-6.0, 1.0), Status::Warn);
         assert_eq!(status(1.0, 12.0), Status::Warn);
         assert_eq!(status(38112.0, 1.0), Status::Fail);
         assert_eq!(status(1.0, f64::NAN), Status::Pass);
-        let f = energy_balance("x14.csv", &energy_force(-25.0, 3.0));
+        let f = energy_balance("x14.csv", &energy_force(-25.0, 3.0), Axis::Linear);
         assert_eq!(f.value, Some(25.0));
         assert!(f.message.contains("x14.csv"));
     }
@@ -712,14 +715,14 @@ mod tests {
             force_noise: 2.0,
             level: 3.48,
         });
-        let f = energy_balance("r", &ef);
+        let f = energy_balance("r", &ef, Axis::Linear);
         assert_eq!(f.status, Status::Pass, "{}", f.message);
         assert!(f.message.contains("not judged: Eq. 7"), "{}", f.message);
         ef.dissipation_skipped = Some(EnergySkip::FewSamples {
             per_half_cycle: 8,
             needed: 20,
         });
-        let f = energy_balance("r", &ef);
+        let f = energy_balance("r", &ef, Axis::Linear);
         assert_eq!(f.status, Status::Skipped, "{}", f.message);
         assert!(
             f.message.contains("8 samples per half-cycle"),

@@ -3,6 +3,7 @@
 
 use super::diagnostics;
 use super::energy_check::{energy_force_check, ForceReference};
+use crate::axis::Axis;
 use crate::energy::{analyze_record, forces_from_states, states_along, states_along_stiff};
 use crate::error::{EngineError, IntegrationFailure};
 use crate::identify::problem::{
@@ -60,7 +61,8 @@ fn record_fit<R: Residuals>(
 ) -> Result<(RecordFit, f64, Option<Finding>), EngineError> {
     let predicted = problem.predict_record(world, ri)?;
     let stacked = problem.residuals.measured(ri, rec);
-    let channels = channel_fits(&problem.residuals.segments(ri, rec), &predicted, stacked);
+    let segments = problem.residuals.segments(ri, rec);
+    let channels = channel_fits(&segments, &predicted, stacked, world.oscillator.axis);
     // The record's first channel is what its `measured` and `fitted` series hold.
     let first = channels.first().map_or(0, |c| c.samples);
     let (fitted, measured) = (predicted[..first].to_vec(), &stacked[..first]);
@@ -69,7 +71,7 @@ fn record_fit<R: Residuals>(
     let (energy_force, ebf, mf, finding) = if problem.residuals.simulates_response() {
         match energy_check(problem.residuals.as_ref(), ri, rec, nuisance, world, opts) {
             Ok((ef, ebf, mf)) => {
-                let finding = diagnostics::energy_balance(&rec.name, &ef);
+                let finding = diagnostics::energy_balance(&rec.name, &ef, world.oscillator.axis);
                 (Some(ef), ebf, mf, Some(finding))
             }
             Err(e) => {
@@ -120,8 +122,14 @@ fn record_fit<R: Residuals>(
 }
 
 /// The fit of each compared channel of a record: its RMS residual and noise level, from the
-/// record's stacked `predicted` and `measured` series cut at `segments`.
-fn channel_fits(segments: &[Segment], predicted: &[f64], measured: &[f64]) -> Vec<ChannelFit> {
+/// record's stacked `predicted` and `measured` series cut at `segments`, in the units of
+/// `axis`.
+fn channel_fits(
+    segments: &[Segment],
+    predicted: &[f64],
+    measured: &[f64],
+    axis: Axis,
+) -> Vec<ChannelFit> {
     let mut start = 0;
     segments
         .iter()
@@ -136,7 +144,7 @@ fn channel_fits(segments: &[Segment], predicted: &[f64], measured: &[f64]) -> Ve
             start = end;
             ChannelFit {
                 channel: s.channel.to_string(),
-                unit: s.unit.to_string(),
+                unit: axis.unit(s.unit),
                 samples,
                 rms_residual: (ss / samples.max(1) as f64).sqrt(),
                 noise: s.noise,

@@ -187,6 +187,7 @@ pub fn summarise<R: Residuals>(
     simulations += ctx.reference.records.len() as u64;
     let levels = ctx.reference.residuals.friction_levels();
     let parameters = parameter_entries(&stats, params, ctx.standings, levels);
+    let axis = stats.world.oscillator.axis;
     let findings = diagnose(ctx, &runs, &stats, &parameters, &fits);
     let n_free = params.len();
     let samples = ctx.reference.n_residuals();
@@ -212,7 +213,7 @@ pub fn summarise<R: Residuals>(
         records: fits.records,
         rms_residual: (fits.sum_sq / fits.n_total.max(1) as f64).sqrt(),
         compared: ctx.reference.residuals.channel().to_string(),
-        residual_unit: ctx.reference.residuals.unit().to_string(),
+        residual_unit: axis.unit(ctx.reference.residuals.unit()),
         cost: 0.5 * stats.ssr,
         aic: aic(samples, stats.ssr, n_free),
         bic: bic(samples, stats.ssr, n_free),
@@ -331,7 +332,7 @@ fn parameter_entries(
         .enumerate()
         .map(|(i, (p, v))| {
             let slot = params.iter().position(|f| f.kind == ParamKind::Model(i));
-            let unit = levels.unit(p);
+            let unit = levels.unit(p, stats.world.oscillator.axis);
             // A value collapsed onto its open lower bound is reported as that bound.
             let v = slot.map_or(v, |s| params[s].reported(v));
             stand(param_entry(&p.name, &unit, v, slot, se, tq), slot)

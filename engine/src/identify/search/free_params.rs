@@ -2,6 +2,7 @@
 //! picks the starting model (data-driven guess or as given) and lays out the free model,
 //! oscillator and nuisance parameters with their bounds and starting values.
 
+use crate::axis::Axis;
 use crate::error::EngineError;
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::values::layout::{FreeParam, ParamKind};
@@ -69,7 +70,7 @@ pub fn build_layout<R: Residuals + ?Sized>(
     let values = layout.start_model.params();
     let levels = residuals.friction_levels();
     for &i in &free {
-        let (param, x) = model_param(&info[i], i, values[i], opts, levels);
+        let (param, x) = model_param(&info[i], i, values[i], opts, (levels, osc.axis));
         layout.push(param, x);
     }
     for &q in &opts.oscillator {
@@ -160,7 +161,7 @@ fn model_param(
     index: usize,
     value: f64,
     opts: &FitOptions,
-    levels: FrictionLevels,
+    (levels, axis): (FrictionLevels, Axis),
 ) -> (FreeParam, f64) {
     let (lo, hi) = opts
         .bounds
@@ -176,7 +177,7 @@ fn model_param(
     x = x.clamp(lo_eff, hi_eff);
     let mut f = FreeParam::linear(
         p.name.clone(),
-        &levels.unit(p),
+        &levels.unit(p, axis),
         ParamKind::Model(index),
         (lo_eff, hi_eff),
         x,
@@ -244,7 +245,7 @@ fn nuisance_param(
         .unwrap_or_else(|| kind.default_bounds(rec, osc));
     let param = FreeParam::linear(
         format!("{}[{}]", kind.key(), rec.name),
-        kind.unit(),
+        &osc.axis.unit(kind.unit()),
         ParamKind::Nuisance { kind, record: r },
         b,
         kind.start(rec),

@@ -7,6 +7,7 @@
 //! report and its bounds come from the data (the largest |force| the fit compares), not from
 //! the dimensionless bound of 10, which a 20 N Coulomb level would sit at.
 
+use crate::axis::Axis;
 use frictionid_models::ParamInfo;
 
 /// The normal force a fit without one multiplies its levels by \[N\].
@@ -41,12 +42,14 @@ impl FrictionLevels {
         matches!(self, Self::Forces { .. })
     }
 
-    /// The unit a report gives `info`: N for a level read as a force, else the declared one.
-    pub fn unit(self, info: &ParamInfo) -> String {
+    /// The unit a report gives `info` on `axis`: N (N m on a rotary axis) for a level read as
+    /// a force, else the declared one on that axis (a law declares its units for a linear
+    /// axis: "N s/m" is "N m s/rad" on a rotary one).
+    pub fn unit(self, info: &ParamInfo, axis: Axis) -> String {
         if self.are_forces() && Self::is_level(info) {
-            "N".into()
+            axis.unit("N")
         } else {
-            info.unit.clone()
+            axis.unit(&info.unit)
         }
     }
 
@@ -85,14 +88,26 @@ mod tests {
         let viscous = ParamSpec::non_negative("viscous", "N s/m", 0.5, "viscous").info();
         let forces = FrictionLevels::Forces { largest: 30.0 };
         assert_eq!(forces.bounds(&mu), (0.0, 150.0));
-        assert_eq!(forces.unit(&mu), "N");
+        assert_eq!(forces.unit(&mu, Axis::Linear), "N");
         assert_eq!(forces.bounds(&delta), (0.0, 10.0));
-        assert_eq!(forces.unit(&delta), "1");
-        assert_eq!(forces.unit(&viscous), "N s/m");
+        assert_eq!(forces.unit(&delta, Axis::Linear), "1");
+        assert_eq!(forces.unit(&viscous, Axis::Linear), "N s/m");
         assert_eq!(forces.clamp_guess(20.0), 20.0);
         let coefficients = FrictionLevels::Coefficients;
         assert_eq!(coefficients.bounds(&mu), (0.0, 10.0));
-        assert_eq!(coefficients.unit(&mu), "1");
+        assert_eq!(coefficients.unit(&mu, Axis::Linear), "1");
         assert_eq!(coefficients.clamp_guess(20.0), 5.0);
+    }
+
+    /// On a rotary axis a level read as a force is a torque in N m and a viscous coefficient
+    /// is in N m s/rad; a coefficient of the normal force stays dimensionless.
+    #[test]
+    fn levels_on_a_rotary_axis_are_torques() {
+        let mu = ParamSpec::new("mu", "1", 0.2, (0.0, 10.0), "level").info();
+        let viscous = ParamSpec::non_negative("viscous", "N s/m", 0.5, "viscous").info();
+        let forces = FrictionLevels::Forces { largest: 30.0 };
+        assert_eq!(forces.unit(&mu, Axis::Rotary), "N m");
+        assert_eq!(forces.unit(&viscous, Axis::Rotary), "N m s/rad");
+        assert_eq!(FrictionLevels::Coefficients.unit(&mu, Axis::Rotary), "1");
     }
 }

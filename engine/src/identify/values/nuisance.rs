@@ -32,7 +32,7 @@ impl NuisanceKind {
         }
     }
 
-    /// SI unit.
+    /// Its unit written for a linear axis ([`crate::Axis::unit`] gives the rotary one).
     pub fn unit(self) -> &'static str {
         match self {
             Self::VelocityOffset => "m/s",

@@ -35,13 +35,14 @@ impl OscillatorParam {
             Self::InputOffset => "input_offset",
         }
     }
-    /// SI unit.
+    /// Its unit written for a linear axis ([`crate::Axis::unit`] gives the rotary one): the
+    /// gravity moment, a torque on the rotary axis it belongs to, is written as the force N.
     pub fn unit(self) -> &'static str {
         match self {
             Self::Mass => "kg",
             Self::Damping => "N s/m",
             Self::Stiffness => "N/m",
-            Self::GravityMoment => "N m",
+            Self::GravityMoment => "N",
             Self::InputOffset => "N",
         }
     }
