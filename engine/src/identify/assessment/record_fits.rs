@@ -12,7 +12,7 @@ use crate::identify::problem::{
 use crate::identify::values::{
     ChannelFit, Check, EnergyForce, Finding, FitOptions, FitSeries, NuisanceValues, RecordFit,
 };
-use crate::record::{NormalForce, Record};
+use crate::record::{Channel, NormalForce, Record};
 use std::sync::Arc;
 
 /// The per-record fits and what they add up to.
@@ -68,7 +68,10 @@ fn record_fit<R: Residuals>(
     let (fitted, measured) = (predicted[..first].to_vec(), &stacked[..first]);
     let sum_sq = channels.first().map_or(0.0, |c| c.rms_residual.powi(2)) * first as f64;
     let nuisance = &world.nuisance[ri];
-    let (energy_force, ebf, mf, finding) = if problem.residuals.simulates_response() {
+    let driven = rec.channel(Channel::InputForce).is_some() || world.oscillator.input_offset != 0.0;
+    let (energy_force, ebf, mf, finding) = if driven && problem.residuals.simulates_response() {
+        (None, Vec::new(), Vec::new(), Some(driven_skip(&rec.name)))
+    } else if problem.residuals.simulates_response() {
         match energy_check(problem.residuals.as_ref(), ri, rec, nuisance, world, opts) {
             Ok((ef, ebf, mf)) => {
                 let finding = diagnostics::energy_balance(&rec.name, &ef, world.oscillator.axis);
@@ -155,6 +158,20 @@ fn channel_fits(
 
 /// The energy check of record `index` (`rec`), its energy-based force and the model force
 /// along it.
+/// The energy-balance finding of a driven record: Eq. 7 and the half-cycle energies hold the
+/// free vibration's balance, which an input (or a constant force) breaks, so the check
+/// cannot judge the fit there.
+fn driven_skip(record: &str) -> Finding {
+    Finding::skipped(
+        Check::EnergyBalance,
+        format!(
+            "record `{record}`: the energy balance (Eq. 7) holds for free vibration; the record is \
+             driven by an input, so the check cannot judge it (inverse dynamics compares the \
+             force balance instead)"
+        ),
+    )
+}
+
 fn energy_check<R: Residuals + ?Sized>(
     residuals: &R,
     index: usize,

@@ -12,7 +12,8 @@ use std::sync::Arc;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum OscillatorParam {
-    /// m [kg].
+    /// m [kg] (J [kg m^2] on a rotary axis, where it is called `inertia`).
+    #[serde(alias = "inertia")]
     Mass,
     /// c [N s/m].
     Damping,
@@ -254,5 +255,32 @@ impl std::fmt::Debug for FitOptions {
             .field("max_iterations", &self.max_iterations)
             .field("parallel", &self.parallel)
             .finish_non_exhaustive()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A rotary axis names its mass `inertia`: `[fit.options] oscillator = ["inertia"]` asks
+    /// for the same property as `"mass"`, and the config name stays `mass` in reports.
+    #[test]
+    fn inertia_is_the_rotary_name_of_the_mass() {
+        let asked: Vec<OscillatorParam> =
+            serde_json::from_value(serde_json::json!(["inertia", "mass", "gravity_moment"]))
+                .unwrap();
+        assert_eq!(
+            asked,
+            [
+                OscillatorParam::Mass,
+                OscillatorParam::Mass,
+                OscillatorParam::GravityMoment
+            ]
+        );
+        assert_eq!(
+            OscillatorParam::parse("inertia"),
+            Some(OscillatorParam::Mass)
+        );
+        assert_eq!(OscillatorParam::Mass.name(), "mass");
     }
 }
