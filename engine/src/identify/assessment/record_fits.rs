@@ -6,7 +6,7 @@ use super::energy_check::{energy_force_check, ForceReference};
 use crate::energy::{analyze_record, forces_from_states, states_along, states_along_stiff};
 use crate::error::{EngineError, IntegrationFailure};
 use crate::identify::problem::{
-    FitProblem, Realised, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
+    AnalysisRequest, FitProblem, Realised, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
 };
 use crate::identify::values::{
     ChannelFit, Check, EnergyForce, Finding, FitOptions, FitSeries, NuisanceValues, RecordFit,
@@ -162,7 +162,12 @@ fn energy_check<R: Residuals + ?Sized>(
     let analysis = if nuisance.offset == 0.0 && x0 == rec.x0 {
         // The record as measured: the analysis the guess made, when m, c and k are those it
         // was made with.
-        residuals.energy_analysis(index, rec, osc, &opts.energy)?
+        residuals.energy_analysis(AnalysisRequest {
+            index,
+            record: rec,
+            osc,
+            options: &opts.energy,
+        })?
     } else {
         let mut corrected = rec.clone();
         corrected.x0 = x0;

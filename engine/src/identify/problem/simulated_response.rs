@@ -14,7 +14,7 @@
 //! the fitted x0 and release shift feeds all of them; the velocity offset applies to the
 //! velocity channel (and needs one in every record).
 
-use super::analysis_cache::AnalysisCache;
+use super::analysis_cache::{AnalysisCache, AnalysisRequest};
 use super::residuals::{Evaluation, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE};
 use crate::energy::record_motion;
 use crate::error::EngineError;
@@ -380,9 +380,15 @@ impl Residuals for SimulatedResponse {
         // A record measured as velocity is analysed once, for the guess and the energy check
         // (the same level as the half-cycle analysis alone gives).
         let level = |index: usize, rec: &Record| {
-            let analysed = records[index]
-                .channel(Channel::Velocity)
-                .and_then(|_| self.energy_analysis(index, rec, osc, &opts.energy).ok());
+            let analysed = records[index].channel(Channel::Velocity).and_then(|_| {
+                self.energy_analysis(AnalysisRequest {
+                    index,
+                    record: rec,
+                    osc,
+                    options: &opts.energy,
+                })
+                .ok()
+            });
             match analysed {
                 Some(analysis) => super::guess::level_of_analysis(&analysis),
                 None => super::guess::friction_level(rec, osc, opts),
