@@ -23,7 +23,8 @@ use crate::identify::values::options::FitOptions;
 use crate::oscillator::Oscillator;
 use crate::record::{channel_list, Channel, Record};
 use crate::simulate::{
-    simulate_driven, simulate_velocity_watched, Initial, Input, SampleGrid, SimOptions, VelocityRun,
+    simulate_driven, simulate_velocity_watched, Initial, Input, RunInputs, SampleGrid, SimOptions,
+    VelocityRun,
 };
 use frictionid_models::GuessHint;
 use std::borrow::Cow;
@@ -127,14 +128,22 @@ impl SimulatedResponse {
             let opts = within_allowance(at, index, record, clock.times.len());
             let mut superseded = |_: usize| at.superseded(index);
             let input = clock.input(record)?;
+            let inputs = RunInputs {
+                osc: at.oscillator,
+                model: at.model,
+                init: &init,
+                input: input.as_ref(),
+                grid: SampleGrid {
+                    t_end,
+                    sample_times: &clock.times,
+                },
+                opts: &opts,
+            };
             let run = VelocityRun {
-                sample_times: &clock.times,
                 v_out: &mut sim,
                 watch: &mut superseded,
-                input: input.as_ref(),
             };
-            let stats =
-                simulate_velocity_watched(at.oscillator, at.model, &init, t_end, &opts, run)?;
+            let stats = simulate_velocity_watched(inputs, run)?;
             at.record_work(index, &stats, clock.times.len());
             if v.is_empty() {
                 return Ok(sim);
@@ -161,12 +170,17 @@ impl SimulatedResponse {
                 let opts = within_allowance(at, index, record, clock.times.len());
                 let init = initial(record, nuisance);
                 let input = clock.input(record)?;
-                let grid = SampleGrid {
-                    t_end,
-                    sample_times: &clock.times,
-                };
-                let trajectory =
-                    simulate_driven(at.oscillator, at.model, &init, input.as_ref(), grid, &opts)?;
+                let trajectory = simulate_driven(RunInputs {
+                    osc: at.oscillator,
+                    model: at.model,
+                    init: &init,
+                    input: input.as_ref(),
+                    grid: SampleGrid {
+                        t_end,
+                        sample_times: &clock.times,
+                    },
+                    opts: &opts,
+                })?;
                 at.record_work(index, &trajectory.stats, clock.times.len());
                 Some(trajectory)
             }
