@@ -24,7 +24,7 @@ use crate::oscillator::Oscillator;
 use crate::record::{channel_list, Channel, Record};
 use crate::simulate::{
     simulate_driven, simulate_velocity_watched, Initial, Input, RunInputs, SampleGrid, SimOptions,
-    VelocityRun,
+    SimStats, VelocityRun,
 };
 use frictionid_models::GuessHint;
 use std::borrow::Cow;
@@ -118,33 +118,20 @@ impl SimulatedResponse {
         at: &Evaluation<'_>,
         case: RecordCase<'_>,
     ) -> Result<Vec<f64>, EngineError> {
-        let (index, record, nuisance) = (case.index, case.record, case.nuisance);
+        let (record, nuisance) = (case.record, case.nuisance);
         let clock = ReleaseClock::new(record, nuisance);
         let mut v = vec![record.v0; clock.before];
         if let Some(&t_end) = clock.times.last() {
-            at.count_simulation();
-            let mut sim = Vec::with_capacity(clock.times.len());
-            let init = initial(record, nuisance);
-            let opts = within_allowance(at, index, record, clock.times.len());
-            let mut superseded = |_: usize| at.superseded(index);
-            let input = clock.input(record)?;
-            let inputs = RunInputs {
-                osc: at.oscillator,
-                model: at.model,
-                init: &init,
-                input: input.as_ref(),
-                grid: SampleGrid {
-                    t_end,
-                    sample_times: &clock.times,
-                },
-                opts: &opts,
-            };
-            let run = VelocityRun {
-                v_out: &mut sim,
-                watch: &mut superseded,
-            };
-            let stats = simulate_velocity_watched(inputs, run)?;
-            at.record_work(index, &stats, clock.times.len());
+            let sim = simulated_from_release(at, case, &clock, t_end, |inputs| {
+                let mut sim = Vec::with_capacity(clock.times.len());
+                let mut superseded = |_: usize| at.superseded(case.index);
+                let run = VelocityRun {
+                    v_out: &mut sim,
+                    watch: &mut superseded,
+                };
+                let stats = simulate_velocity_watched(inputs, run)?;
+                Ok((sim, stats))
+            })?;
             if v.is_empty() {
                 return Ok(sim);
             }
@@ -161,29 +148,15 @@ impl SimulatedResponse {
         case: RecordCase<'_>,
         channels: &[Channel],
     ) -> Result<Vec<f64>, EngineError> {
-        let (index, record, nuisance) = (case.index, case.record, case.nuisance);
+        let (record, nuisance) = (case.record, case.nuisance);
         let clock = ReleaseClock::new(record, nuisance);
         let x0 = nuisance.x0_of(record);
         let trajectory = match clock.times.last() {
-            Some(&t_end) => {
-                at.count_simulation();
-                let opts = within_allowance(at, index, record, clock.times.len());
-                let init = initial(record, nuisance);
-                let input = clock.input(record)?;
-                let trajectory = simulate_driven(RunInputs {
-                    osc: at.oscillator,
-                    model: at.model,
-                    init: &init,
-                    input: input.as_ref(),
-                    grid: SampleGrid {
-                        t_end,
-                        sample_times: &clock.times,
-                    },
-                    opts: &opts,
-                })?;
-                at.record_work(index, &trajectory.stats, clock.times.len());
-                Some(trajectory)
-            }
+            Some(&t_end) => Some(simulated_from_release(at, case, &clock, t_end, |inputs| {
+                let trajectory = simulate_driven(inputs)?;
+                let stats = trajectory.stats;
+                Ok((trajectory, stats))
+            })?),
             None => None,
         };
         let mut out = Vec::with_capacity(channels.len() * record.len());
@@ -256,6 +229,37 @@ impl<'a> ReleaseClock<'a> {
 }
 
 /// The release state of `record` under `nuisance`.
+/// Simulates `case`'s record from its release up to `t_end`, sampled at `clock`'s times,
+/// with `simulation` (the velocity-only or the full run, which returns what it made and its
+/// statistics): from the nuisance values' release state, under the record's input, within
+/// the record's step allowance; the work is counted against the evaluation.
+fn simulated_from_release<T>(
+    at: &Evaluation<'_>,
+    case: RecordCase<'_>,
+    clock: &ReleaseClock<'_>,
+    t_end: f64,
+    simulation: impl FnOnce(RunInputs<'_>) -> Result<(T, SimStats), EngineError>,
+) -> Result<T, EngineError> {
+    let (index, record) = (case.index, case.record);
+    at.count_simulation();
+    let init = initial(record, case.nuisance);
+    let opts = within_allowance(at, index, record, clock.times.len());
+    let input = clock.input(record)?;
+    let (made, stats) = simulation(RunInputs {
+        osc: at.oscillator,
+        model: at.model,
+        init: &init,
+        input: input.as_ref(),
+        grid: SampleGrid {
+            t_end,
+            sample_times: &clock.times,
+        },
+        opts: &opts,
+    })?;
+    at.record_work(index, &stats, clock.times.len());
+    Ok(made)
+}
+
 fn initial(record: &Record, nuisance: &NuisanceValues) -> Initial {
     Initial {
         x0: nuisance.x0_of(record),
