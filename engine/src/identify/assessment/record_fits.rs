@@ -3,7 +3,9 @@
 
 use super::diagnostics;
 use super::energy_check::{energy_force_check, ForceReference};
-use crate::energy::{analyze_record, forces_from_states, states_along, states_along_stiff};
+use crate::energy::{
+    analyze_record, forces_from_states, states_along, states_along_stiff, MeasuredMotion,
+};
 use crate::error::{EngineError, IntegrationFailure};
 use crate::identify::problem::{
     AnalysisRequest, FitProblem, Realised, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
@@ -181,11 +183,16 @@ fn energy_check<R: Residuals + ?Sized>(
     let budget = STEPS_PER_SAMPLE * (analysis.time.len() as u64).max(100);
     let model = world.model.as_ref();
     let normal = NormalForce::Constant(osc.normal_force);
-    let states = match states_along(model, &analysis.time, &analysis.v, &normal, budget) {
+    let motion = MeasuredMotion {
+        time: &analysis.time,
+        v: &analysis.v,
+        normal: &normal,
+    };
+    let states = match states_along(model, motion, budget) {
         Err(EngineError::StateIntegration {
             failure: IntegrationFailure::StepBudgetExceeded { .. },
             ..
-        }) => states_along_stiff(model, &analysis.time, &analysis.v, &normal, budget)?,
+        }) => states_along_stiff(model, motion, budget)?,
         other => other?,
     };
     let model_force = forces_from_states(model, &analysis.v, &normal, &states);
