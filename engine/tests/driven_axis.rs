@@ -200,7 +200,7 @@ fn with_noise_the_truth_lies_within_three_standard_errors() {
 
 #[test]
 fn the_engine_follows_the_reference_under_the_input() {
-    use frictionid_engine::simulate::{simulate_driven, Input, SampleGrid};
+    use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid};
     use frictionid_engine::{Initial, SimOptions};
     let (t, u) = multisine(0.0);
     let reference = reference(&t, &u);
@@ -218,18 +218,17 @@ fn the_engine_follows_the_reference_under_the_input() {
         viscous: VISCOUS,
     };
     let input = Input::new(t.clone(), u).expect("an input");
-    let grid = SampleGrid {
-        t_end: DURATION,
-        sample_times: &t,
-    };
-    let sim = simulate_driven(
-        &truth,
-        &model,
-        &Initial::at_rest(0.0),
-        Some(&input),
-        grid,
-        &SimOptions::default(),
-    )
+    let sim = simulate_driven(RunInputs {
+        osc: &truth,
+        model: &model,
+        init: &Initial::at_rest(0.0),
+        input: Some(&input),
+        grid: SampleGrid {
+            t_end: DURATION,
+            sample_times: &t,
+        },
+        opts: &SimOptions::default(),
+    })
     .expect("a simulation");
     let worst = sim
         .v

@@ -259,11 +259,12 @@ fn inverse_dynamics_without_input_or_motion_or_mass_says_what_to_give() {
     let model = ViscousCoulomb::default();
     let time = || TimeBase::new((0..100).map(|i| i as f64 * 1e-3).collect()).unwrap();
     let v: Vec<f64> = (0..100).map(|i| (i as f64 * 0.05).sin()).collect();
+    let error_of = |record: Record, opts: &FitOptions| {
+        fit(&osc, &model, &[record], opts).unwrap_err().to_string()
+    };
     let no_input =
         Record::from_time_base("drive.csv", time()).with_channel(Channel::Velocity, v.clone());
-    let e = fit(&osc, &model, &[no_input], &opts)
-        .unwrap_err()
-        .to_string();
+    let e = error_of(no_input, &opts);
     assert_eq!(
         e,
         "record `drive.csv`: [fit.options] force_target = \"inverse_dynamics\" but the record \
@@ -272,9 +273,7 @@ fn inverse_dynamics_without_input_or_motion_or_mass_says_what_to_give() {
     );
     let no_motion =
         Record::from_time_base("drive.csv", time()).with_channel(Channel::InputForce, v.clone());
-    let e = fit(&osc, &model, &[no_motion], &opts)
-        .unwrap_err()
-        .to_string();
+    let e = error_of(no_motion, &opts);
     assert_eq!(
         e,
         "record `drive.csv`: a force-domain fit needs the motion: a velocity or displacement \
@@ -286,9 +285,7 @@ fn inverse_dynamics_without_input_or_motion_or_mass_says_what_to_give() {
         ..opts.clone()
     };
     let record = TRUTH.record(200);
-    let e = fit(&osc, &model, &[record], &no_mass)
-        .unwrap_err()
-        .to_string();
+    let e = error_of(record, &no_mass);
     assert!(
         e.contains("needs the mass (the inertia): give `mass`"),
         "{e}"

@@ -5,7 +5,7 @@
 
 use frictionid_engine::error::IntegrationFailure;
 use frictionid_engine::exact::coulomb_free_vibration;
-use frictionid_engine::simulate::{simulate_velocity_watched, VelocityRun};
+use frictionid_engine::simulate::{simulate_velocity_watched, RunInputs, SampleGrid, VelocityRun};
 use frictionid_engine::synthetic::uniform_times;
 use frictionid_engine::{
     simulate, simulate_velocity, EngineError, EventKind, Initial, Integrator, Oscillator,
@@ -390,16 +390,18 @@ fn velocity_only_variant_matches_the_full_trajectory() {
     for name in names() {
         let model = default_model(&name).unwrap();
         let full = fmm_run(model.as_ref(), 0.022, 2.0);
-        let stats = simulate_velocity(
-            &Oscillator::fmm(),
-            model.as_ref(),
-            &Initial::at_rest(0.022),
-            2.0,
-            &times,
-            &SimOptions::default(),
-            &mut buf,
-        )
-        .unwrap();
+        let inputs = RunInputs {
+            osc: &Oscillator::fmm(),
+            model: model.as_ref(),
+            init: &Initial::at_rest(0.022),
+            input: None,
+            grid: SampleGrid {
+                t_end: 2.0,
+                sample_times: &times,
+            },
+            opts: &SimOptions::default(),
+        };
+        let stats = simulate_velocity(inputs, &mut buf).unwrap();
         assert_eq!(buf, full.v, "{name}");
         assert_eq!(stats, full.stats, "{name}");
     }
@@ -414,18 +416,26 @@ fn a_watched_run_stops_when_its_watch_says_so() {
     let model = default_model("lugre").unwrap();
     let init = Initial::at_rest(0.022);
     let opts = SimOptions::default();
+    let inputs = RunInputs {
+        osc: &osc,
+        model: model.as_ref(),
+        init: &init,
+        input: None,
+        grid: SampleGrid {
+            t_end: 2.0,
+            sample_times: &times,
+        },
+        opts: &opts,
+    };
     let mut full = Vec::new();
-    let stats =
-        simulate_velocity(&osc, model.as_ref(), &init, 2.0, &times, &opts, &mut full).unwrap();
+    let stats = simulate_velocity(inputs, &mut full).unwrap();
     let run_watched = |stop_after: usize, v_out: &mut Vec<f64>| {
         let mut watch = |written: usize| written >= stop_after;
         let run = VelocityRun {
-            sample_times: &times,
             v_out,
             watch: &mut watch,
-            input: None,
         };
-        simulate_velocity_watched(&osc, model.as_ref(), &init, 2.0, &opts, run)
+        simulate_velocity_watched(inputs, run)
     };
     let mut unstopped = Vec::new();
     assert_eq!(run_watched(usize::MAX, &mut unstopped).unwrap(), stats);

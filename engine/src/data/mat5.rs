@@ -244,47 +244,26 @@ fn vector_length(dims: &[i64]) -> Result<usize, String> {
 
 /// The values of a numeric element as doubles.
 fn numeric_values(element: Element<'_>, endian: Endian) -> Result<Vec<f64>, String> {
-    fn read<const N: usize>(data: &[u8], endian: Endian, to: fn([u8; N]) -> f64) -> Vec<f64> {
-        data.chunks_exact(N).map(|c| to(endian.le(c))).collect()
+    /// The width of one value and the values, each read from `N` bytes by `to`.
+    fn read<const N: usize>(
+        data: &[u8],
+        endian: Endian,
+        to: fn([u8; N]) -> f64,
+    ) -> (usize, Vec<f64>) {
+        (N, data.chunks_exact(N).map(|c| to(endian.le(c))).collect())
     }
+    let data = element.data;
     let (size, values) = match element.kind {
-        MI_INT8 => (
-            1,
-            read(element.data, endian, |b| f64::from(i8::from_le_bytes(b))),
-        ),
-        MI_UINT8 => (
-            1,
-            read(element.data, endian, |b| f64::from(u8::from_le_bytes(b))),
-        ),
-        MI_INT16 => (
-            2,
-            read(element.data, endian, |b| f64::from(i16::from_le_bytes(b))),
-        ),
-        MI_UINT16 => (
-            2,
-            read(element.data, endian, |b| f64::from(u16::from_le_bytes(b))),
-        ),
-        MI_INT32 => (
-            4,
-            read(element.data, endian, |b| f64::from(i32::from_le_bytes(b))),
-        ),
-        MI_UINT32 => (
-            4,
-            read(element.data, endian, |b| f64::from(u32::from_le_bytes(b))),
-        ),
-        MI_SINGLE => (
-            4,
-            read(element.data, endian, |b| f64::from(f32::from_le_bytes(b))),
-        ),
-        MI_DOUBLE => (8, read(element.data, endian, f64::from_le_bytes)),
-        MI_INT64 => (
-            8,
-            read(element.data, endian, |b| i64::from_le_bytes(b) as f64),
-        ),
-        MI_UINT64 => (
-            8,
-            read(element.data, endian, |b| u64::from_le_bytes(b) as f64),
-        ),
+        MI_INT8 => read(data, endian, |b| f64::from(i8::from_le_bytes(b))),
+        MI_UINT8 => read(data, endian, |b| f64::from(u8::from_le_bytes(b))),
+        MI_INT16 => read(data, endian, |b| f64::from(i16::from_le_bytes(b))),
+        MI_UINT16 => read(data, endian, |b| f64::from(u16::from_le_bytes(b))),
+        MI_INT32 => read(data, endian, |b| f64::from(i32::from_le_bytes(b))),
+        MI_UINT32 => read(data, endian, |b| f64::from(u32::from_le_bytes(b))),
+        MI_SINGLE => read(data, endian, |b| f64::from(f32::from_le_bytes(b))),
+        MI_DOUBLE => read(data, endian, f64::from_le_bytes),
+        MI_INT64 => read(data, endian, |b| i64::from_le_bytes(b) as f64),
+        MI_UINT64 => read(data, endian, |b| u64::from_le_bytes(b) as f64),
         other => return Err(format!("its real part has data type {other}, not a number")),
     };
     if element.data.len() % size != 0 {

@@ -494,22 +494,18 @@ mod tests {
 
     #[test]
     fn format_from_extension() {
-        assert_eq!(
-            resolve_format(Path::new("a/b.UFF"), DataFormat::Auto),
-            DataFormat::Uff58
-        );
-        assert_eq!(
-            resolve_format(Path::new("a/b.MAT"), DataFormat::Auto),
-            DataFormat::Mat
-        );
-        assert_eq!(
-            resolve_format(Path::new("a/b.csv"), DataFormat::Auto),
-            DataFormat::Auto
-        );
-        assert_eq!(
-            resolve_format(Path::new("a/b.uff"), DataFormat::Csv),
-            DataFormat::Csv
-        );
+        for (path, given, resolved) in [
+            ("a/b.UFF", DataFormat::Auto, DataFormat::Uff58),
+            ("a/b.MAT", DataFormat::Auto, DataFormat::Mat),
+            ("a/b.csv", DataFormat::Auto, DataFormat::Auto),
+            ("a/b.uff", DataFormat::Csv, DataFormat::Csv),
+        ] {
+            assert_eq!(
+                resolve_format(Path::new(path), given),
+                resolved,
+                "{path} given {given:?}"
+            );
+        }
     }
 
     #[test]

@@ -79,7 +79,7 @@ pub use differentiate::{
 pub use halfcycle::{HalfCycle, MIN_RUN};
 pub use model_force::{
     force_residuals, forces_at, forces_from_states, model_force_along, model_force_with_normal,
-    states_along, states_along_stiff, ForceResiduals,
+    states_along, states_along_stiff, ForceResiduals, MeasuredMotion,
 };
 
 use crate::error::EngineError;

@@ -77,7 +77,7 @@ pub fn model_force_with_normal(
     v: &[f64],
     normal: &NormalForce,
 ) -> Result<Vec<f64>, EngineError> {
-    let states = states_along(model, time, v, normal, MAX_SUBSTEPS)?;
+    let states = states_along(model, MeasuredMotion { time, v, normal }, MAX_SUBSTEPS)?;
     Ok(forces_from_states(model, v, normal, &states))
 }
 
@@ -89,13 +89,28 @@ pub fn model_force_with_normal(
 /// [`crate::identify::residuals::STEPS_PER_SAMPLE`]).
 pub fn states_along(
     model: &dyn FrictionModel,
-    time: &[f64],
-    v: &[f64],
-    normal: &NormalForce,
+    motion: MeasuredMotion<'_>,
     max_substeps: u64,
 ) -> Result<Vec<f64>, EngineError> {
-    check_motion(time, v, normal)?;
-    states_along_checked(model, CheckedMotion { time, v, normal }, max_substeps)
+    states_along_checked(model, motion.checked()?, max_substeps)
+}
+
+/// A measured motion: its sample times, velocities and normal force (constant, or one value
+/// per sample).
+#[derive(Clone, Copy)]
+pub struct MeasuredMotion<'a> {
+    pub time: &'a [f64],
+    pub v: &'a [f64],
+    pub normal: &'a NormalForce,
+}
+
+impl<'a> MeasuredMotion<'a> {
+    /// The motion once [`check_motion`] accepts it.
+    fn checked(self) -> Result<CheckedMotion<'a>, EngineError> {
+        let MeasuredMotion { time, v, normal } = self;
+        check_motion(time, v, normal)?;
+        Ok(CheckedMotion { time, v, normal })
+    }
 }
 
 /// A motion already checked by [`check_motion`]: its sample times, velocities and normal
@@ -111,23 +126,15 @@ pub(crate) struct CheckedMotion<'a> {
 /// so stiff that the explicit replay would need many sub-steps per sample.
 pub fn states_along_stiff(
     model: &dyn FrictionModel,
-    time: &[f64],
-    v: &[f64],
-    normal: &NormalForce,
+    motion: MeasuredMotion<'_>,
     max_substeps: u64,
 ) -> Result<Vec<f64>, EngineError> {
-    check_motion(time, v, normal)?;
+    let motion = motion.checked()?;
     let Some(states) = model.states() else {
         return Ok(Vec::new());
     };
     let stepper = Rodas4::new(states.n_states(), RTOL, ATOL, f64::INFINITY);
-    replay(
-        stepper,
-        model,
-        states,
-        CheckedMotion { time, v, normal },
-        max_substeps,
-    )
+    replay(stepper, model, states, motion, max_substeps)
 }
 
 /// [`states_along`] of a motion already checked by [`check_motion`] (a fit checks it once,

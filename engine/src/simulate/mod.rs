@@ -290,11 +290,17 @@ pub fn simulate(
     sample_times: &[f64],
     opts: &SimOptions,
 ) -> Result<Trajectory, EngineError> {
-    let times = SampleGrid {
-        t_end,
-        sample_times,
-    };
-    simulate_driven(osc, model, init, None, times, opts)
+    simulate_driven(RunInputs {
+        osc,
+        model,
+        init,
+        input: None,
+        grid: SampleGrid {
+            t_end,
+            sample_times,
+        },
+        opts,
+    })
 }
 
 /// The end time of a run and the times to sample it at (sorted, within [0, t_end]).
@@ -306,21 +312,31 @@ pub struct SampleGrid<'a> {
     pub sample_times: &'a [f64],
 }
 
-/// [`simulate`] under the measured `input` u(t) (free vibration without one): the axis
+/// What a run simulates: the axis, its friction law, the initial state, the measured input
+/// driving it, the times to sample and the integrator's options.
+#[derive(Clone, Copy)]
+pub struct RunInputs<'a> {
+    /// The oscillator (inertia, damping, restoring law).
+    pub osc: &'a Oscillator,
+    /// The friction law.
+    pub model: &'a dyn FrictionModel,
+    /// The initial state.
+    pub init: &'a Initial,
+    /// The measured input u(t) driving the axis (`None`: free vibration).
+    pub input: Option<&'a Input>,
+    /// The end time and the sample times.
+    pub grid: SampleGrid<'a>,
+    /// The integrator and its tolerances and limits.
+    pub opts: &'a SimOptions,
+}
+
+/// [`simulate`] of any [`RunInputs`], under the measured input when it has one: the axis
 /// sticks while |u - R(q)| stays within the static friction and breaks away, at the time
 /// located exactly on the piecewise-linear input, when it leaves it.
-pub fn simulate_driven(
-    osc: &Oscillator,
-    model: &dyn FrictionModel,
-    init: &Initial,
-    input: Option<&Input>,
-    grid: SampleGrid<'_>,
-    opts: &SimOptions,
-) -> Result<Trajectory, EngineError> {
-    let sample_times = grid.sample_times;
-    let n_states = model.n_states();
-    let mut rec = FullRecorder::new(osc, model, sample_times.len(), n_states);
-    let out = run(osc, model, init, input, grid, opts, &mut rec)?;
+pub fn simulate_driven(inputs: RunInputs<'_>) -> Result<Trajectory, EngineError> {
+    let n_samples = inputs.grid.sample_times.len();
+    let mut rec = FullRecorder::new(inputs.osc, inputs.model, n_samples, inputs.model.n_states());
+    let out = run(inputs, &mut rec)?;
     rec.finish_energies();
     Ok(Trajectory {
         events: out.events,
@@ -330,65 +346,41 @@ pub fn simulate_driven(
     })
 }
 
-/// The cheap variant for fitting: only the velocity at `sample_times`, written into `v_out`
-/// (cleared first, so a buffer can be reused across calls). Same method and errors as
-/// [`simulate`]; returns the statistics.
+/// The cheap variant for fitting: only the velocity at the sample times, written into
+/// `v_out` (cleared first, so a buffer can be reused across calls). Same method and errors
+/// as [`simulate`]; returns the statistics.
 pub fn simulate_velocity(
-    osc: &Oscillator,
-    model: &dyn FrictionModel,
-    init: &Initial,
-    t_end: f64,
-    sample_times: &[f64],
-    opts: &SimOptions,
+    inputs: RunInputs<'_>,
     v_out: &mut Vec<f64>,
 ) -> Result<SimStats, EngineError> {
     let mut no_watch = |_: usize| false;
     let velocity = VelocityRun {
-        sample_times,
         v_out,
         watch: &mut no_watch,
-        input: None,
     };
-    simulate_velocity_watched(osc, model, init, t_end, opts, velocity)
+    simulate_velocity_watched(inputs, velocity)
 }
 
 /// Where [`simulate_velocity_watched`] writes, and who watches.
 pub struct VelocityRun<'a> {
-    /// The sample times.
-    pub sample_times: &'a [f64],
-    /// The velocities at them (cleared first).
+    /// The velocities at the sample times (cleared first).
     pub v_out: &'a mut Vec<f64>,
     /// Called after each step with the number of samples written so far; `true` stops the
     /// run with [`IntegrationFailure::Halted`].
     pub watch: &'a mut dyn FnMut(usize) -> bool,
-    /// The measured input driving the axis (`None`: free vibration).
-    pub input: Option<&'a Input>,
 }
 
 /// [`simulate_velocity`] with a watch asked after every step: a fit stops the simulation of a
 /// record once another record of the same evaluation has failed.
 pub fn simulate_velocity_watched(
-    osc: &Oscillator,
-    model: &dyn FrictionModel,
-    init: &Initial,
-    t_end: f64,
-    opts: &SimOptions,
+    inputs: RunInputs<'_>,
     run_to: VelocityRun<'_>,
 ) -> Result<SimStats, EngineError> {
-    let VelocityRun {
-        sample_times,
-        v_out,
-        watch,
-        input,
-    } = run_to;
+    let VelocityRun { v_out, watch } = run_to;
     v_out.clear();
-    v_out.reserve(sample_times.len());
+    v_out.reserve(inputs.grid.sample_times.len());
     let mut rec = VelocityRecorder { v: v_out, watch };
-    let grid = SampleGrid {
-        t_end,
-        sample_times,
-    };
-    Ok(run(osc, model, init, input, grid, opts, &mut rec)?.stats)
+    Ok(run(inputs, &mut rec)?.stats)
 }
 
 /// Events, rest and statistics of a run.
@@ -730,18 +722,20 @@ impl Dynamics<'_> {
 
 /// Validates the inputs, builds the driver and runs it over the chosen stepper.
 pub(crate) fn run<R: Recorder>(
-    osc: &Oscillator,
-    model: &dyn FrictionModel,
-    init: &Initial,
-    input: Option<&Input>,
-    grid: SampleGrid<'_>,
-    opts: &SimOptions,
+    inputs: RunInputs<'_>,
     rec: &mut R,
 ) -> Result<RunOutput, EngineError> {
-    let SampleGrid {
-        t_end,
-        sample_times,
-    } = grid;
+    let RunInputs {
+        osc,
+        model,
+        init,
+        input,
+        grid: SampleGrid {
+            t_end,
+            sample_times,
+        },
+        opts,
+    } = inputs;
     osc.validate()?;
     model.validate()?;
     let y0 = initial_state(model, init)?;

@@ -4,10 +4,12 @@
 use super::diagnostics;
 use super::energy_check::{energy_force_check, ForceReference};
 use crate::axis::Axis;
-use crate::energy::{analyze_record, forces_from_states, states_along, states_along_stiff};
+use crate::energy::{
+    analyze_record, forces_from_states, states_along, states_along_stiff, MeasuredMotion,
+};
 use crate::error::{EngineError, IntegrationFailure};
 use crate::identify::problem::{
-    FitProblem, Realised, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
+    AnalysisRequest, FitProblem, Realised, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
 };
 use crate::identify::values::{
     ChannelFit, Check, EnergyForce, Finding, FitOptions, FitSeries, NuisanceValues, RecordFit,
@@ -187,7 +189,12 @@ fn energy_check<R: Residuals + ?Sized>(
     let analysis = if nuisance.offset == 0.0 && x0 == rec.x0 {
         // The record as measured: the analysis the guess made, when m, c and k are those it
         // was made with.
-        residuals.energy_analysis(index, rec, osc, &opts.energy)?
+        residuals.energy_analysis(AnalysisRequest {
+            index,
+            record: rec,
+            osc,
+            options: &opts.energy,
+        })?
     } else {
         let mut corrected = rec.clone();
         corrected.x0 = x0;
@@ -201,11 +208,16 @@ fn energy_check<R: Residuals + ?Sized>(
     let budget = STEPS_PER_SAMPLE * (analysis.time.len() as u64).max(100);
     let model = world.model.as_ref();
     let normal = NormalForce::Constant(rec.oscillator_for(osc).normal_force);
-    let states = match states_along(model, &analysis.time, &analysis.v, &normal, budget) {
+    let motion = MeasuredMotion {
+        time: &analysis.time,
+        v: &analysis.v,
+        normal: &normal,
+    };
+    let states = match states_along(model, motion, budget) {
         Err(EngineError::StateIntegration {
             failure: IntegrationFailure::StepBudgetExceeded { .. },
             ..
-        }) => states_along_stiff(model, &analysis.time, &analysis.v, &normal, budget)?,
+        }) => states_along_stiff(model, motion, budget)?,
         other => other?,
     };
     let model_force = forces_from_states(model, &analysis.v, &normal, &states);

@@ -19,32 +19,53 @@ struct Key {
     options: EnergyOptions,
 }
 
+/// An energy analysis asked for: the fit's record `index` (`record`, its velocity as
+/// measured) under `osc` and `options`.
+#[derive(Debug, Clone, Copy)]
+pub struct AnalysisRequest<'a> {
+    pub index: usize,
+    pub record: &'a Record,
+    pub osc: &'a Oscillator,
+    pub options: &'a EnergyOptions,
+}
+
+impl AnalysisRequest<'_> {
+    /// The analysis computed afresh ([`analyze_record`]).
+    pub fn compute(&self) -> Result<Arc<EnergyAnalysis>, EngineError> {
+        Ok(Arc::new(analyze_record(
+            self.record,
+            self.osc,
+            self.options,
+        )?))
+    }
+
+    fn key(&self) -> Key {
+        Key {
+            index: self.index,
+            oscillator: *self.osc,
+            x0: self.record.x0,
+            options: *self.options,
+        }
+    }
+}
+
 /// The analyses of the records of one fit, by record index (the fit's records never change
 /// their samples; a velocity corrected by a fitted offset is not asked for here).
 #[derive(Debug, Default)]
 pub struct AnalysisCache(Mutex<Vec<(Key, Arc<EnergyAnalysis>)>>);
 
 impl AnalysisCache {
-    /// The energy analysis of `record` (the fit's record `index`, its velocity as measured)
-    /// under `osc` and `options`: kept from an earlier call with the same oscillator, release
-    /// displacement and options, else computed ([`analyze_record`]).
+    /// The energy analysis `request` asks for: kept from an earlier request with the same
+    /// record index, oscillator, release displacement and options, else computed.
     pub fn analysis(
         &self,
-        index: usize,
-        record: &Record,
-        osc: &Oscillator,
-        options: &EnergyOptions,
+        request: AnalysisRequest<'_>,
     ) -> Result<Arc<EnergyAnalysis>, EngineError> {
-        let key = Key {
-            index,
-            oscillator: *osc,
-            x0: record.x0,
-            options: *options,
-        };
+        let key = request.key();
         if let Some(kept) = self.find(&key) {
             return Ok(kept);
         }
-        let analysis = Arc::new(analyze_record(record, osc, options)?);
+        let analysis = request.compute()?;
         if let Ok(mut entries) = self.0.lock() {
             entries.push((key, analysis.clone()));
         }
@@ -93,15 +114,21 @@ mod tests {
         let rec = &records[0];
         let options = EnergyOptions::default();
         let cache = AnalysisCache::default();
-        let first = cache.analysis(0, rec, &osc, &options).unwrap();
+        let request = |record, osc| AnalysisRequest {
+            index: 0,
+            record,
+            osc,
+            options: &options,
+        };
+        let first = cache.analysis(request(rec, &osc)).unwrap();
         assert!(same(&first, &analyze_record(rec, &osc, &options).unwrap()));
-        let again = cache.analysis(0, rec, &osc, &options).unwrap();
+        let again = cache.analysis(request(rec, &osc)).unwrap();
         assert!(Arc::ptr_eq(&first, &again));
         let heavier = Oscillator {
             mass: osc.mass * 1.01,
             ..osc
         };
-        let other = cache.analysis(0, rec, &heavier, &options).unwrap();
+        let other = cache.analysis(request(rec, &heavier)).unwrap();
         assert!(!Arc::ptr_eq(&first, &other));
         assert!(same(
             &other,
@@ -109,7 +136,7 @@ mod tests {
         ));
         let mut moved = rec.clone();
         moved.x0 += 1e-3;
-        let shifted = cache.analysis(0, &moved, &osc, &options).unwrap();
+        let shifted = cache.analysis(request(&moved, &osc)).unwrap();
         assert!(same(
             &shifted,
             &analyze_record(&moved, &osc, &options).unwrap()

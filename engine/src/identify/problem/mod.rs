@@ -15,6 +15,7 @@ pub mod simulated_response;
 pub mod state_cache;
 pub mod step_allowance;
 
+pub use analysis_cache::AnalysisRequest;
 pub use force_along_motion::{
     check_force_domain, require_mechanics, require_oscillator, ForceAlongMotion,
 };

@@ -10,9 +10,9 @@
 //! nothing else of them, so a producer in the force domain (replay the measured motion,
 //! compare a force) plugs in beside this one.
 
-use super::analysis_cache::AnalysisCache;
+use super::analysis_cache::{AnalysisCache, AnalysisRequest};
 use super::step_allowance::StepAllowance;
-use crate::energy::{analyze_record, EnergyAnalysis, EnergyOptions};
+use crate::energy::EnergyAnalysis;
 use crate::error::EngineError;
 use crate::identify::values::options::FitOptions;
 use crate::identify::values::{
@@ -160,19 +160,16 @@ pub trait Residuals: Send + Sync {
         None
     }
 
-    /// The energy analysis (Eq. 7) of the fit's record `index`, its velocity as measured,
-    /// under `osc`: from the producer's [`Residuals::analysis_cache`] when it has one, else
+    /// The energy analysis (Eq. 7) `request` asks for (the fit's record, its velocity as
+    /// measured): from the producer's [`Residuals::analysis_cache`] when it has one, else
     /// computed.
     fn energy_analysis(
         &self,
-        index: usize,
-        record: &Record,
-        osc: &Oscillator,
-        options: &EnergyOptions,
+        request: AnalysisRequest<'_>,
     ) -> Result<Arc<EnergyAnalysis>, EngineError> {
         match self.analysis_cache() {
-            Some(cache) => cache.analysis(index, record, osc, options),
-            None => Ok(Arc::new(analyze_record(record, osc, options)?)),
+            Some(cache) => cache.analysis(request),
+            None => request.compute(),
         }
     }
 

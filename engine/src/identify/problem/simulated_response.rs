@@ -14,7 +14,7 @@
 //! the fitted x0 and release shift feeds all of them; the velocity offset applies to the
 //! velocity channel (and needs one in every record).
 
-use super::analysis_cache::AnalysisCache;
+use super::analysis_cache::{AnalysisCache, AnalysisRequest};
 use super::residuals::{Evaluation, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE};
 use crate::energy::record_motion;
 use crate::error::EngineError;
@@ -23,7 +23,8 @@ use crate::identify::values::options::FitOptions;
 use crate::oscillator::Oscillator;
 use crate::record::{channel_list, Channel, Record};
 use crate::simulate::{
-    simulate_driven, simulate_velocity_watched, Initial, Input, SampleGrid, SimOptions, VelocityRun,
+    simulate_driven, simulate_velocity_watched, Initial, Input, RunInputs, SampleGrid, SimOptions,
+    SimStats, VelocityRun,
 };
 use frictionid_models::GuessHint;
 use std::borrow::Cow;
@@ -117,25 +118,20 @@ impl SimulatedResponse {
         at: &Evaluation<'_>,
         case: RecordCase<'_>,
     ) -> Result<Vec<f64>, EngineError> {
-        let (index, record, nuisance) = (case.index, case.record, case.nuisance);
+        let (record, nuisance) = (case.record, case.nuisance);
         let clock = ReleaseClock::new(record, nuisance);
         let mut v = vec![record.v0; clock.before];
         if let Some(&t_end) = clock.times.last() {
-            at.count_simulation();
-            let mut sim = Vec::with_capacity(clock.times.len());
-            let init = initial(record, nuisance);
-            let opts = within_allowance(at, index, record, clock.times.len());
-            let mut superseded = |_: usize| at.superseded(index);
-            let input = clock.input(record)?;
-            let run = VelocityRun {
-                sample_times: &clock.times,
-                v_out: &mut sim,
-                watch: &mut superseded,
-                input: input.as_ref(),
-            };
-            let osc = record.oscillator_for(at.oscillator);
-            let stats = simulate_velocity_watched(&osc, at.model, &init, t_end, &opts, run)?;
-            at.record_work(index, &stats, clock.times.len());
+            let sim = simulated_from_release(at, case, &clock, t_end, |inputs| {
+                let mut sim = Vec::with_capacity(clock.times.len());
+                let mut superseded = |_: usize| at.superseded(case.index);
+                let run = VelocityRun {
+                    v_out: &mut sim,
+                    watch: &mut superseded,
+                };
+                let stats = simulate_velocity_watched(inputs, run)?;
+                Ok((sim, stats))
+            })?;
             if v.is_empty() {
                 return Ok(sim);
             }
@@ -152,25 +148,15 @@ impl SimulatedResponse {
         case: RecordCase<'_>,
         channels: &[Channel],
     ) -> Result<Vec<f64>, EngineError> {
-        let (index, record, nuisance) = (case.index, case.record, case.nuisance);
+        let (record, nuisance) = (case.record, case.nuisance);
         let clock = ReleaseClock::new(record, nuisance);
         let x0 = nuisance.x0_of(record);
         let trajectory = match clock.times.last() {
-            Some(&t_end) => {
-                at.count_simulation();
-                let opts = within_allowance(at, index, record, clock.times.len());
-                let init = initial(record, nuisance);
-                let input = clock.input(record)?;
-                let grid = SampleGrid {
-                    t_end,
-                    sample_times: &clock.times,
-                };
-                let osc = record.oscillator_for(at.oscillator);
-                let trajectory =
-                    simulate_driven(&osc, at.model, &init, input.as_ref(), grid, &opts)?;
-                at.record_work(index, &trajectory.stats, clock.times.len());
-                Some(trajectory)
-            }
+            Some(&t_end) => Some(simulated_from_release(at, case, &clock, t_end, |inputs| {
+                let trajectory = simulate_driven(inputs)?;
+                let stats = trajectory.stats;
+                Ok((trajectory, stats))
+            })?),
             None => None,
         };
         let mut out = Vec::with_capacity(channels.len() * record.len());
@@ -243,6 +229,39 @@ impl<'a> ReleaseClock<'a> {
 }
 
 /// The release state of `record` under `nuisance`.
+/// Simulates `case`'s record from its release up to `t_end`, sampled at `clock`'s times,
+/// with `simulation` (the velocity-only or the full run, which returns what it made and its
+/// statistics): from the nuisance values' release state, under the record's input, within
+/// the record's step allowance; the work is counted against the evaluation.
+fn simulated_from_release<T>(
+    at: &Evaluation<'_>,
+    case: RecordCase<'_>,
+    clock: &ReleaseClock<'_>,
+    t_end: f64,
+    simulation: impl FnOnce(RunInputs<'_>) -> Result<(T, SimStats), EngineError>,
+) -> Result<T, EngineError> {
+    let (index, record) = (case.index, case.record);
+    at.count_simulation();
+    let init = initial(record, case.nuisance);
+    let opts = within_allowance(at, index, record, clock.times.len());
+    let input = clock.input(record)?;
+    // A record's own constant normal force reaches its simulation.
+    let osc = record.oscillator_for(at.oscillator);
+    let (made, stats) = simulation(RunInputs {
+        osc: &osc,
+        model: at.model,
+        init: &init,
+        input: input.as_ref(),
+        grid: SampleGrid {
+            t_end,
+            sample_times: &clock.times,
+        },
+        opts: &opts,
+    })?;
+    at.record_work(index, &stats, clock.times.len());
+    Ok(made)
+}
+
 fn initial(record: &Record, nuisance: &NuisanceValues) -> Initial {
     Initial {
         x0: nuisance.x0_of(record),
@@ -381,9 +400,15 @@ impl Residuals for SimulatedResponse {
         // A record measured as velocity is analysed once, for the guess and the energy check
         // (the same level as the half-cycle analysis alone gives).
         let level = |index: usize, rec: &Record| {
-            let analysed = records[index]
-                .channel(Channel::Velocity)
-                .and_then(|_| self.energy_analysis(index, rec, osc, &opts.energy).ok());
+            let analysed = records[index].channel(Channel::Velocity).and_then(|_| {
+                self.energy_analysis(AnalysisRequest {
+                    index,
+                    record: rec,
+                    osc,
+                    options: &opts.energy,
+                })
+                .ok()
+            });
             match analysed {
                 Some(analysis) => super::guess::level_of_analysis(&analysis),
                 None => super::guess::friction_level(rec, osc, opts),
