@@ -170,7 +170,7 @@ fn compare_names_a_level_pinned_at_its_bound_on_stderr_and_in_the_verdict() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert!(
-        stderr.contains("model `coulomb`: `mu` = 1e1 1 is at its upper bound 1e1")
+        stderr.contains("model `coulomb`: `mu` = 1.0000e1 is at its upper bound 1.0000e1")
             && stderr.contains("normal force"),
         "{stderr}"
     );

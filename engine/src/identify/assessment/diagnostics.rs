@@ -374,9 +374,9 @@ pub fn parameters_at_bounds(layout: &[FreeParam], values: &[f64]) -> Vec<Finding
                 Check::ParameterAtBound,
                 Some(shown),
                 format!(
-                    "`{}` = {shown:e} {} is at its {} bound {bound:e}: the data push it further; {}",
+                    "`{}` = {shown:.4e}{} is at its {} bound {bound:.4e}: the data push it further; {}",
                     f.name,
-                    f.unit,
+                    unit_suffix(&f.unit),
                     side.name(),
                     at_bound_advice(f)
                 ),
@@ -385,6 +385,15 @@ pub fn parameters_at_bounds(layout: &[FreeParam], values: &[f64]) -> Vec<Finding
         );
     }
     out
+}
+
+/// " <unit>" after a value, nothing for a dimensionless one ("1").
+fn unit_suffix(unit: &str) -> String {
+    if unit == "1" || unit.is_empty() {
+        String::new()
+    } else {
+        format!(" {unit}")
+    }
 }
 
 /// The largest change of any weighted residual (in units of its noise) that a change of a
