@@ -74,6 +74,7 @@ pub fn build_layout<R: Residuals + ?Sized>(
         layout.push(param, x);
     }
     for &q in &opts.oscillator {
+        check_property_exists(osc, q)?;
         let (param, x) = oscillator_param(osc, q, opts);
         layout.push(param, x);
     }
@@ -187,6 +188,19 @@ fn model_param(
     (f, x)
 }
 
+/// A fitted gravity moment needs a restoring law that has one (the pendulum): otherwise its
+/// start would be undefined.
+fn check_property_exists(osc: &Oscillator, q: OscillatorParam) -> Result<(), EngineError> {
+    if q == OscillatorParam::GravityMoment && osc.restoring.parameter("gravity_moment").is_none() {
+        return Err(EngineError::InvalidInput(format!(
+            "[fit.options] oscillator: `gravity_moment` is fitted, but the restoring law `{}` has \
+             none; set [oscillator] restoring = {{ type = \"pendulum\", gravity_moment = ... }}",
+            osc.restoring.name()
+        )));
+    }
+    Ok(())
+}
+
 /// A free oscillator property: mass, stiffness and gravity moment in log coordinates,
 /// damping and the input offset linear (the offset unbounded).
 fn oscillator_param(osc: &Oscillator, q: OscillatorParam, opts: &FitOptions) -> (FreeParam, f64) {
@@ -252,4 +266,29 @@ fn nuisance_param(
         kind.typical(),
     );
     (param, kind.start(rec).clamp(b.0, b.1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Fitting a gravity moment on the linear spring is an error naming the key and the law to
+    /// set; on a pendulum it is accepted.
+    #[test]
+    fn a_gravity_moment_is_fitted_only_on_a_law_that_has_one() {
+        let spring = Oscillator::fmm();
+        let e = check_property_exists(&spring, OscillatorParam::GravityMoment).unwrap_err();
+        let text = e.to_string();
+        assert!(text.contains("`gravity_moment`"), "{text}");
+        assert!(text.contains("pendulum"), "{text}");
+        assert!(check_property_exists(&spring, OscillatorParam::Stiffness).is_ok());
+        let pendulum: crate::axis::Restoring =
+            serde_json::from_value(serde_json::json!({"type": "pendulum", "gravity_moment": 2.0}))
+                .unwrap();
+        let osc = Oscillator {
+            restoring: pendulum,
+            ..Oscillator::fmm()
+        };
+        assert!(check_property_exists(&osc, OscillatorParam::GravityMoment).is_ok());
+    }
 }
