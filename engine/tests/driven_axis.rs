@@ -172,29 +172,89 @@ fn the_velocity_route_recovers_mass_friction_and_offset_without_noise() {
     }
 }
 
-/// One noise draw (seeds 17 and 18). The standard errors' coverage is not checked over many
-/// draws here: with seeds 7 and 8 the offset lay 8 standard errors from the truth (the other
-/// three within 1), which suggests the finite-difference standard errors of an axis with
-/// sticks are too small; a Monte Carlo check of their coverage is still to be made.
+/// The velocity noise of the noisy records [m/s].
+const NOISE: f64 = 5e-3;
+
+/// Noise draw `draw` of the two records (seeds 2 draw and 2 draw + 1).
+fn noisy_records(draw: u64) -> [Record; 2] {
+    [
+        record("a", 0.0, NOISE, 2 * draw),
+        record("b", 0.8, NOISE, 2 * draw + 1),
+    ]
+}
+
+/// The standard score (estimate - truth) / standard error of each parameter of `TRUTH`.
+fn scores(r: &FitResult) -> [f64; 4] {
+    TRUTH.map(|(name, truth)| {
+        let p = r.param(name).expect("a fitted parameter");
+        (p.value - truth) / p.std_error.unwrap_or(f64::NAN)
+    })
+}
+
+/// One noise draw (seeds 7 and 8): every estimate within three standard errors of the truth.
 #[test]
 fn with_noise_the_truth_lies_within_three_standard_errors() {
-    let noise = 5e-3;
-    let records = [record("a", 0.0, noise, 17), record("b", 0.8, noise, 18)];
+    let records = [record("a", 0.0, NOISE, 7), record("b", 0.8, NOISE, 8)];
     let r = identify(&records);
     eprintln!(
         "{} rms {} iterations {}",
         r.termination, r.rms_residual, r.iterations
     );
     assert!(r.converged, "{}", r.termination);
-    for (name, truth) in TRUTH {
-        let p = r.param(name).expect("a fitted parameter");
-        let se = p.std_error.unwrap_or(f64::NAN);
-        eprintln!("noisy {name}: {} +- {se} (truth {truth})", p.value);
-        assert!(
-            (p.value - truth).abs() < 3.0 * se,
-            "{name} {} +- {se}",
-            p.value
+    for ((name, truth), z) in TRUTH.into_iter().zip(scores(&r)) {
+        eprintln!("noisy {name}: {} standard errors from {truth}", z);
+        assert!(z.abs() < 3.0, "{name}: {z} standard errors off");
+    }
+}
+
+/// How the standard errors of `draws` noise draws cover the truth: per parameter of `TRUTH`,
+/// the number of draws whose estimate lies within two standard errors, and the RMS of the
+/// standard scores (1 when the standard errors are the estimates' spread).
+fn coverage(draws: std::ops::Range<u64>) -> [(usize, f64); 4] {
+    let n = draws.end - draws.start;
+    let all: Vec<[f64; 4]> = draws
+        .map(|d| scores(&identify(&noisy_records(d))))
+        .collect();
+    std::array::from_fn(|k| {
+        let within = all.iter().filter(|z| z[k].abs() < 2.0).count();
+        let rms = (all.iter().map(|z| z[k] * z[k]).sum::<f64>() / n as f64).sqrt();
+        eprintln!(
+            "{}: {within} of {n} within 2 standard errors, RMS score {rms:.3}",
+            TRUTH[k].0
         );
+        (within, rms)
+    })
+}
+
+/// Over 40 noise draws, each parameter's estimate lies within two standard errors in at
+/// least 33 (a nominal 95 % interval misses more than 7 of 40 with probability 0.3 %), and
+/// the RMS of its standard scores is within [0.6, 1.5] (the sampling spread of an RMS of 40
+/// unit normals is 0.11). A simulation whose integration error varied erratically with the
+/// parameters (steps across the input's knots) gave a Jacobian of that noise and stopped
+/// the solver short of the optimum: 14 of 40 offsets within two standard errors, RMS
+/// scores of 9 to 77.
+#[test]
+fn standard_errors_cover_the_truth_over_noise_draws() {
+    for (k, (within, rms)) in coverage(0..40).into_iter().enumerate() {
+        let name = TRUTH[k].0;
+        assert!(
+            within >= 33,
+            "{name}: {within} of 40 within 2 standard errors"
+        );
+        assert!((0.6..1.5).contains(&rms), "{name}: RMS score {rms}");
+    }
+}
+
+/// The same over 400 draws (about a minute in the test profile):
+/// `cargo test -p frictionid-engine --test driven_axis -- --ignored`.
+#[test]
+#[ignore = "400 fits: run on demand"]
+fn standard_errors_cover_the_truth_over_400_noise_draws() {
+    for (k, (within, rms)) in coverage(0..400).into_iter().enumerate() {
+        let name = TRUTH[k].0;
+        let fraction = within as f64 / 400.0;
+        assert!((0.92..=0.985).contains(&fraction), "{name}: {fraction}");
+        assert!((0.85..1.15).contains(&rms), "{name}: RMS score {rms}");
     }
 }
 
@@ -240,5 +300,5 @@ fn the_engine_follows_the_reference_under_the_input() {
         "{} events, worst velocity difference {worst} m/s",
         sim.events.len()
     );
-    assert!(worst < 1e-6, "{worst}");
+    assert!(worst < 1e-9, "{worst}");
 }

@@ -181,6 +181,11 @@ impl Stepper for ClosedForm {
         Ok(())
     }
 
+    /// The motion is exact whatever the end: only the last step moves.
+    fn continue_to(&mut self, t_end: f64) {
+        self.t_end = t_end;
+    }
+
     fn step<S: OdeSystem>(&mut self, _system: &S) -> StepResult<StepOutcome> {
         let candidate = self.mode.t0 + (self.next_phase + PAST_ZERO * PI) / self.mode.omega_d;
         self.next_phase += PI;

@@ -267,6 +267,10 @@ impl Stepper for Dopri5 {
         Ok(())
     }
 
+    fn continue_to(&mut self, t_end: f64) {
+        Dopri5::extend_to(self, t_end);
+    }
+
     fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome> {
         let h = self.ctrl.next_attempt()?;
         self.stages(system, h);

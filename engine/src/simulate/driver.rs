@@ -12,6 +12,11 @@ use frictionid_models::sgn;
 /// Width of the final bracket of a turning point's time [s].
 pub(crate) const EVENT_TOL: f64 = 1e-13;
 
+/// A knot of the input closer than this (relative to 1 + |t|) after a segment's start is not
+/// stopped at: a step that short is lost in round-off, and the kink it would resolve spans
+/// nothing.
+const KNOT_GAP: f64 = 1e-9;
+
 /// The equation of motion within one segment: slip direction `dir` fixed.
 struct Segment<'a> {
     dynamics: Dynamics<'a>,
@@ -100,7 +105,7 @@ impl<R: Recorder> Driver<'_, R> {
                 dynamics: self.dynamics,
                 dir,
             };
-            stepper.reset(&segment, t, &y, t_end)?;
+            stepper.reset(&segment, t, &y, self.stop_after(t, t_end))?;
             match self.advance(stepper, &segment, &mut y, t_end)? {
                 SegmentEnd::Finished => return Ok(()),
                 SegmentEnd::Turn(t_e) => {
@@ -157,6 +162,11 @@ impl<R: Recorder> Driver<'_, R> {
                 stepper.interpolate(t_e, y);
                 return Ok(SegmentEnd::Turn(t_e));
             }
+            if stepper.reached_end() && stepper.end_time() < t_end {
+                self.write_samples(stepper, stepper.time(), dir, y);
+                stepper.continue_to(self.stop_after(stepper.time(), t_end));
+                continue;
+            }
             if stepper.reached_end() {
                 self.write_samples(stepper, t_end, dir, y);
                 y.copy_from_slice(stepper.state());
@@ -165,6 +175,18 @@ impl<R: Recorder> Driver<'_, R> {
             }
             self.write_samples(stepper, stepper.time(), dir, y);
         }
+    }
+
+    /// Where a step from `t` must stop: the input's next knot (a step across one straddles
+    /// the kink of u's slope there, which the error estimate cannot resolve: Dopri5 rejected
+    /// nine steps in ten under a multisine sampled at 1 kHz and left errors of 1e-7 m/s that
+    /// changed erratically with the parameters), else `t_end`.
+    fn stop_after(&self, t: f64, t_end: f64) -> f64 {
+        let gap = KNOT_GAP * (1.0 + t.abs());
+        self.dynamics
+            .input
+            .and_then(|u| u.next_knot(t, gap))
+            .map_or(t_end, |knot| knot.min(t_end))
     }
 
     /// The time of the zero of the event function inside the last step.

@@ -54,6 +54,12 @@ impl Stepper for Euler {
         Ok(())
     }
 
+    /// The steps keep counting from the segment's start; the one that would pass `t_end` is
+    /// cut there.
+    fn continue_to(&mut self, t_end: f64) {
+        self.t_end = t_end;
+    }
+
     fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome> {
         self.steps_in_segment += 1;
         let t_next = (self.t_seg + self.steps_in_segment as f64 * self.h).min(self.t_end);

@@ -58,6 +58,14 @@ impl Input {
         }
     }
 
+    /// The first sample time (a knot, where u's slope changes) later than `after` by more
+    /// than `gap`, if any: an integrator steps from knot to knot, since a step across one
+    /// sees a kink that its error estimate cannot resolve.
+    pub fn next_knot(&self, after: f64, gap: f64) -> Option<f64> {
+        let i = self.time.partition_point(|&ti| ti <= after + gap);
+        self.time.get(i).copied()
+    }
+
     /// The first time in (`from`, `until`] at which |u(t) - `centre`| exceeds `half_width`,
     /// exact for the piecewise-linear input: the stick of an axis held by static friction
     /// `half_width` against the restoring force `centre` ends there. `None` when it holds
@@ -128,6 +136,15 @@ mod tests {
         // u = -1, half-way down to -4.
         assert_eq!(u.first_exceedance(1.2, 3.0, 0.5, 1.5), Some(2.5));
         assert_eq!(u.first_exceedance(0.0, 2.0, 1.0, 5.0), None);
+    }
+
+    #[test]
+    fn the_next_knot_lies_beyond_the_gap() {
+        let u = ramp();
+        assert_eq!(u.next_knot(0.0, 0.0), Some(1.0));
+        assert_eq!(u.next_knot(0.5, 0.0), Some(1.0));
+        assert_eq!(u.next_knot(1.0 - 1e-12, 1e-9), Some(2.0));
+        assert_eq!(u.next_knot(3.0, 0.0), None);
     }
 
     #[test]

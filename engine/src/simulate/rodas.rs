@@ -389,6 +389,10 @@ impl Stepper for Rodas4 {
     /// over components unroll and the copies of 24-byte states stop calling `memcpy` (a
     /// stiff LuGre fit spent a fifth of its time in that overhead). The operations and their
     /// order are those of every size, so the results are the same to the bit.
+    fn continue_to(&mut self, t_end: f64) {
+        Rodas4::extend_to(self, t_end);
+    }
+
     fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome> {
         match self.y.len() {
             2 => self.step_sized(system, 2),

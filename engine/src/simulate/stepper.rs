@@ -304,6 +304,12 @@ pub trait Stepper {
     /// stepper cannot integrate this system (e.g. the closed form needs an affine motion).
     fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()>;
 
+    /// Moves the end time on to `t_end` (after the current time) without starting afresh:
+    /// the state and the step size carry over. Valid where the right-hand side is continuous
+    /// at the current time (a knot of an input taken linear between its samples, where only
+    /// its slope jumps).
+    fn continue_to(&mut self, t_end: f64);
+
     /// Attempts one step. Errors: the step size became too small.
     fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome>;
 
