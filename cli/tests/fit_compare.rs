@@ -146,6 +146,40 @@ fn a_normal_force_uncertainty_in_the_config_reaches_every_fitted_parameter() {
     assert!(row.trim_end().ends_with("| normal_force |"), "{row}");
 }
 
+/// Without a normal force anywhere the Coulomb level is the friction force itself: the
+/// fixture's mu N = 3.48 N within 0.5 %, in N in report.json, report.md and on the terminal,
+/// with no diagnostic failed (exit 0).
+#[test]
+fn a_fit_without_a_normal_force_gives_the_level_in_newtons() {
+    let out = scratch_dir("fc", "no-normal");
+    let config = fixture_config("fmm-fit.toml")
+        .replace("normal_force = 14.5    # N\n", "")
+        .replace("bounds = { mu = [0.0, 1.0] }\n", "");
+    assert!(!config.contains("normal_force") && !config.contains("bounds"));
+    let cfg = out.join("no-normal.toml");
+    std::fs::write(&cfg, config).unwrap();
+    let o = frictionid()
+        .args(["fit", cfg.to_str().unwrap(), "--out"])
+        .arg(out.join("out"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r = read_report(&out.join("out"));
+    let p = &r["parameters"][0];
+    assert_eq!(
+        (p["name"].as_str(), p["unit"].as_str()),
+        (Some("mu"), Some("N"))
+    );
+    let mu = p["value"].as_f64().unwrap();
+    assert!((mu / MU_N - 1.0).abs() < 5e-3, "mu {mu} N");
+    let md = std::fs::read_to_string(out.join("out/report.md")).unwrap();
+    let row = md.lines().find(|l| l.starts_with("| mu ")).unwrap();
+    assert!(row.contains("| N |"), "{row}");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let line = stdout.lines().find(|l| l.starts_with("mu ")).unwrap();
+    assert!(line.split_whitespace().any(|w| w == "N"), "{line}");
+}
+
 #[test]
 fn compare_ranks_the_classical_models() {
     let (out, r) = compare_fixture("compare", "coulomb,viscous_coulomb,none");

@@ -53,9 +53,9 @@ fn assert_rotary_units(out: &Path, shown: &[&str]) {
 
 /// A pendulum released at 60 degrees, simulated by `simulate` (a Coulomb torque of 0.012 N m
 /// times a unit normal force) into a noisy velocity record,
-/// then fitted with its damping and gravity moment free: the velocity residuals are in
-/// rad/s, the release angle in rad, the gravity moment and the Coulomb torque in N m and the
-/// damping in N m s/rad.
+/// then fitted with its damping and gravity moment free and no normal force: the velocity
+/// residuals are in rad/s, the release angle in rad, the gravity moment and the Coulomb
+/// torque (0.012 N m recovered) in N m and the damping in N m s/rad.
 #[test]
 fn a_pendulum_fit_reports_rotary_units() {
     let out = scratch_dir("rotary", "pendulum");
@@ -87,6 +87,16 @@ fn a_pendulum_fit_reports_rotary_units() {
     assert!(!summary.contains("m/s"), "{summary}");
     assert_rotary_units(&fit_out, &["rad/s", "N m", "N m s/rad"]);
     assert!(read(&fit_out.join("report.md")).contains("x0 [rad]"));
+    // No normal force: the Coulomb level is the torque the record was simulated with.
+    let json: serde_json::Value = serde_json::from_str(&read(&fit_out.join("report.json")))
+        .unwrap_or(serde_json::Value::Null);
+    let mu = &json["parameters"][0];
+    assert_eq!(
+        (mu["name"].as_str(), mu["unit"].as_str()),
+        (Some("mu"), Some("N m"))
+    );
+    let torque = mu["value"].as_f64().unwrap_or(f64::NAN);
+    assert!((torque / 0.012 - 1.0).abs() < 0.02, "{torque} N m");
     let _ = std::fs::remove_dir_all(&out);
 }
 

@@ -12,7 +12,7 @@ use super::assessment::identifiability;
 use super::assessment::property_refits::add_property_uncertainty;
 use super::assessment::summary::{summarise, FinishContext};
 use super::problem::{check_force_domain, check_moves, require_mechanics, ForceAlongMotion};
-use super::problem::{FitProblem, ProblemParts, Residuals, SimulatedResponse};
+use super::problem::{simulated_levels, FitProblem, ProblemParts, Residuals, SimulatedResponse};
 use super::search::prefit::{prefit_finding, prefit_options, Prefit, PREFIT_ORIGIN};
 use super::search::starts::{run_starts, start_count, MultiStart, StartRun};
 use super::search::strategy::{plan_starts, Planned, Seeded, StartPlan};
@@ -48,15 +48,14 @@ pub fn fit(
     }
     require_mechanics(&opts.unknown_oscillator, "a velocity-domain fit")?;
     let clock = Instant::now();
-    let residuals = Arc::new(SimulatedResponse::for_records(
-        records,
-        opts.velocity_offset,
-        opts.time_shift,
-        opts.x0,
-    )?);
+    let (levels, simulated) = simulated_levels(records, osc, &opts.unknown_oscillator)?;
+    let residuals = Arc::new(
+        SimulatedResponse::for_records(records, opts.velocity_offset, opts.time_shift, opts.x0)?
+            .with_levels(levels),
+    );
     let seed = prefit_options(model, opts)
         .map(|force_opts| fit_force(osc, model, records, &force_opts).map(Prefit::of));
-    let mut result = fit_seeded(residuals, osc, model, records, opts, seed.as_ref())?;
+    let mut result = fit_seeded(residuals, &simulated, model, records, opts, seed.as_ref())?;
     if let Some(seed) = &seed {
         result.diagnostics.push(prefit_finding(seed, &result));
         result.wall_time_s = clock.elapsed().as_secs_f64();

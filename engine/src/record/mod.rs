@@ -232,15 +232,16 @@ impl Record {
             .unwrap_or(NormalForce::Constant(osc.normal_force))
     }
 
-    /// `osc` under this record's own constant normal force (`[[records]] normal_force`), as
-    /// a free-vibration simulation of the record needs it; `osc` itself otherwise.
+    /// `osc` under this record's own normal force, as a simulation of the record needs it:
+    /// its constant (`[[records]] normal_force`) or the mean of its normal-force channel (a
+    /// simulation holds N constant); `osc` itself without one.
     pub fn oscillator_for(&self, osc: &crate::Oscillator) -> crate::Oscillator {
-        match self.normal_force {
-            Some(NormalForce::Constant(n)) => crate::Oscillator {
-                normal_force: n,
+        match &self.normal_force {
+            Some(n) => crate::Oscillator {
+                normal_force: n.mean(),
                 ..*osc
             },
-            _ => *osc,
+            None => *osc,
         }
     }
 

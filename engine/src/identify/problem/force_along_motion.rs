@@ -38,7 +38,7 @@ use crate::energy::forces_at;
 use crate::energy::model_force::{check_motion, states_along_checked, CheckedMotion};
 use crate::energy::{analyze_record, record_motion};
 use crate::error::EngineError;
-use crate::identify::values::levels::{FrictionLevels, UNIT_NORMAL_FORCE};
+use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::nuisance::NuisanceKind;
 use crate::identify::values::options::{FitDomain, FitOptions, ForceTarget, OscillatorParam};
 use crate::identify::values::result::{ForceBalance, SampleAxes, SlidingSamples};
@@ -150,8 +150,7 @@ impl ForceAlongMotion {
         osc: &Oscillator,
         opts: &FitOptions,
     ) -> Result<Self, EngineError> {
-        let unit_normal = opts.unknown_oscillator.iter().any(|k| k == "normal_force")
-            && records.iter().all(|r| r.normal_force().is_none());
+        let unit_normal = FrictionLevels::read_as_forces(&opts.unknown_oscillator, records);
         let mut tracks = Vec::with_capacity(records.len());
         for record in records {
             let err = |reason: String| EngineError::Record {
@@ -335,7 +334,8 @@ impl ForceTrack {
             ))
         })?;
         let normal =
-            normal_force(record, osc, &opts.unknown_oscillator, unit_normal).map_err(err)?;
+            FrictionLevels::record_normal_force(record, osc, &opts.unknown_oscillator, unit_normal)
+                .map_err(err)?;
         let mut balance = None;
         let (used, target) = match source {
             TargetSource::Measured => {
@@ -451,26 +451,6 @@ fn has_restoring(osc: &Oscillator, opts: &FitOptions) -> bool {
     !osc.restoring.is_linear_spring()
         || opts.oscillator.contains(&OscillatorParam::Stiffness)
         || !opts.unknown_oscillator.iter().any(|k| k == "stiffness")
-}
-
-/// The record's normal force, [`UNIT_NORMAL_FORCE`] when `unit_normal` (none given anywhere:
-/// the levels are forces), or its absence explained (given for some records, not this one).
-fn normal_force(
-    record: &Record,
-    osc: &Oscillator,
-    unknown: &[String],
-    unit_normal: bool,
-) -> Result<NormalForce, String> {
-    match record.normal_force() {
-        Some(n) => Ok(n.clone()),
-        None if unit_normal => Ok(NormalForce::Constant(UNIT_NORMAL_FORCE)),
-        None if unknown.iter().any(|k| k == "normal_force") => Err(
-            "no normal force: give [oscillator] normal_force, the record's `normal_force` or a \
-             normal_force channel (other records have one)"
-                .into(),
-        ),
-        None => Ok(NormalForce::Constant(osc.normal_force)),
-    }
 }
 
 /// The target of a record under `force_target`.

@@ -40,7 +40,7 @@ pub struct Evaluation<'a> {
     /// The oscillator.
     pub oscillator: &'a Oscillator,
     /// The friction model.
-    pub model: &'a dyn FrictionModel,
+    pub model: &'a (dyn FrictionModel + 'static),
     /// Simulation options.
     pub sim: &'a SimOptions,
     simulations: &'a AtomicU64,
@@ -52,7 +52,7 @@ impl<'a> Evaluation<'a> {
     /// Values to evaluate at; `simulations` counts the simulations producers run.
     pub fn new(
         oscillator: &'a Oscillator,
-        model: &'a dyn FrictionModel,
+        model: &'a (dyn FrictionModel + 'static),
         sim: &'a SimOptions,
         simulations: &'a AtomicU64,
     ) -> Self {

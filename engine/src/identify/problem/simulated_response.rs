@@ -18,6 +18,7 @@ use super::analysis_cache::{AnalysisCache, AnalysisRequest};
 use super::residuals::{Evaluation, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE};
 use crate::energy::record_motion;
 use crate::error::EngineError;
+use crate::identify::values::levels::{FrictionLevels, UNIT_NORMAL_FORCE};
 use crate::identify::values::nuisance::{NuisanceKind, NuisanceValues};
 use crate::identify::values::options::FitOptions;
 use crate::oscillator::Oscillator;
@@ -61,6 +62,8 @@ pub struct SimulatedResponse {
     primary: Channel,
     /// The records' energy analyses: the guess's, kept for the energy check.
     analyses: AnalysisCache,
+    /// Whether the law's levels are coefficients or forces (no normal force given).
+    levels: FrictionLevels,
 }
 
 impl SimulatedResponse {
@@ -81,7 +84,13 @@ impl SimulatedResponse {
             tracks: Vec::new(),
             primary: Channel::Velocity,
             analyses: AnalysisCache::default(),
+            levels: FrictionLevels::Coefficients,
         }
+    }
+
+    /// The same, reading the law's levels as `levels` (see [`simulated_levels`]).
+    pub fn with_levels(self, levels: FrictionLevels) -> Self {
+        Self { levels, ..self }
     }
 
     /// The response of `records` over every response channel each holds, with the nuisance
@@ -122,7 +131,7 @@ impl SimulatedResponse {
         let clock = ReleaseClock::new(record, nuisance);
         let mut v = vec![record.v0; clock.before];
         if let Some(&t_end) = clock.times.last() {
-            let sim = simulated_from_release(at, case, &clock, t_end, |inputs| {
+            let sim = simulated_from_release((at, self.levels), case, &clock, t_end, |inputs| {
                 let mut sim = Vec::with_capacity(clock.times.len());
                 let mut superseded = |_: usize| at.superseded(case.index);
                 let run = VelocityRun {
@@ -152,11 +161,17 @@ impl SimulatedResponse {
         let clock = ReleaseClock::new(record, nuisance);
         let x0 = nuisance.x0_of(record);
         let trajectory = match clock.times.last() {
-            Some(&t_end) => Some(simulated_from_release(at, case, &clock, t_end, |inputs| {
-                let trajectory = simulate_driven(inputs)?;
-                let stats = trajectory.stats;
-                Ok((trajectory, stats))
-            })?),
+            Some(&t_end) => Some(simulated_from_release(
+                (at, self.levels),
+                case,
+                &clock,
+                t_end,
+                |inputs| {
+                    let trajectory = simulate_driven(inputs)?;
+                    let stats = trajectory.stats;
+                    Ok((trajectory, stats))
+                },
+            )?),
             None => None,
         };
         let mut out = Vec::with_capacity(channels.len() * record.len());
@@ -183,6 +198,37 @@ impl SimulatedResponse {
             None => vec![Channel::Velocity],
         }
     }
+}
+
+/// How a velocity fit of `records` reads the law's levels, and the oscillator it simulates:
+/// without a normal force in the configuration (`unknown` names `normal_force`) or any record
+/// ([`FrictionLevels::read_as_forces`]), the levels are forces bounded by the largest friction
+/// force the records can hold ([`super::guess::largest_friction_bound`]) and `osc` carries
+/// N = 1; otherwise they are coefficients and every record needs a normal force, its own or
+/// the oscillator's (an error naming the record without one).
+pub fn simulated_levels(
+    records: &[Record],
+    osc: &Oscillator,
+    unknown: &[String],
+) -> Result<(FrictionLevels, Oscillator), EngineError> {
+    let as_forces = FrictionLevels::read_as_forces(unknown, records);
+    for record in records {
+        FrictionLevels::record_normal_force(record, osc, unknown, as_forces).map_err(|reason| {
+            EngineError::Record {
+                record: record.name.clone(),
+                reason,
+            }
+        })?;
+    }
+    if !as_forces {
+        return Ok((FrictionLevels::Coefficients, *osc));
+    }
+    let simulated = Oscillator {
+        normal_force: UNIT_NORMAL_FORCE,
+        ..*osc
+    };
+    let largest = super::guess::largest_friction_bound(records, &simulated);
+    Ok((FrictionLevels::Forces { largest }, simulated))
 }
 
 /// Sample times of a record on the simulation clock (from the shifted release), and how
@@ -228,13 +274,13 @@ impl<'a> ReleaseClock<'a> {
     }
 }
 
-/// The release state of `record` under `nuisance`.
 /// Simulates `case`'s record from its release up to `t_end`, sampled at `clock`'s times,
 /// with `simulation` (the velocity-only or the full run, which returns what it made and its
-/// statistics): from the nuisance values' release state, under the record's input, within
-/// the record's step allowance; the work is counted against the evaluation.
+/// statistics): from the nuisance values' release state, under the record's input and normal
+/// force (the law's levels read as `levels`), within the record's step allowance; the work is
+/// counted against the evaluation.
 fn simulated_from_release<T>(
-    at: &Evaluation<'_>,
+    (at, levels): (&Evaluation<'_>, FrictionLevels),
     case: RecordCase<'_>,
     clock: &ReleaseClock<'_>,
     t_end: f64,
@@ -245,11 +291,20 @@ fn simulated_from_release<T>(
     let init = initial(record, case.nuisance);
     let opts = within_allowance(at, index, record, clock.times.len());
     let input = clock.input(record)?;
-    // A record's own constant normal force reaches its simulation.
-    let osc = record.oscillator_for(at.oscillator);
+    // A record's own constant normal force reaches its simulation; levels read as forces
+    // beyond a coefficient's bound run scaled.
+    let mut osc = record.oscillator_for(at.oscillator);
+    let scaled = levels.scaled_for_simulation(at.model);
+    let model = match &scaled {
+        Some((law, normal)) => {
+            osc.normal_force = *normal;
+            law.as_ref()
+        }
+        None => at.model,
+    };
     let (made, stats) = simulation(RunInputs {
         osc: &osc,
-        model: at.model,
+        model,
         init: &init,
         input: input.as_ref(),
         grid: SampleGrid {
@@ -262,6 +317,7 @@ fn simulated_from_release<T>(
     Ok(made)
 }
 
+/// The release state of `record` under `nuisance`.
 fn initial(record: &Record, nuisance: &NuisanceValues) -> Initial {
     Initial {
         x0: nuisance.x0_of(record),
@@ -414,7 +470,11 @@ impl Residuals for SimulatedResponse {
                 None => super::guess::friction_level(rec, osc, opts),
             }
         };
-        super::guess::guess_hint_with(osc, &with_velocity, level)
+        super::guess::guess_hint_with(osc, &with_velocity, self.levels, level)
+    }
+
+    fn friction_levels(&self) -> FrictionLevels {
+        self.levels
     }
 
     fn analysis_cache(&self) -> Option<&AnalysisCache> {
@@ -523,6 +583,38 @@ mod tests {
                 .contains("velocity_offset = true needs a velocity channel"),
             "{e}"
         );
+    }
+
+    /// Without a normal force anywhere the levels are forces, simulated under N = 1 and
+    /// bounded by the records' balance: on the exact decay from 14 mm under 3.48 N the bound
+    /// lies between the spring's force at the release, k x0, and twice it plus the level. A
+    /// record's own normal force keeps the levels coefficients and the oscillator as it is.
+    #[test]
+    fn without_a_normal_force_the_levels_are_forces_bounded_by_the_balance() {
+        let osc = Oscillator {
+            normal_force: 0.0,
+            ..Oscillator::fmm()
+        };
+        let time: Vec<f64> = (0..1500).map(|i| i as f64 * 1e-3).collect();
+        let exact = coulomb_free_vibration(&osc, 3.48, 0.014, &time).unwrap();
+        let record = Record::new("r", time, exact.v, 0.014);
+        let unknown = vec!["normal_force".to_string()];
+        let (levels, simulated) =
+            simulated_levels(std::slice::from_ref(&record), &osc, &unknown).unwrap();
+        let FrictionLevels::Forces { largest } = levels else {
+            panic!("{levels:?}");
+        };
+        let spring = osc.stiffness * 0.014;
+        assert!(
+            (spring..2.0 * spring + 3.48).contains(&largest),
+            "{largest}"
+        );
+        assert_eq!(simulated.normal_force, UNIT_NORMAL_FORCE);
+        let mut own = record;
+        own.set_normal_force(Some(crate::record::NormalForce::Constant(14.5)));
+        let (levels, simulated) = simulated_levels(&[own], &osc, &unknown).unwrap();
+        assert_eq!(levels, FrictionLevels::Coefficients);
+        assert_eq!(simulated, osc);
     }
 
     /// The velocity response of a Coulomb oscillator against the exact piecewise solution:

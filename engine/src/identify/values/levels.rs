@@ -4,11 +4,16 @@
 //! A law's levels (`mu`, `mu_c`, `mu_s`: dimensionless, multiplied by the normal force N) are
 //! coefficients when the configuration or a record gives N. When neither does, N is taken as
 //! [`UNIT_NORMAL_FORCE`] and a level is the friction force itself: its unit is N in every
-//! report and its bounds come from the data (the largest |force| the fit compares), not from
-//! the dimensionless bound of 10, which a 20 N Coulomb level would sit at.
+//! report (N m on a rotary axis) and its bounds come from the data (the largest |friction
+//! force| the records show), not from the dimensionless bound of 10, which a 20 N Coulomb
+//! level would sit at. The rule holds for every fit: replayed along the measured motion (the
+//! force domain: the largest force compared) or simulated (the velocity domain: the largest
+//! force the records' balance allows, and the oscillator carries N = 1).
 
 use crate::axis::Axis;
-use frictionid_models::ParamInfo;
+use crate::oscillator::Oscillator;
+use crate::record::{NormalForce, Record};
+use frictionid_models::{clone_model, FrictionModel, ParamInfo};
 
 /// The normal force a fit without one multiplies its levels by \[N\].
 pub const UNIT_NORMAL_FORCE: f64 = 1.0;
@@ -23,15 +28,47 @@ pub enum FrictionLevels {
     /// Coefficients (unit 1) of the normal force the configuration or the records give.
     #[default]
     Coefficients,
-    /// Forces \[N\]: no normal force given; `largest` is the largest |force| the fit compares
-    /// \[N\] (the measured, Eq. 7 or inverse-dynamics force).
+    /// Forces \[N\]: no normal force given; `largest` is the largest |friction force| the
+    /// records show \[N\]: the measured, Eq. 7 or inverse-dynamics force a force-domain fit
+    /// compares, or the bound a velocity fit reads off the balance of its records.
     Forces {
-        /// The largest |force| compared \[N\].
+        /// The largest |friction force| \[N\].
         largest: f64,
     },
 }
 
 impl FrictionLevels {
+    /// Whether a fit of `records` reads the levels as forces: the configuration gives no
+    /// normal force (`unknown`, the `[oscillator]` keys not given, names `normal_force`) and
+    /// no record has one of its own (a constant or a channel). One record's own normal force
+    /// keeps them coefficients, and then every record needs one
+    /// ([`FrictionLevels::record_normal_force`]).
+    pub fn read_as_forces(unknown: &[String], records: &[Record]) -> bool {
+        unknown.iter().any(|k| k == "normal_force")
+            && records.iter().all(|r| r.normal_force().is_none())
+    }
+
+    /// The normal force `record` is fitted under: its own; else [`UNIT_NORMAL_FORCE`] when
+    /// the levels are read as forces (`as_forces`); else the oscillator's, unless that is not
+    /// given either (an error: other records have one, so the levels are coefficients).
+    pub fn record_normal_force(
+        record: &Record,
+        osc: &Oscillator,
+        unknown: &[String],
+        as_forces: bool,
+    ) -> Result<NormalForce, String> {
+        match record.normal_force() {
+            Some(n) => Ok(n.clone()),
+            None if as_forces => Ok(NormalForce::Constant(UNIT_NORMAL_FORCE)),
+            None if unknown.iter().any(|k| k == "normal_force") => Err(
+                "no normal force: give [oscillator] normal_force, the record's `normal_force` \
+                 or a normal_force channel (other records have one)"
+                    .into(),
+            ),
+            None => Ok(NormalForce::Constant(osc.normal_force)),
+        }
+    }
+
     /// Whether `info` declares a friction level: dimensionless, named `mu` or `mu_*`.
     pub fn is_level(info: &ParamInfo) -> bool {
         info.unit == "1" && (info.name == "mu" || info.name.starts_with("mu_"))
@@ -40,6 +77,41 @@ impl FrictionLevels {
     /// Whether the levels are forces.
     pub fn are_forces(self) -> bool {
         matches!(self, Self::Forces { .. })
+    }
+
+    /// The law and the normal force a simulation runs `model` under. A simulation checks every
+    /// parameter against its declared bounds, and a level read as a force (a 20 N Coulomb
+    /// level over N = 1) may lie beyond its coefficient's bound of 10: then the levels are
+    /// divided by the power of two that brings them within, and N is that power. A level is a
+    /// coefficient of N (the law reads it as mu N), so the force is the same to the bit (a
+    /// power of two scales exactly). `None`: the law runs as it is, under N = 1.
+    pub fn scaled_for_simulation(
+        self,
+        model: &(dyn FrictionModel + 'static),
+    ) -> Option<(Box<dyn FrictionModel>, f64)> {
+        if !self.are_forces() {
+            return None;
+        }
+        let info = model.param_info();
+        let mut values = model.params();
+        let excess = info
+            .iter()
+            .zip(&values)
+            .filter(|(p, _)| Self::is_level(p) && p.upper > 0.0)
+            .map(|(p, &v)| v / p.upper)
+            .fold(0.0, f64::max);
+        if !(excess > 1.0 && excess.is_finite()) {
+            return None;
+        }
+        let scale = excess.log2().ceil().exp2();
+        for (p, v) in info.iter().zip(values.iter_mut()) {
+            if Self::is_level(p) {
+                *v /= scale;
+            }
+        }
+        let mut scaled = clone_model(model);
+        scaled.set_params(&values).ok()?;
+        Some((scaled, UNIT_NORMAL_FORCE * scale))
     }
 
     /// The unit a report gives `info` on `axis`: N (N m on a rotary axis) for a level read as
@@ -97,6 +169,50 @@ mod tests {
         assert_eq!(coefficients.bounds(&mu), (0.0, 10.0));
         assert_eq!(coefficients.unit(&mu, Axis::Linear), "1");
         assert_eq!(coefficients.clamp_guess(20.0), 5.0);
+    }
+
+    /// A 30 N Coulomb level (beyond a coefficient's bound of 10) runs as 30 / 4 = 7.5 under
+    /// N = 4, the same force to the bit; 3 N runs as it is; coefficients always do.
+    #[test]
+    fn levels_beyond_a_coefficients_bound_are_simulated_under_a_scaled_normal_force() {
+        use frictionid_models::{Coulomb, Stribeck};
+        let forces = FrictionLevels::Forces { largest: 30.0 };
+        let (scaled, normal) = forces
+            .scaled_for_simulation(&Coulomb { mu: 30.0 })
+            .expect("a scaled law");
+        assert_eq!((scaled.params(), normal), (vec![7.5], 4.0));
+        assert_eq!(scaled.force(0.1, &[], normal), 30.0);
+        assert!(forces.scaled_for_simulation(&Coulomb { mu: 3.0 }).is_none());
+        let coefficients = FrictionLevels::Coefficients;
+        assert!(coefficients
+            .scaled_for_simulation(&Coulomb { mu: 20.0 })
+            .is_none());
+        // Every level divides, nothing else: mu_c 12 and mu_s 16 run as 6 and 8 under N = 2.
+        let stribeck = Stribeck {
+            mu_c: 12.0,
+            mu_s: 16.0,
+            ..Stribeck::default()
+        };
+        let (scaled, normal) = forces
+            .scaled_for_simulation(&stribeck)
+            .expect("a scaled law");
+        assert_eq!(normal, 2.0);
+        let expected: Vec<f64> = stribeck
+            .params()
+            .iter()
+            .zip(stribeck.param_info())
+            .map(|(v, p)| {
+                if p.name.starts_with("mu") {
+                    v / 2.0
+                } else {
+                    *v
+                }
+            })
+            .collect();
+        assert_eq!(scaled.params(), expected);
+        for v in [-0.5, -1e-3, 2e-3, 0.3] {
+            assert_eq!(scaled.force(v, &[], normal), stribeck.force(v, &[], 1.0));
+        }
     }
 
     /// On a rotary axis a level read as a force is a torque in N m and a viscous coefficient
