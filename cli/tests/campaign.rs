@@ -343,13 +343,18 @@ fn resume_fits_only_the_missing_groups_and_gives_the_same_table() {
     );
 }
 
-/// A row whose file is missing and one whose file is not a record fail alone: their rows say
-/// why, the others are fitted, and the exit code says a group has no fit.
+/// A row whose file is missing, one whose file is not a record and one of a velocity-only
+/// record without `x0` (nothing to release it from) fail alone: their rows say why, the
+/// others are fitted, and the exit code says a group has no fit.
 #[test]
 fn a_bad_file_fails_its_row_only() {
     let dir = scratch_dir("campaign", "bad-row");
     std::fs::write(dir.join("garbage.csv"), "not,a\nrecord,at all\n").expect("garbage");
-    let config = fixture_campaign(&dir, "missing.csv,0.01,10,C\ngarbage.csv,0.01,10,C\n");
+    std::fs::copy(fixtures_dir().join("x14mm.csv"), dir.join("no-x0.csv")).expect("copy");
+    let config = fixture_campaign(
+        &dir,
+        "missing.csv,0.01,10,C\ngarbage.csv,0.01,10,C\nno-x0.csv,,10,C\n",
+    );
     let out = dir.join("out");
     let o = campaign(&config, &out, &["--quiet"]);
     let stderr = String::from_utf8_lossy(&o.stderr);
@@ -357,12 +362,15 @@ fn a_bad_file_fails_its_row_only() {
     assert!(!stderr.contains("panicked"), "{stderr}");
     let report = read_json(&out.join("report.json"));
     let rows = rows_of(&report, "coulomb");
-    assert_eq!(rows.len(), 5);
+    assert_eq!(rows.len(), 6);
     for row in &rows[..3] {
         assert_eq!(row["verdict"], "ok", "{row}");
         assert!((param(row, "mu").0 - 0.24).abs() < 1e-3);
     }
-    for (row, file) in rows[3..].iter().zip(["missing.csv", "garbage.csv"]) {
+    for (row, file) in rows[3..]
+        .iter()
+        .zip(["missing.csv", "garbage.csv", "no-x0.csv"])
+    {
         assert_eq!(row["verdict"], "failed");
         assert_eq!(row["file"], file);
         assert!(
@@ -370,8 +378,12 @@ fn a_bad_file_fails_its_row_only() {
             "{row}"
         );
     }
+    assert_eq!(
+        rows[5]["error"],
+        "[[records]] entry 7 (`no-x0.csv`): missing `x0` (the release displacement, m)"
+    );
     let csv = std::fs::read_to_string(out.join("campaign.csv")).expect("csv");
-    assert_eq!(csv.lines().count(), 6);
+    assert_eq!(csv.lines().count(), 7);
     assert!(stderr.contains("warning: group `004-missing`"), "{stderr}");
 }
 
@@ -405,10 +417,10 @@ fn manifest_errors_are_one_line_and_name_line_and_column() {
             .says(Contains(
                 "no column `lubricnt` in runs.csv (did you mean `lubricant`?)",
             )),
-            BadInput::new("missing-x0", "campaign", config(runs))
-                .with_file("runs.csv", "file,lubricant\na.csv,oil\n")
+            BadInput::new("zero-weight", "campaign", config(runs))
+                .with_file("runs.csv", "file,weight\na.csv,0\n")
                 .says(Contains(
-                    "runs.csv:2: [[records]] entry 2 (`a.csv`): missing `x0`",
+                    "runs.csv:2: [[records]] entry 2 (`a.csv`): `weight` must be > 0, got 0",
                 )),
             BadInput::new(
                 "unknown-model",

@@ -61,6 +61,45 @@ fn a_displacement_only_record_is_fitted_from_a_config() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A vibrometer and an interferometer side by side, under their default column names
+/// (`displacement`, `velocity`) and with no `x0`: the velocity fit releases the record from
+/// its first displacement sample (14 mm plus its noise), as it would with
+/// `displacement_column` named, and recovers mu = 0.24.
+#[test]
+fn a_record_with_a_displacement_channel_needs_no_x0() {
+    let dir = scratch_dir("channels", "default-x");
+    let osc = Oscillator::fmm();
+    let time = uniform_times(1.5, 1000.0);
+    let exact = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.014, &time).unwrap();
+    let (mut x, mut v) = (exact.x, exact.v);
+    add_gaussian_noise(&mut x, 5e-7, 3);
+    add_gaussian_noise(&mut v, 2e-4, 4);
+    let mut csv = String::from("time,displacement,velocity\n");
+    for ((t, x), v) in time.iter().zip(&x).zip(&v) {
+        csv.push_str(&format!("{t},{x:.9},{v:.9}\n"));
+    }
+    std::fs::write(dir.join("xv.csv"), csv).unwrap();
+    let config = format!("{FMM}[model]\ntype = \"coulomb\"\n[[records]]\nfile = \"xv.csv\"\n");
+    std::fs::write(dir.join("c.toml"), config).unwrap();
+    let out = dir.join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_frictionid"))
+        .arg("fit")
+        .arg(dir.join("c.toml"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let first: f64 = format!("{:.9}", x[0]).parse().unwrap();
+    assert_eq!(r["records"][0]["x0"].as_f64(), Some(first));
+    let mu = r["parameters"][0]["value"].as_f64().unwrap();
+    assert!(((mu - 0.24) / 0.24).abs() < 1e-3, "mu = {mu}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Channel-key and channel-file errors: one line naming the file and the key (same checks
 /// as the CLI's other bad-input tables).
 #[test]

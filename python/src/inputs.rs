@@ -124,8 +124,10 @@ fn add_channel(
     Ok(record.with_channel(channel, values))
 }
 
-/// One record from a dict: `t` and channels as arrays, `x0`, optional `name`, `v0`, `weight`,
-/// `release_time` and `<channel>_noise` levels.
+/// One record from a dict: `t` and channels as arrays, optional `x0`, `name`, `v0`, `weight`,
+/// `release_time` and `<channel>_noise` levels. `x0` follows the configuration's rule
+/// ([`Record::set_release_displacement`]): given, else the first displacement sample, else
+/// unknown, which whatever simulates the record from rest refuses with a message naming it.
 pub fn record(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<Record> {
     let default_name = format!("record {}", index + 1);
     let dict = obj
@@ -135,10 +137,8 @@ pub fn record(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<Record> {
         Some(n) if !n.is_none() => n.str()?.to_string(),
         _ => default_name,
     };
-    let x0 = float_key(dict, "x0", &name)?
-        .ok_or_else(|| value_error(format!("{name}: missing `x0` (release displacement, m)")))?;
+    let x0 = float_key(dict, "x0", &name)?;
     let mut record = Record::from_time_base(name.clone(), time_base(dict, &name)?);
-    record.x0 = x0;
     record.v0 = float_key(dict, "v0", &name)?.unwrap_or(0.0);
     record.weight = float_key(dict, "weight", &name)?.unwrap_or(1.0);
     record.release_time = float_key(dict, "release_time", &name)?;
@@ -155,6 +155,7 @@ pub fn record(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<Record> {
             None => add_channel(record, &key, &value, &name)?,
         };
     }
+    record.set_release_displacement(x0);
     Ok(record)
 }
 

@@ -155,7 +155,7 @@ def test_bad_input_raises_value_error_with_the_cli_message(tmp_path):
         frictionid.simulate({"damping": 0.2}, "coulomb", 0.01, [0.0, 0.1])
     with pytest.raises(ValueError, match=r"3 time stamps but 2 velocities"):
         frictionid.fit(FMM, "coulomb", [{"t": [0.0, 0.1, 0.2], "v": [0.0, 0.1], "x0": 0.01}])
-    with pytest.raises(ValueError, match=r"missing `x0`"):
+    with pytest.raises(ValueError, match=r"record `record 1`: missing `x0`.*velocity-domain fit"):
         frictionid.fit(FMM, "coulomb", [{"t": [0.0, 0.1], "v": [0.0, 0.1]}])
     with pytest.raises(ValueError, match=r"unknown key `velocty`"):
         frictionid.fit(FMM, "coulomb", [{"t": [0.0, 0.1], "velocty": [0.0, 0.1], "x0": 0.01}])
@@ -169,6 +169,21 @@ def test_bad_input_raises_value_error_with_the_cli_message(tmp_path):
         frictionid.fit(FMM, "coulomb", fixture_records(), {"free": ["mu_"]})
     assert "(did you mean `mu`?)" in str(from_dict.value)
     assert str(from_run.value).endswith(str(from_dict.value))
+
+
+def test_x0_comes_from_the_dict_or_the_first_displacement_sample():
+    # The configuration's rule: a record with a displacement channel and no `x0` is released
+    # from its first sample; a velocity-only record needs `x0` only where it is simulated.
+    t = np.linspace(0.0, 1.5, 1501)
+    sim = frictionid.simulate(FMM, {"type": "coulomb", "mu": 0.24}, 0.014, t)
+    pair = {"t": t, "x": sim["x"], "v": sim["v"]}
+    fit = frictionid.fit(FMM, {"type": "coulomb", "mu": 0.2}, [pair], {"free": ["mu"]})
+    assert fit["records"][0]["x0"] == sim["x"][0]
+    assert abs(fit["parameters"][0]["value"] - 0.24) < 1e-4
+    given = frictionid.fit(FMM, {"type": "coulomb", "mu": 0.2}, [dict(pair, x0=0.014)], {"free": ["mu"]})
+    assert given["records"][0]["x0"] == 0.014
+    with pytest.raises(ValueError, match=r"missing `x0` .*: a velocity-domain fit"):
+        frictionid.fit(FMM, "coulomb", [{"t": t, "v": sim["v"]}])
 
 
 def test_a_failed_computation_raises_fit_error():

@@ -244,13 +244,13 @@ mod tests {
             e.contains("no column `lubricnt` in runs.csv (did you mean `lubricant`?)"),
             "{e}"
         );
-        let m = Manifest::parse("runs.csv", "file\na.csv\n").unwrap();
+        let m = Manifest::parse("runs.csv", "file,weight\na.csv,0\n").unwrap();
         let spec = CampaignSpec::default();
         let e = plan_groups(&m, &spec, &RecordSource::default(), Path::new("."), 10)
             .unwrap_err()
             .to_string();
         assert!(
-            e.starts_with("runs.csv:2: [[records]] entry 2 (`a.csv`): missing `x0`"),
+            e.starts_with("runs.csv:2: [[records]] entry 2 (`a.csv`): `weight` must be > 0"),
             "{e}"
         );
     }

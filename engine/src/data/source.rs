@@ -29,11 +29,11 @@
 //!
 //! `x0` is needed only where a record without a displacement channel is simulated from rest
 //! or has its velocity integrated (velocity fits, the energy analysis, the energy-based force
-//! of Eq. 7). A record with a displacement channel starts at its first sample (relative to
-//! the equilibrium); a force-domain fit on a measured force uses no x0. Where the entry is
-//! checked ([`RecordSource::resolve_for`]) an entry without `x0` or `displacement_column` is
-//! refused for a velocity fit; once read, [`crate::record::Record::require_x0`] refuses a
-//! record whose x0 is unknown wherever one is needed.
+//! of Eq. 7). A record with a displacement channel (its column named or found by its default
+//! name) starts at its first sample (relative to the equilibrium); a force-domain fit on a
+//! measured force uses no x0. Once read, an entry of a velocity fit without either is refused
+//! ([`ResolvedSource::load`]), and [`crate::record::Record::require_x0`] refuses a record
+//! whose x0 is unknown wherever else one is needed.
 
 use super::{read_record, DataError, DataFormat, ReadOptions};
 use crate::record::{
@@ -225,11 +225,17 @@ pub struct ResolvedSource {
     pub release: Option<Release>,
     /// How to read the file.
     pub read: ReadOptions,
+    /// The entry's 1-based position (for messages).
+    pub entry: usize,
+    /// How the record is used (a simulated one needs an x0).
+    pub used: RecordUse,
 }
 
 impl ResolvedSource {
-    /// Reads the file into a record named after the file as written, with this entry's x0,
-    /// v0, weight and normal force, starting at its release.
+    /// Reads the file into a record named after the file as written, with this entry's x0
+    /// ([`Record::set_release_displacement`]), v0, weight and normal force, starting at its
+    /// release. A simulated record whose x0 is neither given nor measured is an error naming
+    /// the entry.
     pub fn load(&self) -> Result<Record, DataError> {
         let mut record = read_record(&self.file, &self.read)?;
         record.name = self.file_as_written.clone();
@@ -242,21 +248,15 @@ impl ResolvedSource {
             record = record.with_noise(channel, sigma);
         }
         let mut record = self.start_at_release(record)?;
-        (record.x0, record.x0_source) = self.release_displacement(&record);
-        Ok(record)
-    }
-
-    /// The record's x0 and where it comes from: given, else its first displacement sample,
-    /// else unknown (0).
-    fn release_displacement(&self, record: &Record) -> (f64, X0Source) {
-        let first = record
-            .channel(Channel::Displacement)
-            .and_then(|x| x.first().copied());
-        match (self.x0, first) {
-            (Some(x0), _) => (x0, X0Source::Given),
-            (None, Some(x0)) => (x0, X0Source::FirstDisplacement),
-            (None, None) => (0.0, X0Source::Unknown),
+        record.set_release_displacement(self.x0);
+        if record.x0_source == X0Source::Unknown && self.used == RecordUse::Simulated {
+            return Err(RecordSourceError::MissingX0 {
+                index: self.entry,
+                file: self.file_as_written.clone(),
+            }
+            .into());
         }
+        Ok(record)
     }
 
     /// [`ResolvedSource::load`], then the units checked against `osc`
@@ -334,8 +334,9 @@ impl RecordSource {
     }
 
     /// Checks the entry (the `index`-th, 1-based, for messages) for `used` and resolves its
-    /// file against `base_dir`. A simulated record needs `x0` unless the entry names a
-    /// displacement column (then x0 is its first sample).
+    /// file against `base_dir`. A simulated record without `x0` takes the first sample of its
+    /// displacement channel; one without that channel either is refused once read
+    /// ([`ResolvedSource::load`]).
     pub fn resolve_for(
         &self,
         index: usize,
@@ -345,10 +346,6 @@ impl RecordSource {
         let Some(file) = self.file.clone() else {
             return Err(RecordSourceError::MissingFile { index });
         };
-        let measured_x0 = self.displacement_column.is_some();
-        if self.x0.is_none() && !measured_x0 && used == RecordUse::Simulated {
-            return Err(RecordSourceError::MissingX0 { index, file });
-        }
         let finite = |key: &'static str, value: f64| {
             if value.is_finite() {
                 Ok(value)
@@ -391,6 +388,8 @@ impl RecordSource {
             release: self.release,
             read: self.read_options(),
             file_as_written: file,
+            entry: index,
+            used,
         })
     }
 
@@ -569,11 +568,6 @@ mod tests {
             ),
             (
                 1,
-                "file = \"a.csv\"",
-                "[[records]] entry 1 (`a.csv`): missing `x0` (the release displacement, m)",
-            ),
-            (
-                1,
                 "file = \"a.csv\"\nx0 = 0.01\nweight = 0.0",
                 "[[records]] entry 1 (`a.csv`): `weight` must be > 0, got 0",
             ),
@@ -600,8 +594,9 @@ mod tests {
         );
     }
 
-    /// x0 is required of a simulated record without a displacement column; otherwise it is the
-    /// first displacement sample, or unknown (for a force-domain fit on a measured force).
+    /// x0 is the entry's, else the first sample of the displacement channel (its column named,
+    /// or found under its default name), else unknown: an error for a simulated record once
+    /// read, a stand-in 0 for a force-domain fit on a measured force.
     #[test]
     fn x0_comes_from_the_entry_the_displacement_or_nowhere() {
         let dir = std::env::temp_dir().join(format!("frictionid-x0-{}", std::process::id()));
@@ -610,12 +605,31 @@ mod tests {
             .map(|i| format!("{},{},{}\n", i as f64 * 1e-3, 0.5 - i as f64 * 1e-3, i))
             .collect();
         std::fs::write(dir.join("r.csv"), format!("time,x,velocity\n{rows}")).unwrap();
+        std::fs::write(
+            dir.join("d.csv"),
+            format!("time,displacement,velocity\n{rows}"),
+        )
+        .unwrap();
         let with_x = source("file = \"r.csv\"\ndisplacement_column = \"x\"").unwrap();
         let r = with_x.resolve(1, &dir).unwrap().load().unwrap();
         assert_eq!((r.x0, r.x0_source), (0.5, X0Source::FirstDisplacement));
+        let by_default_name = source("file = \"d.csv\"").unwrap();
+        let r = by_default_name.resolve(1, &dir).unwrap().load().unwrap();
+        assert_eq!((r.x0, r.x0_source), (0.5, X0Source::FirstDisplacement));
+        let given = source("file = \"d.csv\"\nx0 = 0.25").unwrap();
+        let r = given.resolve(1, &dir).unwrap().load().unwrap();
+        assert_eq!((r.x0, r.x0_source), (0.25, X0Source::Given));
         let bare = source("file = \"r.csv\"").unwrap();
-        let e = bare.resolve(1, &dir).unwrap_err();
-        assert!(matches!(e, RecordSourceError::MissingX0 { .. }), "{e}");
+        let e = bare
+            .resolve(2, &dir)
+            .unwrap()
+            .load()
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "[[records]] entry 2 (`r.csv`): missing `x0` (the release displacement, m)"
+        );
         let replayed = bare.resolve_for(1, &dir, RecordUse::Replayed).unwrap();
         let r = replayed.load().unwrap();
         assert_eq!((r.x0, r.x0_source), (0.0, X0Source::Unknown));
@@ -644,7 +658,10 @@ mod tests {
         assert_eq!(r.name, "r.csv");
         assert_eq!((r.x0, r.v0, r.len()), (0.02, 0.1, 12));
         assert_eq!(r.velocity()[11], 11e-3);
-        let e = source("file = \"r.csv\"").unwrap().load(&dir).unwrap_err();
+        let e = source("file = \"r.csv\"\nvelocity_column = \"v\"")
+            .unwrap()
+            .load(&dir)
+            .unwrap_err();
         assert!(
             matches!(e, DataError::Source(RecordSourceError::MissingX0 { .. })),
             "{e}"

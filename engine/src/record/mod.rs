@@ -145,6 +145,20 @@ impl Record {
         self.x0 = x0;
         self
     }
+    /// Sets the release displacement by the one rule for it: `given` when there is one
+    /// (a configuration's or a dict's `x0`), else the first sample of the displacement
+    /// channel (relative to the equilibrium), else unknown (0 stands in, and what needs x0
+    /// refuses the record: [`Record::require_x0`]).
+    pub fn set_release_displacement(&mut self, given: Option<f64>) {
+        let first = self
+            .channel(Channel::Displacement)
+            .and_then(|x| x.first().copied());
+        (self.x0, self.x0_source) = match (given, first) {
+            (Some(x0), _) => (x0, X0Source::Given),
+            (None, Some(x0)) => (x0, X0Source::FirstDisplacement),
+            (None, None) => (0.0, X0Source::Unknown),
+        };
+    }
 
     /// The record's x0 is known (given or measured), as `purpose` needs it: a velocity-only
     /// record is simulated from rest at x0 or has its velocity integrated from it. A record
