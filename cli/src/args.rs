@@ -146,11 +146,7 @@ pub enum Command {
 
 /// An axis as `[oscillator] axis` spells it: `linear` or `rotary`.
 fn parse_axis(text: &str) -> Result<Axis, String> {
-    match text {
-        "linear" => Ok(Axis::Linear),
-        "rotary" => Ok(Axis::Rotary),
-        other => Err(format!("unknown axis `{other}`: `linear` or `rotary`")),
-    }
+    text.parse()
 }
 
 #[cfg(test)]

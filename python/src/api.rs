@@ -14,7 +14,7 @@ use frictionid_engine::record::TimeBase;
 use frictionid_engine::report::ModelsReport;
 use frictionid_engine::simulate::{simulate as simulate_trajectory, Initial};
 use frictionid_engine::spec::{Hooks, IntegratorSpec, ModelSpec};
-use frictionid_engine::Spec;
+use frictionid_engine::{Axis, Spec};
 use frictionid_models::FrictionModel;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
@@ -97,10 +97,15 @@ fn run_job<T: Send + 'static>(
     }
 }
 
-/// Every registered friction model: what `frictionid models --json` prints.
+/// Every registered friction model with its parameters' units on `axis` (`"linear"`, the
+/// default, or `"rotary"`): what `frictionid models --json [--axis rotary]` prints.
 #[pyfunction]
-pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
-    serialized(py, &ModelsReport::registered())
+#[pyo3(signature = (axis = "linear"))]
+pub fn models<'py>(py: Python<'py>, axis: &str) -> PyResult<Bound<'py, PyAny>> {
+    let axis: Axis = axis
+        .parse()
+        .map_err(|e| value_error(format!("models: {e}")))?;
+    serialized(py, &ModelsReport::on_axis(axis))
 }
 
 /// Integrator options and initial internal states from `simulate`'s `options` dict.
@@ -276,7 +281,7 @@ pub fn run<'py>(
     use frictionid_cli::args::OutputArgs;
     use frictionid_cli::commands;
     if command == "models" {
-        return models(py);
+        return models(py, "linear");
     }
     let output = OutputArgs {
         out,

@@ -49,6 +49,17 @@ def test_models_match_the_cli_listing():
     assert "coulomb" in names and "lugre" in names
     coulomb = models[names.index("coulomb")]
     assert [p["name"] for p in coulomb["parameters"]] == ["mu"]
+    # On a rotary axis, as `frictionid models --axis rotary` lists them: N m s/rad, no N s/m.
+    units = lambda listing: {p["unit"] for m in listing for p in m["parameters"]}
+    rotary = frictionid.models(axis="rotary")
+    assert "N m s/rad" in units(rotary) and "N s/m" not in units(rotary)
+    assert "N s/m" in units(models) and not any("rad" in u for u in units(models))
+    binary = os.environ.get("FRICTIONID_BIN")
+    if binary:
+        cli = subprocess.run([binary, "models", "--json", "--axis", "rotary"], capture_output=True, check=True)
+        assert json.loads(cli.stdout) == rotary
+    with pytest.raises(ValueError, match=r"models: unknown axis `angular`: `linear` or `rotary`"):
+        frictionid.models(axis="angular")
 
 
 def test_simulate_reproduces_the_exact_coulomb_rest_position():

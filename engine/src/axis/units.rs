@@ -14,6 +14,20 @@ pub enum Axis {
     Rotary,
 }
 
+impl std::str::FromStr for Axis {
+    type Err = String;
+
+    /// `linear` or `rotary` (a front end's `--axis` or `axis=` argument); an error naming
+    /// both otherwise.
+    fn from_str(text: &str) -> Result<Self, String> {
+        match text {
+            "linear" => Ok(Axis::Linear),
+            "rotary" => Ok(Axis::Rotary),
+            other => Err(format!("unknown axis `{other}`: `linear` or `rotary`")),
+        }
+    }
+}
+
 impl Axis {
     /// Whether this is the default linear axis.
     pub fn is_linear(&self) -> bool {
