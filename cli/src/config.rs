@@ -44,7 +44,7 @@
 
 use crate::error::CliError;
 use frictionid_engine::campaign::CampaignSpec;
-use frictionid_engine::data::{DataError, RecordSource};
+use frictionid_engine::data::{DataError, RecordSource, RecordUse};
 use frictionid_engine::spec::{
     EnergySpec, FitSpec, ModelSpec, OscillatorSpec, SimulationSpec, Spec, SpecError,
 };
@@ -310,6 +310,23 @@ impl Config {
         self.spec
             .require_simulation(purpose)
             .map_err(|e: SpecError| self.error(e))
+    }
+
+    /// Reads the file `[simulation] input` names (as a `[[records]]` entry is read, relative
+    /// to the config), if it names one.
+    pub fn load_simulation_input(&self) -> Result<Option<Record>, CliError> {
+        let Some(source) = self.spec.simulation.as_ref().and_then(|s| s.input.as_ref()) else {
+            return Ok(None);
+        };
+        if source.file.is_none() {
+            return Err(self.error("[simulation]: input: missing `file` (the input's data file)"));
+        }
+        source
+            .resolve_for(1, &self.base_dir, RecordUse::Replayed)
+            .map_err(|e| self.error(format!("[simulation]: input: {e}")))?
+            .load()
+            .map(Some)
+            .map_err(CliError::from)
     }
 
     /// Reads every `[[records]]` file; an error if there are none.

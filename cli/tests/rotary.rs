@@ -118,14 +118,15 @@ fn driven_csv() -> String {
 }
 
 /// Inverse dynamics of the driven pendulum with its inertia, damping and gravity moment
-/// fitted: the inertia in kg m^2, the torques in N m, the damping in N m s/rad; the measured
-/// input torque is plotted against time (`<record>_input.svg`, listed with the files).
+/// fitted: the inertia named so and in kg m^2 in every writer, the torques in N m, the
+/// damping in N m s/rad; the measured input torque is plotted against time
+/// (`<record>_input.svg`, listed with the files).
 #[test]
 fn a_driven_pendulum_reports_rotary_units_and_plots_its_input() {
     let out = scratch_dir("rotary", "driven");
     std::fs::write(out.join("driven.csv"), driven_csv()).unwrap();
     let cfg = format!(
-        "[oscillator]\n{PENDULUM}\n[model]\ntype = \"coulomb\"\nmu = 0.02\n\
+        "[oscillator]\n{PENDULUM}\ninertia_std = 1e-4\n[model]\ntype = \"coulomb\"\nmu = 0.02\n\
          [fit.options]\ndomain = \"force\"\n\
          force_target = \"inverse_dynamics\"\n\
          oscillator = [\"mass\", \"damping\", \"gravity_moment\"]\n\
@@ -158,7 +159,24 @@ fn a_driven_pendulum_reports_rotary_units_and_plots_its_input() {
     };
     let inertia = value_in("kg m^2");
     assert!((inertia - 0.02).abs() < 2e-4, "J = {inertia} kg m^2");
-    assert!(read(&fit_out.join("report.md")).contains("driven_input.svg"));
+    let md = read(&fit_out.join("report.md"));
+    assert!(md.contains("driven_input.svg"));
+    // The inertia is named so in every table: its row, the budget's column (inertia_std
+    // given) and the oscillator's quantities; none says mass or m.
+    assert!(md.contains("| inertia | "), "{md}");
+    assert!(
+        md.contains("| parameter | data | inertia | damping |"),
+        "{md}"
+    );
+    assert!(md.contains("| c/J |"), "{md}");
+    assert!(!md.contains("mass") && !md.contains("c/m"), "{md}");
+    let html = read(&fit_out.join("report.html"));
+    assert!(html.contains(">inertia<") && !html.contains(">mass<"));
+    let terminal = run("fit", &cfg_path, &out.join("again"));
+    assert!(
+        terminal.lines().any(|l| l.starts_with("inertia ")),
+        "{terminal}"
+    );
     let _ = std::fs::remove_dir_all(&out);
 }
 

@@ -15,11 +15,11 @@ use crate::identify::{
     compare, fit, require_mechanics, require_oscillator, FitOptions, FitResult, PropertyUncertainty,
 };
 use crate::oscillator::Oscillator;
-use crate::record::Record;
+use crate::record::{channel_list, Channel, Record};
 use crate::report::{
-    CompareReport, EnergyRecord, EnergyReport, FitReport, GroupReport, SimulateReport,
+    CompareReport, EnergyRecord, EnergyReport, FitReport, GroupReport, InputSeries, SimulateReport,
 };
-use crate::simulate::{simulate, Initial, Trajectory};
+use crate::simulate::{simulate_driven, Initial, Input, RunInputs, SampleGrid, Trajectory};
 use crate::spec::{Hooks, SimulationSpec, Spec, SpecError};
 use crate::synthetic::{add_gaussian_noise, uniform_times};
 use frictionid_models::{Coulomb, FrictionModel};
@@ -54,13 +54,13 @@ pub enum JobError {
     NothingFitted(Vec<String>),
 }
 
-/// Rate of change of the mechanical energy along exact states:
-/// dE/dt = v (m a + k x) = -(c v + F) v.
-pub fn energy_rate(mass: f64, stiffness: f64, x: &[f64], v: &[f64], a: &[f64]) -> Vec<f64> {
+/// Rate of change of the mechanical energy along exact states of `osc`:
+/// dE/dt = v (J a + R(q)) = (u - F_0 - c v - F) v (u = 0 in free vibration).
+pub fn energy_rate(osc: &Oscillator, x: &[f64], v: &[f64], a: &[f64]) -> Vec<f64> {
     x.iter()
         .zip(v)
         .zip(a)
-        .map(|((&x, &v), &a)| v * (mass * a + stiffness * x))
+        .map(|((&x, &v), &a)| v * (osc.mass * a + osc.restoring_force(x)))
         .collect()
 }
 
@@ -103,15 +103,17 @@ pub fn simulate_report(
         noise: None,
         seed: None,
         files: Vec::new(),
-        energy_rate: energy_rate(osc.mass, osc.stiffness, &traj.x, &traj.v, &traj.a),
+        energy_rate: energy_rate(&osc, &traj.x, &traj.v, &traj.a),
         trajectory: traj,
         noisy_velocity: None,
+        input: None,
     }
 }
 
-/// `simulate`: one free vibration of the spec's model from `[simulation]`, with a noisy
-/// velocity record when the spec asks for noise.
-pub fn simulate_job(spec: &Spec) -> Result<SimulateReport, JobError> {
+/// `simulate`: one motion of the spec's model from `[simulation]`, free or driven by the
+/// input-force channel of `input` (the record `[simulation] input` names, read by the front
+/// end), with a noisy velocity record when the spec asks for noise.
+pub fn simulate_job(spec: &Spec, input: Option<&Record>) -> Result<SimulateReport, JobError> {
     let model = &spec.require_model("simulate")?.model;
     require_oscillator(&spec.unknown_oscillator, "simulate").map_err(JobError::Fit)?;
     let sim: &SimulationSpec = spec.require_simulation("simulate")?;
@@ -122,15 +124,19 @@ pub fn simulate_job(spec: &Spec) -> Result<SimulateReport, JobError> {
         z0: sim.z0.clone(),
     };
     let osc = &spec.oscillator;
+    let driving = input.map(driving_input).transpose()?;
     let started = Instant::now();
-    let traj = simulate(
+    let traj = simulate_driven(RunInputs {
         osc,
-        model.as_ref(),
-        &init,
-        sim.duration,
-        &times,
-        &sim.sim_options(),
-    )
+        model: model.as_ref(),
+        init: &init,
+        input: driving.as_ref().map(|d| &d.input),
+        grid: SampleGrid {
+            t_end: sim.duration,
+            sample_times: &times,
+        },
+        opts: &sim.sim_options(),
+    })
     .map_err(JobError::Simulation)?;
     let wall_time_s = started.elapsed().as_secs_f64();
     let noisy_velocity = sim.noise.map(|sigma| {
@@ -144,7 +150,43 @@ pub fn simulate_job(spec: &Spec) -> Result<SimulateReport, JobError> {
     report.noise = sim.noise;
     report.seed = sim.noise.map(|_| sim.seed);
     report.noisy_velocity = noisy_velocity;
+    report.input = driving.map(|d| d.series);
     Ok(report)
+}
+
+/// The input of a simulation and the series it was read from.
+struct Driving {
+    input: Input,
+    series: InputSeries,
+}
+
+/// The input-force channel of `record` on its own clock (its first sample at t = 0 of the
+/// simulation); an error naming the record without one.
+fn driving_input(record: &Record) -> Result<Driving, JobError> {
+    let err = |reason: String| {
+        JobError::Spec(SpecError::Simulation(format!(
+            "input (`{}`): {reason}",
+            record.name
+        )))
+    };
+    let Some(u) = record.channel(Channel::InputForce) else {
+        return Err(err(format!(
+            "no input force channel (the file has: {}); name its column with \
+             `input_force_column`",
+            channel_list(&record.channels())
+        )));
+    };
+    let t0 = record.time().first().copied().unwrap_or(0.0);
+    let time: Vec<f64> = record.time().iter().map(|t| t - t0).collect();
+    let input = Input::new(time.clone(), u.to_vec()).map_err(|e| err(e.to_string()))?;
+    Ok(Driving {
+        input,
+        series: InputSeries {
+            file: record.name.clone(),
+            time,
+            values: u.to_vec(),
+        },
+    })
 }
 
 /// `fit`: the spec's model fitted to `records`; parameters the model table gives start from
@@ -429,7 +471,7 @@ mod tests {
         let f = 0.24 * osc.normal_force;
         let t: Vec<f64> = (0..500).map(|i| i as f64 * 1e-3 + 1e-4).collect();
         let s = coulomb_free_vibration(&osc, f, 0.014, &t).unwrap();
-        let rate = energy_rate(osc.mass, osc.stiffness, &s.x, &s.v, &s.a);
+        let rate = energy_rate(&osc, &s.x, &s.v, &s.a);
         for i in 0..t.len() {
             let v = s.v[i];
             let expect = -(osc.damping * v + f * v.signum()) * v;

@@ -54,6 +54,16 @@ pub struct OscillatorInput {
     pub normal_force: Option<f64>,
 }
 
+/// Whether the `[oscillator]` property `key` is among the `unknown` keys (those not given),
+/// the inertia asked for by either of its names: a rotary axis lists it as `inertia`, the
+/// checks ask for `mass`.
+pub fn is_unknown(unknown: &[String], key: &str) -> bool {
+    let inertia = |k: &str| k == "mass" || k == "inertia";
+    unknown
+        .iter()
+        .any(|u| u == key || (inertia(u) && inertia(key)))
+}
+
 impl OscillatorInput {
     /// The oscillator, with placeholders for the keys not given (m = k = 1, c = N = 0; no
     /// result depends on them), and the names of those keys.

@@ -11,7 +11,7 @@
 //! to the jobs in [`crate::jobs`].
 
 use crate::axis::{Axis, Restoring};
-use crate::data::{RecordUse, MAX_SAMPLES};
+use crate::data::{RecordSource, RecordUse, MAX_SAMPLES};
 use crate::energy::{Differentiator, EnergyOptions};
 use crate::identify::{
     check_min_speed, non_model_bound_keys, FitDomain, FitOptions, ForceTarget, OscillatorParam,
@@ -161,7 +161,8 @@ pub struct OscillatorInput {
     stiffness: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     normal_force: Option<f64>,
-    #[serde(default)]
+    /// One standard deviation of the mass (`inertia_std` on a rotary axis).
+    #[serde(default, alias = "inertia_std")]
     mass_std: f64,
     #[serde(default)]
     damping_std: f64,
@@ -696,6 +697,10 @@ pub struct SimulationSpec {
     pub seed: u64,
     /// Integrator options.
     pub integrator: IntegratorSpec,
+    /// The measured input u(t) that drives the axis: a file read as a `[[records]]` entry
+    /// is (`file`, `time_column`, `input_force_column`, `input_force_scale`, `format`, ...),
+    /// its `input_force` channel taken linear between samples. `None`: free vibration.
+    pub input: Option<RecordSource>,
 }
 
 /// `[simulation]` as written: every key optional; [`SimulationSpec`] is built from it.
@@ -713,6 +718,7 @@ pub struct SimulationInput {
     seed: u64,
     #[serde(default)]
     integrator: IntegratorSpec,
+    input: Option<RecordSource>,
 }
 
 fn positive(what: &str, value: f64) -> Result<f64, SpecError> {
@@ -768,6 +774,7 @@ impl TryFrom<SimulationInput> for SimulationSpec {
             noise: s.noise,
             seed: s.seed,
             integrator: s.integrator,
+            input: s.input,
         })
     }
 }

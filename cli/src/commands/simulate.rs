@@ -1,5 +1,6 @@
-//! `frictionid simulate CONFIG`: one free vibration from `[oscillator]`, `[model]` and
-//! `[simulation]`; writes trajectory.csv, optional record.csv (noisy velocity), plots,
+//! `frictionid simulate CONFIG`: one motion from `[oscillator]`, `[model]` and
+//! `[simulation]`, free or driven by the measured input `[simulation] input` names; writes
+//! trajectory.csv, optional record.csv (noisy velocity), plots (the input's among them),
 //! report.md and report.json.
 
 use super::{load_config, publish, Outcome, REPORT_FILES};
@@ -62,7 +63,8 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
     let cfg = load_config(config)?;
     cfg.require_model("simulate")?;
     cfg.require_simulation("simulate")?;
-    let mut report = simulate_job(&cfg.spec).map_err(|e| cfg.error(e))?;
+    let input = cfg.load_simulation_input()?;
+    let mut report = simulate_job(&cfg.spec, input.as_ref()).map_err(|e| cfg.error(e))?;
     report.config = config.display().to_string();
     // Everything is computed; now write, report.json last.
     let out = OutputDir::create(&output.dir_for(config, "simulate"))?;

@@ -79,7 +79,8 @@ pub fn break_at_reversals(force: &[f64], v: &[f64]) -> Vec<f64> {
     out
 }
 
-/// `simulate`: displacement and velocity; energies and the dissipation rate.
+/// `simulate`: displacement and velocity; energies and their rate of change; the measured
+/// input that drove the axis, when one did (`input.svg`).
 pub fn simulate_plots(out: &OutputDir, report: &SimulateReport) -> Result<Vec<String>, CliError> {
     let traj = &report.trajectory;
     let axis = report.oscillator.axis;
@@ -89,9 +90,14 @@ pub fn simulate_plots(out: &OutputDir, report: &SimulateReport) -> Result<Vec<St
         fmt_num(report.x0),
         axis.unit("m")
     );
+    let motion = if report.input.is_some() {
+        "Driven motion"
+    } else {
+        "Free vibration"
+    };
     super::over_time(
         &out.path("displacement_velocity.svg"),
-        &format!("Free vibration: {title}"),
+        &format!("{motion}: {title}"),
         &traj.time,
         &[Quantity::Displacement(&traj.x), Quantity::Velocity(&traj.v)],
         axis,
@@ -107,17 +113,29 @@ pub fn simulate_plots(out: &OutputDir, report: &SimulateReport) -> Result<Vec<St
                     .with(Series::solid("potential", t, &traj.mechanical.potential))
                     .with(Series::solid("E = KE + PE", t, &traj.mechanical.energy)),
                 Panel::new("dE/dt", "W").with(Series::solid(
-                    "dE/dt = -(c v + F) v",
+                    if report.input.is_some() {
+                        "dE/dt = (u - c v - F) v"
+                    } else {
+                        "dE/dt = -(c v + F) v"
+                    },
                     t,
                     &report.energy_rate,
                 )),
             ],
         ),
     )?;
-    Ok(vec![
-        "displacement_velocity.svg".into(),
-        "energy.svg".into(),
-    ])
+    let mut files = vec!["displacement_velocity.svg".to_string(), "energy.svg".into()];
+    if let Some(input) = &report.input {
+        super::input_force(
+            &out.path("input.svg"),
+            &input.file,
+            &input.time,
+            &input.values,
+            axis,
+        )?;
+        files.push("input.svg".into());
+    }
+    Ok(files)
 }
 
 /// The energy-based against the fitted model's friction force of one fitted record.

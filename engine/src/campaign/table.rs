@@ -85,7 +85,15 @@ pub struct CampaignRow {
 }
 
 /// Oscillator properties that join a row's parameters when they were fitted.
-const OSCILLATOR_PARAMS: [&str; 4] = ["mass", "damping", "stiffness", "normal_force"];
+const OSCILLATOR_PARAMS: [&str; 7] = [
+    "mass",
+    "inertia",
+    "damping",
+    "stiffness",
+    "gravity_moment",
+    "input_offset",
+    "normal_force",
+];
 
 fn finite(x: f64) -> Option<f64> {
     x.is_finite().then_some(x)

@@ -5,6 +5,7 @@ use super::format::{
     fmt_to_error, serialized_name,
 };
 use super::{render_files, render_opening, Render, Role, Sink, Status, Table, Verdict};
+use crate::axis::Axis;
 use crate::identify::values::EnergyForce;
 use crate::identify::{FitResult, FittedParam};
 use serde::{Serialize, Serializer};
@@ -77,7 +78,7 @@ pub fn parameter_table(fit: &FitResult) -> Table {
                 fit_status(p),
             ];
             if budget {
-                row.push(dominant_source(p));
+                row.push(dominant_source(p, fit.oscillator.axis));
             }
             row
         })
@@ -116,11 +117,21 @@ fn has_budget(fit: &FitResult) -> bool {
         .any(|p| p.std_error_components.is_some())
 }
 
-/// The source with the largest part of `p`'s standard error, or `-`.
-fn dominant_source(p: &FittedParam) -> String {
+/// The source with the largest part of `p`'s standard error, named as on `axis`, or `-`.
+fn dominant_source(p: &FittedParam, axis: Axis) -> String {
     p.std_error_components
-        .map(|c| c.dominant().to_string())
+        .map(|c| property_label(c.dominant(), axis).to_string())
         .unwrap_or_else(|| "-".into())
+}
+
+/// A source of a standard error as a report shows it on `axis` (report.json keeps the
+/// property's config name): the mass of a rotary axis is its `inertia`.
+fn property_label(name: &str, axis: Axis) -> &str {
+    if name == "mass" {
+        axis.inertia_name()
+    } else {
+        name
+    }
 }
 
 /// The uncertainty budget: per fitted parameter the part of its standard error from the data
@@ -129,6 +140,7 @@ pub fn budget_table(fit: &FitResult) -> Option<Table> {
     if !has_budget(fit) {
         return None;
     }
+    let axis = fit.oscillator.axis;
     let rows = fit
         .parameters
         .iter()
@@ -143,7 +155,7 @@ pub fn budget_table(fit: &FitResult) -> Option<Table> {
                 part(c.stiffness),
                 part(c.normal_force),
                 fmt_std_error(p.std_error),
-                c.dominant().to_string(),
+                property_label(c.dominant(), axis).to_string(),
             ]
         })
         .collect();
@@ -151,7 +163,7 @@ pub fn budget_table(fit: &FitResult) -> Option<Table> {
         &[
             "parameter",
             "data",
-            "mass",
+            axis.inertia_name(),
             "damping",
             "stiffness",
             "normal_force",
@@ -342,8 +354,10 @@ pub fn channel_table(fit: &FitResult) -> Table {
     )
 }
 
-/// The oscillator's derived quantities: k/m, c/m, the undamped natural frequency and the
-/// damping ratio, with standard errors where the fit gives them.
+/// The oscillator's derived quantities: k/m (where the restoring law has a stiffness k),
+/// c/m, the undamped natural frequency of small motions and their damping ratio (where
+/// there is a restoring force), with standard errors where the fit gives them. On a rotary
+/// axis the inertia's symbol is J (report.json keeps the names `k/m`, `c/m`).
 pub fn oscillator_table(fit: &FitResult) -> Table {
     let osc = &fit.oscillator;
     let (m, c, k) = (osc.mass, osc.damping, osc.stiffness);
@@ -353,34 +367,42 @@ pub fn oscillator_table(fit: &FitResult) -> Table {
             .find(|d| d.name == name)
             .and_then(|d| d.std_error)
     };
-    let row = |name: &str, value: f64, se: Option<f64>, unit: &str| {
+    let row = |name: String, value: f64, se: Option<f64>, unit: &str| {
         vec![
-            name.to_string(),
+            name,
             fmt_estimate(value, se),
             fmt_std_error(se),
             unit.to_string(),
         ]
     };
-    let omega = (k / m).sqrt();
-    Table::new(
-        &["quantity", "value", "std error", "unit"],
-        vec![
-            row("k/m", k / m, std_error("k/m"), "1/s²"),
-            row("c/m", c / m, std_error("c/m"), "1/s"),
-            row(
-                "natural frequency sqrt(k/m)/2π",
-                omega / (2.0 * std::f64::consts::PI),
-                None,
-                "Hz",
-            ),
-            row(
-                "damping ratio c/(2 sqrt(k m))",
-                c / (2.0 * (k * m).sqrt()),
-                None,
-                "1",
-            ),
-        ],
-    )
+    let j = if osc.axis.is_linear() { "m" } else { "J" };
+    let mut rows = Vec::new();
+    if osc.restoring.law().reads_stiffness() {
+        rows.push(row(format!("k/{j}"), k / m, std_error("k/m"), "1/s²"));
+    }
+    rows.push(row(format!("c/{j}"), c / m, std_error("c/m"), "1/s"));
+    let small = osc.small_motion_stiffness();
+    // The stiffness of small motions: k of the linear spring, else R'(0).
+    let r0 = if osc.has_linear_spring() {
+        "k"
+    } else {
+        "R'(0)"
+    };
+    if small > 0.0 {
+        rows.push(row(
+            format!("natural frequency sqrt({r0}/{j})/2π"),
+            osc.omega_n() / (2.0 * std::f64::consts::PI),
+            None,
+            "Hz",
+        ));
+        rows.push(row(
+            format!("damping ratio c/(2 sqrt({r0} {j}))"),
+            c / (2.0 * (small * m).sqrt()),
+            None,
+            "1",
+        ));
+    }
+    Table::new(&["quantity", "value", "std error", "unit"], rows)
 }
 
 impl FitReport {

@@ -28,7 +28,7 @@ pub use energy::{EnergyRecord, EnergyReport};
 pub use fit::FitReport;
 pub use format::fmt_num;
 pub use models::ModelsReport;
-pub use simulate::SimulateReport;
+pub use simulate::{InputSeries, SimulateReport};
 
 /// Where a block belongs: in the short summary a terminal shows, or only in the full report.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

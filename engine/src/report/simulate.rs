@@ -1,4 +1,4 @@
-//! The report of `simulate`: one free vibration.
+//! The report of `simulate`: one motion, free or driven by a measured input.
 
 use super::format::{column, fmt_num, fmt_opt, on_axis};
 use super::{render_files, render_opening, Render, Role, Sink, Table};
@@ -7,7 +7,7 @@ use crate::simulate::{Event, SimStats, Trajectory};
 use frictionid_models::FrictionModel;
 use serde::Serialize;
 
-/// A simulated free vibration with its summary figures. The trajectory itself (for plots and
+/// A simulated motion with its summary figures. The trajectory itself (for plots and
 /// trajectory.csv) is not part of report.json.
 #[derive(Debug, Clone, Serialize)]
 pub struct SimulateReport {
@@ -56,6 +56,33 @@ pub struct SimulateReport {
     /// The noisy velocity of the synthetic record \[m/s\], if one was made.
     #[serde(skip)]
     pub noisy_velocity: Option<Vec<f64>>,
+    /// The measured input that drove the axis (`None`: free vibration); report.json names
+    /// its file.
+    #[serde(rename = "input_file", serialize_with = "input_file")]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub input: Option<InputSeries>,
+}
+
+/// The measured input u(t) of a driven simulation, as read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputSeries {
+    /// The file it came from, as the configuration names it.
+    pub file: String,
+    /// Its sample times on the simulation's clock \[s\].
+    pub time: Vec<f64>,
+    /// u at those times \[N, or N m on a rotary axis\].
+    pub values: Vec<f64>,
+}
+
+/// An input as its file's name in report.json.
+fn input_file<S: serde::Serializer>(
+    input: &Option<InputSeries>,
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    match input {
+        Some(i) => serializer.serialize_str(&i.file),
+        None => serializer.serialize_none(),
+    }
 }
 
 impl SimulateReport {
@@ -72,6 +99,13 @@ impl SimulateReport {
             &["quantity", "value", "unit"],
             vec![
                 row("model", self.model.name().to_string(), ""),
+                row(
+                    "input",
+                    self.input
+                        .as_ref()
+                        .map_or("none (free vibration)".into(), |i| format!("`{}`", i.file)),
+                    "",
+                ),
                 row("x0", fmt_num(self.x0), "m"),
                 row("final displacement", fmt_num(self.final_displacement), "m"),
                 row(

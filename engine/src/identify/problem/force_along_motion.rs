@@ -42,7 +42,7 @@ use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::nuisance::NuisanceKind;
 use crate::identify::values::options::{FitDomain, FitOptions, ForceTarget, OscillatorParam};
 use crate::identify::values::result::{ForceBalance, SampleAxes, SlidingSamples};
-use crate::oscillator::Oscillator;
+use crate::oscillator::{is_unknown, Oscillator};
 use crate::record::noise::noise_floor_level;
 use crate::record::{channel_list, Channel, NormalForce, Record};
 use frictionid_models::GuessHint;
@@ -125,10 +125,16 @@ fn require_properties(
     needed: &[&str],
     purpose: &str,
 ) -> Result<(), EngineError> {
+    // A rotary axis names its mass `inertia`, in the list of keys not given and here.
+    let rotary = missing.iter().any(|m| m == "inertia");
+    let needed: Vec<&str> = needed
+        .iter()
+        .map(|&k| if rotary && k == "mass" { "inertia" } else { k })
+        .collect();
     let absent: Vec<&str> = needed
         .iter()
         .copied()
-        .filter(|k| missing.iter().any(|m| m == k))
+        .filter(|k| is_unknown(missing, k))
         .collect();
     if absent.is_empty() {
         return Ok(());
@@ -136,7 +142,7 @@ fn require_properties(
     Err(EngineError::InvalidInput(format!(
         "[oscillator]: {purpose} needs {}; `{}` not given (only a force-domain fit on a \
          measured force channel does without mass, damping and stiffness)",
-        spoken_list(needed),
+        spoken_list(&needed),
         absent.join("`, `")
     )))
 }
@@ -686,7 +692,7 @@ pub fn check_force_domain(opts: &FitOptions) -> Result<(), EngineError> {
 
 /// Inverse dynamics knows the mass (the inertia): given in `[oscillator]` or fitted.
 fn check_inverse_dynamics(opts: &FitOptions) -> Result<(), EngineError> {
-    let mass_unknown = opts.unknown_oscillator.iter().any(|k| k == "mass")
+    let mass_unknown = is_unknown(&opts.unknown_oscillator, "mass")
         && !opts.oscillator.contains(&OscillatorParam::Mass);
     if opts.force_target == ForceTarget::InverseDynamics && mass_unknown {
         return Err(EngineError::InvalidInput(

@@ -201,8 +201,9 @@ fn check_property_exists(osc: &Oscillator, q: OscillatorParam) -> Result<(), Eng
     Ok(())
 }
 
-/// A free oscillator property: mass, stiffness and gravity moment in log coordinates,
-/// damping and the input offset linear (the offset unbounded).
+/// A free oscillator property, named as reports name it on the axis (a rotary axis's mass
+/// is its `inertia`, bounded under either name): mass, stiffness and gravity moment in log
+/// coordinates, damping and the input offset linear (the offset unbounded).
 fn oscillator_param(osc: &Oscillator, q: OscillatorParam, opts: &FitOptions) -> (FreeParam, f64) {
     let gravity_moment = osc.restoring.parameter("gravity_moment");
     let (current, kind) = match q {
@@ -221,7 +222,13 @@ fn oscillator_param(osc: &Oscillator, q: OscillatorParam, opts: &FitOptions) -> 
         OscillatorParam::InputOffset => unbounded,
         _ => (0.0, f64::INFINITY),
     };
-    let (lo, hi) = opts.bounds.get(q.name()).copied().unwrap_or(default_bounds);
+    let name = q.name_on(osc.axis);
+    let (lo, hi) = opts
+        .bounds
+        .get(q.name())
+        .or_else(|| opts.bounds.get(name))
+        .copied()
+        .unwrap_or(default_bounds);
     let typical = match q {
         // A damping's scale: 2e-3 of the critical damping of small motions (of a
         // kilogram-second without a restoring force); an offset's: a newton.
@@ -232,7 +239,7 @@ fn oscillator_param(osc: &Oscillator, q: OscillatorParam, opts: &FitOptions) -> 
         _ => 2e-3 * osc.mass,
     };
     let mut f = FreeParam::linear(
-        q.name().to_string(),
+        name.to_string(),
         &osc.axis.unit(q.unit()),
         kind,
         (lo, hi),

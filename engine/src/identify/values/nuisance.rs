@@ -129,10 +129,17 @@ impl NuisanceValues {
     }
 }
 
-/// Bound keys that are not model parameters: the oscillator properties, then every nuisance
-/// parameter's key.
+/// Bound keys that are not model parameters: the oscillator properties a fit may vary (the
+/// mass under either of its names), then every nuisance parameter's key.
 pub fn non_model_bound_keys() -> Vec<&'static str> {
-    let mut keys = vec!["mass", "damping", "stiffness"];
+    let mut keys = vec![
+        "mass",
+        "inertia",
+        "damping",
+        "stiffness",
+        "gravity_moment",
+        "input_offset",
+    ];
     keys.extend(NuisanceKind::ALL.map(NuisanceKind::key));
     keys
 }

@@ -36,6 +36,15 @@ impl OscillatorParam {
             Self::InputOffset => "input_offset",
         }
     }
+    /// Its name in reports on `axis`: the config name, `inertia` for the mass of a rotary
+    /// axis.
+    pub fn name_on(self, axis: crate::axis::Axis) -> &'static str {
+        match self {
+            Self::Mass => axis.inertia_name(),
+            other => other.name(),
+        }
+    }
+
     /// Its unit written for a linear axis ([`crate::Axis::unit`] gives the rotary one): the
     /// gravity moment, a torque on the rotary axis it belongs to, is written as the force N.
     pub fn unit(self) -> &'static str {
@@ -263,7 +272,7 @@ mod tests {
     use super::*;
 
     /// A rotary axis names its mass `inertia`: `[fit.options] oscillator = ["inertia"]` asks
-    /// for the same property as `"mass"`, and the config name stays `mass` in reports.
+    /// for the same property as `"mass"`, and reports name it after the axis.
     #[test]
     fn inertia_is_the_rotary_name_of_the_mass() {
         let asked: Vec<OscillatorParam> =
@@ -282,5 +291,9 @@ mod tests {
             Some(OscillatorParam::Mass)
         );
         assert_eq!(OscillatorParam::Mass.name(), "mass");
+        use crate::axis::Axis;
+        assert_eq!(OscillatorParam::Mass.name_on(Axis::Rotary), "inertia");
+        assert_eq!(OscillatorParam::Mass.name_on(Axis::Linear), "mass");
+        assert_eq!(OscillatorParam::Damping.name_on(Axis::Rotary), "damping");
     }
 }
