@@ -3,7 +3,8 @@
 //! record with a measured input gets a plot of it.
 
 use assert_cmd::Command;
-use frictionid_cli::testing::scratch_dir;
+use frictionid_cli::testing::Says::Contains;
+use frictionid_cli::testing::{assert_bad_inputs, scratch_dir, BadInput};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -195,4 +196,42 @@ fn models_list_rotary_units_on_request() {
     let linear = listing(&["models", "--json"]);
     assert!(linear.contains("\"N s/m\""));
     assert!(!linear.contains("rad"));
+}
+
+/// A rotary config without `inertia` is refused where the inertia is needed (a velocity fit,
+/// inverse dynamics without it fitted), naming the key by its rotary name, never fitted on
+/// the placeholder J = 1.
+#[test]
+fn a_rotary_axis_without_inertia_is_named_where_it_is_needed() {
+    let oscillator = "[oscillator]\naxis = \"rotary\"\ndamping = 0.002\nstiffness = 20.0\n\
+                      normal_force = 1.0\n[model]\ntype = \"coulomb\"\n";
+    let record = "[[records]]\nfile = \"driven.csv\"\nx0 = 0.0\ndisplacement_column = \"angle\"\n\
+                  velocity_column = \"velocity\"\ninput_force_column = \"torque\"\n";
+    let binary = std::path::Path::new(env!("CARGO_BIN_EXE_frictionid"));
+    assert_bad_inputs(
+        binary,
+        "rotary",
+        &[
+            BadInput::new(
+                "no-inertia-velocity",
+                "fit",
+                format!("{oscillator}{record}"),
+            )
+            .with_file("driven.csv", driven_csv())
+            .says(Contains(
+                "a velocity-domain fit needs inertia, damping and stiffness; `inertia` not \
+                     given",
+            )),
+            BadInput::new(
+                "no-inertia-inverse",
+                "fit",
+                format!(
+                    "{oscillator}[fit.options]\ndomain = \"force\"\n\
+                     force_target = \"inverse_dynamics\"\n{record}"
+                ),
+            )
+            .with_file("driven.csv", driven_csv())
+            .says(Contains("needs the mass (the inertia)")),
+        ],
+    );
 }
