@@ -187,14 +187,27 @@ def test_x0_comes_from_the_dict_or_the_first_displacement_sample():
     # from its first sample; a velocity-only record needs `x0` only where it is simulated.
     t = np.linspace(0.0, 1.5, 1501)
     sim = frictionid.simulate(FMM, {"type": "coulomb", "mu": 0.24}, 0.014, t)
-    pair = {"t": t, "x": sim["x"], "v": sim["v"]}
-    fit = frictionid.fit(FMM, {"type": "coulomb", "mu": 0.2}, [pair], {"free": ["mu"]})
-    assert fit["records"][0]["x0"] == sim["x"][0]
-    assert abs(fit["parameters"][0]["value"] - 0.24) < 1e-4
-    given = frictionid.fit(FMM, {"type": "coulomb", "mu": 0.2}, [dict(pair, x0=0.014)], {"free": ["mu"]})
+    rng = np.random.default_rng(3)
+    x = sim["x"] + rng.normal(0.0, 5e-7, t.size)
+    v = sim["v"] + rng.normal(0.0, 2e-4, t.size)
+    pair = {"t": t, "x": x, "v": v}
+    fit = frictionid.fit(FMM, "coulomb", [pair], {"free": ["mu"]})
+    assert fit["records"][0]["x0"] == x[0]
+    assert abs(fit["parameters"][0]["value"] / 0.24 - 1.0) < 1e-3
+    given = frictionid.fit(FMM, "coulomb", [dict(pair, x0=0.014)], {"free": ["mu"]})
     assert given["records"][0]["x0"] == 0.014
     with pytest.raises(ValueError, match=r"missing `x0` .*: a velocity-domain fit"):
         frictionid.fit(FMM, "coulomb", [{"t": t, "v": sim["v"]}])
+
+
+def test_a_fit_without_a_normal_force_gives_the_level_in_newtons():
+    # No normal force in the dict nor in the records: the Coulomb level is the friction
+    # force itself, the fixture's mu N = 0.24 * 14.5 N.
+    stage = {k: v for k, v in FMM.items() if k != "normal_force"}
+    fit = frictionid.fit(stage, "coulomb", fixture_records(), {"free": ["mu"]})
+    (mu,) = fit["parameters"]
+    assert mu["unit"] == "N"
+    assert abs(mu["value"] / (0.24 * 14.5) - 1.0) < 5e-3
 
 
 def test_a_failed_computation_raises_fit_error():
