@@ -131,15 +131,6 @@ impl Dopri5 {
         self
     }
 
-    /// Moves the end time on to `t_end` (after the current time) without starting afresh: the
-    /// state, the step size and f there (k[0], the final stage of the last accepted step)
-    /// carry over. Valid where the right-hand side is continuous at the current time, as at
-    /// the sample knots of a motion taken linear between samples; it saves the two
-    /// evaluations of f a reset makes.
-    pub fn extend_to(&mut self, t_end: f64) {
-        self.ctrl.extend_to(t_end);
-    }
-
     /// The starting step of Hairer's DOPRI5 (two RHS evaluations, the first kept in k[0]).
     fn initial_step<S: OdeSystem>(&mut self, system: &S) -> f64 {
         let (f0, rest) = self.k.split_at_mut(1);

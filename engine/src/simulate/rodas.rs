@@ -168,15 +168,6 @@ impl Rodas4 {
         self
     }
 
-    /// Moves the end time on to `t_end` (after the current time) without starting afresh: the
-    /// state and the step size carry over, f and J are evaluated at the next attempt. Valid
-    /// where the right-hand side is continuous at the current time (the sample knots of a
-    /// motion taken linear between samples).
-    pub fn extend_to(&mut self, t_end: f64) {
-        self.ctrl.extend_to(t_end);
-        self.stale = true;
-    }
-
     /// Evaluates f and J at the current point.
     fn refresh<S: OdeSystem>(&mut self, system: &S) {
         system.rhs(self.ctrl.t, &self.y, &mut self.fx);
