@@ -25,21 +25,25 @@
 //!
 //! # Numerical replay
 //! A law without an exact step (a plugin, GMS at another sharpness) has each interval
-//! integrated on its own (the right-hand side jumps at the samples, where v̄ and N̄ change),
-//! under error control (rtol 1e-8, atol 1e-12 per state): by the Dormand-Prince 5(4) pair where
-//! the interval is not stiff, by the linearly implicit Rodas4 where it is (lambda dt > 3 at its
-//! start, lambda the largest rate of the law's state Jacobian) or where Dopri5 needs more than
-//! a few hundred steps (states that stiffen within the interval, as an element that starts
-//! loading). Bristle models are stiff while sliding: LuGre's and Dahl's states relax at a rate
-//! lambda ~ sigma0 |v| / (mu N), about 3e3 1/s for sigma0 = 1e5 N/m at 0.1 m/s with
-//! mu N = 3.5 N, where Dopri5 would be held at its stability limit (~3.3 / lambda). The work is
-//! budgeted over the whole record: [`STEPS_PER_INTERVAL`] steps per interval plus one per
-//! relaxation of the states (lambda dt, up to [`SETTLED_RELAXATIONS`] per interval), so a long
-//! record, or one that travels far, is allowed the work it needs and the transient after a
-//! reversal draws on the quiet intervals around it; a law that needs more (a chattering or
-//! runaway law) fails with [`IntegrationFailure::StepBudgetExceeded`]. The replay needs nothing
-//! of the model beyond `state_derivative` (and the state Jacobian, by finite differences where
-//! the law has none), so every registered model works unchanged.
+//! integrated on its own (the right-hand side jumps at the samples, where v̄ and N̄ change;
+//! each interval starts with the step size the last ended on), under error control
+//! (rtol 1e-8, atol 1e-12 per state): by the Dormand-Prince 5(4) pair where the interval is
+//! not stiff, by the linearly implicit Rodas4 where it is or where Dopri5 needs more than a
+//! few hundred steps (states that stiffen within the interval, as an element that starts
+//! loading). Friction states relax with the distance travelled: an interval holds as many
+//! relaxations as its travel times the law's rate per unit travel (the state Jacobian's rate
+//! over the speed, taken once per replay at the record's RMS speed and mean normal force, at
+//! the law's sliding states), and more than three make it stiff. Bristle models are stiff
+//! while sliding: LuGre's and Dahl's states relax at sigma0 / (mu N) per metre, about 3e3 1/s
+//! for sigma0 = 1e5 N/m at 0.1 m/s with mu N = 3.5 N, where Dopri5 would be held at its
+//! stability limit (~3.3 / lambda). The work is budgeted over the whole record:
+//! [`STEPS_PER_INTERVAL`] steps per interval plus one per relaxation (up to
+//! [`SETTLED_RELAXATIONS`] per interval), so a long record, or one that travels far, is
+//! allowed the work it needs and the transient after a reversal draws on the quiet intervals
+//! around it; a law that needs more (a chattering or runaway law) fails with
+//! [`IntegrationFailure::StepBudgetExceeded`]. The replay needs nothing of the model beyond
+//! `state_derivative` (and the state Jacobian, by finite differences where the law has none),
+//! so every registered model works unchanged.
 //!
 //! [`IntegrationFailure::StepBudgetExceeded`]: crate::error::IntegrationFailure::StepBudgetExceeded
 
