@@ -262,6 +262,9 @@ pub(crate) fn force_derivatives_checked(
     };
     let propagator = exact_propagator(model)?;
     out.given = propagator.exact_sensitivities();
+    if out.given.len() != np {
+        return None;
+    }
     let mut replay = SensitivityReplay::new(model, gradients, Derivatives::of(law), np);
     let mut next = samples.iter().enumerate().peekable();
     for i in 0..motion.len() {

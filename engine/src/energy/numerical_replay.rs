@@ -56,7 +56,9 @@ pub(crate) fn numerical_replay(
     let mut replay = Replay::new(law, budget);
     let mut z = vec![0.0; ns];
     let mut out = Vec::with_capacity(time.len() * ns);
-    out.extend_from_slice(&z);
+    if !time.is_empty() {
+        out.extend_from_slice(&z);
+    }
     for (iv, &t0) in intervals.iter().zip(time) {
         replay.interval(t0, *iv, relaxations(iv), &mut z)?;
         out.extend_from_slice(&z);

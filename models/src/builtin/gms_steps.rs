@@ -194,7 +194,8 @@ impl Propagator for Gms {
 
     fn propagate_with_sensitivities(&self, interval: Interval, z: &mut [f64], sens: &mut [f64]) {
         let (s, s_slopes) = self.s_and_param_slopes(interval.v, interval.normal);
-        let np = self.params().len();
+        // The parameter vector: three per element, then six shared ones.
+        let np = 3 * self.elements.len() + 6;
         let sharpness = 3 * self.elements.len() + 4;
         let u = sgn(interval.v);
         for (i, (e, zi)) in self.elements.iter().zip(z.iter_mut()).enumerate() {

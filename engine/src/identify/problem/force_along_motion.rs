@@ -665,14 +665,13 @@ impl Residuals for ForceAlongMotion {
     ) -> Result<JacobianColumns, EngineError> {
         let track = self.track_of(case.index, case.record)?;
         let weight = case.record.weight.sqrt() / track.noise;
-        let law = if layout.iter().any(|f| matches!(f.kind, ParamKind::Model(_))) {
-            if at.model.n_states() > 0 {
-                at.count_simulation();
-            }
-            force_derivatives_checked(at.model, track.motion(), &track.used)
-        } else {
-            None
-        };
+        let wanted = layout.iter().any(|f| matches!(f.kind, ParamKind::Model(_)));
+        let law = wanted
+            .then(|| force_derivatives_checked(at.model, track.motion(), &track.used))
+            .flatten();
+        if law.is_some() && at.model.n_states() > 0 {
+            at.count_simulation();
+        }
         let columns = layout.iter().map(|f| {
             let column = match (f.kind, &law) {
                 (ParamKind::Model(j), Some(d)) if d.given.get(j).copied().unwrap_or(false) => {
