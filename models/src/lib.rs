@@ -9,6 +9,7 @@ pub mod builtin;
 pub mod error;
 pub mod formula;
 pub mod hints;
+pub mod interval;
 pub mod linearisation;
 pub mod model;
 pub mod param_info;
@@ -21,10 +22,11 @@ pub mod testing;
 pub use builtin::*;
 pub use error::ModelError;
 pub use hints::{GuessHint, StartContext};
+pub use interval::Interval;
 pub use linearisation::Linearisation;
 pub use model::{
-    clone_model, decay, sgn, Derivatives, FrictionModel, InternalStates, Jacobians, RigidLimit,
-    Staging, SwitchedLaw,
+    clone_model, decay, sgn, Derivatives, FrictionModel, InternalStates, Jacobians, ParamGradients,
+    Propagator, RigidLimit, Staging, SwitchedLaw,
 };
 pub use param_info::{check_bounds, check_len, ParamInfo};
 pub use params::{DeclaredParams, ParamSpec};

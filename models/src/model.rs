@@ -7,12 +7,15 @@
 //! | [`Jacobians`] | [`InternalStates::jacobians`] | closed-form derivatives for the stiff integrator (finite differences otherwise) |
 //! | [`SwitchedLaw`] | [`FrictionModel::switching`] | a set-valued force at v = 0 (stick-slip), closed-form half-cycles |
 //! | [`Staging`] | [`FrictionModel::staging`] | data-driven first guesses and starts from fitted simpler models |
+//! | [`Propagator`] | [`InternalStates::propagator`] | the states' exact step over an interval of constant velocity, with their parameter sensitivities (a measured motion replayed without an integrator) |
+//! | [`ParamGradients`] | [`FrictionModel::param_gradients`] | the force's derivatives with respect to the parameters at fixed states (analytic Jacobians of force-domain fits) |
 //!
 //! A law implements the group's trait for itself and names the group in
 //! [`law_groups!`](crate::law_groups), which writes the accessor (`Some(self)`).
 
 use crate::error::ModelError;
 use crate::hints::{GuessHint, StartContext};
+use crate::interval::Interval;
 use crate::linearisation::{state_step, velocity_step, Linearisation};
 use crate::param_info::{check_bounds, ParamInfo};
 
@@ -68,6 +71,12 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
     /// The staging of a fit: data-driven first guesses and starts from fitted simpler models
     /// (`Some(self)`); `None` (the default) keeps the declared defaults.
     fn staging(&mut self) -> Option<&mut dyn Staging> {
+        None
+    }
+
+    /// The force's derivatives with respect to the parameters at fixed states
+    /// (`Some(self)`); `None` (the default) leaves them to finite differences of whole fits.
+    fn param_gradients(&self) -> Option<&dyn ParamGradients> {
         None
     }
 
@@ -157,6 +166,13 @@ pub trait InternalStates: FrictionModel {
     fn jacobians(&self) -> Option<&dyn Jacobians> {
         None
     }
+
+    /// The states' exact step over an interval of constant velocity and normal force
+    /// (`Some(self)`); `None` (the default) lets the engine integrate
+    /// [`state_derivative`](Self::state_derivative) over each interval.
+    fn propagator(&self) -> Option<&dyn Propagator> {
+        None
+    }
 }
 
 /// The partial derivatives a stiff integrator needs, each with a finite-difference default.
@@ -219,6 +235,50 @@ pub trait SwitchedLaw: FrictionModel {
     }
 }
 
+/// The exact step of a law's states over an [`Interval`] of constant velocity v and normal
+/// force N, and of their sensitivities to the parameters. The engine replays a measured motion
+/// interval by interval at the mean velocity of each (see the engine's `energy::model_force`):
+/// with a propagator that replay is one call per sample instead of an integration, exact
+/// whatever the stiffness, and the sensitivities give a force-domain fit its Jacobian from the
+/// same pass.
+///
+/// The step must be the exact solution of [`InternalStates::state_derivative`] at constant v
+/// and N, every branch of the law included (the harness compares it with a tight numerical
+/// integration, `testing::check_exact_steps`).
+pub trait Propagator: InternalStates {
+    /// Whether [`propagate`](Self::propagate) is exact at the current parameter values (GMS:
+    /// only for sharpness 1 and 2); where it is not, the engine integrates the states
+    /// numerically. Default: `true`.
+    fn propagates_exactly(&self) -> bool {
+        true
+    }
+
+    /// Advances the states `z` over `interval`: z(dt) of dz/dt = h(v, z, N) from z(0) = `z`.
+    fn propagate(&self, interval: Interval, z: &mut [f64]);
+
+    /// [`propagate`](Self::propagate), carrying the sensitivities `sens` = dz/dp with the
+    /// states (n_states x n_params, row-major, parameters in [`FrictionModel::params`] order):
+    /// sens <- (dz(dt)/dz(0)) sens + dz(dt)/dp. The states must be those of `propagate`, bit for
+    /// bit.
+    fn propagate_with_sensitivities(&self, interval: Interval, z: &mut [f64], sens: &mut [f64]);
+
+    /// For each parameter, whether [`propagate_with_sensitivities`](Self::propagate_with_sensitivities)
+    /// gives its sensitivities (the entries of the others are unspecified: the engine
+    /// differentiates the residuals numerically along them). Default: every parameter.
+    fn exact_sensitivities(&self) -> Vec<bool> {
+        vec![true; self.params().len()]
+    }
+}
+
+/// The force's partial derivatives with respect to the parameters, states held: with a
+/// [`Propagator`]'s sensitivities S, the total derivative of the force along a replayed
+/// motion is dF/dp + dF/dz S; for a static law dF/dp alone.
+pub trait ParamGradients: FrictionModel {
+    /// dF/dp_j at velocity `v`, states `z` and normal force `normal`, into `out` (one entry
+    /// per parameter, in [`FrictionModel::params`] order).
+    fn force_param_gradient(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]);
+}
+
 /// How a model starts a fit: from the data, or from a fitted simpler model.
 pub trait Staging {
     /// Sets data-driven initial values (levels from the energy estimate). Default: keep.
@@ -232,8 +292,8 @@ pub trait Staging {
 }
 
 /// Writes the accessors of the optional groups a law implements, each `Some(self)`: inside
-/// its `impl FrictionModel` block `states`, `switching` and `staging`, inside its
-/// `impl InternalStates` block `jacobians`.
+/// its `impl FrictionModel` block `states`, `switching`, `staging` and `param_gradients`,
+/// inside its `impl InternalStates` block `jacobians` and `propagator`.
 ///
 /// ```ignore
 /// frictionid_models::law_groups!(switching, staging);
@@ -260,6 +320,16 @@ macro_rules! law_groups {
     };
     (@accessor jacobians) => {
         fn jacobians(&self) -> ::core::option::Option<&dyn $crate::Jacobians> {
+            ::core::option::Option::Some(self)
+        }
+    };
+    (@accessor propagator) => {
+        fn propagator(&self) -> ::core::option::Option<&dyn $crate::Propagator> {
+            ::core::option::Option::Some(self)
+        }
+    };
+    (@accessor param_gradients) => {
+        fn param_gradients(&self) -> ::core::option::Option<&dyn $crate::ParamGradients> {
             ::core::option::Option::Some(self)
         }
     };

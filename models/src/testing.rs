@@ -20,6 +20,10 @@
 //! that the caller implements with the engine: this crate knows no solver.
 
 pub mod motion;
+pub mod reference;
+mod steps;
+
+pub use steps::{check_exact_steps, check_param_gradients, check_step};
 
 use crate::error::ModelError;
 use crate::linearisation::Linearisation;
@@ -76,6 +80,11 @@ pub enum Check {
     CombinedLinearisation,
     /// Stated sliding states are a fixed point of the states with the steady-state force.
     SlidingStates,
+    /// An exact step ([`crate::Propagator`]) equals a tight reference integration of
+    /// `state_derivative` at constant velocity, and its sensitivities central differences.
+    ExactSteps,
+    /// The force's parameter gradient ([`crate::ParamGradients`]) equals central differences.
+    ParamGradients,
     /// (motion) The simulator completes every release.
     Simulates,
     /// (motion) KE + PE + stored never increases.
@@ -136,7 +145,9 @@ pub fn check_model(model: &Model) -> Outcome {
     check_force_only_params(model)?;
     check_combined_rhs(model)?;
     check_combined_linearisation(model)?;
-    check_sliding_states(model)
+    check_sliding_states(model)?;
+    check_param_gradients(model)?;
+    check_exact_steps(model)
 }
 
 /// [`check_model`] for tests: panics with the violation.

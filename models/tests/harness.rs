@@ -26,6 +26,22 @@ fn other_parameter_sets_pass_the_harness() {
             alpha: 2.5,
             ..Dahl::default()
         }),
+        Box::new(Gms {
+            sharpness: 1.0,
+            elements: vec![
+                GmsElement {
+                    stiffness: 2e5,
+                    weight: 0.7,
+                    damping: 3.0,
+                },
+                GmsElement {
+                    stiffness: 4e4,
+                    weight: 0.3,
+                    damping: 0.0,
+                },
+            ],
+            ..Gms::default()
+        }),
         Box::new(LuGre {
             sigma1: 0.0,
             ..LuGre::default()

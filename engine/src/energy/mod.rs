@@ -69,6 +69,7 @@
 pub mod differentiate;
 pub mod halfcycle;
 pub mod model_force;
+mod numerical_replay;
 
 pub use crate::simulate::MechanicalEnergy;
 pub use differentiate::{
@@ -78,8 +79,9 @@ pub use differentiate::{
 };
 pub use halfcycle::{HalfCycle, MIN_RUN};
 pub use model_force::{
-    force_residuals, forces_at, forces_from_states, model_force_along, model_force_with_normal,
-    states_along, states_along_stiff, ForceResiduals, MeasuredMotion,
+    force_derivatives_along, force_residuals, forces_at, forces_from_states, model_force_along,
+    model_force_with_normal, replay_interval, states_along, ForceDerivatives, ForceResiduals,
+    MeasuredMotion, SETTLED_RELAXATIONS, STEPS_PER_INTERVAL,
 };
 
 use crate::error::EngineError;

@@ -1,45 +1,61 @@
 //! A friction model's force along a measured motion, and its residuals against the
 //! energy-based force.
 //!
-//! # Integrating the internal states
-//! A dynamic model's states obey z' = f(v(t), z) with v the measured velocity, taken linear
-//! between samples. Bristle models are stiff while sliding: LuGre's and Dahl's states relax
-//! at a rate lambda ~ sigma0 |v| / (mu N), about 3e3 1/s for sigma0 = 1e5 N/m at 0.1 m/s with
-//! mu N = 3.5 N, so a plain explicit step of dt = 1 ms (lambda dt ~ 3) would diverge. Each
-//! sample interval is therefore integrated with the Dormand-Prince 5(4) pair under error
-//! control (rtol 1e-8, atol 1e-12 per state). The controller shrinks the sub-step to what
-//! accuracy needs in the transients after a reversal and to the method's stability limit
-//! (~3.3 / lambda) while the state sits on its slow manifold, so the result stays stable and
-//! accurate for any stiffness. The stepper runs on from one interval into the next (v and N are
-//! continuous at the samples, so its step size and its last stage carry over): on the
-//! tribometer record a GMS force takes about 1.2 steps per sample, where the Bogacki-Shampine
-//! 3(2) pair this replaced took 2.4 at the same tolerance and 19 % more evaluations of f. An
-//! interval in which v changes sign is split at the zero of the linear v: the states' rate,
-//! odd in v, has a kink there that a step's error estimate would not see. It
-//! needs nothing of the model beyond
-//! `state_derivative`, so every registered model works unchanged.
+//! # The replay convention
+//! A dynamic model's states obey z' = h(v(t), z, N(t)) along the measured motion, which is
+//! known at its samples only. Between samples i-1 and i the motion is replayed at the constant
+//! velocity v̄ = (v\[i-1\] + v\[i\]) / 2 under the constant normal force N̄ = (N\[i-1\] + N\[i\]) / 2
+//! for the interval's duration ([`replay_interval`]): the displacement is the trapezoid's,
+//! the same as a velocity linear between the samples would travel, and within the interval
+//! the states see one velocity, so an interval with a reversal is one stretch at the mean
+//! velocity of its ends. The force at sample i is `force(v[i], z_i, N[i])`, with the states
+//! z_i reached at the end of interval i; the states start relaxed (z = 0) at the first sample.
+//! Every replay, exact or numerical, follows this convention, so the replayed states are one
+//! function of the data whichever way they are computed.
 //!
-//! Bristles far stiffer than that (sigma0 = 1e7 N/m: lambda ~ 4e5 1/s) hold Dopri5 at its
-//! stability limit, hundreds of sub-steps per sample; [`states_along_stiff`] integrates the
-//! same intervals with Rodas4 (linearly implicit, no stability bound, the states' Jacobian by
-//! forward differences), which the energy check falls back on when the explicit replay runs
-//! out of its step budget.
+//! # Exact steps
+//! At constant v and N a law's states often have a closed form over the interval (LuGre's
+//! bristle relaxes exponentially in the distance travelled; Dahl's force, and each GMS element
+//! for sharpness 1 and 2, follow separable laws in the travel): a law with a
+//! [`Propagator`](frictionid_models::Propagator) exact at its parameters is stepped by it, one
+//! call per sample whatever its stiffness, and the same pass carries the states' sensitivities
+//! to the parameters ([`force_derivatives_along`]): with the force's parameter gradient
+//! ([`ParamGradients`](frictionid_models::ParamGradients)) and its state gradient, the
+//! derivatives of the force along the motion, dF/dp + dF/dz dz/dp, from one replay.
+//!
+//! # Numerical replay
+//! A law without an exact step (a plugin, GMS at another sharpness) has each interval
+//! integrated on its own (the right-hand side jumps at the samples, where v̄ and N̄ change;
+//! each interval starts with the step size the last ended on), under error control
+//! (rtol 1e-8, atol 1e-12 per state): by the Dormand-Prince 5(4) pair where the interval is
+//! not stiff, by the linearly implicit Rodas4 where it is or where Dopri5 needs more than a
+//! few hundred steps (states that stiffen within the interval, as an element that starts
+//! loading). Friction states relax with the distance travelled: an interval holds as many
+//! relaxations as its travel times the law's rate per unit travel (the state Jacobian's rate
+//! over the speed, taken once per replay at the record's RMS speed and mean normal force, at
+//! the law's sliding states), and more than three make it stiff. Bristle models are stiff
+//! while sliding: LuGre's and Dahl's states relax at sigma0 / (mu N) per metre, about 3e3 1/s
+//! for sigma0 = 1e5 N/m at 0.1 m/s with mu N = 3.5 N, where Dopri5 would be held at its
+//! stability limit (~3.3 / lambda). The work is budgeted over the whole record:
+//! [`STEPS_PER_INTERVAL`] steps per interval plus one per relaxation (up to
+//! [`SETTLED_RELAXATIONS`] per interval), so a long record, or one that travels far, is
+//! allowed the work it needs and the transient after a reversal draws on the quiet intervals
+//! around it; a law that needs more (a chattering or runaway law) fails with
+//! [`IntegrationFailure::StepBudgetExceeded`]. The replay needs nothing of the model beyond
+//! `state_derivative` (and the state Jacobian, by finite differences where the law has none),
+//! so every registered model works unchanged.
+//!
+//! [`IntegrationFailure::StepBudgetExceeded`]: crate::error::IntegrationFailure::StepBudgetExceeded
 
+use super::numerical_replay::numerical_replay;
 use super::EnergyAnalysis;
-use crate::error::{EngineError, IntegrationFailure};
+use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::NormalForce;
-use crate::simulate::{Dopri5, OdeSystem, Rodas4, StepOutcome, Stepper};
-use frictionid_models::{FrictionModel, InternalStates};
+use frictionid_models::{Derivatives, FrictionModel, Interval, ParamGradients, Propagator};
 use serde::Serialize;
 
-const RTOL: f64 = 1e-8;
-const ATOL: f64 = 1e-12;
-/// Fraction of a sample interval next to its ends where a reversal does not split it (a
-/// piece that short could not be resolved in time; its kink is negligible).
-const REVERSAL_MARGIN: f64 = 1e-6;
-/// Total sub-step budget of one call (accepted and rejected).
-const MAX_SUBSTEPS: u64 = 20_000_000;
+pub use super::numerical_replay::{SETTLED_RELAXATIONS, STEPS_PER_INTERVAL};
 
 /// The model force along a record against the energy-based force.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -67,32 +83,28 @@ pub fn model_force_along(
 }
 
 /// The friction force of `model` along the measured motion (`time`, `v`) under the normal
-/// force `normal` (constant, or one value per sample, taken linear between samples). Static
-/// models are evaluated sample by sample, `model.force(v, &[], N)`; dynamic models have their
-/// states integrated along v (linear between samples) from zero (relaxed bristles at the
-/// first sample), see the module docs.
+/// force `normal` (constant, or one value per sample). Static models are evaluated sample by
+/// sample, `model.force(v, &[], N)`; dynamic models have their states replayed along the
+/// motion from relaxed states at the first sample (see the module docs).
 pub fn model_force_with_normal(
     model: &dyn FrictionModel,
     time: &[f64],
     v: &[f64],
     normal: &NormalForce,
 ) -> Result<Vec<f64>, EngineError> {
-    let states = states_along(model, MeasuredMotion { time, v, normal }, MAX_SUBSTEPS)?;
+    let states = states_along(model, MeasuredMotion { time, v, normal })?;
     Ok(forces_from_states(model, v, normal, &states))
 }
 
-/// The model's internal states at every sample of the motion (`time`, `v`) under `normal`,
-/// sample after sample (`n_states` values each; empty for a static law), integrated from
-/// relaxed states at the first sample within `max_substeps` sub-steps (accepted and
-/// rejected) for the whole motion: a fit rejects trial parameters whose states are so stiff,
-/// or so little smooth, that they would need more (see
-/// [`crate::identify::residuals::STEPS_PER_SAMPLE`]).
+/// The model's internal states at every sample of the motion (`n_states` values each, sample
+/// after sample; empty for a static law), replayed from relaxed states at the first sample
+/// under the convention of the module docs: by the law's exact step where it has one, else
+/// integrated interval by interval within the work the record allows.
 pub fn states_along(
     model: &dyn FrictionModel,
     motion: MeasuredMotion<'_>,
-    max_substeps: u64,
 ) -> Result<Vec<f64>, EngineError> {
-    states_along_checked(model, motion.checked()?, max_substeps)
+    states_along_checked(model, motion.checked()?)
 }
 
 /// A measured motion: its sample times, velocities and normal force (constant, or one value
@@ -122,19 +134,27 @@ pub(crate) struct CheckedMotion<'a> {
     pub normal: &'a NormalForce,
 }
 
-/// [`states_along`] integrated with the stiff Rodas4 (see the module docs): for bristles
-/// so stiff that the explicit replay would need many sub-steps per sample.
-pub fn states_along_stiff(
-    model: &dyn FrictionModel,
-    motion: MeasuredMotion<'_>,
-    max_substeps: u64,
-) -> Result<Vec<f64>, EngineError> {
-    let motion = motion.checked()?;
-    let Some(states) = model.states() else {
-        return Ok(Vec::new());
-    };
-    let stepper = Rodas4::new(states.n_states(), RTOL, ATOL, f64::INFINITY);
-    replay(stepper, model, states, motion, max_substeps)
+impl CheckedMotion<'_> {
+    /// The replay's interval ending at sample `i` (>= 1), see [`replay_interval`].
+    pub fn interval(&self, i: usize) -> Interval {
+        replay_interval(self.time, self.v, self.normal, i)
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.time.len()
+    }
+}
+
+/// The interval the replay moves through between samples `i - 1` and `i` (`i` >= 1): the mean
+/// velocity and the mean normal force of its ends for its duration. The one place of the
+/// replay convention (module docs).
+pub fn replay_interval(time: &[f64], v: &[f64], normal: &NormalForce, i: usize) -> Interval {
+    Interval {
+        v: 0.5 * (v[i - 1] + v[i]),
+        normal: 0.5 * (normal.at(i - 1) + normal.at(i)),
+        dt: time[i] - time[i - 1],
+    }
 }
 
 /// [`states_along`] of a motion already checked by [`check_motion`] (a fit checks it once,
@@ -142,73 +162,176 @@ pub fn states_along_stiff(
 pub(crate) fn states_along_checked(
     model: &dyn FrictionModel,
     motion: CheckedMotion<'_>,
-    max_substeps: u64,
 ) -> Result<Vec<f64>, EngineError> {
-    let Some(states) = model.states() else {
+    let Some(law) = model.states() else {
         return Ok(Vec::new());
     };
-    let stepper = Dopri5::new(states.n_states(), RTOL, ATOL, f64::INFINITY);
-    replay(stepper, model, states, motion, max_substeps)
-}
-
-/// A stepper that can run on from one sample interval into the next (see the module docs).
-trait ReplayStepper: Stepper {
-    fn extend_to(&mut self, t_end: f64);
-}
-
-impl ReplayStepper for Dopri5 {
-    fn extend_to(&mut self, t_end: f64) {
-        Dopri5::extend_to(self, t_end);
+    match exact_propagator(model) {
+        Some(propagator) => Ok(exact_replay(propagator, motion)),
+        None => numerical_replay(law, motion.time, |i| motion.interval(i)).map_err(|failure| {
+            EngineError::StateIntegration {
+                model: model.name().to_string(),
+                failure,
+            }
+        }),
     }
 }
 
-impl ReplayStepper for Rodas4 {
-    fn extend_to(&mut self, t_end: f64) {
-        Rodas4::extend_to(self, t_end);
-    }
+/// The law's propagator, where it has one exact at its current parameters.
+fn exact_propagator(model: &dyn FrictionModel) -> Option<&dyn Propagator> {
+    model
+        .states()?
+        .propagator()
+        .filter(|p| p.propagates_exactly())
 }
 
-/// The states at every sample, integrated interval after interval with `stepper`.
-fn replay<S: ReplayStepper>(
-    mut stepper: S,
-    model: &dyn FrictionModel,
-    states: &dyn InternalStates,
-    motion: CheckedMotion<'_>,
-    max_substeps: u64,
-) -> Result<Vec<f64>, EngineError> {
-    let CheckedMotion { time, v, normal } = motion;
-    let ns = states.n_states();
+/// The states at every sample, stepped exactly interval by interval.
+fn exact_replay(propagator: &dyn Propagator, motion: CheckedMotion<'_>) -> Vec<f64> {
+    let ns = propagator.n_states();
     let mut z = vec![0.0; ns];
-    let mut out = Vec::with_capacity(v.len() * ns);
-    if ns == 0 {
-        return Ok(out);
-    }
-    for i in 0..time.len() {
+    let mut out = Vec::with_capacity(motion.len() * ns);
+    for i in 0..motion.len() {
         if i > 0 {
-            let along = AlongMotion {
-                states,
-                n0: normal.at(i - 1),
-                n1: normal.at(i),
-                t0: time[i - 1],
-                v0: v[i - 1],
-                v1: v[i],
-                span: time[i] - time[i - 1],
-            };
-            let start = if i == 1 {
-                Start::Fresh
-            } else {
-                Start::Continued
-            };
-            integrate_interval(&mut stepper, &along, &mut z, start, max_substeps).map_err(
-                |failure| EngineError::StateIntegration {
-                    model: model.name().to_string(),
-                    failure,
-                },
-            )?;
+            propagator.propagate(motion.interval(i), &mut z);
         }
         out.extend_from_slice(&z);
     }
-    Ok(out)
+    out
+}
+
+/// The model's force at some samples of a replayed motion and its derivatives with respect to
+/// every model parameter there ([`force_derivatives_along`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ForceDerivatives {
+    /// The force at each requested sample \[N\].
+    pub force: Vec<f64>,
+    /// dF/dp at each requested sample, one row of `n_params` entries per sample (parameters in
+    /// `FrictionModel::params` order).
+    pub gradient: Vec<f64>,
+    /// For each parameter, whether its entries are given (the others' are NaN: the law has no
+    /// closed form of its sensitivity).
+    pub given: Vec<bool>,
+}
+
+impl ForceDerivatives {
+    /// The derivative of the force at requested sample `k` with respect to parameter `j`.
+    pub fn at(&self, k: usize, j: usize) -> f64 {
+        self.gradient[k * self.given.len() + j]
+    }
+}
+
+/// The force of `model` at the samples `samples` (ascending) of the motion and its
+/// derivatives with respect to the model's parameters, from one replay of the states with
+/// their sensitivities (module docs); `None` when the law has no parameter gradient, or has
+/// states without a propagator exact at its parameters.
+pub fn force_derivatives_along(
+    model: &dyn FrictionModel,
+    motion: MeasuredMotion<'_>,
+    samples: &[usize],
+) -> Result<Option<ForceDerivatives>, EngineError> {
+    let motion = motion.checked()?;
+    if let Some(&bad) = samples.iter().find(|&&i| i >= motion.len()) {
+        return Err(EngineError::InvalidInput(format!(
+            "sample {bad} of a motion of {} samples",
+            motion.len()
+        )));
+    }
+    Ok(force_derivatives_checked(model, motion, samples))
+}
+
+/// [`force_derivatives_along`] of a checked motion and samples within it.
+pub(crate) fn force_derivatives_checked(
+    model: &dyn FrictionModel,
+    motion: CheckedMotion<'_>,
+    samples: &[usize],
+) -> Option<ForceDerivatives> {
+    let gradients = model.param_gradients()?;
+    let np = model.params().len();
+    let mut out = ForceDerivatives {
+        force: Vec::with_capacity(samples.len()),
+        gradient: vec![0.0; samples.len() * np],
+        given: vec![true; np],
+    };
+    let Some(law) = model.states() else {
+        for (k, &i) in samples.iter().enumerate() {
+            let (v, normal) = (motion.v[i], motion.normal.at(i));
+            out.force.push(model.force(v, &[], normal));
+            gradients.force_param_gradient(v, &[], normal, &mut out.gradient[k * np..(k + 1) * np]);
+        }
+        return Some(out);
+    };
+    let propagator = exact_propagator(model)?;
+    out.given = propagator.exact_sensitivities();
+    if out.given.len() != np {
+        return None;
+    }
+    let mut replay = SensitivityReplay::new(model, gradients, Derivatives::of(law), np);
+    let mut next = samples.iter().enumerate().peekable();
+    for i in 0..motion.len() {
+        if i > 0 {
+            propagator.propagate_with_sensitivities(
+                motion.interval(i),
+                &mut replay.z,
+                &mut replay.sens,
+            );
+        }
+        while let Some((k, _)) = next.next_if(|(_, &s)| s == i) {
+            let row = &mut out.gradient[k * np..(k + 1) * np];
+            out.force
+                .push(replay.derivatives_at(motion.v[i], motion.normal.at(i), row));
+        }
+    }
+    for (j, given) in out.given.iter().enumerate() {
+        if !given {
+            (0..samples.len()).for_each(|k| out.gradient[k * np + j] = f64::NAN);
+        }
+    }
+    Some(out)
+}
+
+/// The states and their sensitivities along a replay, and the force's derivatives from them.
+struct SensitivityReplay<'a> {
+    model: &'a dyn FrictionModel,
+    gradients: &'a dyn ParamGradients,
+    derivatives: Derivatives<'a>,
+    z: Vec<f64>,
+    /// dz/dp, n_states x n_params row-major.
+    sens: Vec<f64>,
+    df_dz: Vec<f64>,
+}
+
+impl<'a> SensitivityReplay<'a> {
+    fn new(
+        model: &'a dyn FrictionModel,
+        gradients: &'a dyn ParamGradients,
+        derivatives: Derivatives<'a>,
+        np: usize,
+    ) -> Self {
+        let ns = model.n_states();
+        Self {
+            model,
+            gradients,
+            derivatives,
+            z: vec![0.0; ns],
+            sens: vec![0.0; ns * np],
+            df_dz: vec![0.0; ns],
+        }
+    }
+
+    /// The force at velocity `v` and normal force `normal` with the current states, its
+    /// total derivatives dF/dp + dF/dz dz/dp written into `row`.
+    fn derivatives_at(&mut self, v: f64, normal: f64, row: &mut [f64]) -> f64 {
+        self.gradients.force_param_gradient(v, &self.z, normal, row);
+        self.derivatives
+            .force_gradient(v, &self.z, normal, &mut self.df_dz);
+        let np = row.len();
+        for (s, &d) in self.df_dz.iter().enumerate() {
+            for (r, &dz) in row.iter_mut().zip(&self.sens[s * np..(s + 1) * np]) {
+                *r += d * dz;
+            }
+        }
+        self.model.force(v, &self.z, normal)
+    }
 }
 
 /// The model's force at every sample from its states there ([`states_along`]).
@@ -324,93 +447,4 @@ pub fn force_residuals(
         rms,
         used,
     })
-}
-
-/// The states' equation along one sample interval: z' = f(v(t), z, N(t)) with v linear from
-/// (t0, v0) to (t0 + span, v1) and N linear from n0 to n1.
-struct AlongMotion<'a> {
-    states: &'a dyn InternalStates,
-    n0: f64,
-    n1: f64,
-    t0: f64,
-    v0: f64,
-    v1: f64,
-    span: f64,
-}
-
-impl AlongMotion<'_> {
-    /// Where v changes sign inside the interval: the states' rate, odd in v, has a kink there
-    /// that a step must not straddle (its error estimate assumes a smooth right-hand side). A
-    /// reversal within [`REVERSAL_MARGIN`] of an end is left to the step ending there.
-    fn reversal(&self) -> Option<f64> {
-        let share = self.v0 / (self.v0 - self.v1);
-        let inside = REVERSAL_MARGIN..1.0 - REVERSAL_MARGIN;
-        (self.v0 * self.v1 < 0.0 && inside.contains(&share)).then_some(self.t0 + self.span * share)
-    }
-}
-
-impl OdeSystem for AlongMotion<'_> {
-    fn rhs(&self, t: f64, z: &[f64], dz: &mut [f64]) {
-        let s = (t - self.t0) / self.span;
-        let v = self.v0 + (self.v1 - self.v0) * s;
-        let normal = self.n0 + (self.n1 - self.n0) * s;
-        self.states.state_derivative(v, z, normal, dz);
-    }
-}
-
-/// How an interval's integration begins.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Start {
-    /// From the states `z` (the first interval).
-    Fresh,
-    /// Where the previous interval ended: the stepper's state is `z` and z' is continuous at
-    /// the knot (v and N are), so the stepper carries its last stage over.
-    Continued,
-}
-
-/// Integrates the states `z` over one sample interval (the stepper keeps its step size
-/// across intervals).
-fn integrate_interval<S: ReplayStepper>(
-    stepper: &mut S,
-    along: &AlongMotion<'_>,
-    z: &mut [f64],
-    start: Start,
-    max_substeps: u64,
-) -> Result<(), IntegrationFailure> {
-    let t_end = along.t0 + along.span;
-    for (k, stop) in along.reversal().into_iter().chain([t_end]).enumerate() {
-        match start {
-            Start::Fresh if k == 0 => stepper.reset(along, along.t0, z, stop)?,
-            _ => stepper.extend_to(stop),
-        }
-        run_to_stop(stepper, along, max_substeps)?;
-    }
-    z.copy_from_slice(stepper.state());
-    Ok(())
-}
-
-/// Steps to the stepper's end time within the sub-step budget, refusing non-finite states.
-fn run_to_stop<S: ReplayStepper>(
-    stepper: &mut S,
-    along: &AlongMotion<'_>,
-    max_substeps: u64,
-) -> Result<(), IntegrationFailure> {
-    while !stepper.reached_end() {
-        if stepper.counts().attempts() >= max_substeps {
-            return Err(IntegrationFailure::StepBudgetExceeded {
-                time: stepper.time(),
-                max_steps: max_substeps,
-            });
-        }
-        // No events along a measured motion: the event function stays positive.
-        let outcome = stepper.step(along)?;
-        let state = stepper.state();
-        if outcome != StepOutcome::Rejected && state.iter().any(|x| !x.is_finite()) {
-            return Err(IntegrationFailure::NonFiniteState {
-                time: stepper.time(),
-                state: state.to_vec(),
-            });
-        }
-    }
-    Ok(())
 }

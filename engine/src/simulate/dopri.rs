@@ -131,13 +131,27 @@ impl Dopri5 {
         self
     }
 
-    /// Moves the end time on to `t_end` (after the current time) without starting afresh: the
-    /// state, the step size and f there (k[0], the final stage of the last accepted step)
-    /// carry over. Valid where the right-hand side is continuous at the current time, as at
-    /// the sample knots of a motion taken linear between samples; it saves the two
-    /// evaluations of f a reset makes.
-    pub fn extend_to(&mut self, t_end: f64) {
-        self.ctrl.extend_to(t_end);
+    /// Restarts at state `y` at time `t` towards `t_end` with the step size the last run
+    /// proposed (Hairer's starting step only when there is none yet): for a sequence of
+    /// intervals whose right-hand side jumps between them but keeps its scale (the sample
+    /// intervals of a replayed motion), one evaluation of f instead of two, and a first step
+    /// of the scale the last interval found.
+    pub fn restart<S: OdeSystem>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        t_end: f64,
+    ) -> StepResult<()> {
+        if self.ctrl.h.is_nan() || self.ctrl.h <= 0.0 {
+            return self.reset(system, t, y, t_end);
+        }
+        self.ctrl.restart(t, t_end);
+        self.y.copy_from_slice(y);
+        self.old_error = MIN_OLD_ERROR;
+        system.rhs(t, y, &mut self.k[0]);
+        self.counts.rhs_evaluations += 1;
+        Ok(())
     }
 
     /// The starting step of Hairer's DOPRI5 (two RHS evaluations, the first kept in k[0]).
@@ -267,8 +281,10 @@ impl Stepper for Dopri5 {
         Ok(())
     }
 
+    /// The state, the step size and f there (k[0], the final stage of the last accepted
+    /// step) carry over: it saves the two evaluations of f a reset makes.
     fn continue_to(&mut self, t_end: f64) {
-        Dopri5::extend_to(self, t_end);
+        self.ctrl.extend_to(t_end);
     }
 
     fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome> {

@@ -168,13 +168,32 @@ impl Rodas4 {
         self
     }
 
-    /// Moves the end time on to `t_end` (after the current time) without starting afresh: the
-    /// state and the step size carry over, f and J are evaluated at the next attempt. Valid
-    /// where the right-hand side is continuous at the current time (the sample knots of a
-    /// motion taken linear between samples).
-    pub fn extend_to(&mut self, t_end: f64) {
-        self.ctrl.extend_to(t_end);
-        self.stale = true;
+    /// Restarts at state `y` at time `t` towards `t_end` with the step size the last run
+    /// proposed (the starting step of [`Stepper::reset`] only when there is none yet), as
+    /// [`crate::simulate::Dopri5::restart`] does: f and J are evaluated afresh, the step-size
+    /// controller's memory of the last run is dropped.
+    pub fn restart<S: OdeSystem>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        t_end: f64,
+    ) -> StepResult<()> {
+        if self.ctrl.h.is_nan() || self.ctrl.h <= 0.0 {
+            return self.reset(system, t, y, t_end);
+        }
+        self.ctrl.restart(t, t_end);
+        self.y.copy_from_slice(y);
+        self.cont[0].copy_from_slice(y);
+        self.cont[1].copy_from_slice(y);
+        self.cont[2].fill(0.0);
+        self.cont[3].fill(0.0);
+        self.ctrl.h_last = 0.0;
+        self.first = false;
+        self.h_acc = 0.0;
+        self.err_acc = 1e-2;
+        self.refresh(system);
+        Ok(())
     }
 
     /// Evaluates f and J at the current point.
@@ -389,8 +408,10 @@ impl Stepper for Rodas4 {
     /// over components unroll and the copies of 24-byte states stop calling `memcpy` (a
     /// stiff LuGre fit spent a fifth of its time in that overhead). The operations and their
     /// order are those of every size, so the results are the same to the bit.
+    /// The state and the step size carry over; f and J are evaluated at the next attempt.
     fn continue_to(&mut self, t_end: f64) {
-        Rodas4::extend_to(self, t_end);
+        self.ctrl.extend_to(t_end);
+        self.stale = true;
     }
 
     fn step<S: OdeSystem>(&mut self, system: &S) -> StepResult<StepOutcome> {

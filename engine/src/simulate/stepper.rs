@@ -457,21 +457,4 @@ mod tests {
         assert!((y[0] - expected).abs() < 1e-14, "{}", y[0]);
         assert_eq!(s.counts().rhs_evaluations, 10);
     }
-
-    /// Extending the end time carries the state, the step size and f over: the same end
-    /// value as one run to the far end, and no evaluation of f beyond the steps' own.
-    #[test]
-    fn dopri5_extends_its_end_time_without_a_new_start() {
-        let mut s = Dopri5::new(1, 1e-10, 1e-12, f64::INFINITY);
-        assert!(s.reset(&Decay(2.0), 0.0, &[1.0], 0.75).is_ok());
-        run_to_end(&mut s, &Decay(2.0), |t| (-2.0 * t).exp(), 1e-9);
-        assert_eq!(s.time(), 0.75);
-        s.extend_to(1.5);
-        assert!(!s.reached_end());
-        let end = run_to_end(&mut s, &Decay(2.0), |t| (-2.0 * t).exp(), 1e-9);
-        assert_eq!(s.time(), 1.5);
-        assert!((end - (-3.0f64).exp()).abs() < 1e-10, "{end}");
-        let c = s.counts();
-        assert_eq!(c.rhs_evaluations, 2 + 6 * c.attempts());
-    }
 }

@@ -10,7 +10,7 @@
 //! Coulomb friction is the paper's Eq. (1).
 
 use crate::hints::GuessHint;
-use crate::model::{sgn, FrictionModel, Staging, SwitchedLaw};
+use crate::model::{sgn, FrictionModel, ParamGradients, Staging, SwitchedLaw};
 use crate::start::{StartContext, StribeckLevels};
 
 crate::declare_params! {
@@ -32,7 +32,16 @@ impl FrictionModel for Coulomb {
     fn steady_state(&self, v: f64, normal: f64) -> f64 {
         self.force(v, &[], normal)
     }
-    crate::law_groups!(switching, staging);
+    crate::law_groups!(switching, staging, param_gradients);
+}
+
+impl ParamGradients for Coulomb {
+    /// dF/dmu = N sgn(v).
+    fn force_param_gradient(&self, v: f64, _z: &[f64], normal: f64, out: &mut [f64]) {
+        if let Some(d) = out.first_mut() {
+            *d = normal * sgn(v);
+        }
+    }
 }
 
 impl SwitchedLaw for Coulomb {

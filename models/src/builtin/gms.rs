@@ -76,6 +76,11 @@
 //! events; its stiffness near saturation, m k_i |v| / (w_i s), sets the step size, as sigma0
 //! does for LuGre.
 //!
+//! Exact steps (`Propagator`, in `gms_steps.rs`): at constant velocity each element's law is
+//! separable in the distance travelled, with closed forms for sharpness 1 (exponential) and 2
+//! (tanh), the stick branch of an unloaded element included; the engine integrates other
+//! sharpnesses.
+//!
 //! Energy: the elements store sum_i k_i z_i^2 / 2 and dissipate
 //! k_i z_i (v - dz_i/dt) = |v| w_i s max(0, sgn(v) rho_i)^(m+1) >= 0 each, so with
 //! sigma_i = 0 the model is passive. An element whose sliding force w_i s(v) is zero (w_i = 0
@@ -284,7 +289,7 @@ impl Gms {
     /// loads the element towards its sliding force in the direction of motion (unloading, v
     /// against the deflection, is purely elastic). `None` for a frozen element (no sliding
     /// force).
-    fn element_load(e: &GmsElement, v: f64, z: f64, s: f64) -> Option<(f64, f64)> {
+    pub(super) fn element_load(e: &GmsElement, v: f64, z: f64, s: f64) -> Option<(f64, f64)> {
         let limit = e.weight * s;
         if limit <= 0.0 {
             return None;
@@ -304,7 +309,7 @@ impl Gms {
     }
 
     /// The element law dz/dt = v (1 - max(0, sgn(v) rho)^m).
-    fn z_dot(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
+    pub(super) fn z_dot(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> f64 {
         match Self::element_load(e, v, z, s) {
             None => 0.0,
             Some((_, load)) if load > 0.0 => {
@@ -633,7 +638,7 @@ impl FrictionModel for Gms {
         let total_weight: f64 = self.elements.iter().map(|e| e.weight).sum();
         total_weight * self.s(v, normal) * sgn(v) + self.viscous * v
     }
-    crate::law_groups!(states, staging);
+    crate::law_groups!(states, staging, param_gradients);
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         if self.elements.is_empty() {
             return Err(bad_key(
@@ -726,7 +731,7 @@ impl InternalStates for Gms {
             also_free: vec!["delta"],
         })
     }
-    crate::law_groups!(jacobians);
+    crate::law_groups!(jacobians, propagator);
 }
 
 impl Jacobians for Gms {

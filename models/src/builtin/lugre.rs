@@ -14,14 +14,23 @@
 //!
 //! Stored energy: sigma0 z^2 / 2. mu_s < mu_c is admissible but reported as a warning.
 //!
+//! Exact steps (`Propagator`): at constant v and N the bristle equation is linear in z,
+//! z' = v - lambda z with lambda = sigma0 |v| / g(v), so z relaxes exponentially towards
+//! z_ss = g(v) sgn(v) / sigma0 over the distance travelled: z(t) = z_ss + (z0 - z_ss)
+//! exp(-sigma0 |v| t / g(v)). Without normal load (g = 0) or motion the bristles stay.
+//!
 //! Reference: C. Canudas de Wit, H. Olsson, K. J. Åström, P. Lischinsky, "A new model for
 //! control of systems with friction", IEEE Trans. Automatic Control 40(3), 419-425, 1995.
 
 use crate::builtin::stribeck::{mu_s_warning, Stribeck};
 use crate::error::ModelError;
 use crate::hints::GuessHint;
+use crate::interval::Interval;
 use crate::linearisation::Linearisation;
-use crate::model::{decay, sgn, FrictionModel, InternalStates, Jacobians, RigidLimit, Staging};
+use crate::model::{
+    decay, sgn, FrictionModel, InternalStates, Jacobians, ParamGradients, Propagator, RigidLimit,
+    Staging,
+};
 use crate::param_info::check_bounds;
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
@@ -72,6 +81,26 @@ impl LuGre {
         self.sigma0 * z + self.sigma1 * z_dot + self.sigma2 * v
     }
 
+    /// The Stribeck level g(v) and its derivatives with respect to mu_c, mu_s and v_s.
+    fn g_and_slopes(&self, v: f64, normal: f64) -> (f64, [f64; 3]) {
+        let r = v / self.v_s;
+        let e = decay(r * r);
+        let g = normal * (self.mu_c + (self.mu_s - self.mu_c) * e);
+        let d_vs = normal * (self.mu_s - self.mu_c) * e * 2.0 * r * r / self.v_s;
+        (g, [normal * (1.0 - e), normal * e, d_vs])
+    }
+
+    /// The step's relaxation: (z_ss, exp(-x), -expm1(-x), x) with x = sigma0 |v| dt / g, or
+    /// `None` where the bristles do not move (no load, no motion).
+    fn relaxation(&self, interval: Interval, g: f64) -> Option<(f64, f64, f64, f64)> {
+        if g.is_nan() || g <= 0.0 || interval.v == 0.0 || interval.dt <= 0.0 {
+            return None;
+        }
+        let x = self.sigma0 * interval.travel() / g;
+        let settled = -(-x).exp_m1();
+        Some((sgn(interval.v) * g / self.sigma0, 1.0 - settled, settled, x))
+    }
+
     fn z_dot(&self, v: f64, z: f64, normal: f64) -> f64 {
         let g = self.g(v, normal);
         if g > 0.0 {
@@ -96,10 +125,76 @@ impl FrictionModel for LuGre {
     fn steady_state(&self, v: f64, normal: f64) -> f64 {
         self.g(v, normal) * sgn(v) + self.sigma2 * v
     }
-    crate::law_groups!(states, staging);
+    crate::law_groups!(states, staging, param_gradients);
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(self.name(), &self.param_info(), &self.params())?;
         Ok(mu_s_warning(self.name(), self.mu_s, self.mu_c))
+    }
+}
+
+impl ParamGradients for LuGre {
+    /// F = sigma0 z + sigma1 z' + sigma2 v with z' = v - sigma0 |v| z / g(v): sigma0 enters
+    /// the spring and the rate, the levels and v_s the rate through g.
+    fn force_param_gradient(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) {
+        let z0 = z.first().copied().unwrap_or(0.0);
+        let (g, slopes) = self.g_and_slopes(v, normal);
+        let (z_dot, d_sigma0, level) = if g > 0.0 {
+            let relax = v.abs() * z0 / g;
+            (
+                v - self.sigma0 * relax,
+                -relax,
+                self.sigma1 * self.sigma0 * relax / g,
+            )
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        let gradient = [
+            z0 + self.sigma1 * d_sigma0,
+            z_dot,
+            v,
+            level * slopes[0],
+            level * slopes[1],
+            level * slopes[2],
+        ];
+        for (o, d) in out.iter_mut().zip(gradient) {
+            *o = d;
+        }
+    }
+}
+
+impl Propagator for LuGre {
+    fn propagate(&self, interval: Interval, z: &mut [f64]) {
+        let g = self.g(interval.v, interval.normal);
+        let (Some(z0), Some((z_ss, _, settled, _))) = (z.first_mut(), self.relaxation(interval, g))
+        else {
+            return;
+        };
+        *z0 += (z_ss - *z0) * settled;
+    }
+
+    /// With Q = (1 - E) z_ss + (z0 - z_ss) E x (E = exp(-x)): dz1/dsigma0 = E S0 - Q / sigma0
+    /// and dz1/dp = E S0 + Q (dg/dp) / g for the levels and v_s (z_ss and x hold sigma0 / g).
+    fn propagate_with_sensitivities(&self, interval: Interval, z: &mut [f64], sens: &mut [f64]) {
+        let (g, slopes) = self.g_and_slopes(interval.v, interval.normal);
+        let (Some(z0), Some((z_ss, kept, settled, x))) =
+            (z.first_mut(), self.relaxation(interval, g))
+        else {
+            return;
+        };
+        let q = settled * z_ss + (*z0 - z_ss) * kept * x;
+        let level = q / g;
+        let direct = [
+            -q / self.sigma0,
+            0.0,
+            0.0,
+            level * slopes[0],
+            level * slopes[1],
+            level * slopes[2],
+        ];
+        for (s, d) in sens.iter_mut().zip(direct) {
+            *s = kept * *s + d;
+        }
+        *z0 += (z_ss - *z0) * settled;
     }
 }
 
@@ -139,7 +234,7 @@ impl InternalStates for LuGre {
             also_free: Vec::new(),
         })
     }
-    crate::law_groups!(jacobians);
+    crate::law_groups!(jacobians, propagator);
 }
 
 impl Jacobians for LuGre {

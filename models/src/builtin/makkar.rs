@@ -27,7 +27,7 @@
 
 use crate::error::ModelError;
 use crate::hints::GuessHint;
-use crate::model::{FrictionModel, Staging};
+use crate::model::{FrictionModel, ParamGradients, Staging};
 use crate::param_info::check_bounds;
 
 crate::declare_params! {
@@ -56,7 +56,7 @@ impl FrictionModel for Makkar {
     fn steady_state(&self, v: f64, normal: f64) -> f64 {
         self.force(v, &[], normal)
     }
-    crate::law_groups!(staging);
+    crate::law_groups!(staging, param_gradients);
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(self.name(), &self.param_info(), &self.params())?;
         let mut warnings = Vec::new();
@@ -67,6 +67,28 @@ impl FrictionModel for Makkar {
             ));
         }
         Ok(warnings)
+    }
+}
+
+impl ParamGradients for Makkar {
+    /// The derivatives of each tanh term: d tanh(g v)/dg = v (1 - tanh(g v)^2).
+    fn force_param_gradient(&self, v: f64, _z: &[f64], _normal: f64, out: &mut [f64]) {
+        let (t2, t3, t5) = (
+            (self.g2 * v).tanh(),
+            (self.g3 * v).tanh(),
+            (self.g5 * v).tanh(),
+        );
+        let gradient = [
+            t2 - t3,
+            self.g1 * v * (1.0 - t2 * t2),
+            -self.g1 * v * (1.0 - t3 * t3),
+            t5,
+            self.g4 * v * (1.0 - t5 * t5),
+            v,
+        ];
+        for (o, d) in out.iter_mut().zip(gradient) {
+            *o = d;
+        }
     }
 }
 

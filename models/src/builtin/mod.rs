@@ -4,6 +4,7 @@ mod coulomb;
 mod dahl;
 mod expression;
 mod gms;
+mod gms_steps;
 mod lugre;
 mod makkar;
 mod none;

@@ -1,7 +1,7 @@
 //! No friction (F = 0), for identifying the oscillator itself from a free vibration without
 //! friction contact (as the paper does for m, c and k).
 
-use crate::model::{FrictionModel, SwitchedLaw};
+use crate::model::{FrictionModel, ParamGradients, SwitchedLaw};
 
 crate::declare_params! {
     /// The zero friction force.
@@ -20,7 +20,12 @@ impl FrictionModel for NoFriction {
     fn steady_state(&self, _v: f64, _normal: f64) -> f64 {
         0.0
     }
-    crate::law_groups!(switching);
+    crate::law_groups!(switching, param_gradients);
+}
+
+/// No parameters: nothing to write.
+impl ParamGradients for NoFriction {
+    fn force_param_gradient(&self, _v: f64, _z: &[f64], _normal: f64, _out: &mut [f64]) {}
 }
 
 impl SwitchedLaw for NoFriction {

@@ -18,7 +18,7 @@
 
 use crate::error::ModelError;
 use crate::hints::GuessHint;
-use crate::model::{decay, sgn, FrictionModel, Staging, SwitchedLaw};
+use crate::model::{decay, sgn, FrictionModel, ParamGradients, Staging, SwitchedLaw};
 use crate::param_info::check_bounds;
 use crate::start::{StartContext, StribeckLevels};
 
@@ -67,10 +67,38 @@ impl FrictionModel for Stribeck {
     fn steady_state(&self, v: f64, normal: f64) -> f64 {
         self.force(v, &[], normal)
     }
-    crate::law_groups!(switching, staging);
+    crate::law_groups!(switching, staging, param_gradients);
     fn validate(&self) -> Result<Vec<String>, ModelError> {
         check_bounds(self.name(), &self.param_info(), &self.params())?;
         Ok(mu_s_warning(self.name(), self.mu_s, self.mu_c))
+    }
+}
+
+impl ParamGradients for Stribeck {
+    /// With a = |v / v_s|, e = exp(-a^delta) and the dip D = N (mu_s - mu_c) e sgn(v):
+    /// dF/dmu_c = N (1 - e) sgn(v), dF/dmu_s = N e sgn(v), dF/dv_s = D delta a^delta / v_s,
+    /// dF/ddelta = -D a^delta ln(a), dF/dviscous = v.
+    fn force_param_gradient(&self, v: f64, _z: &[f64], normal: f64, out: &mut [f64]) {
+        let a = (v / self.v_s).abs();
+        let power = self.shape(a);
+        let e = decay(power);
+        let sign = sgn(v);
+        let dip = normal * (self.mu_s - self.mu_c) * e * sign;
+        let (d_vs, d_delta) = if power > 0.0 {
+            (dip * self.delta * power / self.v_s, -dip * power * a.ln())
+        } else {
+            (0.0, 0.0)
+        };
+        let gradient = [
+            normal * (1.0 - e) * sign,
+            normal * e * sign,
+            d_vs,
+            d_delta,
+            v,
+        ];
+        for (o, d) in out.iter_mut().zip(gradient) {
+            *o = d;
+        }
     }
 }
 

@@ -12,7 +12,7 @@
 //! for the control of machines with friction", Automatica 30(7), 1994.
 
 use crate::hints::GuessHint;
-use crate::model::{sgn, FrictionModel, Staging, SwitchedLaw};
+use crate::model::{sgn, FrictionModel, ParamGradients, Staging, SwitchedLaw};
 
 crate::declare_params! {
     /// Coulomb friction with a viscous term proportional to the sliding velocity.
@@ -34,7 +34,16 @@ impl FrictionModel for ViscousCoulomb {
     fn steady_state(&self, v: f64, normal: f64) -> f64 {
         self.force(v, &[], normal)
     }
-    crate::law_groups!(switching, staging);
+    crate::law_groups!(switching, staging, param_gradients);
+}
+
+impl ParamGradients for ViscousCoulomb {
+    /// dF/dmu = N sgn(v), dF/dviscous = v.
+    fn force_param_gradient(&self, v: f64, _z: &[f64], normal: f64, out: &mut [f64]) {
+        for (o, d) in out.iter_mut().zip([normal * sgn(v), v]) {
+            *o = d;
+        }
+    }
 }
 
 impl SwitchedLaw for ViscousCoulomb {

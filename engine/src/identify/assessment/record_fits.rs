@@ -4,12 +4,10 @@
 use super::diagnostics;
 use super::energy_check::{energy_force_check, ForceReference};
 use crate::axis::Axis;
-use crate::energy::{
-    analyze_record, forces_from_states, states_along, states_along_stiff, MeasuredMotion,
-};
-use crate::error::{EngineError, IntegrationFailure};
+use crate::energy::{analyze_record, forces_from_states, states_along, MeasuredMotion};
+use crate::error::EngineError;
 use crate::identify::problem::{
-    AnalysisRequest, FitProblem, Realised, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
+    AnalysisRequest, FitProblem, Realised, RecordCase, Residuals, Segment,
 };
 use crate::identify::values::{
     ChannelFit, Check, EnergyForce, Finding, FitOptions, FitSeries, NuisanceValues, RecordFit,
@@ -203,9 +201,6 @@ fn energy_check<R: Residuals + ?Sized>(
         }
         Arc::new(analyze_record(&corrected, osc, &opts.energy)?)
     };
-    // The fit's step budget, for the explicit replay and then, for bristles too stiff for
-    // it, for the stiff one; a replay that fails both leaves the check skipped.
-    let budget = STEPS_PER_SAMPLE * (analysis.time.len() as u64).max(100);
     let model = world.model.as_ref();
     let normal = NormalForce::Constant(rec.oscillator_for(osc).normal_force);
     let motion = MeasuredMotion {
@@ -213,13 +208,7 @@ fn energy_check<R: Residuals + ?Sized>(
         v: &analysis.v,
         normal: &normal,
     };
-    let states = match states_along(model, motion, budget) {
-        Err(EngineError::StateIntegration {
-            failure: IntegrationFailure::StepBudgetExceeded { .. },
-            ..
-        }) => states_along_stiff(model, motion, budget)?,
-        other => other?,
-    };
+    let states = states_along(model, motion)?;
     let model_force = forces_from_states(model, &analysis.v, &normal, &states);
     let ef = energy_force_check(&analysis, ForceReference::ModelForce(&model_force))?;
     Ok((ef, analysis.friction.clone(), model_force))

@@ -31,13 +31,15 @@
 use super::inverse_dynamics::{
     linear_start, sliding_samples, Balance, BalanceSamples, LinearStart,
 };
-use super::residuals::STEPS_PER_SAMPLE;
-use super::residuals::{Evaluation, RecordCase, Residuals, Segment};
+use super::residuals::{Evaluation, JacobianColumns, RecordCase, Residuals, Segment};
 use super::state_cache::StateCache;
 use crate::energy::forces_at;
-use crate::energy::model_force::{check_motion, states_along_checked, CheckedMotion};
+use crate::energy::model_force::{
+    check_motion, force_derivatives_checked, states_along_checked, CheckedMotion,
+};
 use crate::energy::{analyze_record, record_motion};
 use crate::error::EngineError;
+use crate::identify::values::layout::{FreeParam, ParamKind};
 use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::nuisance::NuisanceKind;
 use crate::identify::values::options::{FitDomain, FitOptions, ForceTarget, OscillatorParam};
@@ -269,15 +271,9 @@ impl ForceAlongMotion {
         at: &Evaluation<'_>,
         track: &ForceTrack,
     ) -> Result<Arc<Vec<f64>>, EngineError> {
-        let budget = STEPS_PER_SAMPLE * (track.time.len() as u64).max(100);
         self.states.states(index, at.model, || {
             at.count_simulation();
-            let motion = CheckedMotion {
-                time: &track.time,
-                v: &track.velocity,
-                normal: &track.normal,
-            };
-            states_along_checked(at.model, motion, budget)
+            states_along_checked(at.model, track.motion())
         })
     }
 
@@ -400,6 +396,51 @@ impl ForceTrack {
             balance,
             sliding,
         })
+    }
+
+    /// The record's motion and normal force, checked when the track was prepared.
+    fn motion(&self) -> CheckedMotion<'_> {
+        CheckedMotion {
+            time: &self.time,
+            v: &self.velocity,
+            normal: &self.normal,
+        }
+    }
+
+    /// The derivative of the prediction at the compared samples with respect to the
+    /// oscillator property or nuisance parameter `kind` at `osc`: the balance's terms are
+    /// linear in J, c, the input offset and a linear spring's k, the force offset adds
+    /// itself to record `index` only. `None` for what is not that simple (a restoring law's
+    /// own parameters, another law's stiffness).
+    fn balance_column(&self, kind: ParamKind, index: usize, osc: &Oscillator) -> Option<Vec<f64>> {
+        let pick = |f: &dyn Fn(usize) -> f64| Some(self.used.iter().map(|&i| f(i)).collect());
+        let zeros = || Some(vec![0.0; self.used.len()]);
+        match (kind, &self.balance) {
+            (
+                ParamKind::Nuisance {
+                    kind: NuisanceKind::ForceOffset,
+                    record,
+                },
+                _,
+            ) => {
+                if record == index {
+                    Some(vec![1.0; self.used.len()])
+                } else {
+                    zeros()
+                }
+            }
+            (ParamKind::Nuisance { record, .. }, _) if record != index => zeros(),
+            (ParamKind::Nuisance { .. } | ParamKind::Model(_), _) => None,
+            (_, None) => zeros(),
+            (ParamKind::Mass, Some(b)) => pick(&|i| b.acceleration[i]),
+            (ParamKind::Damping, Some(_)) => pick(&|i| self.velocity[i]),
+            (ParamKind::InputOffset, Some(_)) => Some(vec![1.0; self.used.len()]),
+            (ParamKind::Stiffness | ParamKind::GravityMoment, Some(b)) if !b.restoring => zeros(),
+            (ParamKind::Stiffness, Some(_)) if osc.restoring.is_linear_spring() => {
+                pick(&|i| self.displacement[i])
+            }
+            (ParamKind::Stiffness | ParamKind::GravityMoment, Some(_)) => None,
+        }
     }
 
     /// The oscillator's terms J a + c v + R(q) at the compared samples (inverse dynamics;
@@ -593,6 +634,41 @@ impl Residuals for ForceAlongMotion {
 
     fn check_record(&self, record: &Record) -> Result<(), EngineError> {
         record.validate_channels(3)
+    }
+
+    fn has_jacobian(&self) -> bool {
+        true
+    }
+
+    /// The law's columns from one replay with sensitivities (where the law has exact steps
+    /// and a parameter gradient: `energy::model_force::force_derivatives_along`), the offset's
+    /// and the balance's linear terms; each weighted as the residuals are.
+    fn jacobian_columns(
+        &self,
+        at: &Evaluation<'_>,
+        case: RecordCase<'_>,
+        layout: &[FreeParam],
+    ) -> Result<JacobianColumns, EngineError> {
+        let track = self.track_of(case.index, case.record)?;
+        let weight = case.record.weight.sqrt() / track.noise;
+        let wanted = layout.iter().any(|f| matches!(f.kind, ParamKind::Model(_)));
+        let law = wanted
+            .then(|| force_derivatives_checked(at.model, track.motion(), &track.used))
+            .flatten();
+        if law.is_some() && at.model.n_states() > 0 {
+            at.count_simulation();
+        }
+        let columns = layout.iter().map(|f| {
+            let column = match (f.kind, &law) {
+                (ParamKind::Model(j), Some(d)) if d.given.get(j).copied().unwrap_or(false) => {
+                    Some((0..track.used.len()).map(|k| d.at(k, j)).collect())
+                }
+                (ParamKind::Model(_), _) => None,
+                (kind, _) => track.balance_column(kind, case.index, at.oscillator),
+            };
+            column.map(|c: Vec<f64>| c.into_iter().map(|x| weight * x).collect())
+        });
+        Ok(columns.collect())
     }
 
     /// The friction level from the target (mean |F| over the compared samples over the mean

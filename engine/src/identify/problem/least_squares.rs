@@ -3,10 +3,14 @@
 //! What the residuals are comes from a [`Residuals`] producer (the velocity response by
 //! default); the problem maps the solver's coordinates to a model, an oscillator and the
 //! per-record nuisance values, and concatenates the producer's residuals over the records.
-//! It implements argmin's [`Operator`] (residuals) and [`Jacobian`] (forward differences), so
-//! any argmin least-squares solver can drive it; ours is [`crate::identify::search::LevenbergMarquardt`].
+//! It implements argmin's [`Operator`] (residuals) and [`Jacobian`], so any argmin
+//! least-squares solver can drive it; ours is [`crate::identify::search::LevenbergMarquardt`].
+//! The Jacobian's columns come from the producer where it has them in closed form
+//! ([`Residuals::jacobian_columns`]: the force domain's law columns from one replay with
+//! sensitivities, its offsets' and the balance's linear terms), mapped from physical to
+//! internal coordinates by dp/du; every other column is a forward difference.
 
-use super::residuals::{Evaluation, RecordCase, Residuals};
+use super::residuals::{Evaluation, JacobianColumns, RecordCase, Residuals};
 use super::simulated_response::SimulatedResponse;
 use super::step_allowance::StepAllowance;
 use crate::error::{EngineError, IntegrationFailure};
@@ -249,14 +253,19 @@ impl<R: Residuals> FitProblem<R> {
         }
     }
 
-    /// Forward-difference Jacobian of the residuals in internal coordinates, stepping
-    /// inwards at an upper bound.
+    /// The Jacobian of the residuals in internal coordinates: the producer's closed-form
+    /// columns where it gives them, forward differences (stepping inwards at an upper bound)
+    /// for the others.
     pub fn jacobian_internal(&self, u: &DVector<f64>, r0: &DVector<f64>) -> DMatrix<f64> {
         let n = self.layout.len();
         if n == 0 {
             return DMatrix::zeros(r0.len(), 0);
         }
+        let analytic = self.analytic_columns(u, r0);
         let column = |j: usize| -> DVector<f64> {
+            if let Some(c) = &analytic[j] {
+                return c.clone();
+            }
             let (_, hi) = self.layout[j].internal_bounds();
             let h = self.fd_step(u, j);
             self.difference_column(u, r0, j, if u[j] + h > hi { -h } else { h })
@@ -267,6 +276,58 @@ impl<R: Residuals> FitProblem<R> {
             (0..n).map(column).collect()
         };
         DMatrix::from_columns(&cols)
+    }
+
+    /// The columns the producer gives in closed form at `u` (internal coordinates), `None` for
+    /// the others: all `None` when it gives none, when the residuals `r0` there are not finite
+    /// (a failed evaluation, whose columns the differences make NaN) or when it fails.
+    fn analytic_columns(&self, u: &DVector<f64>, r0: &DVector<f64>) -> Vec<Option<DVector<f64>>> {
+        let n = self.layout.len();
+        if !self.residuals.has_jacobian() || r0.iter().any(|r| !r.is_finite()) {
+            return vec![None; n];
+        }
+        let p = self.physical(u);
+        let Ok(world) = self.realise(&p) else {
+            return vec![None; n];
+        };
+        let at = self.evaluation(&world);
+        let record = |r: usize| -> Option<JacobianColumns> {
+            let case = RecordCase {
+                index: r,
+                record: &self.records[r],
+                nuisance: &world.nuisance[r],
+            };
+            let columns = self
+                .residuals
+                .jacobian_columns(&at, case, &self.layout)
+                .ok()?;
+            let len = self.residuals.residual_count(r, &self.records[r]);
+            let fits = |c: &Option<Vec<f64>>| c.as_ref().is_none_or(|c| c.len() == len);
+            (columns.len() == n && columns.iter().all(fits)).then_some(columns)
+        };
+        let parts: Vec<Option<JacobianColumns>> = if self.worth_threads() && self.records.len() > 1
+        {
+            (0..self.records.len())
+                .into_par_iter()
+                .map(record)
+                .collect()
+        } else {
+            (0..self.records.len()).map(record).collect()
+        };
+        let Some(parts) = parts.into_iter().collect::<Option<Vec<_>>>() else {
+            return vec![None; n];
+        };
+        (0..n)
+            .map(|j| {
+                let mut column = Vec::with_capacity(r0.len());
+                for part in &parts {
+                    column.extend_from_slice(part[j].as_ref()?);
+                }
+                // d r / d u = d r / d p * d p / d u, with d u / d p = internal_derivative.
+                let dp_du = 1.0 / self.layout[j].internal_derivative(p[j]);
+                Some(DVector::from_vec(column) * dp_du)
+            })
+            .collect()
     }
 
     /// Whether simulations should go to other threads: allowed, and the records are not so

@@ -22,6 +22,8 @@ pub use force_along_motion::{
 pub use guess::guess_hint;
 pub use least_squares::{FitProblem, ProblemParts, Realised};
 pub use motion_check::check_moves;
-pub use residuals::{Evaluation, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE};
+pub use residuals::{
+    Evaluation, JacobianColumns, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
+};
 pub use simulated_response::{simulated_levels, SimulatedResponse};
 pub use step_allowance::StepAllowance;

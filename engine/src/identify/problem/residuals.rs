@@ -16,7 +16,8 @@ use crate::energy::EnergyAnalysis;
 use crate::error::EngineError;
 use crate::identify::values::options::FitOptions;
 use crate::identify::values::{
-    ForceBalance, FrictionLevels, NuisanceKind, NuisanceValues, SampleAxes, SlidingSamples,
+    ForceBalance, FreeParam, FrictionLevels, NuisanceKind, NuisanceValues, SampleAxes,
+    SlidingSamples,
 };
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -227,6 +228,26 @@ pub trait Residuals: Send + Sync {
         }]
     }
 
+    /// Whether [`Residuals::jacobian_columns`] may give any column (default: `false`, and the
+    /// fit takes every column by finite differences without asking).
+    fn has_jacobian(&self) -> bool {
+        false
+    }
+
+    /// The derivatives of record `index`'s weighted residuals ([`Residuals::residuals`]) with
+    /// respect to the physical values of the free parameters `layout`, where the producer has
+    /// them without finite differences: one entry per free parameter, each a column of the
+    /// record's residual count, or `None` for a parameter it leaves to the fit's difference
+    /// quotients. Default: none.
+    fn jacobian_columns(
+        &self,
+        _at: &Evaluation<'_>,
+        _case: RecordCase<'_>,
+        layout: &[FreeParam],
+    ) -> Result<JacobianColumns, EngineError> {
+        Ok(vec![None; layout.len()])
+    }
+
     /// Weighted residuals `sqrt(weight) scale (predicted - measured)` of record `index`, with
     /// the scale of each of its [`Residuals::segments`].
     fn residuals(
@@ -257,6 +278,9 @@ pub trait Residuals: Send + Sync {
         Ok(out)
     }
 }
+
+/// A record's Jacobian columns, one per free parameter ([`Residuals::jacobian_columns`]).
+pub type JacobianColumns = Vec<Option<Vec<f64>>>;
 
 /// One record as a producer evaluates it: its place in the fit (for the per-record state of
 /// the producer and the step allowance), its data and its nuisance values.

@@ -1,0 +1,288 @@
+//! The GMS model's exact steps and parameter gradients (the model itself is in `gms.rs`).
+//!
+//! At constant v and N every element moves on its own: with its load y = sgn(v) k z / (w s(v))
+//! and the dimensionless travel sigma = k |v| t / (w s(v)), its law dz/dt = v (1 - max(0,
+//! sgn(v) rho)^m) reads
+//!
+//!   dy/dsigma = 1 - max(0, y)^m,
+//!
+//! separable in the travel. Unloaded (y <= 0) the element sticks, y grows by the travel, until
+//! it crosses 0 within the step and loads from there on. Loading it relaxes towards y = 1:
+//! 1 - y = (1 - y0) exp(-sigma) for m = 1, and for m = 2 y = tanh(atanh(y0) + sigma), written
+//! y = (y0 + tanh sigma) / (1 + y0 tanh sigma) so that it holds for an overloaded element
+//! (y0 > 1, where s(v) fell: it is coth(acoth(y0) + sigma)) as well. Other sharpnesses have no
+//! such closed form: the engine integrates them. A frozen element (w s = 0) stays.
+//!
+//! Sensitivities: the load and the travel scale with rho = k / (w s), so a parameter moves an
+//! element's step through d ln(rho)/dp (1/k, -1/w, -(ds/dp)/s for the Stribeck parameters):
+//! dy0/dp = y0 d ln(rho)/dp + sgn(v) rho dz0/dp, dsigma/dp = sigma d ln(rho)/dp, and
+//! dz1/dp = sgn(v) (dy1/dp - y1 d ln(rho)/dp) / rho with dy1 = (dy1/dy0) dy0 + (dy1/dsigma)
+//! dsigma. The sharpness has none (its derivative of the step is no closed form): those
+//! entries are NaN and `exact_sensitivities` says so.
+
+use super::gms::{Gms, GmsElement};
+use crate::interval::Interval;
+use crate::model::{sgn, FrictionModel, ParamGradients, Propagator};
+
+/// An element's exact step in its load y over the travel sigma.
+struct LoadStep {
+    /// y1 - y0.
+    change: f64,
+    /// dy1/dy0.
+    gain: f64,
+    /// dy1/dsigma (the rate 1 - max(0, y1)^m).
+    slope: f64,
+    /// The element stuck throughout (dz = v dt, whatever its parameters).
+    stuck: bool,
+}
+
+/// tanh(x) and 1 - tanh(x)^2 for x >= 0, from exp(-2x) (no cancellation near 1).
+fn tanh_and_rate(x: f64) -> (f64, f64) {
+    let e2 = (-2.0 * x).exp();
+    let t = -(-2.0 * x).exp_m1() / (1.0 + e2);
+    (t, 4.0 * e2 / ((1.0 + e2) * (1.0 + e2)))
+}
+
+/// The load after the travel `rest` from y = 0 and the rate there: (y, 1 - y^m).
+fn loaded_from_zero(two: bool, rest: f64) -> (f64, f64) {
+    if two {
+        tanh_and_rate(rest)
+    } else {
+        let kept = (-rest).exp();
+        (-(-rest).exp_m1(), kept)
+    }
+}
+
+/// The step of a loaded element (y0 > 0) over the travel `sigma`.
+fn loaded_step(two: bool, y0: f64, sigma: f64) -> LoadStep {
+    if two {
+        let (t, rate) = tanh_and_rate(sigma);
+        let den = 1.0 + y0 * t;
+        let change = t * (1.0 - y0) * (1.0 + y0) / den;
+        // 1 - y1 = (1 - y0)(1 - tanh sigma) / den, with 1 - tanh sigma from exp(-2 sigma).
+        let e2 = (-2.0 * sigma).exp();
+        let unloaded = (1.0 - y0) * (2.0 * e2 / (1.0 + e2)) / den;
+        LoadStep {
+            change,
+            gain: rate / (den * den),
+            slope: unloaded * (2.0 - unloaded),
+            stuck: false,
+        }
+    } else {
+        let kept = (-sigma).exp();
+        LoadStep {
+            change: -(1.0 - y0) * (-sigma).exp_m1(),
+            gain: kept,
+            slope: (1.0 - y0) * kept,
+            stuck: false,
+        }
+    }
+}
+
+/// The exact step of an element's load from `y0` over the travel `sigma` >= 0 (m = 2 when
+/// `two`, else m = 1).
+fn load_step(two: bool, y0: f64, sigma: f64) -> LoadStep {
+    if y0 > 0.0 {
+        return loaded_step(two, y0, sigma);
+    }
+    if y0 + sigma <= 0.0 {
+        return LoadStep {
+            change: sigma,
+            gain: 1.0,
+            slope: 1.0,
+            stuck: true,
+        };
+    }
+    // Stuck until the load crosses 0, then loading over the rest of the travel.
+    let (y1, rate) = loaded_from_zero(two, y0 + sigma);
+    LoadStep {
+        change: y1 - y0,
+        gain: rate,
+        slope: rate,
+        stuck: false,
+    }
+}
+
+/// An element's frame in one interval: rho = k / (w s), its load and its travel.
+struct ElementFrame {
+    rho: f64,
+    y0: f64,
+    sigma: f64,
+    step: LoadStep,
+}
+
+impl Gms {
+    /// Whether the element law has a closed form: sharpness 1 or 2.
+    fn has_closed_form(&self) -> bool {
+        self.sharpness == 1.0 || self.sharpness == 2.0
+    }
+
+    /// Steps the element `e` of deflection `z` over `interval` at the Stribeck level `s`;
+    /// `None` where it stays (frozen, or no motion).
+    fn step_element(
+        &self,
+        e: &GmsElement,
+        interval: Interval,
+        s: f64,
+        z: &mut f64,
+    ) -> Option<ElementFrame> {
+        let limit = e.weight * s;
+        if limit.is_nan() || limit <= 0.0 || interval.v == 0.0 || interval.dt <= 0.0 {
+            return None;
+        }
+        let u = sgn(interval.v);
+        let rho = e.stiffness / limit;
+        let y0 = u * rho * *z;
+        let sigma = rho * interval.travel();
+        let step = load_step(self.sharpness == 2.0, y0, sigma);
+        *z += if step.stuck {
+            interval.v * interval.dt
+        } else {
+            u * step.change / rho
+        };
+        Some(ElementFrame {
+            rho,
+            y0,
+            sigma,
+            step,
+        })
+    }
+
+    /// s(v) and its derivatives with respect to mu_c, mu_s, v_s and delta (s computed as
+    /// [`Gms::s`] computes it, to the bit).
+    fn s_and_param_slopes(&self, v: f64, normal: f64) -> (f64, [f64; 4]) {
+        let power = (v / self.v_s).abs().powf(self.delta);
+        let e = crate::model::decay(power);
+        let s = normal * (self.mu_c + (self.mu_s - self.mu_c) * e);
+        let dip = normal * (self.mu_s - self.mu_c) * e;
+        let (d_vs, d_delta) = if power > 0.0 {
+            let ln_ratio = (v / self.v_s).abs().ln();
+            (dip * self.delta * power / self.v_s, -dip * power * ln_ratio)
+        } else {
+            (0.0, 0.0)
+        };
+        (s, [normal * (1.0 - e), normal * e, d_vs, d_delta])
+    }
+
+    /// d ln(rho_i)/dp_j for element `i` (see the module docs), `n` elements.
+    fn log_rho_slope(&self, i: usize, j: usize, s: f64, s_slopes: &[f64; 4]) -> f64 {
+        let n = self.elements.len();
+        let e = &self.elements[i];
+        if j == i {
+            1.0 / e.stiffness
+        } else if j == n + i {
+            -1.0 / e.weight
+        } else if (3 * n..3 * n + 4).contains(&j) {
+            -s_slopes[j - 3 * n] / s
+        } else {
+            0.0
+        }
+    }
+}
+
+impl Propagator for Gms {
+    fn propagates_exactly(&self) -> bool {
+        self.has_closed_form()
+    }
+
+    fn propagate(&self, interval: Interval, z: &mut [f64]) {
+        let s = self.s(interval.v, interval.normal);
+        for (e, zi) in self.elements.iter().zip(z.iter_mut()) {
+            self.step_element(e, interval, s, zi);
+        }
+    }
+
+    fn propagate_with_sensitivities(&self, interval: Interval, z: &mut [f64], sens: &mut [f64]) {
+        let (s, s_slopes) = self.s_and_param_slopes(interval.v, interval.normal);
+        // The parameter vector: three per element, then six shared ones.
+        let np = 3 * self.elements.len() + 6;
+        let sharpness = 3 * self.elements.len() + 4;
+        let u = sgn(interval.v);
+        for (i, (e, zi)) in self.elements.iter().zip(z.iter_mut()).enumerate() {
+            let Some(row) = sens.get_mut(i * np..(i + 1) * np) else {
+                return;
+            };
+            row[sharpness] = f64::NAN;
+            let Some(frame) = self.step_element(e, interval, s, zi) else {
+                continue;
+            };
+            if frame.step.stuck {
+                continue;
+            }
+            let y1 = frame.y0 + frame.step.change;
+            for (j, sj) in row.iter_mut().enumerate() {
+                if j == sharpness {
+                    continue;
+                }
+                let g = self.log_rho_slope(i, j, s, &s_slopes);
+                let dy0 = frame.y0 * g + u * frame.rho * *sj;
+                let dy1 = frame.step.gain * dy0 + frame.step.slope * frame.sigma * g;
+                *sj = u * (dy1 - y1 * g) / frame.rho;
+            }
+        }
+    }
+
+    /// Every parameter but the sharpness.
+    fn exact_sensitivities(&self) -> Vec<bool> {
+        let sharpness = 3 * self.elements.len() + 4;
+        (0..self.params().len()).map(|j| j != sharpness).collect()
+    }
+}
+
+impl ParamGradients for Gms {
+    /// Per element F_i = k_i z_i + sigma_i dz_i/dt: the spring's k_i, and through a damped
+    /// element's rate v (1 - load^m) (load = sgn(v) k z / (w s) > 0) its k_i, w_i, the
+    /// Stribeck parameters and the sharpness; sigma_i gives the rate; the viscous term v.
+    fn force_param_gradient(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) {
+        let n = self.elements.len();
+        out.iter_mut().for_each(|o| *o = 0.0);
+        let (s, s_slopes) = self.s_and_param_slopes(v, normal);
+        let mut d_s = 0.0;
+        let mut d_sharpness = 0.0;
+        for (i, e) in self.elements.iter().enumerate() {
+            let zi = z.get(i).copied().unwrap_or(0.0);
+            let rate = self.z_dot(e, v, zi, s);
+            let (d_load, d_m) = self.rate_slopes(e, v, zi, s);
+            let (d_k, d_w) = if d_load == 0.0 || e.damping == 0.0 {
+                (0.0, 0.0)
+            } else {
+                d_s -= e.damping * d_load / s;
+                d_sharpness += e.damping * d_m;
+                (
+                    e.damping * d_load / e.stiffness,
+                    -e.damping * d_load / e.weight,
+                )
+            };
+            for (k, d) in [zi + d_k, d_w, rate].into_iter().enumerate() {
+                if let Some(o) = out.get_mut(k * n + i) {
+                    *o = d;
+                }
+            }
+        }
+        for (k, slope) in s_slopes.iter().enumerate() {
+            if let Some(o) = out.get_mut(3 * n + k) {
+                *o = d_s * slope;
+            }
+        }
+        if let Some(o) = out.get_mut(3 * n + 4) {
+            *o = d_sharpness;
+        }
+        if let Some(o) = out.get_mut(3 * n + 5) {
+            *o = v;
+        }
+    }
+}
+
+impl Gms {
+    /// A loading element's d(rate)/d(ln load) = -v m load^m and d(rate)/dm = -v load^m
+    /// ln(load); (0, 0) unloading or frozen.
+    fn rate_slopes(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> (f64, f64) {
+        match Gms::element_load(e, v, z, s) {
+            Some((_, load)) if load > 0.0 => {
+                let p = load.powf(self.sharpness);
+                (-v * self.sharpness * p, -v * p * load.ln())
+            }
+            _ => (0.0, 0.0),
+        }
+    }
+}
