@@ -367,7 +367,7 @@ fn load_group(spec: &Spec, task: &GroupTask) -> Result<Vec<Record>, String> {
         .zip(&task.lines)
         .map(|(source, &line)| {
             let resolved = source
-                .resolve(line, &task.base_dir)
+                .resolve_for(line, &task.base_dir, spec.record_use())
                 .map_err(|e| e.to_string())?;
             // Units are checked against k/m only when the oscillator is known.
             if spec.unknown_oscillator.is_empty() {
