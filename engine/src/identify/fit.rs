@@ -153,7 +153,8 @@ fn fit_seeded<R: Residuals + 'static>(
         )?;
         (runs, seeded.into_iter().map(|s: Seeded| s.origin).collect())
     };
-    if let Some((jac, r)) = &runs.best.linearisation {
+    let mut runs = runs;
+    if let Some((jac, r)) = runs.best.linearisation.take() {
         reference.adopt_linearisation(&runs.best.u, jac, r);
     }
     let (runs, standings) = identifiability::settle(&reference, runs, opts)?;

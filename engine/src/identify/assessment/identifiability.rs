@@ -435,7 +435,7 @@ fn restart_from<R: Residuals + 'static>(
     let before = std::mem::replace(&mut runs.best, run);
     runs.best.iterations += before.iterations;
     runs.best.simulations += before.simulations;
-    if let Some((jac, r)) = &runs.best.linearisation {
+    if let Some((jac, r)) = runs.best.linearisation.take() {
         reference.adopt_linearisation(&runs.best.u, jac, r);
     }
     true

@@ -368,6 +368,11 @@ impl LevenbergMarquardt {
         (&self.jacobian, &self.residuals)
     }
 
+    /// The same, moved out of the solver at the end of its run.
+    pub fn into_linearisation(self) -> (DMatrix<f64>, DVector<f64>) {
+        (self.jacobian, self.residuals)
+    }
+
     /// The typed reason of the last run's convergence (`None` while running, or when it was
     /// stopped from outside, e.g. by the iteration limit).
     pub fn termination(&self) -> Option<&TerminationReason> {

@@ -16,7 +16,7 @@ use argmin::core::{Executor, State, KV};
 use frictionid_models::FrictionModel;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// The relative damping start of the fits that take one (see [`damping_start_for`]).
 pub const RELATIVE_DAMPING: f64 = 1e-5;
@@ -270,25 +270,63 @@ pub fn run_start<R: Residuals + 'static>(
         .get_best_param()
         .cloned()
         .ok_or_else(|| EngineError::Fit("the solver returned no parameters".into()))?;
-    let (jac, r) = res.solver.linearisation();
-    let linearisation =
-        (jac.ncols() == u.len() && r.len() == jac.nrows()).then(|| (jac.clone(), r.clone()));
+    let cost = state.get_best_cost();
+    let iterations = state.get_iter();
+    let termination =
+        termination_reason(&res.solver, &state.termination_status, slot.max_iterations);
+    let (jac, r) = res.solver.into_linearisation();
+    let linearisation = (jac.ncols() == u.len() && r.len() == jac.nrows()).then_some((jac, r));
     let run = StartRun {
         u,
         linearisation,
-        cost: state.get_best_cost(),
-        iterations: state.get_iter(),
+        cost,
+        iterations,
         simulations,
-        termination: termination_reason(
-            &res.solver,
-            &state.termination_status,
-            slot.max_iterations,
-        ),
+        termination,
     };
     if let (Some(pace), true) = (&slot.pace, run.converged()) {
         pace.converged_at(run.cost);
     }
     Ok(run)
+}
+
+/// A run's Jacobian (internal coordinates) and residuals at its best point.
+type Linearisation = (DMatrix<f64>, DVector<f64>);
+
+/// The linearisation of the lowest-cost run among those handed in: the fit adopts the best
+/// run's only, and each is as large as the records times the free parameters, so the others
+/// are dropped as they finish (a global search screens a dozen starts).
+#[derive(Default)]
+struct BestLinearisation(Mutex<Option<(f64, usize, Linearisation)>>);
+
+impl BestLinearisation {
+    /// Takes the linearisation of start `start`'s `run`, keeping it if the run is the best so
+    /// far.
+    fn offer(&self, start: usize, run: &mut StartRun) {
+        let Some(linearisation) = run.linearisation.take() else {
+            return;
+        };
+        if let Ok(mut best) = self.0.lock() {
+            let better = best
+                .as_ref()
+                .is_none_or(|(cost, _, _)| run.cost.total_cmp(cost).is_lt());
+            if better && run.cost.is_finite() {
+                *best = Some((run.cost, start, linearisation));
+            }
+        }
+    }
+
+    /// Gives the kept linearisation back to its run among `runs` (the same start, still at
+    /// the same cost).
+    fn restore(self, runs: &mut [(usize, StartRun)]) {
+        let Some((cost, start, linearisation)) = self.0.into_inner().ok().flatten() else {
+            return;
+        };
+        let owner = runs.iter_mut().find(|(s, r)| *s == start && r.cost == cost);
+        if let Some((_, run)) = owner {
+            run.linearisation = Some(linearisation);
+        }
+    }
 }
 
 /// The result of every start: the best run and what became of each start.
@@ -364,6 +402,7 @@ where
         pace.converged_at(cost);
         Arc::new(pace)
     });
+    let best = BestLinearisation::default();
     let run = |(s, p): (usize, &Vec<f64>)| {
         let problem = make_problem();
         let u0 = problem.internal(p);
@@ -374,7 +413,9 @@ where
             pace: screen_pace.clone(),
             cost_resolution: None,
         };
-        run_start(problem, u0, opts, slot)
+        let mut run = run_start(problem, u0, opts, slot)?;
+        best.offer(s, &mut run);
+        Ok(run)
     };
     let runs: Vec<Result<StartRun, EngineError>> = if opts.parallel && n_starts > 1 {
         points.par_iter().enumerate().map(run).collect()
@@ -382,6 +423,7 @@ where
         points.iter().enumerate().map(run).collect()
     };
     let mut screened = classify(runs);
+    best.restore(&mut screened.ok);
     if n_starts > 1 && screen < opts.max_iterations {
         let phase = Phase {
             screen,
@@ -449,9 +491,14 @@ fn continue_best<R, F>(
     // and Jacobian columns in parallel).
     let finished: Vec<(usize, Result<StartRun, EngineError>)> =
         promoted.iter().map(finish).collect();
+    let best = BestLinearisation::default();
+    for (start, run) in &mut screened.ok {
+        best.offer(*start, run);
+    }
     for (start, run) in finished {
         match run {
-            Ok(o) if o.cost.is_finite() => {
+            Ok(mut o) if o.cost.is_finite() => {
+                best.offer(start, &mut o);
                 if let Some(slot) = screened.ok.iter_mut().find(|(t, _)| *t == start) {
                     merge_continuation(&mut slot.1, o, opts.max_iterations);
                 }
@@ -462,6 +509,7 @@ fn continue_best<R, F>(
                 .push((start, StartOutcome::ContinuationFailed { start, error })),
         }
     }
+    best.restore(&mut screened.ok);
 }
 
 /// Replaces a screened run by its continuation, adding up the work of both; an iteration
