@@ -423,6 +423,7 @@ fn restart_from<R: Residuals + 'static>(
         max_iterations: opts.max_iterations,
         pace: None,
         cost_resolution: None,
+        explain: false,
     };
     let Ok(run) = run_start(problem, u, opts, slot) else {
         return false;
@@ -577,6 +578,7 @@ fn pinned_fit<R: Residuals + 'static>(
             max_iterations: iterations,
             pace: None,
             cost_resolution,
+            explain: false,
         };
         run_start(sub, others.clone(), opts, slot).ok()?
     };
