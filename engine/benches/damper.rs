@@ -61,7 +61,13 @@ fn damper_fits(c: &mut Criterion) {
     let models: Vec<Box<dyn FrictionModel>> =
         vec![Box::new(Coulomb::default()), Box::new(Dahl::default())];
     let fit_one = |record: &Record| -> Comparison {
-        compare(&osc, black_box(&models), std::slice::from_ref(record), &opts).expect("compare")
+        compare(
+            &osc,
+            black_box(&models),
+            std::slice::from_ref(record),
+            &opts,
+        )
+        .expect("compare")
     };
     let mut group = c.benchmark_group("damper");
     group.sample_size(10);

@@ -251,7 +251,12 @@ fn drive_friction_record() -> Record {
     let time: Vec<f64> = (0..25_000).map(|i| i as f64 * 1e-3).collect();
     let v: Vec<f64> = time
         .iter()
-        .map(|&t| TONES.iter().map(|&(a, f, p)| a * (TAU * f * t + p).sin()).sum())
+        .map(|&t| {
+            TONES
+                .iter()
+                .map(|&(a, f, p)| a * (TAU * f * t + p).sin())
+                .sum()
+        })
         .collect();
     let mut force = lugre_force_along(&v);
     add_gaussian_noise(&mut force, 0.3, 25);
@@ -279,9 +284,10 @@ fn drive_compare(c: &mut Criterion) {
     let record = [drive_friction_record()];
     let mut group = c.benchmark_group("compare");
     group.sample_size(10);
-    group.bench_function("five models, force domain, 25 000-sample drive record", |b| {
-        b.iter(|| compare(&osc, black_box(&models), &record, &opts).expect("compare"))
-    });
+    group.bench_function(
+        "five models, force domain, 25 000-sample drive record",
+        |b| b.iter(|| compare(&osc, black_box(&models), &record, &opts).expect("compare")),
+    );
     group.finish();
 }
 

@@ -17,7 +17,10 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: writing the damper records to {}: {e}", dir.display());
+            eprintln!(
+                "error: writing the damper records to {}: {e}",
+                dir.display()
+            );
             ExitCode::FAILURE
         }
     }

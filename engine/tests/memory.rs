@@ -124,7 +124,10 @@ fn damper_stroke(samples: usize) -> Record {
     use std::f64::consts::TAU;
     let (sigma0, level) = (5e5, 60.0);
     let time: Vec<f64> = (0..samples).map(|i| i as f64 * 1e-3).collect();
-    let x: Vec<f64> = time.iter().map(|&t| 0.002 * (TAU * 3.0 * t).sin()).collect();
+    let x: Vec<f64> = time
+        .iter()
+        .map(|&t| 0.002 * (TAU * 3.0 * t).sin())
+        .collect();
     let mut force = Vec::with_capacity(samples);
     let mut f = 0.0;
     for (i, &xi) in x.iter().enumerate() {

@@ -37,7 +37,10 @@ fn a_start_below_the_domain_is_projected_and_the_fit_succeeds() {
 fn damper_stroke() -> Record {
     let (sigma0, level) = (4e5, 50.0);
     let time: Vec<f64> = (0..4000).map(|i| i as f64 * 1e-3).collect();
-    let x: Vec<f64> = time.iter().map(|&t| 0.003 * (TAU * 2.0 * t).sin()).collect();
+    let x: Vec<f64> = time
+        .iter()
+        .map(|&t| 0.003 * (TAU * 2.0 * t).sin())
+        .collect();
     let mut force = Vec::with_capacity(x.len());
     let mut f = 0.0;
     for (i, &xi) in x.iter().enumerate() {

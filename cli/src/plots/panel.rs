@@ -113,7 +113,12 @@ pub(super) fn envelope(points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
         let by_y = |a: &&(f64, f64), b: &&(f64, f64)| a.1.total_cmp(&b.1);
         let lowest = c.iter().enumerate().min_by(|a, b| by_y(&a.1, &b.1));
         let highest = c.iter().enumerate().max_by(|a, b| by_y(&a.1, &b.1));
-        let mut picks = [0, lowest.map_or(0, |p| p.0), highest.map_or(0, |p| p.0), c.len() - 1];
+        let mut picks = [
+            0,
+            lowest.map_or(0, |p| p.0),
+            highest.map_or(0, |p| p.0),
+            c.len() - 1,
+        ];
         picks.sort_unstable();
         let mut last = None;
         for i in picks {

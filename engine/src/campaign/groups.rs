@@ -235,7 +235,14 @@ mod tests {
             models: None,
         };
         let defaults = RecordSource::default();
-        plan_groups(&m, &spec, &defaults, RecordUse::Simulated, Path::new("d"), 1000)
+        plan_groups(
+            &m,
+            &spec,
+            &defaults,
+            RecordUse::Simulated,
+            Path::new("d"),
+            1000,
+        )
     }
 
     #[test]
@@ -267,15 +274,29 @@ mod tests {
         let m = Manifest::parse("runs.csv", "file\na.csv\n").unwrap();
         let spec = CampaignSpec::default();
         let defaults = RecordSource::default();
-        let e = plan_groups(&m, &spec, &defaults, RecordUse::Simulated, Path::new("."), 10)
-            .unwrap_err()
-            .to_string();
+        let e = plan_groups(
+            &m,
+            &spec,
+            &defaults,
+            RecordUse::Simulated,
+            Path::new("."),
+            10,
+        )
+        .unwrap_err()
+        .to_string();
         assert!(
             e.starts_with("runs.csv:2: [[records]] entry 2 (`a.csv`): missing `x0`"),
             "{e}"
         );
         // Replayed along its measured motion (a force-domain fit), a record needs no x0.
-        let replayed = plan_groups(&m, &spec, &defaults, RecordUse::Replayed, Path::new("."), 10);
+        let replayed = plan_groups(
+            &m,
+            &spec,
+            &defaults,
+            RecordUse::Replayed,
+            Path::new("."),
+            10,
+        );
         assert_eq!(replayed.unwrap()[0].single_file(), Some("a.csv"));
     }
 }

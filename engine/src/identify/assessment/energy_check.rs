@@ -355,7 +355,10 @@ mod tests {
                 .iter()
                 .map(|v| 0.24 * osc.normal_force * v.signum())
                 .collect();
-            for reference in [ForceReference::ModelForce(&model), ForceReference::Level(3.5)] {
+            for reference in [
+                ForceReference::ModelForce(&model),
+                ForceReference::Level(3.5),
+            ] {
                 let of = |a: &EnergyAnalysis| {
                     serde_json::to_string(&energy_force_check(a, reference).unwrap()).unwrap()
                 };

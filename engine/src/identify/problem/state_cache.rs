@@ -155,9 +155,15 @@ mod tests {
         assert_eq!(*cache.states(0, &at(1.0), computed(0.0)).unwrap(), [1.0]);
         cache.states(0, &at(10.0), computed(10.0)).unwrap();
         assert!(cache.find(&Key::of(0, &at(1.0))).is_some());
-        assert!(cache.find(&Key::of(0, &at(2.0))).is_none(), "least recently used");
+        assert!(
+            cache.find(&Key::of(0, &at(2.0))).is_none(),
+            "least recently used"
+        );
         assert!(cache.find(&Key::of(1, &at(1.0))).is_some());
         let kept = cache.entries.lock().unwrap();
-        assert_eq!(kept.iter().filter(|(k, _)| k.record == 0).count(), per_record);
+        assert_eq!(
+            kept.iter().filter(|(k, _)| k.record == 0).count(),
+            per_record
+        );
     }
 }

@@ -8,11 +8,11 @@ use super::lm::{
 use crate::error::EngineError;
 use crate::identify::problem::least_squares::{FitProblem, Realised};
 use crate::identify::problem::residuals::{RecordCase, Residuals};
-use crate::record::Record;
 use crate::identify::values::layout::{FreeParam, ParamKind};
 use crate::identify::values::options::{FitOptions, Progress, ProgressFn};
 use crate::identify::values::outcome::{StartOutcome, TerminationReason};
 use crate::identify::values::search::fits_directly;
+use crate::record::Record;
 use argmin::core::observers::{Observe, ObserverMode};
 use argmin::core::{Error, Executor, Jacobian, Operator, State, KV};
 use frictionid_models::FrictionModel;
@@ -265,10 +265,12 @@ pub fn run_start<R: Residuals + 'static>(
             ObserverMode::Always,
         );
     }
-    let res = exec.run().map_err(|e| match e.downcast_ref::<NonFiniteStart>() {
-        Some(_) if slot.explain => non_finite_start(&problem, &u0),
-        _ => EngineError::Fit(e.to_string()),
-    })?;
+    let res = exec
+        .run()
+        .map_err(|e| match e.downcast_ref::<NonFiniteStart>() {
+            Some(_) if slot.explain => non_finite_start(&problem, &u0),
+            _ => EngineError::Fit(e.to_string()),
+        })?;
     let state = res.state();
     let u = state
         .get_best_param()

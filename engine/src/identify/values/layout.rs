@@ -232,7 +232,14 @@ mod tests {
         assert_eq!(linear.project(f64::NAN, 0.3), 0.3);
         let log = FreeParam {
             log: true,
-            ..FreeParam::linear("sigma0".into(), "N/m", ParamKind::Model(0), (0.0, 1e9), 1e5, 1.0)
+            ..FreeParam::linear(
+                "sigma0".into(),
+                "N/m",
+                ParamKind::Model(0),
+                (0.0, 1e9),
+                1e5,
+                1.0,
+            )
         };
         assert_eq!(log.project(-1e5, 1e5), 1e5);
         assert_eq!(log.project(0.0, 1e5), 1e5);
