@@ -106,6 +106,8 @@ fn fmm_record(model: &dyn frictionid_models::FrictionModel, x0: f64) -> Record {
     Record::new("fmm", times, traj.v, x0)
 }
 
+/// A coefficient beyond the law's bounds is refused by a simulation, by a fit that holds it
+/// fixed and by a config; a fit that frees it starts at the bound and finds the record's.
 #[test]
 fn an_extreme_friction_coefficient_is_refused_by_simulation_and_fit() {
     let osc = Oscillator::fmm();
@@ -122,8 +124,19 @@ fn an_extreme_friction_coefficient_is_refused_by_simulation_and_fit() {
     .unwrap_err();
     assert!(one_line(&e).contains("`mu`"), "{e}");
     let rec = fmm_record(&Coulomb { mu: 0.2 }, 0.02);
-    let e = fit(&osc, &model, &[rec], &FitOptions::default()).unwrap_err();
+    let fixed = FitOptions {
+        free: Some(Vec::new()),
+        ..FitOptions::default()
+    };
+    let e = fit(&osc, &model, std::slice::from_ref(&rec), &fixed).unwrap_err();
     assert!(one_line(&e).contains("`mu`"), "{e}");
+    let projected = FitOptions {
+        guess: false,
+        ..FitOptions::default()
+    };
+    let fitted = fit(&osc, &model, &[rec], &projected).expect("a start projected to the bound");
+    let mu = fitted.fitted_model.params()[0];
+    assert!((mu - 0.2).abs() < 1e-6, "mu = {mu}");
     // Through a config file the message names the table.
     let text = OSC.replace("type = \"coulomb\"", "type = \"coulomb\"\nmu = 1e6");
     let e = Config::parse(std::path::Path::new("mu.toml"), &text).unwrap_err();

@@ -121,7 +121,8 @@ fn dahl_force(time: &[f64], amplitude: f64, omega: f64, sigma0: f64, fc: f64) ->
 
 /// The Dahl campaign: a tribometer imposing x = A sin(2 pi t), A = 0.5, 1 and 2 mm, under
 /// each normal force, two records (noise seeds) per group; force at 1 kHz for 1.5 s with
-/// 0.01 N noise. m, c, k are unknown: a measured force needs only the normal force.
+/// 0.01 N noise. m, c, k are unknown: a measured force needs only the normal force, and no
+/// record needs x0 (its motion is replayed as measured).
 fn dahl_campaign(dir: &Path) -> PathBuf {
     let omega = 2.0 * PI;
     let time: Vec<f64> = (0..1500).map(|i| i as f64 * 1e-3).collect();
@@ -149,7 +150,7 @@ fn dahl_campaign(dir: &Path) -> PathBuf {
     std::fs::write(dir.join("runs.csv"), rows).expect("manifest");
     let config = dir.join("dahl.toml");
     let text = "[oscillator]\n[model]\ntype = \"dahl\"\nalpha = 1.0\n[fit]\nfree = [\"sigma0\", \"mu_c\"]\n\
-                [fit.options]\ndomain = \"force\"\n[record_defaults]\nx0 = 0.0\n\
+                [fit.options]\ndomain = \"force\"\n\
                 [campaign]\nmanifest = \"runs.csv\"\ngroup_by = [\"normal_force\", \"amplitude_mm\"]\n";
     std::fs::write(&config, text).expect("config");
     config

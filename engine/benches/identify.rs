@@ -2,7 +2,9 @@
 //! five-model comparison, and LuGre fits from the default start and from the truth of stiff
 //! (sigma0 = 1e7) records. Records: the acceptance set-up of the tests (releases of 10, 14
 //! and 22 mm, 2 s at 1 kHz, 0.2 mm/s noise). And the inverse-dynamics fit of a driven axis
-//! (25 000 samples; `benches/scipy_inverse_dynamics.py` is SciPy's counterpart).
+//! (25 000 samples; `benches/scipy_inverse_dynamics.py` is SciPy's counterpart), and five
+//! models compared in the force domain along a driven axis's measured motion and friction
+//! force (25 000 samples).
 
 /// mimalloc, as the `frictionid` binary and the Python module use (glibc's malloc returned
 /// and refaulted the fits' buffers, a sixth of a Coulomb fit's time).
@@ -209,11 +211,92 @@ fn inverse_dynamics(c: &mut Criterion) {
     group.finish();
 }
 
+/// LuGre's friction force (in N: no normal force) along the velocity `v` sampled at 1 kHz,
+/// linear between samples, by classical Runge-Kutta with 50 steps per sample from z = 0:
+/// sigma0 1e5 N/m, sigma1 300 N s/m, sigma2 5 N s/m, F_c 20 N, F_s 30 N, v_s 0.01 m/s.
+fn lugre_force_along(v: &[f64]) -> Vec<f64> {
+    const SUBSTEPS: usize = 50;
+    let (sigma0, sigma1, sigma2) = (1e5, 300.0, 5.0);
+    let (fc, fs, vs) = (20.0, 30.0, 0.01);
+    let rate = |z: f64, v: f64| {
+        let g = fc + (fs - fc) * (-(v / vs).powi(2)).exp();
+        v - sigma0 * v.abs() * z / g
+    };
+    let h = 1e-3 / SUBSTEPS as f64;
+    let mut z = 0.0;
+    let mut out = Vec::with_capacity(v.len());
+    for (i, &vi) in v.iter().enumerate() {
+        out.push(sigma0 * z + sigma1 * rate(z, vi) + sigma2 * vi);
+        let Some(&next) = v.get(i + 1) else { break };
+        let at = |s: f64| vi + (next - vi) * s / SUBSTEPS as f64;
+        for k in 0..SUBSTEPS {
+            let s = k as f64;
+            let k1 = rate(z, at(s));
+            let k2 = rate(z + 0.5 * h * k1, at(s + 0.5));
+            let k3 = rate(z + 0.5 * h * k2, at(s + 0.5));
+            let k4 = rate(z + h * k3, at(s + 1.0));
+            z += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+        }
+    }
+    out
+}
+
+/// A driven axis's record: 25 000 samples at 1 kHz of a three-tone velocity that reverses
+/// (0.05, 0.03 and 0.01 m/s at 0.3, 1.1 and 2.9 Hz), measured with 0.1 mm/s noise, and its
+/// LuGre friction force measured with 0.3 N noise.
+fn drive_friction_record() -> Record {
+    use frictionid_engine::synthetic::add_gaussian_noise;
+    use std::f64::consts::TAU;
+    const TONES: [(f64, f64, f64); 3] = [(0.05, 0.3, 0.0), (0.03, 1.1, 1.0), (0.01, 2.9, 2.0)];
+    let time: Vec<f64> = (0..25_000).map(|i| i as f64 * 1e-3).collect();
+    let v: Vec<f64> = time
+        .iter()
+        .map(|&t| {
+            TONES
+                .iter()
+                .map(|&(a, f, p)| a * (TAU * f * t + p).sin())
+                .sum()
+        })
+        .collect();
+    let mut force = lugre_force_along(&v);
+    add_gaussian_noise(&mut force, 0.3, 25);
+    let mut measured_v = v;
+    add_gaussian_noise(&mut measured_v, 1e-4, 26);
+    Record::from_time_base("drive", TimeBase::new(time).expect("time"))
+        .with_channel(Channel::Velocity, measured_v)
+        .with_channel(Channel::Force, force)
+}
+
+/// coulomb, viscous_coulomb, stribeck, dahl and lugre compared in the force domain on the
+/// driven axis's measured friction force (no oscillator given: the levels are forces in N).
+fn drive_compare(c: &mut Criterion) {
+    let (osc, unknown) = OscillatorInput::default().resolve();
+    let opts = FitOptions {
+        domain: FitDomain::Force,
+        unknown_oscillator: unknown,
+        ..FitOptions::default()
+    };
+    let models: Vec<Box<dyn FrictionModel>> =
+        ["coulomb", "viscous_coulomb", "stribeck", "dahl", "lugre"]
+            .iter()
+            .filter_map(|n| default_model(n).ok())
+            .collect();
+    let record = [drive_friction_record()];
+    let mut group = c.benchmark_group("compare");
+    group.sample_size(10);
+    group.bench_function(
+        "five models, force domain, 25 000-sample drive record",
+        |b| b.iter(|| compare(&osc, black_box(&models), &record, &opts).expect("compare")),
+    );
+    group.finish();
+}
+
 criterion_group!(
     benches,
     coulomb_and_compare,
     lugre,
     force_route,
-    inverse_dynamics
+    inverse_dynamics,
+    drive_compare
 );
 criterion_main!(benches);

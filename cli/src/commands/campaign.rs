@@ -99,6 +99,7 @@ pub fn plan(cfg: Config, campaign: Option<CampaignSpec>) -> anyhow::Result<Plan>
         &manifest,
         &campaign,
         &cfg.record_defaults,
+        cfg.spec.record_use(),
         &cfg.base_dir,
         MAX_RECORDS,
     )

@@ -308,6 +308,37 @@ mod tests {
         );
     }
 
+    /// A run longer than four points per drawn column is drawn by each chunk's first,
+    /// lowest, highest and last point: at most four per column, the ends and every chunk's
+    /// extremes kept, in order; a short run is drawn as it is.
+    #[test]
+    fn a_long_line_is_drawn_by_its_envelope() {
+        use panel::{envelope, DRAWN_COLUMNS};
+        let n: usize = 1_000_003;
+        let points: Vec<(f64, f64)> = (0..n)
+            .map(|i| {
+                let t = i as f64 * 1e-5;
+                (t, (200.0 * t).sin() + if i == 777_777 { 5.0 } else { 0.0 })
+            })
+            .collect();
+        let drawn = envelope(points.clone());
+        assert!(drawn.len() <= 4 * DRAWN_COLUMNS, "{}", drawn.len());
+        assert_eq!(drawn.first(), points.first());
+        assert_eq!(drawn.last(), points.last());
+        assert!(drawn.windows(2).all(|w| w[0].0 < w[1].0), "in order");
+        assert!(drawn.contains(&points[777_777]), "a spike is kept");
+        let chunk = n.div_ceil(DRAWN_COLUMNS);
+        for c in points.chunks(chunk) {
+            let lowest = c.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+            let highest = c.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+            for extreme in [lowest, highest] {
+                assert!(drawn.iter().any(|p| p.1 == extreme && p.0 >= c[0].0));
+            }
+        }
+        let short: Vec<(f64, f64)> = points[..4 * DRAWN_COLUMNS].to_vec();
+        assert_eq!(envelope(short.clone()), short);
+    }
+
     #[test]
     fn ticks_hide_round_off_and_follow_the_span() {
         assert_eq!(tick(-5.6e-17, 0.5), "0");

@@ -79,7 +79,7 @@ pub(super) fn range(values: impl Iterator<Item = f64>, pad: bool) -> (f64, f64) 
     (lo - p, hi + p)
 }
 
-/// Runs of consecutive finite points.
+/// Runs of consecutive finite points, each as drawn ([`envelope`]).
 pub(super) fn segments(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
     let mut out = Vec::new();
     let mut cur = Vec::new();
@@ -87,11 +87,46 @@ pub(super) fn segments(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
         if a.is_finite() && b.is_finite() {
             cur.push((a, b));
         } else if !cur.is_empty() {
-            out.push(std::mem::take(&mut cur));
+            out.push(envelope(std::mem::take(&mut cur)));
         }
     }
     if !cur.is_empty() {
-        out.push(cur);
+        out.push(envelope(cur));
+    }
+    out
+}
+
+/// Columns a drawn line is reduced to at most: twice the widest plot's pixels (960).
+pub(super) const DRAWN_COLUMNS: usize = 2000;
+
+/// A run of points as drawn: up to four points per column of [`DRAWN_COLUMNS`] as they are,
+/// a longer run (a long record) cut into that many consecutive chunks, each drawn by its
+/// first, lowest, highest and last point in their order: every pixel column still spans the
+/// line's extremes there, and a million-sample record's plot is not a file of 50 MB.
+pub(super) fn envelope(points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    if points.len() <= 4 * DRAWN_COLUMNS {
+        return points;
+    }
+    let chunk = points.len().div_ceil(DRAWN_COLUMNS);
+    let mut out = Vec::with_capacity(4 * DRAWN_COLUMNS);
+    for c in points.chunks(chunk) {
+        let by_y = |a: &&(f64, f64), b: &&(f64, f64)| a.1.total_cmp(&b.1);
+        let lowest = c.iter().enumerate().min_by(|a, b| by_y(&a.1, &b.1));
+        let highest = c.iter().enumerate().max_by(|a, b| by_y(&a.1, &b.1));
+        let mut picks = [
+            0,
+            lowest.map_or(0, |p| p.0),
+            highest.map_or(0, |p| p.0),
+            c.len() - 1,
+        ];
+        picks.sort_unstable();
+        let mut last = None;
+        for i in picks {
+            if last != Some(i) {
+                out.push(c[i]);
+                last = Some(i);
+            }
+        }
     }
     out
 }

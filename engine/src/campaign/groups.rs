@@ -4,7 +4,7 @@
 use super::cell::CellValue;
 use super::manifest::{Manifest, FILE_COLUMN};
 use super::{CampaignError, CampaignSpec};
-use crate::data::RecordSource;
+use crate::data::{RecordSource, RecordUse};
 use frictionid_models::suggest::did_you_mean;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -50,12 +50,13 @@ pub fn condition_columns(manifest: &Manifest) -> Vec<usize> {
 }
 
 /// The groups of a campaign, in the order of their first rows. Every row's entry is checked
-/// (with `defaults` merged, files against `base_dir`) and no group may hold more than
-/// `max_records` records.
+/// for how the fits `used` its record (with `defaults` merged, files against `base_dir`: a
+/// replayed record needs no `x0`) and no group may hold more than `max_records` records.
 pub fn plan_groups(
     manifest: &Manifest,
     spec: &CampaignSpec,
     defaults: &RecordSource,
+    used: RecordUse,
     base_dir: &Path,
     max_records: usize,
 ) -> Result<Vec<GroupTask>, CampaignError> {
@@ -80,7 +81,13 @@ pub fn plan_groups(
         .enumerate()
         .map(|(n, (key, rows))| {
             let id = group_id(n + 1, width, key, manifest, rows);
-            group_task(manifest, id, rows, defaults, base_dir, max_records)
+            let entries = GroupEntries {
+                rows,
+                defaults,
+                used,
+                base_dir,
+            };
+            group_task(manifest, id, entries, max_records)
         })
         .collect()
 }
@@ -138,15 +145,27 @@ fn group_id(n: usize, width: usize, key: &[&str], manifest: &Manifest, rows: &[u
     format!("{n:0width$}-{safe}")
 }
 
+/// The manifest rows of one group and how their entries are completed and checked.
+struct GroupEntries<'a> {
+    rows: &'a [usize],
+    defaults: &'a RecordSource,
+    used: RecordUse,
+    base_dir: &'a Path,
+}
+
 /// The task of one group: its checked entries and its conditions.
 fn group_task(
     manifest: &Manifest,
     id: String,
-    rows: &[usize],
-    defaults: &RecordSource,
-    base_dir: &Path,
+    entries: GroupEntries<'_>,
     max_records: usize,
 ) -> Result<GroupTask, CampaignError> {
+    let GroupEntries {
+        rows,
+        defaults,
+        used,
+        base_dir,
+    } = entries;
     if rows.len() > max_records {
         return Err(CampaignError::TooManyRecords {
             file: manifest.file.clone(),
@@ -160,7 +179,7 @@ fn group_task(
         let row = &manifest.rows[r];
         let source = row.source.with_defaults(defaults);
         source
-            .resolve(row.line, base_dir)
+            .resolve_for(row.line, base_dir, used)
             .map_err(|source| CampaignError::Record {
                 file: manifest.file.clone(),
                 line: row.line,
@@ -215,7 +234,15 @@ mod tests {
             group_by: group_by.iter().map(|s| s.to_string()).collect(),
             models: None,
         };
-        plan_groups(&m, &spec, &RecordSource::default(), Path::new("d"), 1000)
+        let defaults = RecordSource::default();
+        plan_groups(
+            &m,
+            &spec,
+            &defaults,
+            RecordUse::Simulated,
+            Path::new("d"),
+            1000,
+        )
     }
 
     #[test]
@@ -246,12 +273,31 @@ mod tests {
         );
         let m = Manifest::parse("runs.csv", "file,weight\na.csv,0\n").unwrap();
         let spec = CampaignSpec::default();
-        let e = plan_groups(&m, &spec, &RecordSource::default(), Path::new("."), 10)
-            .unwrap_err()
-            .to_string();
+        let defaults = RecordSource::default();
+        let e = plan_groups(
+            &m,
+            &spec,
+            &defaults,
+            RecordUse::Simulated,
+            Path::new("."),
+            10,
+        )
+        .unwrap_err()
+        .to_string();
         assert!(
             e.starts_with("runs.csv:2: [[records]] entry 2 (`a.csv`): `weight` must be > 0"),
             "{e}"
         );
+        // Replayed along its measured motion (a force-domain fit), a record needs no x0.
+        let bare = Manifest::parse("runs.csv", "file\na.csv\n").unwrap();
+        let replayed = plan_groups(
+            &bare,
+            &spec,
+            &defaults,
+            RecordUse::Replayed,
+            Path::new("."),
+            10,
+        );
+        assert_eq!(replayed.unwrap()[0].single_file(), Some("a.csv"));
     }
 }

@@ -312,8 +312,8 @@ pub fn read_record(path: &Path, opts: &ReadOptions) -> Result<Record, DataError>
     let bytes = read_bytes(path)?;
     match resolve_format(path, opts.format) {
         DataFormat::Mat => read_mat(path, &bytes, opts),
-        DataFormat::Uff58 => read_uff58(path, &as_text(&bytes), opts),
-        fmt => read_delimited(path, &as_text(&bytes), fmt, opts),
+        DataFormat::Uff58 => read_uff58(path, &into_text(bytes), opts),
+        fmt => read_delimited(path, &into_text(bytes), fmt, opts),
     }
 }
 
@@ -364,12 +364,17 @@ fn read_bytes(path: &Path) -> Result<Vec<u8>, DataError> {
     Ok(bytes)
 }
 
-/// The text of a file's bytes, invalid UTF-8 replaced and a byte-order mark dropped.
-fn as_text(bytes: &[u8]) -> String {
-    let text = String::from_utf8_lossy(bytes).into_owned();
-    text.strip_prefix('\u{feff}')
-        .map(str::to_string)
-        .unwrap_or(text)
+/// The file's text, its bytes taken over (a valid UTF-8 file is not copied: a long record's
+/// text is tens of megabytes); invalid sequences replaced, a byte-order mark dropped.
+fn into_text(bytes: Vec<u8>) -> String {
+    let mut text = match String::from_utf8(bytes) {
+        Ok(text) => text,
+        Err(e) => String::from_utf8_lossy(e.as_bytes()).into_owned(),
+    };
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
+    }
+    text
 }
 
 /// The error for a record with more than [`MAX_SAMPLES`] samples.

@@ -244,6 +244,11 @@ type WeightTable = Arc<Vec<Vec<f64>>>;
 /// shorter than it.
 const MAX_TABLES: usize = 64;
 
+/// Weights kept at most over all tables (16 MiB): a table holds window² weights (8 MB for
+/// the widest window, 1001 samples), so a process that met many wide windows would otherwise
+/// keep up to half a gigabyte.
+const MAX_KEPT_WEIGHTS: usize = 2 << 20;
+
 static UNIT_WEIGHTS: Mutex<Vec<((usize, usize), WeightTable)>> = Mutex::new(Vec::new());
 
 /// The unit-spacing weight table of `window` samples and degree `order`.
@@ -267,7 +272,8 @@ fn unit_weights(window: usize, order: usize) -> Result<WeightTable, EngineError>
             .collect::<Result<_, _>>()?,
     );
     if let Ok(mut tables) = UNIT_WEIGHTS.lock() {
-        if tables.len() >= MAX_TABLES {
+        let kept: usize = tables.iter().map(|(k, _)| k.0 * k.0).sum();
+        if tables.len() >= MAX_TABLES || kept + window * window > MAX_KEPT_WEIGHTS {
             tables.clear();
         }
         tables.push((key, table.clone()));

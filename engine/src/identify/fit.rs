@@ -107,8 +107,9 @@ fn fit_seeded<R: Residuals + 'static>(
     seed: Option<&Result<Prefit, EngineError>>,
 ) -> Result<FitResult, EngineError> {
     let clock = Instant::now();
-    check_inputs(osc, model, records, residuals.as_ref())?;
+    check_inputs(osc, records, residuals.as_ref())?;
     let layout = build_layout(osc, model, records, residuals.as_ref(), opts)?;
+    layout.validate_fixed(model)?;
     let seed_model = seed.and_then(|s| s.as_ref().ok()).map(|p| p.model.as_ref());
     let simulated = residuals.simulates_response();
     let direct = fits_directly(model, simulated);
@@ -141,7 +142,7 @@ fn fit_seeded<R: Residuals + 'static>(
             opts,
         };
         let Planned { seeded, reachable } = starts_with_prefit(&plan, search, n_starts, seed_model);
-        let points: Vec<Vec<f64>> = seeded.iter().map(|s| s.point.clone()).collect();
+        let points: Vec<Vec<f64>> = seeded.iter().map(|s| layout.projected(&s.point)).collect();
         let runs = run_starts(
             make_problem,
             &reference,
@@ -152,7 +153,8 @@ fn fit_seeded<R: Residuals + 'static>(
         )?;
         (runs, seeded.into_iter().map(|s: Seeded| s.origin).collect())
     };
-    if let Some((jac, r)) = &runs.best.linearisation {
+    let mut runs = runs;
+    if let Some((jac, r)) = runs.best.linearisation.take() {
         reference.adopt_linearisation(&runs.best.u, jac, r);
     }
     let (runs, standings) = identifiability::settle(&reference, runs, opts)?;
@@ -208,16 +210,15 @@ fn seeded_point(layout: &Layout, seeded: &dyn FrictionModel) -> Vec<f64> {
         .collect()
 }
 
-/// The model, the oscillator and every record are valid (as `residuals` needs them), every
-/// record moves ([`check_moves`]), and there is a record.
+/// The oscillator and every record are valid (as `residuals` needs them), every record moves
+/// ([`check_moves`]), and there is a record. (The model's fixed parameters are checked once
+/// the layout says which are free: [`Layout::validate_fixed`].)
 fn check_inputs<R: Residuals + ?Sized>(
     osc: &Oscillator,
-    model: &dyn FrictionModel,
     records: &[Record],
     residuals: &R,
 ) -> Result<(), EngineError> {
     osc.validate()?;
-    model.validate()?;
     if records.is_empty() {
         return Err(EngineError::InvalidInput(
             "a fit needs at least one record".into(),

@@ -22,6 +22,7 @@ pub use time::{check_sorted, check_time, TimeBase, TimeError};
 use crate::error::EngineError;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 /// One measured record: time stamps, the channels sampled on them and the known release state.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -30,8 +31,10 @@ pub struct Record {
     pub name: String,
     /// Time stamps [s], strictly increasing.
     time: TimeBase,
-    /// Sampled channels other than the normal force, each as long as the time base.
-    channels: BTreeMap<Channel, Vec<f64>>,
+    /// Sampled channels other than the normal force, each as long as the time base; shared
+    /// by the record's clones (a fit, each model of a comparison and each stage of a search
+    /// clones its records) until one of them changes its samples.
+    channels: BTreeMap<Channel, Arc<Vec<f64>>>,
     /// The contact's normal force; `None`: the oscillator's.
     normal_force: Option<NormalForce>,
     /// Noise levels given for channels (`<channel>_noise`), in the channel's unit.
@@ -135,7 +138,7 @@ impl Record {
         match channel {
             Channel::NormalForce => self.normal_force = Some(NormalForce::Sampled(values)),
             other => {
-                self.channels.insert(other, values);
+                self.channels.insert(other, Arc::new(values));
             }
         }
         self
@@ -204,7 +207,7 @@ impl Record {
                 Some(NormalForce::Sampled(values)) => Some(values),
                 _ => None,
             },
-            other => self.channels.get(&other).map(Vec::as_slice),
+            other => self.channels.get(&other).map(|v| v.as_slice()),
         }
     }
 
@@ -221,7 +224,10 @@ impl Record {
                 Some(NormalForce::Sampled(values)) => Some(values),
                 _ => None,
             },
-            other => self.channels.get_mut(&other).map(Vec::as_mut_slice),
+            other => self
+                .channels
+                .get_mut(&other)
+                .map(|v| Arc::make_mut(v).as_mut_slice()),
         }
     }
 
@@ -271,7 +277,11 @@ impl Record {
         Self {
             name: self.name.clone(),
             time: self.time.tail(first),
-            channels: self.channels.iter().map(|(&c, v)| (c, tail(v))).collect(),
+            channels: self
+                .channels
+                .iter()
+                .map(|(&c, v)| (c, Arc::new(tail(v))))
+                .collect(),
             normal_force: self.normal_force.as_ref().map(|n| match n {
                 NormalForce::Sampled(v) => NormalForce::Sampled(tail(v)),
                 constant => constant.clone(),
@@ -506,6 +516,22 @@ mod tests {
         assert_eq!(r.channels(), vec![Channel::Velocity]);
         assert!(r.normal_force().is_none());
         r.validate(4).unwrap();
+    }
+
+    /// A clone shares the samples (a fit and each model of a comparison clone their
+    /// records) until one of them changes its own: the other keeps its values.
+    #[test]
+    fn clones_share_the_samples_until_one_changes_them() {
+        let time: Vec<f64> = (0..100).map(|i| i as f64 * 1e-3).collect();
+        let v: Vec<f64> = time.iter().map(|t| (10.0 * t).sin()).collect();
+        let original = Record::new("r", time, v.clone(), 0.01);
+        let mut copy = original.clone();
+        assert!(std::ptr::eq(copy.time(), original.time()));
+        assert!(std::ptr::eq(copy.velocity(), original.velocity()));
+        copy.velocity_mut()[3] = 7.0;
+        assert_eq!(copy.velocity()[3], 7.0);
+        assert_eq!(original.velocity(), v.as_slice());
+        assert!(std::ptr::eq(copy.time(), original.time()));
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! [`check_time`] or [`check_sorted`] and turns the typed [`TimeError`] into its own message.
 
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 use thiserror::Error;
 
 /// Fewest samples a time base holds (a step needs two).
@@ -72,23 +73,28 @@ pub fn check_count(time: &[f64], min_samples: usize) -> Result<(), TimeError> {
 }
 
 /// The time stamps of a record \[s\]: finite and strictly increasing (see [`TimeBase::new`]).
+/// Clones share the stamps.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(transparent)]
 pub struct TimeBase {
-    samples: Vec<f64>,
+    samples: Arc<Vec<f64>>,
 }
 
 impl TimeBase {
     /// A checked time base: at least [`MIN_TIME_SAMPLES`] finite, strictly increasing stamps.
     pub fn new(samples: Vec<f64>) -> Result<Self, TimeError> {
         check_time_base(&samples, MIN_TIME_SAMPLES)?;
-        Ok(Self { samples })
+        Ok(Self {
+            samples: Arc::new(samples),
+        })
     }
 
     /// Time stamps taken as they are; [`super::Record::validate`] checks them before any
     /// analysis (this keeps [`super::Record::new`] infallible).
     pub(crate) fn unchecked(samples: Vec<f64>) -> Self {
-        Self { samples }
+        Self {
+            samples: Arc::new(samples),
+        }
     }
 
     /// The time stamps.
@@ -119,7 +125,7 @@ impl TimeBase {
     /// The samples from index `first` on (none if `first` is past the end).
     pub(crate) fn tail(&self, first: usize) -> Self {
         Self {
-            samples: self.samples.get(first..).unwrap_or_default().to_vec(),
+            samples: Arc::new(self.samples.get(first..).unwrap_or_default().to_vec()),
         }
     }
 }

@@ -175,9 +175,11 @@ fn pooled_correlation(
     }
 }
 
-fn demeaned(v: &[f64]) -> Vec<f64> {
+/// `v` less its mean (in place: on a long record each series is as large as the record).
+fn demeaned(mut v: Vec<f64>) -> Vec<f64> {
     let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
-    v.iter().map(|x| x - mean).collect()
+    v.iter_mut().for_each(|x| *x -= mean);
+    v
 }
 
 /// The moving part of a record fit: from its first sample to the last one whose fitted speed
@@ -206,14 +208,9 @@ fn moving_part(r: &RecordFit, osc: &Oscillator, threshold: f64) -> Option<Moving
     let wd = osc.omega_n() * (1.0 - osc.damping_ratio().powi(2)).max(0.0).sqrt();
     let period = 2.0 * std::f64::consts::PI / wd / dt;
     Some(Moving {
-        residual: demeaned(&residual),
-        sign: demeaned(
-            &r.series.fitted[..end]
-                .iter()
-                .map(|v| v.signum())
-                .collect::<Vec<_>>(),
-        ),
-        x: demeaned(&x),
+        residual: demeaned(residual),
+        sign: demeaned(r.series.fitted[..end].iter().map(|v| v.signum()).collect()),
+        x: demeaned(x),
         period_samples: if period.is_finite() && period >= 1.0 {
             period.round() as usize
         } else {

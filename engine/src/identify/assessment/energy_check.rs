@@ -321,6 +321,52 @@ mod tests {
         assert_eq!(ef.samples, fr.used);
     }
 
+    /// The energy check of a fit reads the analysis its residuals kept since the guess, which
+    /// holds only some series: on a velocity record and on a quantised displacement's (whose
+    /// turning points read the displacement and potential energy), the check is the same as
+    /// on the whole analysis.
+    #[test]
+    fn the_check_of_a_kept_analysis_is_the_check_of_the_whole() {
+        use crate::identify::problem::analysis_cache::{AnalysisCache, AnalysisRequest};
+        use crate::record::{Channel, Record, TimeBase};
+        let osc = Oscillator::fmm();
+        let time: Vec<f64> = (0..2000).map(|i| i as f64 * 1e-3).collect();
+        let e = coulomb_free_vibration(&osc, 0.24 * osc.normal_force, 0.014, &time).unwrap();
+        let velocity = Record::new("v", time.clone(), e.v.clone(), 0.014);
+        let step = 5e-6;
+        let counts: Vec<f64> = e.x.iter().map(|x| (x / step).round() * step).collect();
+        let encoder = Record::from_time_base("x", TimeBase::new(time).unwrap())
+            .with_channel(Channel::Displacement, counts);
+        let options = EnergyOptions::default();
+        for (index, record) in [velocity, encoder].iter().enumerate() {
+            let whole = crate::energy::analyze_record(record, &osc, &options).unwrap();
+            let cache = AnalysisCache::default();
+            let kept = cache
+                .analysis(AnalysisRequest {
+                    index,
+                    record,
+                    osc: &osc,
+                    options: &options,
+                })
+                .unwrap();
+            assert_eq!(kept.displacement_step.is_some(), index == 1);
+            let model: Vec<f64> = whole
+                .v
+                .iter()
+                .map(|v| 0.24 * osc.normal_force * v.signum())
+                .collect();
+            for reference in [
+                ForceReference::ModelForce(&model),
+                ForceReference::Level(3.5),
+            ] {
+                let of = |a: &EnergyAnalysis| {
+                    serde_json::to_string(&energy_force_check(a, reference).unwrap()).unwrap()
+                };
+                assert_eq!(of(&kept), of(&whole), "record {}", record.name);
+            }
+        }
+    }
+
     #[test]
     fn a_level_reference_gives_the_percentage_by_definition() {
         let osc = Oscillator::fmm();

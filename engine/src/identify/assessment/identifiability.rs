@@ -423,6 +423,7 @@ fn restart_from<R: Residuals + 'static>(
         max_iterations: opts.max_iterations,
         pace: None,
         cost_resolution: None,
+        explain: false,
     };
     let Ok(run) = run_start(problem, u, opts, slot) else {
         return false;
@@ -435,7 +436,7 @@ fn restart_from<R: Residuals + 'static>(
     let before = std::mem::replace(&mut runs.best, run);
     runs.best.iterations += before.iterations;
     runs.best.simulations += before.simulations;
-    if let Some((jac, r)) = &runs.best.linearisation {
+    if let Some((jac, r)) = runs.best.linearisation.take() {
         reference.adopt_linearisation(&runs.best.u, jac, r);
     }
     true
@@ -577,6 +578,7 @@ fn pinned_fit<R: Residuals + 'static>(
             max_iterations: iterations,
             pace: None,
             cost_resolution,
+            explain: false,
         };
         run_start(sub, others.clone(), opts, slot).ok()?
     };

@@ -59,40 +59,19 @@ fn record_fit<R: Residuals>(
     ri: usize,
     rec: &Record,
 ) -> Result<(RecordFit, f64, Option<Finding>), EngineError> {
-    let predicted = problem.predict_record(world, ri)?;
+    // The energy check first: its analysis is freed before the fitted series are made (on a
+    // long record each is as large as the record).
+    let checked = record_energy_check(problem, world, opts, ri, rec);
+    let mut predicted = problem.predict_record(world, ri)?;
     let stacked = problem.residuals.measured(ri, rec);
     let segments = problem.residuals.segments(ri, rec);
     let channels = channel_fits(&segments, &predicted, stacked, world.oscillator.axis);
     // The record's first channel is what its `measured` and `fitted` series hold.
     let first = channels.first().map_or(0, |c| c.samples);
-    let (fitted, measured) = (predicted[..first].to_vec(), &stacked[..first]);
+    predicted.truncate(first);
+    let measured = &stacked[..first];
     let sum_sq = channels.first().map_or(0.0, |c| c.rms_residual.powi(2)) * first as f64;
     let nuisance = &world.nuisance[ri];
-    let driven = rec.channel(Channel::InputForce).is_some() || world.oscillator.input_offset != 0.0;
-    let (energy_force, ebf, mf, finding) = if driven && problem.residuals.simulates_response() {
-        (None, Vec::new(), Vec::new(), Some(driven_skip(&rec.name)))
-    } else if problem.residuals.simulates_response() {
-        match energy_check(problem.residuals.as_ref(), ri, rec, nuisance, world, opts) {
-            Ok((ef, ebf, mf)) => {
-                let finding = diagnostics::energy_balance(&rec.name, &ef, world.oscillator.axis);
-                (Some(ef), ebf, mf, Some(finding))
-            }
-            Err(e) => {
-                let message = format!("record `{}`: no energy-based force check: {e}", rec.name);
-                let finding = match e {
-                    // The model's force along the measured motion could not be computed:
-                    // the check has nothing to judge the fit with.
-                    EngineError::StateIntegration { .. } => {
-                        Finding::skipped(Check::EnergyBalance, message)
-                    }
-                    _ => Finding::warn(Check::EnergyBalance, None, message),
-                };
-                (None, Vec::new(), Vec::new(), Some(finding))
-            }
-        }
-    } else {
-        (None, Vec::new(), Vec::new(), None)
-    };
     let axes = problem.residuals.sample_axes(ri, rec);
     let case = RecordCase {
         index: ri,
@@ -111,17 +90,76 @@ fn record_fit<R: Residuals>(
         channel: problem.residuals.record_channel(ri).to_string(),
         rms_residual: (sum_sq / measured.len() as f64).sqrt(),
         channels,
-        energy_force,
+        energy_force: checked.energy_force,
         axes,
         series: FitSeries {
             measured: measured.to_vec(),
-            fitted,
-            energy_based_force: ebf,
-            model_force: mf,
+            fitted: predicted,
+            energy_based_force: checked.energy_based_force,
+            model_force: checked.model_force,
             balance,
         },
     };
-    Ok((record, sum_sq, finding))
+    Ok((record, sum_sq, checked.finding))
+}
+
+/// A record's energy-based force check: its figures, Eq. 7's force and the model's along the
+/// measured motion, and its finding (none where the check does not apply).
+#[derive(Default)]
+struct CheckedRecord {
+    energy_force: Option<EnergyForce>,
+    energy_based_force: Vec<f64>,
+    model_force: Vec<f64>,
+    finding: Option<Finding>,
+}
+
+/// The energy check of record `ri` where it applies: a fit of the free response (a driven
+/// record is skipped with the reason), not one along the measured motion.
+fn record_energy_check<R: Residuals>(
+    problem: &FitProblem<R>,
+    world: &Realised,
+    opts: &FitOptions,
+    ri: usize,
+    rec: &Record,
+) -> CheckedRecord {
+    if !problem.residuals.simulates_response() {
+        return CheckedRecord::default();
+    }
+    let driven = rec.channel(Channel::InputForce).is_some() || world.oscillator.input_offset != 0.0;
+    if driven {
+        return CheckedRecord {
+            finding: Some(driven_skip(&rec.name)),
+            ..CheckedRecord::default()
+        };
+    }
+    let nuisance = &world.nuisance[ri];
+    match energy_check(problem.residuals.as_ref(), ri, rec, nuisance, world, opts) {
+        Ok((ef, ebf, mf)) => CheckedRecord {
+            finding: Some(diagnostics::energy_balance(
+                &rec.name,
+                &ef,
+                world.oscillator.axis,
+            )),
+            energy_force: Some(ef),
+            energy_based_force: ebf,
+            model_force: mf,
+        },
+        Err(e) => {
+            let message = format!("record `{}`: no energy-based force check: {e}", rec.name);
+            let finding = match e {
+                // The model's force along the measured motion could not be computed: the
+                // check has nothing to judge the fit with.
+                EngineError::StateIntegration { .. } => {
+                    Finding::skipped(Check::EnergyBalance, message)
+                }
+                _ => Finding::warn(Check::EnergyBalance, None, message),
+            };
+            CheckedRecord {
+                finding: Some(finding),
+                ..CheckedRecord::default()
+            }
+        }
+    }
 }
 
 /// The fit of each compared channel of a record: its RMS residual and noise level, from the
@@ -186,8 +224,8 @@ fn energy_check<R: Residuals + ?Sized>(
     let x0 = nuisance.x0_of(rec);
     let analysis = if nuisance.offset == 0.0 && x0 == rec.x0 {
         // The record as measured: the analysis the guess made, when m, c and k are those it
-        // was made with.
-        residuals.energy_analysis(AnalysisRequest {
+        // was made with (the check is its last reader).
+        residuals.last_energy_analysis(AnalysisRequest {
             index,
             record: rec,
             osc,
@@ -211,5 +249,11 @@ fn energy_check<R: Residuals + ?Sized>(
     let states = states_along(model, motion)?;
     let model_force = forces_from_states(model, &analysis.v, &normal, &states);
     let ef = energy_force_check(&analysis, ForceReference::ModelForce(&model_force))?;
-    Ok((ef, analysis.friction.clone(), model_force))
+    drop(states);
+    // The analysis is the check's own unless a cache still shares it: its force is moved out.
+    let friction = match Arc::try_unwrap(analysis) {
+        Ok(own) => own.friction,
+        Err(shared) => shared.friction.clone(),
+    };
+    Ok((ef, friction, model_force))
 }

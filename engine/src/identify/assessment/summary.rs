@@ -59,7 +59,8 @@ fn statistics<R: Residuals>(
 ) -> Result<Statistics, EngineError> {
     // Statistics in physical coordinates at the optimum, of the determined parameters.
     let p_best = reference.physical(&best.u);
-    let (jac, r) = reference.jacobian_physical(&p_best)?;
+    // The statistics are the Jacobian's last reader.
+    let (jac, r) = reference.take_jacobian_physical(&p_best)?;
     let ssr = r.norm_squared();
     let without_effect = diagnostics::parameters_without_effect(&reference.layout, &p_best, &jac);
     let mut cov = covariance_of_determined(&jac, ssr, standings);

@@ -2,8 +2,11 @@
 //! reads its friction level from the analysis the energy check needs at the end, when nothing
 //! that analysis depends on (the oscillator's m, c and k, the release displacement, the
 //! velocity offset) was fitted.
+//!
+//! A kept analysis holds only the series those two read ([`for_the_fit`]): on a long record
+//! each series is as large as the record, and the cache holds them through the whole search.
 
-use crate::energy::{analyze_record, EnergyAnalysis, EnergyOptions};
+use crate::energy::{analyze_record, EnergyAnalysis, EnergyOptions, MechanicalEnergy};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -65,11 +68,29 @@ impl AnalysisCache {
         if let Some(kept) = self.find(&key) {
             return Ok(kept);
         }
-        let analysis = request.compute()?;
+        let analysis = Arc::new(for_the_fit(analyze_record(
+            request.record,
+            request.osc,
+            request.options,
+        )?));
         if let Ok(mut entries) = self.0.lock() {
             entries.push((key, analysis.clone()));
         }
         Ok(analysis)
+    }
+
+    /// The same, for its last reader: a kept analysis leaves the cache (on a long record it
+    /// holds several series as long as the record).
+    pub fn take(&self, request: AnalysisRequest<'_>) -> Result<Arc<EnergyAnalysis>, EngineError> {
+        let key = request.key();
+        let kept = self.0.lock().ok().and_then(|mut entries| {
+            let at = entries.iter().position(|(k, _)| *k == key)?;
+            Some(entries.swap_remove(at).1)
+        });
+        match kept {
+            Some(analysis) => Ok(analysis),
+            None => request.compute(),
+        }
     }
 
     fn find(&self, key: &Key) -> Option<Arc<EnergyAnalysis>> {
@@ -78,6 +99,27 @@ impl AnalysisCache {
             .iter()
             .find(|(k, _)| k == key)
             .map(|(_, a)| a.clone())
+    }
+}
+
+/// `analysis` with the series a fit reads (the guess its scalars, the energy check
+/// ([`crate::identify::assessment::energy_check`]) time, velocity, Eq. 7's force and the
+/// half-cycles; the displacement and potential energy only to weigh a quantised displacement's
+/// turning points), the others (acceleration, energy rate, kinetic and total energy) emptied.
+fn for_the_fit(analysis: EnergyAnalysis) -> EnergyAnalysis {
+    let quantised = analysis.displacement_step.is_some();
+    let keep = |series: Vec<f64>| if quantised { series } else { Vec::new() };
+    let EnergyAnalysis { x, mechanical, .. } = analysis;
+    EnergyAnalysis {
+        x: keep(x),
+        a: Vec::new(),
+        mechanical: MechanicalEnergy {
+            kinetic: Vec::new(),
+            potential: keep(mechanical.potential),
+            energy: Vec::new(),
+        },
+        de_dt: Vec::new(),
+        ..analysis
     }
 }
 
@@ -121,7 +163,11 @@ mod tests {
             options: &options,
         };
         let first = cache.analysis(request(rec, &osc)).unwrap();
-        assert!(same(&first, &analyze_record(rec, &osc, &options).unwrap()));
+        let fresh = |record, osc| for_the_fit(analyze_record(record, osc, &options).unwrap());
+        assert!(same(&first, &fresh(rec, &osc)));
+        // The series no reader of a fit's analysis reads are not kept.
+        assert!(first.a.is_empty() && first.de_dt.is_empty() && first.x.is_empty());
+        assert_eq!(first.friction.len(), rec.len());
         let again = cache.analysis(request(rec, &osc)).unwrap();
         assert!(Arc::ptr_eq(&first, &again));
         let heavier = Oscillator {
@@ -129,18 +175,17 @@ mod tests {
             ..osc
         };
         let other = cache.analysis(request(rec, &heavier)).unwrap();
+        // Its last reader takes it out: the next request computes it again.
+        let taken = cache.take(request(rec, &heavier)).unwrap();
+        assert!(Arc::ptr_eq(&other, &taken));
+        let again = cache.analysis(request(rec, &heavier)).unwrap();
+        assert!(!Arc::ptr_eq(&other, &again));
         assert!(!Arc::ptr_eq(&first, &other));
-        assert!(same(
-            &other,
-            &analyze_record(rec, &heavier, &options).unwrap()
-        ));
+        assert!(same(&other, &fresh(rec, &heavier)));
         let mut moved = rec.clone();
         moved.x0 += 1e-3;
         let shifted = cache.analysis(request(&moved, &osc)).unwrap();
-        assert!(same(
-            &shifted,
-            &analyze_record(&moved, &osc, &options).unwrap()
-        ));
+        assert!(same(&shifted, &fresh(&moved, &osc)));
         assert!(!Arc::ptr_eq(&first, &shifted));
     }
 }

@@ -234,6 +234,11 @@ impl<R: Residuals> FitProblem<R> {
             } else {
                 (0..self.records.len()).map(run).collect()
             };
+        if parts.len() == 1 {
+            // One record: its residuals as they are (a long record's are not copied).
+            let only = parts.into_iter().next().unwrap_or_else(|| Ok(Vec::new()))?;
+            return Ok(DVector::from_vec(only));
+        }
         let mut out = Vec::with_capacity(self.n_residuals());
         for part in parts {
             out.extend(part?);
@@ -381,14 +386,28 @@ impl<R: Residuals> FitProblem<R> {
 
     /// Takes the Jacobian `jac` (internal coordinates) and residuals `r` a solver run of this
     /// problem's twin computed at `u`, as the physical Jacobian there (saves recomputing it).
-    pub fn adopt_linearisation(&self, u: &DVector<f64>, jac: &DMatrix<f64>, r: &DVector<f64>) {
+    pub fn adopt_linearisation(&self, u: &DVector<f64>, jac: DMatrix<f64>, r: DVector<f64>) {
         let p = self.physical(u);
+        let physical = self.to_physical_columns(jac, &p);
         if let Ok(mut c) = self.physical_cache.lock() {
-            *c = Some((
-                p.clone(),
-                self.to_physical_columns(jac.clone(), &p),
-                r.clone(),
-            ));
+            *c = Some((p, physical, r));
+        }
+    }
+
+    /// The physical Jacobian and the residuals at `p` for their last reader: taken out of the
+    /// cache (not copied) when it holds them, else computed and not kept. On a long record
+    /// each is as large as the record's samples.
+    pub fn take_jacobian_physical(
+        &self,
+        p: &[f64],
+    ) -> Result<(DMatrix<f64>, DVector<f64>), EngineError> {
+        let kept = self.physical_cache.lock().ok().and_then(|mut c| {
+            let hit = c.as_ref().is_some_and(|(at, _, _)| at.as_slice() == p);
+            hit.then(|| c.take()).flatten()
+        });
+        match kept {
+            Some((_, j, r)) => Ok((j, r)),
+            None => self.compute_jacobian_physical(p),
         }
     }
 

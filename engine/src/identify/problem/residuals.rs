@@ -174,6 +174,18 @@ pub trait Residuals: Send + Sync {
         }
     }
 
+    /// The same, for its last reader in a fit (the energy check): the cached analysis leaves
+    /// the cache.
+    fn last_energy_analysis(
+        &self,
+        request: AnalysisRequest<'_>,
+    ) -> Result<Arc<EnergyAnalysis>, EngineError> {
+        match self.analysis_cache() {
+            Some(cache) => cache.take(request),
+            None => request.compute(),
+        }
+    }
+
     /// Whether the law's levels are coefficients of a normal force or forces (default:
     /// coefficients).
     fn friction_levels(&self) -> FrictionLevels {

@@ -11,10 +11,12 @@ use frictionid_models::FrictionModel;
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
 
-/// Entries kept: a Jacobian's worth of trial points (each state parameter's column adds one)
-/// for a few records, so the point a Jacobian is taken at is still there for its force-only
-/// columns.
-const CAPACITY: usize = 64;
+/// Entries kept per record beyond one per state parameter: a Jacobian's worth (the point it
+/// is taken at, refreshed by every column that reads it, and the trial point of each state
+/// parameter's column computed since, so the force-only and offset columns find it) and one
+/// more. Each entry is as long as the record (times its states): a Jacobian's worth, not
+/// dozens, on a long record.
+const SPARE_PER_RECORD: usize = 2;
 
 /// What the states were computed for: the record and the model's state parameters.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -77,19 +79,26 @@ impl StateCache {
         Ok(states)
     }
 
+    /// The states kept for `key`, which become the most recently used.
     fn find(&self, key: &Key) -> Option<Arc<Vec<f64>>> {
-        let entries = self.entries.lock().ok()?;
-        entries
-            .iter()
-            .rev()
-            .find(|(k, _)| k == key)
-            .map(|(_, s)| s.clone())
+        let mut entries = self.entries.lock().ok()?;
+        let at = entries.iter().rposition(|(k, _)| k == key)?;
+        let entry = entries.remove(at)?;
+        let states = entry.1.clone();
+        entries.push_back(entry);
+        Some(states)
     }
 
+    /// Keeps `states`, dropping the least recently used entry of its record beyond one per
+    /// state parameter and [`SPARE_PER_RECORD`].
     fn keep(&self, key: Key, states: Arc<Vec<f64>>) {
         if let Ok(mut entries) = self.entries.lock() {
-            if entries.len() >= CAPACITY {
-                entries.pop_front();
+            let record = key.record;
+            let same_record = entries.iter().filter(|(k, _)| k.record == record).count();
+            if same_record >= key.state_params.len() + SPARE_PER_RECORD {
+                if let Some(oldest) = entries.iter().position(|(k, _)| k.record == record) {
+                    entries.remove(oldest);
+                }
             }
             entries.push_back((key, states));
         }
@@ -123,5 +132,38 @@ mod tests {
         assert_eq!(*cache.states(1, &base, computed(4.0)).unwrap(), [4.0]);
         assert_eq!(*cache.states(0, &base, computed(5.0)).unwrap(), [1.0]);
         assert!(cache.clone().find(&Key::of(0, &base)).is_none());
+    }
+
+    /// A record keeps its few most recently used states: the point read last survives the
+    /// trial points computed after it, the least recently used goes, and other records keep
+    /// theirs.
+    #[test]
+    fn a_record_keeps_its_most_recently_used_states() {
+        let cache = StateCache::default();
+        let at = |sigma0: f64| LuGre {
+            sigma0,
+            ..LuGre::default()
+        };
+        let computed = |x: f64| move || Ok::<_, ()>(vec![x]);
+        cache.states(1, &at(1.0), computed(-1.0)).unwrap();
+        cache.states(0, &at(1.0), computed(1.0)).unwrap();
+        let per_record = Key::of(0, &at(1.0)).state_params.len() + SPARE_PER_RECORD;
+        for k in 2..=per_record {
+            cache.states(0, &at(k as f64), computed(k as f64)).unwrap();
+        }
+        // Read again: the most recently used of record 0.
+        assert_eq!(*cache.states(0, &at(1.0), computed(0.0)).unwrap(), [1.0]);
+        cache.states(0, &at(10.0), computed(10.0)).unwrap();
+        assert!(cache.find(&Key::of(0, &at(1.0))).is_some());
+        assert!(
+            cache.find(&Key::of(0, &at(2.0))).is_none(),
+            "least recently used"
+        );
+        assert!(cache.find(&Key::of(1, &at(1.0))).is_some());
+        let kept = cache.entries.lock().unwrap();
+        assert_eq!(
+            kept.iter().filter(|(k, _)| k.record == 0).count(),
+            per_record
+        );
     }
 }

@@ -44,6 +44,36 @@ impl Layout {
         self.params.push(param);
         self.start.push(start);
     }
+
+    /// `point` projected into every free parameter's domain ([`FreeParam::project`]; the
+    /// fit's own start where a value has no nearest valid one): where a search may start.
+    pub fn projected(&self, point: &[f64]) -> Vec<f64> {
+        self.params
+            .iter()
+            .zip(point)
+            .zip(&self.start)
+            .map(|((f, &x), &start)| f.project(x, start))
+            .collect()
+    }
+
+    /// The law's own checks ([`FrictionModel::validate`]) on `model`'s fixed parameters; the
+    /// free ones start projected into their domain, so they are checked at their declared
+    /// defaults.
+    pub fn validate_fixed(&self, model: &(dyn FrictionModel + 'static)) -> Result<(), EngineError> {
+        let mut checked = frictionid_models::clone_model(model);
+        let info = checked.param_info();
+        let mut values = checked.params();
+        for f in &self.params {
+            if let ParamKind::Model(i) = f.kind {
+                if let (Some(v), Some(p)) = (values.get_mut(i), info.get(i)) {
+                    *v = p.default;
+                }
+            }
+        }
+        checked.set_params(&values)?;
+        checked.validate()?;
+        Ok(())
+    }
 }
 
 /// Builds the starting model and the free-parameter layout from the options, with the
@@ -70,7 +100,7 @@ pub fn build_layout<R: Residuals + ?Sized>(
     let values = layout.start_model.params();
     let levels = residuals.friction_levels();
     for &i in &free {
-        let (param, x) = model_param(&info[i], i, values[i], opts, (levels, osc.axis));
+        let (param, x) = model_param(&info[i], i, values[i], opts, (levels, osc.axis))?;
         layout.push(param, x);
     }
     for &q in &opts.oscillator {
@@ -155,37 +185,64 @@ fn starting_model(
 }
 
 /// A free model parameter: log coordinates for a strictly positive one, its bounds from the
-/// options, else the model's (a level read as a force: from the data, see
-/// [`FrictionLevels`]); the start clipped into them.
+/// options within the law's domain ([`law_domain`]), else the model's (a level read as a
+/// force: from the data, see [`FrictionLevels`]); the start projected into them
+/// ([`FreeParam::project`], the law's default where the value has no nearest valid one).
 fn model_param(
     p: &ParamInfo,
     index: usize,
     value: f64,
     opts: &FitOptions,
     (levels, axis): (FrictionLevels, Axis),
-) -> (FreeParam, f64) {
-    let (lo, hi) = opts
-        .bounds
-        .get(&p.name)
-        .copied()
-        .unwrap_or_else(|| levels.bounds(p));
+) -> Result<(FreeParam, f64), EngineError> {
+    let (lo, hi) = match opts.bounds.get(&p.name) {
+        Some(&(lo, hi)) => within_domain(p, (lo, hi), levels)?,
+        None => levels.bounds(p),
+    };
     let log = p.lower_exclusive && p.lower == 0.0 && lo >= 0.0;
-    let (lo_eff, hi_eff) = if log { (lo.max(0.0), hi) } else { (lo, hi) };
-    let mut x = value;
-    if log {
-        x = x.max(lo_eff).max(f64::MIN_POSITIVE);
+    let param = |start: f64| FreeParam {
+        log,
+        ..FreeParam::linear(
+            p.name.clone(),
+            &levels.unit(p, axis),
+            ParamKind::Model(index),
+            (lo, hi),
+            start,
+            1.0,
+        )
+    };
+    let x = param(p.default).project(value, p.default);
+    Ok((param(x), x))
+}
+
+/// The law's domain of `p`: its declared bounds, without the upper one for a level read as a
+/// force (whose declared bounds are a coefficient's).
+fn law_domain(p: &ParamInfo, levels: FrictionLevels) -> (f64, f64) {
+    if levels.are_forces() && FrictionLevels::is_level(p) {
+        (p.lower, f64::INFINITY)
+    } else {
+        (p.lower, p.upper)
     }
-    x = x.clamp(lo_eff, hi_eff);
-    let mut f = FreeParam::linear(
-        p.name.clone(),
-        &levels.unit(p, axis),
-        ParamKind::Model(index),
-        (lo_eff, hi_eff),
-        x,
-        1.0,
-    );
-    f.log = log;
-    (f, x)
+}
+
+/// The bounds `(lo, hi)` the options give `p`, within the law's domain: a search beyond it
+/// would evaluate the law where it is not defined. An error when they do not meet it.
+fn within_domain(
+    p: &ParamInfo,
+    (lo, hi): (f64, f64),
+    levels: FrictionLevels,
+) -> Result<(f64, f64), EngineError> {
+    let (d_lo, d_hi) = law_domain(p, levels);
+    let (lo_in, hi_in) = (lo.max(d_lo), hi.min(d_hi));
+    let empty = lo_in > hi_in || (p.lower_exclusive && hi_in <= d_lo);
+    if empty {
+        return Err(EngineError::InvalidInput(format!(
+            "[fit] bounds of `{}` = [{lo}, {hi}] lie outside its domain {}{d_lo}, {d_hi}]",
+            p.name,
+            if p.lower_exclusive { "(" } else { "[" },
+        )));
+    }
+    Ok((lo_in, hi_in))
 }
 
 /// A fitted gravity moment needs a restoring law that has one (the pendulum): otherwise its

@@ -104,6 +104,12 @@ impl DampingStart {
     }
 }
 
+/// The residuals at the initial parameters are not finite: the run cannot start (its caller,
+/// which knows the problem, says where they stop being finite).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("the residuals at the initial parameters are not finite")]
+pub struct NonFiniteStart;
+
 /// Bounded Levenberg-Marquardt.
 #[derive(Debug, Clone)]
 pub struct LevenbergMarquardt {
@@ -236,9 +242,7 @@ where
         let r = problem.apply(&p0)?;
         let cost = half_sq(&r);
         if !cost.is_finite() {
-            return Err(Error::msg(
-                "the residuals at the initial parameters are not finite",
-            ));
+            return Err(NonFiniteStart.into());
         }
         let j = problem.jacobian(&p0)?;
         self.mu = self.damping_start.initial(&j);
@@ -366,6 +370,11 @@ impl LevenbergMarquardt {
     /// point of lower cost, and linearises there before it decides to stop.
     pub fn linearisation(&self) -> (&DMatrix<f64>, &DVector<f64>) {
         (&self.jacobian, &self.residuals)
+    }
+
+    /// The same, moved out of the solver at the end of its run.
+    pub fn into_linearisation(self) -> (DMatrix<f64>, DVector<f64>) {
+        (self.jacobian, self.residuals)
     }
 
     /// The typed reason of the last run's convergence (`None` while running, or when it was

@@ -2,21 +2,23 @@
 //! screening of every start and the continuation of the most promising one.
 
 use super::lm::{
-    termination_reason, DampingStart, LevenbergMarquardt, LmState, Pace, LARGEST_DIAGONAL_TAU,
+    termination_reason, DampingStart, LevenbergMarquardt, LmState, NonFiniteStart, Pace,
+    LARGEST_DIAGONAL_TAU,
 };
 use crate::error::EngineError;
-use crate::identify::problem::least_squares::FitProblem;
-use crate::identify::problem::residuals::Residuals;
+use crate::identify::problem::least_squares::{FitProblem, Realised};
+use crate::identify::problem::residuals::{RecordCase, Residuals};
 use crate::identify::values::layout::{FreeParam, ParamKind};
 use crate::identify::values::options::{FitOptions, Progress, ProgressFn};
 use crate::identify::values::outcome::{StartOutcome, TerminationReason};
 use crate::identify::values::search::fits_directly;
+use crate::record::Record;
 use argmin::core::observers::{Observe, ObserverMode};
-use argmin::core::{Executor, State, KV};
+use argmin::core::{Error, Executor, Jacobian, Operator, State, KV};
 use frictionid_models::FrictionModel;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// The relative damping start of the fits that take one (see [`damping_start_for`]).
 pub const RELATIVE_DAMPING: f64 = 1e-5;
@@ -229,9 +231,14 @@ pub struct RunSlot {
     /// profile's rise): it stops when the Gauss-Newton step promises less. `None`: the
     /// solver's own convergence tests only.
     pub cost_resolution: Option<f64>,
+    /// Whether a start that cannot be evaluated is explained ([`non_finite_start`] evaluates
+    /// it again, record by record): the fit's starts, whose failures are reported; not the
+    /// identifiability's re-optimisations, whose failures only end a profile or a restart.
+    pub explain: bool,
 }
 
-/// Runs the solver on `problem` from `u0`.
+/// Runs the solver on `problem` from `u0`. A start whose residuals are not finite is dropped
+/// at once, with the error [`non_finite_start`] writes.
 pub fn run_start<R: Residuals + 'static>(
     problem: FitProblem<R>,
     u0: DVector<f64>,
@@ -242,8 +249,8 @@ pub fn run_start<R: Residuals + 'static>(
     solver.pace = slot.pace.clone();
     solver.cost_resolution = slot.cost_resolution;
     let model_name = problem.model.name().to_string();
-    let mut exec = Executor::new(problem, solver)
-        .configure(|s| s.param(u0).max_iters(slot.max_iterations))
+    let mut exec = Executor::new(&problem, solver)
+        .configure(|s| s.param(u0.clone()).max_iters(slot.max_iterations))
         .ctrlc(false)
         .timer(false);
     if let Some(cb) = &opts.progress {
@@ -258,37 +265,166 @@ pub fn run_start<R: Residuals + 'static>(
             ObserverMode::Always,
         );
     }
-    let res = exec.run().map_err(|e| EngineError::Fit(e.to_string()))?;
+    let res = exec
+        .run()
+        .map_err(|e| match e.downcast_ref::<NonFiniteStart>() {
+            Some(_) if slot.explain => non_finite_start(&problem, &u0),
+            _ => EngineError::Fit(e.to_string()),
+        })?;
     let state = res.state();
-    let simulations = res
-        .problem()
-        .problem
-        .as_ref()
-        .map(FitProblem::simulations)
-        .unwrap_or(0);
     let u = state
         .get_best_param()
         .cloned()
         .ok_or_else(|| EngineError::Fit("the solver returned no parameters".into()))?;
-    let (jac, r) = res.solver.linearisation();
-    let linearisation =
-        (jac.ncols() == u.len() && r.len() == jac.nrows()).then(|| (jac.clone(), r.clone()));
+    let cost = state.get_best_cost();
+    let iterations = state.get_iter();
+    let termination =
+        termination_reason(&res.solver, &state.termination_status, slot.max_iterations);
+    let (jac, r) = res.solver.into_linearisation();
+    let linearisation = (jac.ncols() == u.len() && r.len() == jac.nrows()).then_some((jac, r));
     let run = StartRun {
         u,
         linearisation,
-        cost: state.get_best_cost(),
-        iterations: state.get_iter(),
-        simulations,
-        termination: termination_reason(
-            &res.solver,
-            &state.termination_status,
-            slot.max_iterations,
-        ),
+        cost,
+        iterations,
+        simulations: problem.simulations(),
+        termination,
     };
     if let (Some(pace), true) = (&slot.pace, run.converged()) {
         pace.converged_at(run.cost);
     }
     Ok(run)
+}
+
+/// A run borrows its problem (argmin's solvers take the problem by value), which then
+/// explains a start that cannot be evaluated.
+impl<R: Residuals> Operator for &FitProblem<R> {
+    type Param = DVector<f64>;
+    type Output = DVector<f64>;
+    fn apply(&self, u: &DVector<f64>) -> Result<DVector<f64>, Error> {
+        <FitProblem<R> as Operator>::apply(self, u)
+    }
+}
+
+impl<R: Residuals> Jacobian for &FitProblem<R> {
+    type Param = DVector<f64>;
+    type Jacobian = DMatrix<f64>;
+    fn jacobian(&self, u: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+        <FitProblem<R> as Jacobian>::jacobian(self, u)
+    }
+}
+
+/// The error of a start at `u0` whose residuals are not finite: the parameter values, and
+/// the first record whose residuals cannot be evaluated (with the evaluation's error) or are
+/// not finite (with the channel and sample of the first such residual).
+pub fn non_finite_start<R: Residuals>(problem: &FitProblem<R>, u0: &DVector<f64>) -> EngineError {
+    let p = problem.physical(u0);
+    let values: Vec<String> = problem
+        .layout
+        .iter()
+        .zip(&p)
+        .map(|(f, x)| match f.unit.as_str() {
+            "1" | "" => format!("{} = {x:.4e}", f.name),
+            unit => format!("{} = {x:.4e} {unit}", f.name),
+        })
+        .collect();
+    let reason = match problem.realise(&p) {
+        Err(e) => format!("cannot be evaluated: {e}"),
+        Ok(world) => first_failing_record(problem, &world),
+    };
+    EngineError::Fit(format!(
+        "the residuals at the start ({}) {reason}; the start is dropped",
+        values.join(", ")
+    ))
+}
+
+/// Why the residuals at `world` are not finite: the first record whose residuals cannot be
+/// evaluated or are not finite, and where.
+fn first_failing_record<R: Residuals>(problem: &FitProblem<R>, world: &Realised) -> String {
+    let at = problem.evaluation(world);
+    for (index, record) in problem.records.iter().enumerate() {
+        let case = RecordCase {
+            index,
+            record,
+            nuisance: &world.nuisance[index],
+        };
+        match problem.residuals.residuals(&at, case) {
+            Err(e) => return format!("cannot be evaluated: record `{}`: {e}", record.name),
+            Ok(r) => {
+                if let Some(place) = first_non_finite(problem, index, record, &r) {
+                    return format!("are not finite: record `{}`: {place}", record.name);
+                }
+            }
+        }
+    }
+    "are not finite".into()
+}
+
+/// Where the first non-finite residual of record `index` (`r`) lies: its channel's residual
+/// index and, where the channel's samples have times, its time.
+fn first_non_finite<R: Residuals>(
+    problem: &FitProblem<R>,
+    index: usize,
+    record: &Record,
+    r: &[f64],
+) -> Option<String> {
+    let first = r.iter().position(|x| !x.is_finite())?;
+    let mut k = first;
+    for segment in problem.residuals.segments(index, record) {
+        if k >= segment.len {
+            k -= segment.len;
+            continue;
+        }
+        let times = problem.residuals.sample_axes(index, record).time;
+        let time = match times.get(k) {
+            Some(t) if times.len() == segment.len => format!(" (t = {t} s)"),
+            _ => String::new(),
+        };
+        return Some(format!(
+            "{} residual {k} of {}{time} is {}",
+            segment.channel, segment.len, r[first]
+        ));
+    }
+    None
+}
+
+/// A run's Jacobian (internal coordinates) and residuals at its best point.
+type Linearisation = (DMatrix<f64>, DVector<f64>);
+
+/// The linearisation of the lowest-cost run among those handed in: the fit adopts the best
+/// run's only, and each is as large as the records times the free parameters, so the others
+/// are dropped as they finish (a global search screens a dozen starts).
+#[derive(Default)]
+struct BestLinearisation(Mutex<Option<(f64, usize, Linearisation)>>);
+
+impl BestLinearisation {
+    /// Takes the linearisation of start `start`'s `run`, keeping it if the run is the best so
+    /// far.
+    fn offer(&self, start: usize, run: &mut StartRun) {
+        let Some(linearisation) = run.linearisation.take() else {
+            return;
+        };
+        if let Ok(mut best) = self.0.lock() {
+            let better = best
+                .as_ref()
+                .is_none_or(|(cost, _, _)| run.cost.total_cmp(cost).is_lt());
+            if better && run.cost.is_finite() {
+                *best = Some((run.cost, start, linearisation));
+            }
+        }
+    }
+
+    /// Gives the kept linearisation back to its run among `runs` (the same start, still at
+    /// the same cost).
+    fn restore(self, runs: &mut [(usize, StartRun)]) {
+        let Some((cost, start, linearisation)) = self.0.into_inner().ok().flatten() else {
+            return;
+        };
+        let owner = runs.iter_mut().find(|(s, r)| *s == start && r.cost == cost);
+        if let Some((_, run)) = owner {
+            run.linearisation = Some(linearisation);
+        }
+    }
 }
 
 /// The result of every start: the best run and what became of each start.
@@ -364,6 +500,7 @@ where
         pace.converged_at(cost);
         Arc::new(pace)
     });
+    let best = BestLinearisation::default();
     let run = |(s, p): (usize, &Vec<f64>)| {
         let problem = make_problem();
         let u0 = problem.internal(p);
@@ -373,8 +510,11 @@ where
             max_iterations: screen,
             pace: screen_pace.clone(),
             cost_resolution: None,
+            explain: true,
         };
-        run_start(problem, u0, opts, slot)
+        let mut run = run_start(problem, u0, opts, slot)?;
+        best.offer(s, &mut run);
+        Ok(run)
     };
     let runs: Vec<Result<StartRun, EngineError>> = if opts.parallel && n_starts > 1 {
         points.par_iter().enumerate().map(run).collect()
@@ -382,6 +522,7 @@ where
         points.iter().enumerate().map(run).collect()
     };
     let mut screened = classify(runs);
+    best.restore(&mut screened.ok);
     if n_starts > 1 && screen < opts.max_iterations {
         let phase = Phase {
             screen,
@@ -441,6 +582,7 @@ fn continue_best<R, F>(
         max_iterations: opts.max_iterations - screen,
         pace: Some(pace.clone()),
         cost_resolution: None,
+        explain: true,
     };
     let finish =
         |(s, u): &(usize, DVector<f64>)| (*s, run_start(make_problem(), u.clone(), opts, slot(*s)));
@@ -449,9 +591,14 @@ fn continue_best<R, F>(
     // and Jacobian columns in parallel).
     let finished: Vec<(usize, Result<StartRun, EngineError>)> =
         promoted.iter().map(finish).collect();
+    let best = BestLinearisation::default();
+    for (start, run) in &mut screened.ok {
+        best.offer(*start, run);
+    }
     for (start, run) in finished {
         match run {
-            Ok(o) if o.cost.is_finite() => {
+            Ok(mut o) if o.cost.is_finite() => {
+                best.offer(start, &mut o);
                 if let Some(slot) = screened.ok.iter_mut().find(|(t, _)| *t == start) {
                     merge_continuation(&mut slot.1, o, opts.max_iterations);
                 }
@@ -462,6 +609,7 @@ fn continue_best<R, F>(
                 .push((start, StartOutcome::ContinuationFailed { start, error })),
         }
     }
+    best.restore(&mut screened.ok);
 }
 
 /// Replaces a screened run by its continuation, adding up the work of both; an iteration

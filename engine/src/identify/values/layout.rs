@@ -105,6 +105,15 @@ impl FreeParam {
         }
     }
 
+    /// A start's value projected into the parameter's domain: `p` clipped into the bounds,
+    /// or `fallback` (a valid value: the law's default, the fit's own start) clipped where
+    /// `p` has no nearest valid value (not finite, or at or below the open lower bound 0 of a
+    /// log-coordinate parameter, where any positive value is as near as another).
+    pub fn project(&self, p: f64, fallback: f64) -> f64 {
+        let lost = !p.is_finite() || (self.log && p <= 0.0);
+        self.clip(if lost { fallback } else { p })
+    }
+
     /// A physical value clipped into the bounds (strictly positive for log coordinates).
     pub fn clip(&self, p: f64) -> f64 {
         let lo = if self.log {
@@ -211,6 +220,32 @@ impl BoundSide {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A value outside the bounds is clipped to the nearest bound; one with no nearest valid
+    /// value (not finite, or not positive in log coordinates) takes the fallback.
+    #[test]
+    fn a_start_is_projected_into_the_domain() {
+        let linear = FreeParam::linear("mu".into(), "1", ParamKind::Model(0), (0.1, 0.5), 0.2, 1.0);
+        assert_eq!(linear.project(0.05, 0.3), 0.1);
+        assert_eq!(linear.project(0.7, 0.3), 0.5);
+        assert_eq!(linear.project(0.25, 0.3), 0.25);
+        assert_eq!(linear.project(f64::NAN, 0.3), 0.3);
+        let log = FreeParam {
+            log: true,
+            ..FreeParam::linear(
+                "sigma0".into(),
+                "N/m",
+                ParamKind::Model(0),
+                (0.0, 1e9),
+                1e5,
+                1.0,
+            )
+        };
+        assert_eq!(log.project(-1e5, 1e5), 1e5);
+        assert_eq!(log.project(0.0, 1e5), 1e5);
+        assert_eq!(log.project(2e9, 1e5), 1e9);
+        assert_eq!(log.project(3e4, 1e5), 3e4);
+    }
 
     #[test]
     fn coordinates_round_trip() {
