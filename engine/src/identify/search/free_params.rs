@@ -249,9 +249,10 @@ fn within_domain(
 /// start would be undefined.
 fn check_property_exists(osc: &Oscillator, q: OscillatorParam) -> Result<(), EngineError> {
     if q == OscillatorParam::GravityMoment && osc.restoring.parameter("gravity_moment").is_none() {
+        const PENDULUM: &str = r#"{ type = "pendulum", gravity_moment = ... }"#;
         return Err(EngineError::InvalidInput(format!(
             "[fit.options] oscillator: `gravity_moment` is fitted, but the restoring law `{}` has \
-             none; set [oscillator] restoring = {{ type = \"pendulum\", gravity_moment = ... }}",
+             none; set [oscillator] restoring = {PENDULUM}",
             osc.restoring.name()
         )));
     }
