@@ -193,44 +193,9 @@ enum RunFailure {
     Failed(IntegrationFailure),
 }
 
-/// A stepper that starts each interval with the step size it ended the last on.
-trait Restart: Stepper {
-    fn restart(
-        &mut self,
-        system: &ConstantMotion<'_>,
-        t: f64,
-        y: &[f64],
-        t_end: f64,
-    ) -> Result<(), IntegrationFailure>;
-}
-
-impl Restart for Dopri5 {
-    fn restart(
-        &mut self,
-        system: &ConstantMotion<'_>,
-        t: f64,
-        y: &[f64],
-        t_end: f64,
-    ) -> Result<(), IntegrationFailure> {
-        Dopri5::restart(self, system, t, y, t_end)
-    }
-}
-
-impl Restart for Rodas4 {
-    fn restart(
-        &mut self,
-        system: &ConstantMotion<'_>,
-        t: f64,
-        y: &[f64],
-        t_end: f64,
-    ) -> Result<(), IntegrationFailure> {
-        Rodas4::restart(self, system, t, y, t_end)
-    }
-}
-
 /// Runs `stepper` from `z` over `(t0, t1)` within `limit` steps (accepted and rejected),
 /// refusing non-finite states; the steps taken.
-fn run<S: Restart>(
+fn run<S: Stepper>(
     stepper: &mut S,
     system: &ConstantMotion<'_>,
     (t0, t1): (f64, f64),

@@ -131,29 +131,6 @@ impl Dopri5 {
         self
     }
 
-    /// Restarts at state `y` at time `t` towards `t_end` with the step size the last run
-    /// proposed (Hairer's starting step only when there is none yet): for a sequence of
-    /// intervals whose right-hand side jumps between them but keeps its scale (the sample
-    /// intervals of a replayed motion), one evaluation of f instead of two, and a first step
-    /// of the scale the last interval found.
-    pub fn restart<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        t: f64,
-        y: &[f64],
-        t_end: f64,
-    ) -> StepResult<()> {
-        if self.ctrl.h.is_nan() || self.ctrl.h <= 0.0 {
-            return self.reset(system, t, y, t_end);
-        }
-        self.ctrl.restart(t, t_end);
-        self.y.copy_from_slice(y);
-        self.old_error = MIN_OLD_ERROR;
-        system.rhs(t, y, &mut self.k[0]);
-        self.counts.rhs_evaluations += 1;
-        Ok(())
-    }
-
     /// The starting step of Hairer's DOPRI5 (two RHS evaluations, the first kept in k[0]).
     fn initial_step<S: OdeSystem>(&mut self, system: &S) -> f64 {
         let (f0, rest) = self.k.split_at_mut(1);
@@ -270,6 +247,29 @@ impl Dopri5 {
 
 impl Stepper for Dopri5 {
     current_point_accessors!(ctrl);
+
+    /// Restarts at state `y` at time `t` towards `t_end` with the step size the last run
+    /// proposed (Hairer's starting step only when there is none yet): for a sequence of
+    /// intervals whose right-hand side jumps between them but keeps its scale (the sample
+    /// intervals of a replayed motion), one evaluation of f instead of two, and a first step
+    /// of the scale the last interval found.
+    fn restart<S: OdeSystem>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        t_end: f64,
+    ) -> StepResult<()> {
+        if self.ctrl.h.is_nan() || self.ctrl.h <= 0.0 {
+            return self.reset(system, t, y, t_end);
+        }
+        self.ctrl.restart(t, t_end);
+        self.y.copy_from_slice(y);
+        self.old_error = MIN_OLD_ERROR;
+        system.rhs(t, y, &mut self.k[0]);
+        self.counts.rhs_evaluations += 1;
+        Ok(())
+    }
 
     fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()> {
         self.ctrl.restart(t, t_end);

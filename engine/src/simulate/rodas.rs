@@ -168,34 +168,6 @@ impl Rodas4 {
         self
     }
 
-    /// Restarts at state `y` at time `t` towards `t_end` with the step size the last run
-    /// proposed (the starting step of [`Stepper::reset`] only when there is none yet), as
-    /// [`crate::simulate::Dopri5::restart`] does: f and J are evaluated afresh, the step-size
-    /// controller's memory of the last run is dropped.
-    pub fn restart<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        t: f64,
-        y: &[f64],
-        t_end: f64,
-    ) -> StepResult<()> {
-        if self.ctrl.h.is_nan() || self.ctrl.h <= 0.0 {
-            return self.reset(system, t, y, t_end);
-        }
-        self.ctrl.restart(t, t_end);
-        self.y.copy_from_slice(y);
-        self.cont[0].copy_from_slice(y);
-        self.cont[1].copy_from_slice(y);
-        self.cont[2].fill(0.0);
-        self.cont[3].fill(0.0);
-        self.ctrl.h_last = 0.0;
-        self.first = false;
-        self.h_acc = 0.0;
-        self.err_acc = 1e-2;
-        self.refresh(system);
-        Ok(())
-    }
-
     /// Evaluates f and J at the current point.
     fn refresh<S: OdeSystem>(&mut self, system: &S) {
         system.rhs(self.ctrl.t, &self.y, &mut self.fx);
@@ -386,6 +358,34 @@ impl Rodas4 {
 
 impl Stepper for Rodas4 {
     current_point_accessors!(ctrl);
+
+    /// Restarts at state `y` at time `t` towards `t_end` with the step size the last run
+    /// proposed (the starting step of [`Stepper::reset`] only when there is none yet), as
+    /// Dopri5's does: f and J are evaluated afresh, the step-size
+    /// controller's memory of the last run is dropped.
+    fn restart<S: OdeSystem>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        t_end: f64,
+    ) -> StepResult<()> {
+        if self.ctrl.h.is_nan() || self.ctrl.h <= 0.0 {
+            return self.reset(system, t, y, t_end);
+        }
+        self.ctrl.restart(t, t_end);
+        self.y.copy_from_slice(y);
+        self.cont[0].copy_from_slice(y);
+        self.cont[1].copy_from_slice(y);
+        self.cont[2].fill(0.0);
+        self.cont[3].fill(0.0);
+        self.ctrl.h_last = 0.0;
+        self.first = false;
+        self.h_acc = 0.0;
+        self.err_acc = 1e-2;
+        self.refresh(system);
+        Ok(())
+    }
 
     fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()> {
         self.ctrl.restart(t, t_end);

@@ -304,6 +304,19 @@ pub trait Stepper {
     /// stepper cannot integrate this system (e.g. the closed form needs an affine motion).
     fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()>;
 
+    /// Restarts at state `y` at time `t` towards `t_end`, keeping what the stepper learnt of
+    /// the step size: for a sequence of intervals whose right-hand side jumps between them
+    /// but keeps its scale (the sample intervals of a replayed motion). By default a reset.
+    fn restart<S: OdeSystem>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64],
+        t_end: f64,
+    ) -> StepResult<()> {
+        self.reset(system, t, y, t_end)
+    }
+
     /// Moves the end time on to `t_end` (after the current time) without starting afresh:
     /// the state and the step size carry over. Valid where the right-hand side is continuous
     /// at the current time (a knot of an input taken linear between its samples, where only
