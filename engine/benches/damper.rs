@@ -15,7 +15,7 @@ mod damper;
 use criterion::{criterion_group, criterion_main, Criterion};
 use frictionid_engine::data::{RecordSource, RecordUse};
 use frictionid_engine::identify::{compare, Comparison, FitDomain, FitOptions};
-use frictionid_engine::oscillator::OscillatorInput;
+use frictionid_engine::oscillator::PartialOscillator;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{Coulomb, Dahl, FrictionModel};
 use rayon::prelude::*;
@@ -44,7 +44,7 @@ fn damper_records() -> Vec<Record> {
 /// The campaign's options: the force domain, a force offset per record, Dahl's alpha fixed
 /// (not in `free`), no oscillator given (the levels are forces in N).
 fn damper_options() -> (Oscillator, FitOptions) {
-    let (osc, unknown) = OscillatorInput::default().resolve();
+    let (osc, unknown) = PartialOscillator::default().resolve();
     let opts = FitOptions {
         domain: FitDomain::Force,
         force_offset: true,

@@ -19,7 +19,7 @@ use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use frictionid_engine::data::RecordSource;
 use frictionid_engine::identify::{compare, fit, FitDomain, FitOptions, ForceTarget};
 use frictionid_engine::identify::{OscillatorParam, Search};
-use frictionid_engine::oscillator::OscillatorInput;
+use frictionid_engine::oscillator::PartialOscillator;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre, ViscousCoulomb};
@@ -193,7 +193,7 @@ fn driven_axis_record() -> Record {
 /// Inverse dynamics (`force_target = "inverse_dynamics"`): the mass, a viscous+Coulomb law
 /// (its level a force: no normal force given) and an offset, on 25 000 samples.
 fn inverse_dynamics(c: &mut Criterion) {
-    let (osc, unknown) = OscillatorInput::default().resolve();
+    let (osc, unknown) = PartialOscillator::default().resolve();
     let opts = FitOptions {
         domain: FitDomain::Force,
         force_target: ForceTarget::InverseDynamics,
@@ -270,7 +270,7 @@ fn drive_friction_record() -> Record {
 /// coulomb, viscous_coulomb, stribeck, dahl and lugre compared in the force domain on the
 /// driven axis's measured friction force (no oscillator given: the levels are forces in N).
 fn drive_compare(c: &mut Criterion) {
-    let (osc, unknown) = OscillatorInput::default().resolve();
+    let (osc, unknown) = PartialOscillator::default().resolve();
     let opts = FitOptions {
         domain: FitDomain::Force,
         unknown_oscillator: unknown,

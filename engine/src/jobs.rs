@@ -115,7 +115,8 @@ pub fn simulate_report(
 /// end), with a noisy velocity record when the spec asks for noise.
 pub fn simulate_job(spec: &Spec, input: Option<&Record>) -> Result<SimulateReport, JobError> {
     let model = &spec.require_model("simulate")?.model;
-    require_oscillator(&spec.unknown_oscillator, "simulate").map_err(JobError::Fit)?;
+    require_oscillator(&spec.unknown_oscillator, spec.oscillator.axis, "simulate")
+        .map_err(JobError::Fit)?;
     let sim: &SimulationSpec = spec.require_simulation("simulate")?;
     let times = uniform_times(sim.duration, sim.sample_rate);
     let init = Initial {
@@ -308,7 +309,12 @@ pub fn energy_job(
     records: &[Record],
     hooks: &Hooks,
 ) -> Result<EnergyReport, JobError> {
-    require_mechanics(&spec.unknown_oscillator, "the energy analysis").map_err(JobError::Fit)?;
+    require_mechanics(
+        &spec.unknown_oscillator,
+        spec.oscillator.axis,
+        "the energy analysis",
+    )
+    .map_err(JobError::Fit)?;
     let opts = spec.energy.options();
     let model = reference_model(spec, records, hooks)?;
     let analysed = records

@@ -17,7 +17,7 @@ use crate::identify::{
     check_min_speed, non_model_bound_keys, FitDomain, FitOptions, ForceTarget, OscillatorParam,
     ProgressFn, PropertyUncertainty, Search,
 };
-use crate::oscillator::Oscillator;
+use crate::oscillator::{Oscillator, OscillatorProperty, PartialOscillator};
 use crate::simulate::{Integrator, SimOptions};
 use frictionid_models::suggest::did_you_mean;
 use frictionid_models::{default_model, names, FrictionModel, ModelError};
@@ -131,10 +131,10 @@ pub struct OscillatorSpec {
     pub oscillator: Oscillator,
     /// Their standard deviations.
     pub uncertainty: PropertyUncertainty,
-    /// The property keys not given: a force-domain fit on a measured force needs only the
+    /// The properties not given: a force-domain fit on a measured force needs only the
     /// normal force; the analyses that need the others name them
     /// ([`crate::identify::require_mechanics`]).
-    pub unknown: Vec<String>,
+    pub unknown: Vec<OscillatorProperty>,
 }
 
 /// `[oscillator]` as written; [`OscillatorSpec`] is built from it.
@@ -177,7 +177,7 @@ impl TryFrom<OscillatorInput> for OscillatorSpec {
 
     fn try_from(o: OscillatorInput) -> Result<Self, SpecError> {
         let (axis, restoring) = axis_of(&o)?;
-        let (mut oscillator, mut unknown) = crate::oscillator::OscillatorInput {
+        let (mut oscillator, mut unknown) = PartialOscillator {
             mass: o.mass.or(o.inertia),
             damping: o.damping,
             stiffness: o.stiffness,
@@ -187,11 +187,8 @@ impl TryFrom<OscillatorInput> for OscillatorSpec {
         oscillator.axis = axis;
         oscillator.restoring = restoring;
         oscillator.input_offset = o.input_offset.unwrap_or(0.0);
-        for name in unknown.iter_mut().filter(|n| *n == "mass") {
-            *name = axis.inertia_name().to_string();
-        }
         if !restoring.law().reads_stiffness() {
-            unknown.retain(|n| n != "stiffness");
+            unknown.retain(|&p| p != OscillatorProperty::Stiffness);
         }
         let spec = Self {
             oscillator,
@@ -242,19 +239,20 @@ fn axis_of(o: &OscillatorInput) -> Result<(Axis, Restoring), SpecError> {
 impl From<OscillatorSpec> for OscillatorInput {
     fn from(o: OscillatorSpec) -> Self {
         let (p, u) = (o.oscillator, o.uncertainty);
-        let given =
-            |name: &str, value: f64| (!o.unknown.iter().any(|k| k == name)).then_some(value);
+        let given = |property: OscillatorProperty, value: f64| {
+            (!o.unknown.contains(&property)).then_some(value)
+        };
         let rotary = !p.axis.is_linear();
         Self {
             axis: rotary.then_some(p.axis),
-            inertia: given("inertia", p.mass).filter(|_| rotary),
+            inertia: given(OscillatorProperty::Mass, p.mass).filter(|_| rotary),
             restoring: (!p.restoring.is_linear_spring()).then_some(p.restoring),
             input_offset: (p.input_offset != 0.0).then_some(p.input_offset),
-            mass: given("mass", p.mass).filter(|_| !rotary),
-            damping: given("damping", p.damping),
-            stiffness: given("stiffness", p.stiffness)
+            mass: given(OscillatorProperty::Mass, p.mass).filter(|_| !rotary),
+            damping: given(OscillatorProperty::Damping, p.damping),
+            stiffness: given(OscillatorProperty::Stiffness, p.stiffness)
                 .filter(|_| p.restoring.law().reads_stiffness()),
-            normal_force: given("normal_force", p.normal_force),
+            normal_force: given(OscillatorProperty::NormalForce, p.normal_force),
             mass_std: u.mass,
             damping_std: u.damping,
             stiffness_std: u.stiffness,
@@ -299,9 +297,9 @@ pub struct Spec {
     pub simulation: Option<SimulationSpec>,
     /// Energy-analysis settings (defaults when absent).
     pub energy: EnergySpec,
-    /// `[oscillator]` keys not given (their values in `oscillator` are placeholders): a
-    /// force-domain fit on a measured force needs only the normal force.
-    pub unknown_oscillator: Vec<String>,
+    /// `[oscillator]` properties not given (their values in `oscillator` are placeholders):
+    /// a force-domain fit on a measured force needs only the normal force.
+    pub unknown_oscillator: Vec<OscillatorProperty>,
 }
 
 /// The friction model of a spec and which of its parameters were given explicitly.

@@ -15,6 +15,7 @@ use frictionid_engine::identify::search::build_layout;
 use frictionid_engine::identify::{
     FitDomain, FitOptions, ForceAlongMotion, ForceTarget, OscillatorParam,
 };
+use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::simulate::SimOptions;
 use frictionid_engine::{Oscillator, Record};
@@ -83,7 +84,11 @@ fn force_options(free: &[&str]) -> FitOptions {
         force_offset: true,
         min_speed: Some(5e-4),
         free: Some(free.iter().map(|s| s.to_string()).collect()),
-        unknown_oscillator: vec!["mass".into(), "damping".into(), "stiffness".into()],
+        unknown_oscillator: vec![
+            OscillatorProperty::Mass,
+            OscillatorProperty::Damping,
+            OscillatorProperty::Stiffness,
+        ],
         ..FitOptions::default()
     }
 }

@@ -11,7 +11,7 @@
 
 use frictionid_engine::identify::OscillatorParam;
 use frictionid_engine::identify::{fit, FitDomain, FitOptions, FitResult, ForceTarget};
-use frictionid_engine::oscillator::OscillatorInput;
+use frictionid_engine::oscillator::PartialOscillator;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::Record;
@@ -170,7 +170,7 @@ struct State {
 
 /// The inverse-dynamics options: the mass and an offset fitted, no normal force, no spring.
 fn options() -> (frictionid_engine::Oscillator, FitOptions) {
-    let (osc, unknown) = OscillatorInput::default().resolve();
+    let (osc, unknown) = PartialOscillator::default().resolve();
     let opts = FitOptions {
         domain: FitDomain::Force,
         force_target: ForceTarget::InverseDynamics,

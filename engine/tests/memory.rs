@@ -151,7 +151,7 @@ fn a_force_domain_fit_holds_a_bounded_number_of_bytes_per_sample() {
     let samples = 20_000;
     let record = [damper_stroke(samples)];
     // No oscillator given: the levels are forces in N.
-    let (osc, unknown) = frictionid_engine::oscillator::OscillatorInput::default().resolve();
+    let (osc, unknown) = frictionid_engine::oscillator::PartialOscillator::default().resolve();
     // One thread: the starts in flight at once would depend on the machine's cores.
     let opts = FitOptions {
         domain: FitDomain::Force,

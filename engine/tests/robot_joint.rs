@@ -9,6 +9,7 @@
 //! logarithmic grid of v_s and refining the best grid point by golden-section search.
 
 use frictionid_engine::identify::{fit, FitDomain, FitOptions, Search};
+use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
@@ -165,7 +166,11 @@ fn joint() -> Oscillator {
 fn force_options() -> FitOptions {
     FitOptions {
         domain: FitDomain::Force,
-        unknown_oscillator: vec!["mass".into(), "damping".into(), "stiffness".into()],
+        unknown_oscillator: vec![
+            OscillatorProperty::Mass,
+            OscillatorProperty::Damping,
+            OscillatorProperty::Stiffness,
+        ],
         ..FitOptions::default()
     }
 }

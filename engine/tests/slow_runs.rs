@@ -13,6 +13,7 @@
 
 use frictionid_engine::axis::Axis;
 use frictionid_engine::identify::{fit, FitDomain, FitOptions, FitResult};
+use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
@@ -36,7 +37,11 @@ fn options(free: &[&str]) -> FitOptions {
     FitOptions {
         domain: FitDomain::Force,
         free: Some(free.iter().map(|s| s.to_string()).collect()),
-        unknown_oscillator: vec!["mass".into(), "damping".into(), "stiffness".into()],
+        unknown_oscillator: vec![
+            OscillatorProperty::Mass,
+            OscillatorProperty::Damping,
+            OscillatorProperty::Stiffness,
+        ],
         ..FitOptions::default()
     }
 }

@@ -9,7 +9,7 @@ mod common;
 
 use common::{records, NOISE};
 use frictionid_engine::identify::{fit, FitDomain, FitOptions, Search};
-use frictionid_engine::oscillator::OscillatorInput;
+use frictionid_engine::oscillator::PartialOscillator;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
@@ -63,7 +63,7 @@ fn damper_stroke() -> Record {
 #[test]
 fn a_start_and_bounds_beyond_the_domain_are_projected_into_it() {
     let record = [damper_stroke()];
-    let (osc, unknown) = OscillatorInput::default().resolve();
+    let (osc, unknown) = PartialOscillator::default().resolve();
     let base = FitOptions {
         domain: FitDomain::Force,
         free: Some(vec!["sigma0".into(), "mu_c".into()]),
@@ -129,7 +129,7 @@ fn a_start_whose_residuals_are_not_finite_names_the_record_and_sample() {
             .with_channel(Channel::Velocity, v)
             .with_channel(Channel::Force, force),
     ];
-    let (osc, unknown) = OscillatorInput::default().resolve();
+    let (osc, unknown) = PartialOscillator::default().resolve();
     let opts = FitOptions {
         domain: FitDomain::Force,
         free: Some(vec!["mu".into()]),

@@ -3,6 +3,7 @@
 pub use super::cell::CellValue;
 use super::groups::GroupTask;
 use crate::identify::{FitResult, FittedParam, Verdict};
+use crate::oscillator::OscillatorProperty;
 use serde::{Deserialize, Serialize};
 
 /// What a row's fit is worth: the fit's [`Verdict`], or no fit at all.
@@ -84,16 +85,13 @@ pub struct CampaignRow {
     pub error: Option<String>,
 }
 
-/// Oscillator properties that join a row's parameters when they were fitted.
-const OSCILLATOR_PARAMS: [&str; 7] = [
-    "mass",
-    "inertia",
-    "damping",
-    "stiffness",
-    "gravity_moment",
-    "input_offset",
-    "normal_force",
-];
+/// Whether `name` is an oscillator property (under any of its names), which joins a row's
+/// parameters when it was fitted.
+fn is_oscillator_property(name: &str) -> bool {
+    OscillatorProperty::ALL
+        .iter()
+        .any(|p| p.keys().contains(&name))
+}
 
 fn finite(x: f64) -> Option<f64> {
     x.is_finite().then_some(x)
@@ -125,9 +123,7 @@ impl CampaignRow {
         let parameters = fit
             .parameters
             .iter()
-            .filter(|p| {
-                names.contains(&p.name) || (p.free && OSCILLATOR_PARAMS.contains(&p.name.as_str()))
-            })
+            .filter(|p| names.contains(&p.name) || (p.free && is_oscillator_property(&p.name)))
             .map(param_cell)
             .collect();
         Self {

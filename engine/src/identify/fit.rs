@@ -22,7 +22,7 @@ use super::values::{
     TerminationReason,
 };
 use crate::error::EngineError;
-use crate::oscillator::Oscillator;
+use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::Record;
 use frictionid_models::FrictionModel;
 use nalgebra::DVector;
@@ -46,7 +46,7 @@ pub fn fit(
     if opts.domain == FitDomain::Force {
         return fit_force(osc, model, records, opts);
     }
-    require_mechanics(&opts.unknown_oscillator, "a velocity-domain fit")?;
+    require_mechanics(&opts.unknown_oscillator, osc.axis, "a velocity-domain fit")?;
     let clock = Instant::now();
     let (levels, simulated) = simulated_levels(records, osc, &opts.unknown_oscillator)?;
     let residuals = Arc::new(
@@ -90,7 +90,10 @@ pub fn fit_force(
     // Inverse dynamics starts its oscillator properties at the linear estimate.
     let start = producer.starting_oscillator(osc, &opts.oscillator);
     let mut result = fit_with(Arc::new(producer), &start, model, records, opts)?;
-    if opts.unknown_oscillator.iter().any(|k| k == "normal_force") {
+    if opts
+        .unknown_oscillator
+        .contains(&OscillatorProperty::NormalForce)
+    {
         // The records carry the normal force; the result's oscillator shows their mean.
         result.oscillator.normal_force = mean_normal;
     }

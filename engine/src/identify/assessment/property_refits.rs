@@ -48,7 +48,6 @@ pub(crate) fn add_property_uncertainty(
         opts.search = Some(Search::Local);
     }
     opts.progress = None;
-    let fitted: Vec<&str> = opts_in.oscillator.iter().map(|q| q.name()).collect();
     let mut components: Vec<StdErrorComponents> = result
         .parameters
         .iter()
@@ -58,7 +57,7 @@ pub(crate) fn add_property_uncertainty(
         })
         .collect();
     for (property, s) in sigma.properties() {
-        if s <= 0.0 || fitted.contains(&property.name()) {
+        if s <= 0.0 || opts_in.oscillator.contains(&property) {
             continue;
         }
         let at = |by: f64| {

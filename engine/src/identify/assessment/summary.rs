@@ -425,11 +425,21 @@ fn derived_ratios(
     }
     let slot = |kind: ParamKind| layout.iter().position(|f| f.kind == kind);
     let (m, c, k) = (osc.mass, osc.damping, osc.stiffness);
-    let sm = slot(ParamKind::Mass);
+    let sm = slot(ParamKind::Property(OscillatorParam::Mass));
     let mut out = Vec::new();
     for (name, unit, num, kind) in [
-        ("k/m", "1/s^2", k, ParamKind::Stiffness),
-        ("c/m", "1/s", c, ParamKind::Damping),
+        (
+            "k/m",
+            "1/s^2",
+            k,
+            ParamKind::Property(OscillatorParam::Stiffness),
+        ),
+        (
+            "c/m",
+            "1/s",
+            c,
+            ParamKind::Property(OscillatorParam::Damping),
+        ),
     ] {
         let sn = slot(kind);
         // gradient of num/m with respect to (num, m)

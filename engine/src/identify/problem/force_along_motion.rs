@@ -33,6 +33,7 @@ use super::inverse_dynamics::{
 };
 use super::residuals::{Evaluation, JacobianColumns, RecordCase, Residuals, Segment};
 use super::state_cache::StateCache;
+use crate::axis::Axis;
 use crate::energy::forces_at;
 use crate::energy::model_force::{
     check_motion, force_derivatives_checked, states_along_checked, CheckedMotion,
@@ -42,9 +43,9 @@ use crate::error::EngineError;
 use crate::identify::values::layout::{FreeParam, ParamKind};
 use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::nuisance::NuisanceKind;
-use crate::identify::values::options::{FitDomain, FitOptions, ForceTarget, OscillatorParam};
+use crate::identify::values::options::{FitDomain, FitOptions, ForceTarget};
 use crate::identify::values::result::{ForceBalance, SampleAxes, SlidingSamples};
-use crate::oscillator::{is_unknown, Oscillator};
+use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::noise::noise_floor_level;
 use crate::record::{channel_list, Channel, NormalForce, Record};
 use frictionid_models::GuessHint;
@@ -96,18 +97,29 @@ pub struct ForceAlongMotion {
 }
 
 /// The oscillator properties a force-domain fit on the energy-based force, a velocity fit or
-/// an energy analysis needs, and the message when `missing` (as `[oscillator]` keys) holds
+/// an energy analysis needs, and the message (naming them on `axis`) when `missing` holds
 /// any of them. The one place of this rule.
-pub fn require_mechanics(missing: &[String], purpose: &str) -> Result<(), EngineError> {
-    require_properties(missing, &["mass", "damping", "stiffness"], purpose)
+pub fn require_mechanics(
+    missing: &[OscillatorProperty],
+    axis: Axis,
+    purpose: &str,
+) -> Result<(), EngineError> {
+    use OscillatorProperty::{Damping, Mass, Stiffness};
+    require_properties(missing, axis, &[Mass, Damping, Stiffness], purpose)
 }
 
 /// Every oscillator property, the normal force included, is given: what a simulation of the
 /// oscillator needs (a placeholder N = 0 would silently simulate no friction at all).
-pub fn require_oscillator(missing: &[String], purpose: &str) -> Result<(), EngineError> {
+pub fn require_oscillator(
+    missing: &[OscillatorProperty],
+    axis: Axis,
+    purpose: &str,
+) -> Result<(), EngineError> {
+    use OscillatorProperty::{Damping, Mass, NormalForce, Stiffness};
     require_properties(
         missing,
-        &["mass", "damping", "stiffness", "normal_force"],
+        axis,
+        &[Mass, Damping, Stiffness, NormalForce],
         purpose,
     )
 }
@@ -120,27 +132,23 @@ fn spoken_list(items: &[&str]) -> String {
     }
 }
 
-/// The `needed` `[oscillator]` keys are not among the `missing` ones; otherwise an error
-/// naming those that are.
+/// None of the `needed` properties is among the `missing` ones; otherwise an error naming
+/// those that are, as `axis` names them.
 fn require_properties(
-    missing: &[String],
-    needed: &[&str],
+    missing: &[OscillatorProperty],
+    axis: Axis,
+    needed: &[OscillatorProperty],
     purpose: &str,
 ) -> Result<(), EngineError> {
-    // A rotary axis names its mass `inertia`, in the list of keys not given and here.
-    let rotary = missing.iter().any(|m| m == "inertia");
-    let needed: Vec<&str> = needed
-        .iter()
-        .map(|&k| if rotary && k == "mass" { "inertia" } else { k })
-        .collect();
     let absent: Vec<&str> = needed
         .iter()
-        .copied()
-        .filter(|k| is_unknown(missing, k))
+        .filter(|p| missing.contains(p))
+        .map(|p| p.name_on(axis))
         .collect();
     if absent.is_empty() {
         return Ok(());
     }
+    let needed: Vec<&str> = needed.iter().map(|p| p.name_on(axis)).collect();
     Err(EngineError::InvalidInput(format!(
         "[oscillator]: {purpose} needs {}; `{}` not given (only a force-domain fit on a \
          measured force channel does without mass, damping and stiffness)",
@@ -218,18 +226,18 @@ impl ForceAlongMotion {
 
     /// The oscillator an inverse-dynamics fit starts from: `osc` with the properties in
     /// `fitted` at the linear estimate (`osc` itself without one).
-    pub fn starting_oscillator(&self, osc: &Oscillator, fitted: &[OscillatorParam]) -> Oscillator {
+    pub fn starting_oscillator(
+        &self,
+        osc: &Oscillator,
+        fitted: &[OscillatorProperty],
+    ) -> Oscillator {
         let Some(start) = &self.start else {
             return *osc;
         };
         let mut out = *osc;
         for p in fitted {
-            match p {
-                OscillatorParam::Mass => out.mass = start.oscillator.mass,
-                OscillatorParam::Damping => out.damping = start.oscillator.damping,
-                OscillatorParam::Stiffness => out.stiffness = start.oscillator.stiffness,
-                OscillatorParam::GravityMoment => out.restoring = start.oscillator.restoring,
-                OscillatorParam::InputOffset => out.input_offset = start.oscillator.input_offset,
+            if let Some(value) = p.value(&start.oscillator) {
+                p.set(&mut out, value);
             }
         }
         out
@@ -237,7 +245,7 @@ impl ForceAlongMotion {
 
     /// The linear inverse-dynamics estimate over every record (see
     /// [`super::inverse_dynamics::linear_start`]).
-    fn linear_start(&self, osc: &Oscillator, fitted: &[OscillatorParam]) -> Option<LinearStart> {
+    fn linear_start(&self, osc: &Oscillator, fitted: &[OscillatorProperty]) -> Option<LinearStart> {
         let samples: Vec<BalanceSamples<'_>> = self
             .tracks
             .iter()
@@ -345,7 +353,11 @@ impl ForceTrack {
                 ((0..f.len()).collect(), f)
             }
             TargetSource::EnergyBased => {
-                require_mechanics(&opts.unknown_oscillator, "the energy-based force (Eq. 7)")?;
+                require_mechanics(
+                    &opts.unknown_oscillator,
+                    osc.axis,
+                    "the energy-based force (Eq. 7)",
+                )?;
                 energy_target(record, osc, opts)?
             }
             TargetSource::InverseDynamics => {
@@ -432,14 +444,11 @@ impl ForceTrack {
             (ParamKind::Nuisance { record, .. }, _) if record != index => zeros(),
             (ParamKind::Nuisance { .. } | ParamKind::Model(_), _) => None,
             (_, None) => zeros(),
-            (ParamKind::Mass, Some(b)) => pick(&|i| b.acceleration[i]),
-            (ParamKind::Damping, Some(_)) => pick(&|i| self.velocity[i]),
-            (ParamKind::InputOffset, Some(_)) => Some(vec![1.0; self.used.len()]),
-            (ParamKind::Stiffness | ParamKind::GravityMoment, Some(b)) if !b.restoring => zeros(),
-            (ParamKind::Stiffness, Some(_)) if osc.restoring.is_linear_spring() => {
-                pick(&|i| self.displacement[i])
-            }
-            (ParamKind::Stiffness | ParamKind::GravityMoment, Some(_)) => None,
+            (ParamKind::Property(p), Some(b)) if p.is_restoring() && !b.restoring => zeros(),
+            (ParamKind::Property(p), Some(b)) if p.balance_column_exact(osc) => pick(&|i| {
+                p.balance_column(b.acceleration[i], self.velocity[i], self.displacement[i])
+            }),
+            (ParamKind::Property(_), Some(_)) => None,
         }
     }
 
@@ -496,8 +505,10 @@ fn keep_sliding(
 /// (an axis without a spring gives no `stiffness`).
 fn has_restoring(osc: &Oscillator, opts: &FitOptions) -> bool {
     !osc.restoring.is_linear_spring()
-        || opts.oscillator.contains(&OscillatorParam::Stiffness)
-        || !opts.unknown_oscillator.iter().any(|k| k == "stiffness")
+        || opts.oscillator.contains(&OscillatorProperty::Stiffness)
+        || !opts
+            .unknown_oscillator
+            .contains(&OscillatorProperty::Stiffness)
 }
 
 /// The target of a record under `force_target`.
@@ -768,8 +779,8 @@ pub fn check_force_domain(opts: &FitOptions) -> Result<(), EngineError> {
 
 /// Inverse dynamics knows the mass (the inertia): given in `[oscillator]` or fitted.
 fn check_inverse_dynamics(opts: &FitOptions) -> Result<(), EngineError> {
-    let mass_unknown = is_unknown(&opts.unknown_oscillator, "mass")
-        && !opts.oscillator.contains(&OscillatorParam::Mass);
+    let mass_unknown = opts.unknown_oscillator.contains(&OscillatorProperty::Mass)
+        && !opts.oscillator.contains(&OscillatorProperty::Mass);
     if opts.force_target == ForceTarget::InverseDynamics && mass_unknown {
         return Err(EngineError::InvalidInput(
             "[oscillator]: force_target = \"inverse_dynamics\" needs the mass (the inertia): \
@@ -826,7 +837,7 @@ mod tests {
              channel (it has: displacement; name its column with `force_column`)"
         );
         let no_mechanics = FitOptions {
-            unknown_oscillator: vec!["mass".into(), "stiffness".into()],
+            unknown_oscillator: vec![OscillatorProperty::Mass, OscillatorProperty::Stiffness],
             ..opts.clone()
         };
         let e = ForceAlongMotion::new(std::slice::from_ref(&bare), &osc, &no_mechanics)

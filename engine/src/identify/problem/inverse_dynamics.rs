@@ -29,8 +29,7 @@
 
 use crate::energy::{savitzky_golay_derivative, SeriesSource};
 use crate::error::EngineError;
-use crate::identify::values::options::OscillatorParam;
-use crate::oscillator::Oscillator;
+use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::{Channel, Record};
 use nalgebra::{DMatrix, DVector};
 
@@ -172,7 +171,7 @@ pub struct LinearStart {
 pub fn linear_start(
     records: &[BalanceSamples<'_>],
     osc: &Oscillator,
-    fitted: &[OscillatorParam],
+    fitted: &[OscillatorProperty],
 ) -> Option<LinearStart> {
     let columns = regressor_columns(fitted);
     let width = columns.len() + records.len();
@@ -215,7 +214,7 @@ pub fn linear_start(
 /// A column of the linear start's regression.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Regressor {
-    Property(OscillatorParam),
+    Property(OscillatorProperty),
     Coulomb,
     Viscous,
 }
@@ -223,36 +222,29 @@ enum Regressor {
 impl Regressor {
     fn value(self, a: f64, v: f64, q: f64) -> f64 {
         match self {
-            Self::Property(OscillatorParam::Mass) => a,
-            Self::Property(OscillatorParam::Damping) | Self::Viscous => v,
-            Self::Property(OscillatorParam::Stiffness) => q,
-            Self::Property(OscillatorParam::GravityMoment) => q.sin(),
-            Self::Property(OscillatorParam::InputOffset) => 1.0,
+            Self::Property(p) => p.balance_column(a, v, q),
+            Self::Viscous => v,
             Self::Coulomb => v.signum(),
         }
     }
 
-    /// Sets the property this column estimates (a mass or stiffness only when positive).
+    /// Sets the property this column estimates, where the estimate lies in its domain
+    /// ([`OscillatorProperty::admissible`]).
     fn assign(self, osc: &mut Oscillator, value: f64) {
-        match self {
-            Self::Property(OscillatorParam::Mass) if value > 0.0 => osc.mass = value,
-            Self::Property(OscillatorParam::Damping) => osc.damping = value.max(0.0),
-            Self::Property(OscillatorParam::Stiffness) if value > 0.0 => osc.stiffness = value,
-            Self::Property(OscillatorParam::GravityMoment) if value > 0.0 => {
-                osc.restoring.set_parameter("gravity_moment", value);
+        if let Self::Property(p) = self {
+            if let Some(value) = p.admissible(value) {
+                p.set(osc, value);
             }
-            Self::Property(OscillatorParam::InputOffset) => osc.input_offset = value,
-            _ => {}
         }
     }
 }
 
 /// The fitted properties' columns, the Coulomb level's and a viscous one (unless the damping
 /// is fitted: the two would be the same column).
-fn regressor_columns(fitted: &[OscillatorParam]) -> Vec<Regressor> {
+fn regressor_columns(fitted: &[OscillatorProperty]) -> Vec<Regressor> {
     let mut columns: Vec<Regressor> = fitted.iter().map(|&p| Regressor::Property(p)).collect();
     columns.push(Regressor::Coulomb);
-    if !fitted.contains(&OscillatorParam::Damping) {
+    if !fitted.contains(&OscillatorProperty::Damping) {
         columns.push(Regressor::Viscous);
     }
     columns
@@ -261,22 +253,22 @@ fn regressor_columns(fitted: &[OscillatorParam]) -> Vec<Regressor> {
 /// The terms of the balance that are not fitted, at `osc`'s values.
 fn known_terms(
     osc: &Oscillator,
-    fitted: &[OscillatorParam],
+    fitted: &[OscillatorProperty],
     restoring: bool,
     (a, v, q): (f64, f64, f64),
 ) -> f64 {
-    let held = |p: OscillatorParam| !fitted.contains(&p);
+    let held = |p: OscillatorProperty| !fitted.contains(&p);
     let mut sum = 0.0;
-    if held(OscillatorParam::Mass) {
+    if held(OscillatorProperty::Mass) {
         sum += osc.mass * a;
     }
-    if held(OscillatorParam::Damping) {
+    if held(OscillatorProperty::Damping) {
         sum += osc.damping * v;
     }
-    if restoring && held(OscillatorParam::Stiffness) && held(OscillatorParam::GravityMoment) {
+    if restoring && !fitted.iter().any(|p| p.is_restoring()) {
         sum += restoring_force(osc, q);
     }
-    if held(OscillatorParam::InputOffset) {
+    if held(OscillatorProperty::InputOffset) {
         sum += osc.input_offset;
     }
     sum

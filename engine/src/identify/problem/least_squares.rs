@@ -156,13 +156,7 @@ impl<R: Residuals> FitProblem<R> {
                         *v = x;
                     }
                 }
-                ParamKind::Mass => osc.mass = x,
-                ParamKind::Damping => osc.damping = x,
-                ParamKind::Stiffness => osc.stiffness = x,
-                ParamKind::GravityMoment => {
-                    osc.restoring.set_parameter("gravity_moment", x);
-                }
-                ParamKind::InputOffset => osc.input_offset = x,
+                ParamKind::Property(property) => property.set(&mut osc, x),
                 ParamKind::Nuisance { kind, record } => {
                     if let Some(n) = nuisance.get_mut(record) {
                         n.set(kind, x);

@@ -21,7 +21,7 @@ use crate::error::EngineError;
 use crate::identify::values::levels::{FrictionLevels, UNIT_NORMAL_FORCE};
 use crate::identify::values::nuisance::{NuisanceKind, NuisanceValues};
 use crate::identify::values::options::FitOptions;
-use crate::oscillator::Oscillator;
+use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::{channel_list, Channel, Record};
 use crate::simulate::{
     simulate_driven, simulate_velocity_watched, Initial, Input, RunInputs, SampleGrid, SimOptions,
@@ -209,7 +209,7 @@ impl SimulatedResponse {
 pub fn simulated_levels(
     records: &[Record],
     osc: &Oscillator,
-    unknown: &[String],
+    unknown: &[OscillatorProperty],
 ) -> Result<(FrictionLevels, Oscillator), EngineError> {
     let as_forces = FrictionLevels::read_as_forces(unknown, records);
     for record in records {
@@ -598,7 +598,7 @@ mod tests {
         let time: Vec<f64> = (0..1500).map(|i| i as f64 * 1e-3).collect();
         let exact = coulomb_free_vibration(&osc, 3.48, 0.014, &time).unwrap();
         let record = Record::new("r", time, exact.v, 0.014);
-        let unknown = vec!["normal_force".to_string()];
+        let unknown = vec![OscillatorProperty::NormalForce];
         let (levels, simulated) =
             simulated_levels(std::slice::from_ref(&record), &osc, &unknown).unwrap();
         let FrictionLevels::Forces { largest } = levels else {

@@ -8,8 +8,8 @@ use crate::identify::problem::residuals::Residuals;
 use crate::identify::values::layout::{FreeParam, ParamKind};
 use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::nuisance::{non_model_bound_keys, NuisanceKind};
-use crate::identify::values::options::{FitOptions, OscillatorParam};
-use crate::oscillator::Oscillator;
+use crate::identify::values::options::FitOptions;
+use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::Record;
 use frictionid_models::{FrictionModel, GuessHint, ParamInfo};
 
@@ -151,7 +151,7 @@ fn free_model_indices(
         match names.iter().position(|n| n == name) {
             Some(i) if !idx.contains(&i) => idx.push(i),
             Some(_) => {}
-            None if OscillatorParam::parse(name).is_some() => {}
+            None if OscillatorProperty::parse(name).is_some() => {}
             None => return Err(unknown_name("free parameter", name, names)),
         }
     }
@@ -245,14 +245,21 @@ fn within_domain(
     Ok((lo_in, hi_in))
 }
 
-/// A fitted gravity moment needs a restoring law that has one (the pendulum): otherwise its
-/// start would be undefined.
-fn check_property_exists(osc: &Oscillator, q: OscillatorParam) -> Result<(), EngineError> {
-    if q == OscillatorParam::GravityMoment && osc.restoring.parameter("gravity_moment").is_none() {
+/// A fitted property is one a fit may vary, and a restoring law's parameter (the gravity
+/// moment) needs a law that has one (the pendulum): otherwise its start would be undefined.
+fn check_property_exists(osc: &Oscillator, q: OscillatorProperty) -> Result<(), EngineError> {
+    if !q.is_fitted() {
+        return Err(EngineError::InvalidInput(format!(
+            "[fit.options] oscillator: `{}` is not fitted",
+            q.key()
+        )));
+    }
+    if q.value(osc).is_none() {
         const PENDULUM: &str = r#"{ type = "pendulum", gravity_moment = ... }"#;
         return Err(EngineError::InvalidInput(format!(
-            "[fit.options] oscillator: `gravity_moment` is fitted, but the restoring law `{}` has \
+            "[fit.options] oscillator: `{}` is fitted, but the restoring law `{}` has \
              none; set [oscillator] restoring = {PENDULUM}",
+            q.key(),
             osc.restoring.name()
         )));
     }
@@ -260,49 +267,29 @@ fn check_property_exists(osc: &Oscillator, q: OscillatorParam) -> Result<(), Eng
 }
 
 /// A free oscillator property, named as reports name it on the axis (a rotary axis's mass
-/// is its `inertia`, bounded under either name): mass, stiffness and gravity moment in log
-/// coordinates, damping and the input offset linear (the offset unbounded).
-fn oscillator_param(osc: &Oscillator, q: OscillatorParam, opts: &FitOptions) -> (FreeParam, f64) {
-    let gravity_moment = osc.restoring.parameter("gravity_moment");
-    let (current, kind) = match q {
-        OscillatorParam::Mass => (osc.mass, ParamKind::Mass),
-        OscillatorParam::Damping => (osc.damping, ParamKind::Damping),
-        OscillatorParam::Stiffness => (osc.stiffness, ParamKind::Stiffness),
-        OscillatorParam::GravityMoment => {
-            (gravity_moment.unwrap_or(f64::NAN), ParamKind::GravityMoment)
-        }
-        OscillatorParam::InputOffset => (osc.input_offset, ParamKind::InputOffset),
-    };
-    let linear = matches!(q, OscillatorParam::Damping | OscillatorParam::InputOffset);
-    let log = !linear;
-    let unbounded = (f64::NEG_INFINITY, f64::INFINITY);
-    let default_bounds = match q {
-        OscillatorParam::InputOffset => unbounded,
-        _ => (0.0, f64::INFINITY),
-    };
+/// is its `inertia`, bounded under either name): the strictly positive ones in log
+/// coordinates, the others linear (see [`OscillatorProperty::domain`]).
+fn oscillator_param(
+    osc: &Oscillator,
+    q: OscillatorProperty,
+    opts: &FitOptions,
+) -> (FreeParam, f64) {
+    let current = q.value(osc).unwrap_or(f64::NAN);
+    let log = q.log_coordinates();
     let name = q.name_on(osc.axis);
     let (lo, hi) = opts
         .bounds
-        .get(q.name())
+        .get(q.key())
         .or_else(|| opts.bounds.get(name))
         .copied()
-        .unwrap_or(default_bounds);
-    let typical = match q {
-        // A damping's scale: 2e-3 of the critical damping of small motions (of a
-        // kilogram-second without a restoring force); an offset's: a newton.
-        OscillatorParam::InputOffset => 1.0,
-        _ if osc.small_motion_stiffness() > 0.0 => {
-            2e-3 * (osc.mass * osc.small_motion_stiffness()).sqrt()
-        }
-        _ => 2e-3 * osc.mass,
-    };
+        .unwrap_or(q.default_bounds());
     let mut f = FreeParam::linear(
         name.to_string(),
-        &osc.axis.unit(q.unit()),
-        kind,
+        &q.unit_on(osc.axis),
+        ParamKind::Property(q),
         (lo, hi),
         current,
-        typical,
+        q.typical(osc),
     );
     f.log = log;
     let floor = if log { f64::MIN_POSITIVE } else { lo };
@@ -342,11 +329,11 @@ mod tests {
     #[test]
     fn a_gravity_moment_is_fitted_only_on_a_law_that_has_one() {
         let spring = Oscillator::fmm();
-        let e = check_property_exists(&spring, OscillatorParam::GravityMoment).unwrap_err();
+        let e = check_property_exists(&spring, OscillatorProperty::GravityMoment).unwrap_err();
         let text = e.to_string();
         assert!(text.contains("`gravity_moment`"), "{text}");
         assert!(text.contains("pendulum"), "{text}");
-        assert!(check_property_exists(&spring, OscillatorParam::Stiffness).is_ok());
+        assert!(check_property_exists(&spring, OscillatorProperty::Stiffness).is_ok());
         let pendulum: crate::axis::Restoring =
             serde_json::from_value(serde_json::json!({"type": "pendulum", "gravity_moment": 2.0}))
                 .unwrap();
@@ -354,6 +341,6 @@ mod tests {
             restoring: pendulum,
             ..Oscillator::fmm()
         };
-        assert!(check_property_exists(&osc, OscillatorParam::GravityMoment).is_ok());
+        assert!(check_property_exists(&osc, OscillatorProperty::GravityMoment).is_ok());
     }
 }

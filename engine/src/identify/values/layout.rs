@@ -6,6 +6,7 @@
 //! map to bounds of the internal coordinates, which the projected Levenberg-Marquardt keeps.
 
 use super::nuisance::NuisanceKind;
+use crate::oscillator::OscillatorProperty;
 use serde::Serialize;
 
 /// What a free parameter is.
@@ -14,16 +15,8 @@ use serde::Serialize;
 pub enum ParamKind {
     /// The model parameter at this index of `FrictionModel::params`.
     Model(usize),
-    /// The oscillator mass.
-    Mass,
-    /// The oscillator damping.
-    Damping,
-    /// The oscillator stiffness.
-    Stiffness,
-    /// The pendulum's gravity moment.
-    GravityMoment,
-    /// The input's offset.
-    InputOffset,
+    /// An oscillator property.
+    Property(OscillatorProperty),
     /// A nuisance parameter of one record.
     Nuisance {
         /// What it is.

@@ -11,7 +11,7 @@
 //! force the records' balance allows, and the oscillator carries N = 1).
 
 use crate::axis::Axis;
-use crate::oscillator::Oscillator;
+use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::{NormalForce, Record};
 use frictionid_models::{clone_model, FrictionModel, ParamInfo};
 
@@ -39,12 +39,12 @@ pub enum FrictionLevels {
 
 impl FrictionLevels {
     /// Whether a fit of `records` reads the levels as forces: the configuration gives no
-    /// normal force (`unknown`, the `[oscillator]` keys not given, names `normal_force`) and
+    /// normal force (`unknown`, the `[oscillator]` properties not given, holds the normal force) and
     /// no record has one of its own (a constant or a channel). One record's own normal force
     /// keeps them coefficients, and then every record needs one
     /// ([`FrictionLevels::record_normal_force`]).
-    pub fn read_as_forces(unknown: &[String], records: &[Record]) -> bool {
-        unknown.iter().any(|k| k == "normal_force")
+    pub fn read_as_forces(unknown: &[OscillatorProperty], records: &[Record]) -> bool {
+        unknown.contains(&OscillatorProperty::NormalForce)
             && records.iter().all(|r| r.normal_force().is_none())
     }
 
@@ -54,13 +54,13 @@ impl FrictionLevels {
     pub fn record_normal_force(
         record: &Record,
         osc: &Oscillator,
-        unknown: &[String],
+        unknown: &[OscillatorProperty],
         as_forces: bool,
     ) -> Result<NormalForce, String> {
         match record.normal_force() {
             Some(n) => Ok(n.clone()),
             None if as_forces => Ok(NormalForce::Constant(UNIT_NORMAL_FORCE)),
-            None if unknown.iter().any(|k| k == "normal_force") => Err(
+            None if unknown.contains(&OscillatorProperty::NormalForce) => Err(
                 "no normal force: give [oscillator] normal_force, the record's `normal_force` \
                  or a normal_force channel (other records have one)"
                     .into(),

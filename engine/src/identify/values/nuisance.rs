@@ -1,7 +1,7 @@
 //! The per-record nuisance parameters a residual producer adds to a fit (a velocity offset,
 //! a release-time shift, the release displacement, a force offset) and their values.
 
-use crate::oscillator::Oscillator;
+use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::Record;
 use serde::{Deserialize, Serialize};
 
@@ -132,14 +132,7 @@ impl NuisanceValues {
 /// Bound keys that are not model parameters: the oscillator properties a fit may vary (the
 /// mass under either of its names), then every nuisance parameter's key.
 pub fn non_model_bound_keys() -> Vec<&'static str> {
-    let mut keys = vec![
-        "mass",
-        "inertia",
-        "damping",
-        "stiffness",
-        "gravity_moment",
-        "input_offset",
-    ];
+    let mut keys: Vec<&'static str> = OscillatorProperty::bound_keys().collect();
     keys.extend(NuisanceKind::ALL.map(NuisanceKind::key));
     keys
 }

@@ -3,71 +3,15 @@
 use super::search::Search;
 use super::uncertainty::PropertyUncertainty;
 use crate::energy::EnergyOptions;
+use crate::oscillator::OscillatorProperty;
 use crate::simulate::{Integrator, SimOptions};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-/// An oscillator property that a fit may vary.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum OscillatorParam {
-    /// m [kg] (J [kg m^2] on a rotary axis, where it is called `inertia`).
-    #[serde(alias = "inertia")]
-    Mass,
-    /// c [N s/m].
-    Damping,
-    /// k [N/m].
-    Stiffness,
-    /// The pendulum's gravity moment m g l [N m] (`restoring = { type = "pendulum" }`).
-    GravityMoment,
-    /// The input's offset F_0 [N] (see `Oscillator::input_offset`).
-    InputOffset,
-}
-
-impl OscillatorParam {
-    /// Config name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Mass => "mass",
-            Self::Damping => "damping",
-            Self::Stiffness => "stiffness",
-            Self::GravityMoment => "gravity_moment",
-            Self::InputOffset => "input_offset",
-        }
-    }
-    /// Its name in reports on `axis`: the config name, `inertia` for the mass of a rotary
-    /// axis.
-    pub fn name_on(self, axis: crate::axis::Axis) -> &'static str {
-        match self {
-            Self::Mass => axis.inertia_name(),
-            other => other.name(),
-        }
-    }
-
-    /// Its unit written for a linear axis ([`crate::Axis::unit`] gives the rotary one): the
-    /// gravity moment, a torque on the rotary axis it belongs to, is written as the force N.
-    pub fn unit(self) -> &'static str {
-        match self {
-            Self::Mass => "kg",
-            Self::Damping => "N s/m",
-            Self::Stiffness => "N/m",
-            Self::GravityMoment => "N",
-            Self::InputOffset => "N",
-        }
-    }
-    /// Parses a config name.
-    pub fn parse(name: &str) -> Option<Self> {
-        match name {
-            "mass" | "inertia" => Some(Self::Mass),
-            "damping" => Some(Self::Damping),
-            "stiffness" => Some(Self::Stiffness),
-            "gravity_moment" => Some(Self::GravityMoment),
-            "input_offset" => Some(Self::InputOffset),
-            _ => None,
-        }
-    }
-}
+/// An oscillator property that a fit may vary (the normal force excepted): one typed value
+/// per property, in [`crate::oscillator`].
+pub use crate::oscillator::OscillatorProperty as OscillatorParam;
 
 /// What a fit compares (`[fit.options] domain`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -181,9 +125,9 @@ pub struct FitOptions {
     /// Velocity fits of models with internal states start also from the optimum of a
     /// force-domain fit to the energy-based force (the prefit).
     pub prefit: bool,
-    /// `[oscillator]` keys that were not given (their values are placeholders): fits that need
-    /// them fail with a message naming them.
-    pub unknown_oscillator: Vec<String>,
+    /// `[oscillator]` properties that were not given (their values are placeholders): fits
+    /// that need them fail with a message naming them.
+    pub unknown_oscillator: Vec<OscillatorProperty>,
     /// Number of starts; `None`: 1 when at most two model parameters are free, else
     /// [`crate::identify::search::starts::DEFAULT_STARTS`].
     pub multistart: Option<usize>,
@@ -264,36 +208,5 @@ impl std::fmt::Debug for FitOptions {
             .field("max_iterations", &self.max_iterations)
             .field("parallel", &self.parallel)
             .finish_non_exhaustive()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A rotary axis names its mass `inertia`: `[fit.options] oscillator = ["inertia"]` asks
-    /// for the same property as `"mass"`, and reports name it after the axis.
-    #[test]
-    fn inertia_is_the_rotary_name_of_the_mass() {
-        let asked: Vec<OscillatorParam> =
-            serde_json::from_value(serde_json::json!(["inertia", "mass", "gravity_moment"]))
-                .unwrap();
-        assert_eq!(
-            asked,
-            [
-                OscillatorParam::Mass,
-                OscillatorParam::Mass,
-                OscillatorParam::GravityMoment
-            ]
-        );
-        assert_eq!(
-            OscillatorParam::parse("inertia"),
-            Some(OscillatorParam::Mass)
-        );
-        assert_eq!(OscillatorParam::Mass.name(), "mass");
-        use crate::axis::Axis;
-        assert_eq!(OscillatorParam::Mass.name_on(Axis::Rotary), "inertia");
-        assert_eq!(OscillatorParam::Mass.name_on(Axis::Linear), "mass");
-        assert_eq!(OscillatorParam::Damping.name_on(Axis::Rotary), "damping");
     }
 }

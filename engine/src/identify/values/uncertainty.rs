@@ -3,7 +3,7 @@
 //! [`crate::identify::assessment::property_refits`]).
 
 use crate::error::EngineError;
-use crate::oscillator::Oscillator;
+use crate::oscillator::OscillatorProperty;
 use serde::{Deserialize, Serialize};
 
 /// One standard deviation of each oscillator property (0: known exactly).
@@ -27,12 +27,12 @@ impl PropertyUncertainty {
     }
 
     /// Every property with its standard deviation.
-    pub(crate) fn properties(&self) -> [(Property, f64); 4] {
+    pub(crate) fn properties(&self) -> [(OscillatorProperty, f64); 4] {
         [
-            (Property::Mass, self.mass),
-            (Property::Damping, self.damping),
-            (Property::Stiffness, self.stiffness),
-            (Property::NormalForce, self.normal_force),
+            (OscillatorProperty::Mass, self.mass),
+            (OscillatorProperty::Damping, self.damping),
+            (OscillatorProperty::Stiffness, self.stiffness),
+            (OscillatorProperty::NormalForce, self.normal_force),
         ]
     }
 
@@ -45,47 +45,10 @@ impl PropertyUncertainty {
         {
             Some((p, s)) => Err(EngineError::InvalidOscillator(format!(
                 "`{}_std` must be finite and >= 0, got {s}",
-                p.name()
+                p.key()
             ))),
             None => Ok(()),
         }
-    }
-}
-
-/// An oscillator property a fit can be uncertain of.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Property {
-    /// The mass.
-    Mass,
-    /// The damping.
-    Damping,
-    /// The stiffness.
-    Stiffness,
-    /// The normal force.
-    NormalForce,
-}
-
-impl Property {
-    /// Config-style name.
-    pub(crate) fn name(self) -> &'static str {
-        match self {
-            Self::Mass => "mass",
-            Self::Damping => "damping",
-            Self::Stiffness => "stiffness",
-            Self::NormalForce => "normal_force",
-        }
-    }
-
-    /// `osc` with this property moved by `by`.
-    pub(crate) fn shifted(self, osc: &Oscillator, by: f64) -> Oscillator {
-        let mut o = *osc;
-        match self {
-            Self::Mass => o.mass += by,
-            Self::Damping => o.damping += by,
-            Self::Stiffness => o.stiffness += by,
-            Self::NormalForce => o.normal_force += by,
-        }
-        o
     }
 }
 
@@ -105,13 +68,14 @@ pub struct StdErrorComponents {
 }
 
 impl StdErrorComponents {
-    /// Sets the component of `p`.
-    pub(crate) fn set(&mut self, p: Property, value: f64) {
+    /// Sets the component of `p` (none for a property without an uncertainty).
+    pub(crate) fn set(&mut self, p: OscillatorProperty, value: f64) {
         match p {
-            Property::Mass => self.mass = value,
-            Property::Damping => self.damping = value,
-            Property::Stiffness => self.stiffness = value,
-            Property::NormalForce => self.normal_force = value,
+            OscillatorProperty::Mass => self.mass = value,
+            OscillatorProperty::Damping => self.damping = value,
+            OscillatorProperty::Stiffness => self.stiffness = value,
+            OscillatorProperty::NormalForce => self.normal_force = value,
+            OscillatorProperty::GravityMoment | OscillatorProperty::InputOffset => {}
         }
     }
 

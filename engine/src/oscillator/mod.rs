@@ -1,6 +1,10 @@
 //! The single-degree-of-freedom oscillator of the paper's Eq. (1), generalised to any axis:
 //! J q'' + c q' + R(q) + F_f = u(t).
 
+mod property;
+
+pub use property::{OscillatorProperty, PropertyDomain};
+
 use crate::axis::{Axis, Restoring};
 use crate::error::EngineError;
 use serde::{Deserialize, Serialize};
@@ -38,12 +42,12 @@ fn is_zero(value: &f64) -> bool {
     *value == 0.0
 }
 
-/// `[oscillator]` as written: every key optional. A force-domain fit on a measured force
-/// needs none of m, c and k, and no normal force when its records carry one; the fits and
-/// analyses that need them say so ([`crate::identify::require_mechanics`]).
+/// The oscillator's m, c, k and N as given: any of them may be absent. A force-domain fit on
+/// a measured force needs none of m, c and k, and no normal force when its records carry
+/// one; the fits and analyses that need them say so ([`crate::identify::require_mechanics`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct OscillatorInput {
+pub struct PartialOscillator {
     /// Mass m [kg].
     pub mass: Option<f64>,
     /// Viscous damping c [N s/m].
@@ -54,32 +58,22 @@ pub struct OscillatorInput {
     pub normal_force: Option<f64>,
 }
 
-/// Whether the `[oscillator]` property `key` is among the `unknown` keys (those not given),
-/// the inertia asked for by either of its names: a rotary axis lists it as `inertia`, the
-/// checks ask for `mass`.
-pub fn is_unknown(unknown: &[String], key: &str) -> bool {
-    let inertia = |k: &str| k == "mass" || k == "inertia";
-    unknown
-        .iter()
-        .any(|u| u == key || (inertia(u) && inertia(key)))
-}
-
-impl OscillatorInput {
-    /// The oscillator, with placeholders for the keys not given (m = k = 1, c = N = 0; no
-    /// result depends on them), and the names of those keys.
-    pub fn resolve(&self) -> (Oscillator, Vec<String>) {
+impl PartialOscillator {
+    /// The oscillator, with placeholders for the properties not given (m = k = 1, c = N = 0;
+    /// no result depends on them), and those properties.
+    pub fn resolve(&self) -> (Oscillator, Vec<OscillatorProperty>) {
         let mut missing = Vec::new();
-        let mut take = |name: &str, value: Option<f64>, placeholder: f64| {
+        let mut take = |property: OscillatorProperty, value: Option<f64>, placeholder: f64| {
             value.unwrap_or_else(|| {
-                missing.push(name.to_string());
+                missing.push(property);
                 placeholder
             })
         };
         let osc = Oscillator {
-            mass: take("mass", self.mass, 1.0),
-            damping: take("damping", self.damping, 0.0),
-            stiffness: take("stiffness", self.stiffness, 1.0),
-            normal_force: take("normal_force", self.normal_force, 0.0),
+            mass: take(OscillatorProperty::Mass, self.mass, 1.0),
+            damping: take(OscillatorProperty::Damping, self.damping, 0.0),
+            stiffness: take(OscillatorProperty::Stiffness, self.stiffness, 1.0),
+            normal_force: take(OscillatorProperty::NormalForce, self.normal_force, 0.0),
             axis: Axis::Linear,
             restoring: Restoring::default(),
             input_offset: 0.0,
@@ -138,11 +132,20 @@ impl Oscillator {
     pub fn validate(&self) -> Result<(), EngineError> {
         let law = self.restoring.law();
         let checks = [
-            (self.axis.inertia_name(), self.mass, true),
-            ("damping", self.damping, false),
-            ("stiffness", self.stiffness, law.reads_stiffness()),
-            ("normal_force", self.normal_force, false),
-        ];
+            OscillatorProperty::Mass,
+            OscillatorProperty::Damping,
+            OscillatorProperty::Stiffness,
+            OscillatorProperty::NormalForce,
+        ]
+        .map(|p| {
+            let positive = p.domain() == PropertyDomain::Positive
+                && (p != OscillatorProperty::Stiffness || law.reads_stiffness());
+            (
+                p.name_on(self.axis),
+                p.value(self).unwrap_or(f64::NAN),
+                positive,
+            )
+        });
         if !self.input_offset.is_finite() {
             return Err(EngineError::InvalidOscillator(format!(
                 "`input_offset` must be finite, got {}",
