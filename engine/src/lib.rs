@@ -25,7 +25,6 @@ pub use energy::{
     Differentiator, EnergyAnalysis, EnergyOptions, ForceResiduals, HalfCycle, MechanicalEnergy,
 };
 pub use error::EngineError;
-pub use jobs::JobError;
 pub use oscillator::Oscillator;
 pub use record::Record;
 pub use report::{CompareReport, EnergyReport, FitReport, ModelsReport, SimulateReport};

@@ -1,5 +1,9 @@
 //! Synthetic measurements: reproducible Gaussian noise and uniform sample times.
 
+use crate::error::EngineError;
+use crate::oscillator::Oscillator;
+use crate::record::Record;
+use crate::simulate::{simulate, Initial, SimOptions};
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
@@ -33,14 +37,14 @@ pub fn add_gaussian_noise(values: &mut [f64], sigma: f64, seed: u64) {
 /// Gaussian velocity noise of `noise` m/s (seed `seed + i` for the i-th release). Record
 /// names are `x{mm}mm`.
 pub fn release_records(
-    osc: &crate::Oscillator,
+    osc: &Oscillator,
     model: &dyn frictionid_models::FrictionModel,
     releases: &[f64],
     duration: f64,
     sample_rate: f64,
     noise: f64,
     seed: u64,
-) -> Result<Vec<crate::Record>, crate::EngineError> {
+) -> Result<Vec<Record>, EngineError> {
     let times = uniform_times(duration, sample_rate);
     releases
         .iter()
@@ -48,7 +52,7 @@ pub fn release_records(
         .map(|(i, &x0)| {
             let mut v = released_velocity(osc, model, x0, duration, &times)?;
             add_gaussian_noise(&mut v, noise, seed + i as u64);
-            Ok(crate::Record::new(
+            Ok(Record::new(
                 format!("x{}mm", (x0 * 1e3).round()),
                 times.clone(),
                 v,
@@ -61,15 +65,15 @@ pub fn release_records(
 /// The velocity of the free vibration of `osc` with `model` released from rest at `x0`,
 /// simulated until `t_end` with the default options, at `times`.
 fn released_velocity(
-    osc: &crate::Oscillator,
+    osc: &Oscillator,
     model: &dyn frictionid_models::FrictionModel,
     x0: f64,
     t_end: f64,
     times: &[f64],
-) -> Result<Vec<f64>, crate::EngineError> {
-    let initial = crate::Initial::at_rest(x0);
-    let opts = crate::SimOptions::default();
-    Ok(crate::simulate(osc, model, &initial, t_end, times, &opts)?.v)
+) -> Result<Vec<f64>, EngineError> {
+    let initial = Initial::at_rest(x0);
+    let opts = SimOptions::default();
+    Ok(simulate(osc, model, &initial, t_end, times, &opts)?.v)
 }
 
 /// Adds stationary AR(1) ("coloured") noise of standard deviation `sigma` and lag-one
@@ -108,14 +112,14 @@ pub struct Defects {
 /// from t = 0, with the offset and the (coloured) noise of `defects` over the whole record.
 /// The release is at t = `defects.rest`; the record's x0 is the true one.
 pub fn defective_record(
-    osc: &crate::Oscillator,
+    osc: &Oscillator,
     model: &dyn frictionid_models::FrictionModel,
     x0: f64,
     duration: f64,
     sample_rate: f64,
     defects: &Defects,
     seed: u64,
-) -> Result<crate::Record, crate::EngineError> {
+) -> Result<Record, EngineError> {
     let times = uniform_times(defects.rest + duration, sample_rate);
     let first_moving = times.partition_point(|&t| t < defects.rest);
     let moving: Vec<f64> = times[first_moving..]
@@ -127,7 +131,7 @@ pub fn defective_record(
     v.extend(released_velocity(osc, model, x0, end, &moving)?);
     add_coloured_noise(&mut v, defects.noise, defects.correlation, seed);
     v.iter_mut().for_each(|x| *x += defects.offset);
-    Ok(crate::Record::new(
+    Ok(Record::new(
         format!("x{}mm-rest", (x0 * 1e3).round()),
         times,
         v,

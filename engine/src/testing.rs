@@ -3,9 +3,9 @@
 //! agree) to this crate's simulator, so a model crate checks its laws in motion with one line
 //! (see docs/writing-a-model.md).
 
+use crate::oscillator::Oscillator;
 use crate::simulate::{simulate, Initial, Integrator, SimOptions};
 use crate::synthetic::uniform_times;
-use crate::Oscillator;
 use frictionid_models::testing::motion::{Integration, Motion, Release, Simulator};
 use frictionid_models::testing::Model;
 

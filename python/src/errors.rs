@@ -1,7 +1,8 @@
 //! Errors as Python exceptions: bad input is a `ValueError`, a fit that failed is a
 //! `frictionid.FitError`; both carry the one-line message the CLI prints.
 
-use frictionid_engine::{EngineError, JobError};
+use frictionid_engine::jobs::JobError;
+use frictionid_engine::EngineError;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::PyErr;
 

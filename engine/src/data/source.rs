@@ -36,10 +36,10 @@
 //! whose x0 is unknown wherever else one is needed.
 
 use super::{read_record, DataError, DataFormat, ReadOptions};
+use crate::oscillator::Oscillator;
 use crate::record::{
     check_scales, detect_release, Channel, NormalForce, Record, Release, X0Source,
 };
-use crate::Oscillator;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use thiserror::Error;

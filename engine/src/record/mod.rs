@@ -20,6 +20,7 @@ pub use sanity::{check_scales, ScaleError};
 pub use time::{check_sorted, check_time, TimeBase, TimeError};
 
 use crate::error::EngineError;
+use crate::oscillator::Oscillator;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -246,7 +247,7 @@ impl Record {
 
     /// The normal force acting on this record: its own (sampled or constant), else the
     /// oscillator's `normal_force` as a constant.
-    pub fn normal_force_with(&self, osc: &crate::Oscillator) -> NormalForce {
+    pub fn normal_force_with(&self, osc: &Oscillator) -> NormalForce {
         self.normal_force
             .clone()
             .unwrap_or(NormalForce::Constant(osc.normal_force))
@@ -255,9 +256,9 @@ impl Record {
     /// `osc` under this record's own normal force, as a simulation of the record needs it:
     /// its constant (`[[records]] normal_force`) or the mean of its normal-force channel (a
     /// simulation holds N constant); `osc` itself without one.
-    pub fn oscillator_for(&self, osc: &crate::Oscillator) -> crate::Oscillator {
+    pub fn oscillator_for(&self, osc: &Oscillator) -> Oscillator {
         match &self.normal_force {
-            Some(n) => crate::Oscillator {
+            Some(n) => Oscillator {
                 normal_force: n.mean(),
                 ..*osc
             },
@@ -544,7 +545,7 @@ mod tests {
             vec![Channel::Velocity, Channel::Force, Channel::NormalForce]
         );
         assert_eq!(r.normal_force().map(|n| n.mean()), Some(5.5));
-        let osc = crate::Oscillator::fmm();
+        let osc = crate::oscillator::Oscillator::fmm();
         assert_eq!(r.normal_force_with(&osc).at(2), 6.0);
         assert_eq!(
             record().normal_force_with(&osc),

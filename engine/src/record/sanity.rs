@@ -16,7 +16,7 @@
 //!   scales with the angle, so its records cannot tell.
 
 use super::{Channel, Record};
-use crate::Oscillator;
+use crate::oscillator::Oscillator;
 use thiserror::Error;
 
 /// Largest accepted ratio of the peak speed to what x0, v0 and k/m allow.
