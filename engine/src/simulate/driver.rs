@@ -364,7 +364,7 @@ impl<R: Recorder> Driver<'_, R> {
             return None;
         };
         // The input itself must leave the band about R(x) + F_0.
-        let centre = self.dynamics.restoring_force(x) + self.dynamics.input_offset;
+        let centre = self.dynamics.restoring_force(x) + self.dynamics.osc.input_offset;
         let t_b = input.first_exceedance(t, t_end, centre, limit)?;
         // A stick that the input leaves at once is a stick the slip force cannot end
         // (a law whose slip force at rest exceeds its static limit): it lasts.

@@ -41,8 +41,8 @@ impl Dynamics<'_> {
             row0.fill(0.0);
             row0[1] = 1.0;
         }
-        jac[n] = -self.restoring_stiffness(*x) / self.mass;
-        jac[n + 1] = -(self.damping + df_dv) / self.mass;
+        jac[n] = -self.restoring_stiffness(*x) / self.osc.mass;
+        jac[n + 1] = -(self.osc.damping + df_dv) / self.osc.mass;
     }
 
     /// d(slip_force)/dv of a static law in direction `dir`.
@@ -93,7 +93,7 @@ impl Dynamics<'_> {
             row[2..].copy_from_slice(&dz_dz[i * nz..(i + 1) * nz]);
         }
         for (d, &f) in jac[n + 2..2 * n].iter_mut().zip(df_dz) {
-            *d = f / -self.mass;
+            *d = f / -self.osc.mass;
         }
         df_dv
     }
