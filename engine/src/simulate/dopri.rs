@@ -243,6 +243,14 @@ impl Dopri5 {
         std::mem::swap(&mut self.y, &mut self.y_next);
         self.ctrl.advance(h);
     }
+
+    /// Starts an interval at state `y` at `t` towards `t_end` (the step size as it is): what
+    /// a reset and a restart share.
+    fn start_at(&mut self, t: f64, y: &[f64], t_end: f64) {
+        self.ctrl.restart(t, t_end);
+        self.y.copy_from_slice(y);
+        self.old_error = MIN_OLD_ERROR;
+    }
 }
 
 impl Stepper for Dopri5 {
@@ -260,21 +268,17 @@ impl Stepper for Dopri5 {
         y: &[f64],
         t_end: f64,
     ) -> StepResult<()> {
-        if self.ctrl.h.is_nan() || self.ctrl.h <= 0.0 {
+        if !self.ctrl.has_step() {
             return self.reset(system, t, y, t_end);
         }
-        self.ctrl.restart(t, t_end);
-        self.y.copy_from_slice(y);
-        self.old_error = MIN_OLD_ERROR;
+        self.start_at(t, y, t_end);
         system.rhs(t, y, &mut self.k[0]);
         self.counts.rhs_evaluations += 1;
         Ok(())
     }
 
     fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()> {
-        self.ctrl.restart(t, t_end);
-        self.y.copy_from_slice(y);
-        self.old_error = MIN_OLD_ERROR;
+        self.start_at(t, y, t_end);
         // Leaves f(t, y) in k[0], ready for the first step.
         self.ctrl.h = self.initial_step(system);
         self.counts.rhs_evaluations += 2;

@@ -347,6 +347,28 @@ impl Rodas4 {
     }
 
     /// Handles a rejected attempt of size `h` with next size `h_new`.
+    /// Starts an interval at state `y` at `t` towards `t_end` with f and J evaluated afresh
+    /// and the controller's memory dropped (the step size as it is); `first`: the step is
+    /// a starting guess (a reset), not one learnt (a restart).
+    fn start_at<S: OdeSystem>(
+        &mut self,
+        system: &S,
+        (t, y, t_end): (f64, &[f64], f64),
+        first: bool,
+    ) {
+        self.ctrl.restart(t, t_end);
+        self.y.copy_from_slice(y);
+        self.cont[0].copy_from_slice(y);
+        self.cont[1].copy_from_slice(y);
+        self.cont[2].fill(0.0);
+        self.cont[3].fill(0.0);
+        self.ctrl.h_last = 0.0;
+        self.first = first;
+        self.h_acc = 0.0;
+        self.err_acc = 1e-2;
+        self.refresh(system);
+    }
+
     fn reject(&mut self, h: f64, h_new: f64) -> StepOutcome {
         self.ctrl.h = if self.first { 0.1 * h } else { h_new };
         self.ctrl.after_reject = true;
@@ -370,35 +392,15 @@ impl Stepper for Rodas4 {
         y: &[f64],
         t_end: f64,
     ) -> StepResult<()> {
-        if self.ctrl.h.is_nan() || self.ctrl.h <= 0.0 {
+        if !self.ctrl.has_step() {
             return self.reset(system, t, y, t_end);
         }
-        self.ctrl.restart(t, t_end);
-        self.y.copy_from_slice(y);
-        self.cont[0].copy_from_slice(y);
-        self.cont[1].copy_from_slice(y);
-        self.cont[2].fill(0.0);
-        self.cont[3].fill(0.0);
-        self.ctrl.h_last = 0.0;
-        self.first = false;
-        self.h_acc = 0.0;
-        self.err_acc = 1e-2;
-        self.refresh(system);
+        self.start_at(system, (t, y, t_end), false);
         Ok(())
     }
 
     fn reset<S: OdeSystem>(&mut self, system: &S, t: f64, y: &[f64], t_end: f64) -> StepResult<()> {
-        self.ctrl.restart(t, t_end);
-        self.y.copy_from_slice(y);
-        self.cont[0].copy_from_slice(y);
-        self.cont[1].copy_from_slice(y);
-        self.cont[2].fill(0.0);
-        self.cont[3].fill(0.0);
-        self.ctrl.h_last = 0.0;
-        self.first = true;
-        self.h_acc = 0.0;
-        self.err_acc = 1e-2;
-        self.refresh(system);
+        self.start_at(system, (t, y, t_end), true);
         self.ctrl.h = self.initial_step();
         Ok(())
     }

@@ -230,6 +230,11 @@ impl StepControl {
         }
     }
 
+    /// Whether a step size was learnt (a restart keeps it; none yet before the first reset).
+    pub fn has_step(&self) -> bool {
+        self.h > 0.0
+    }
+
     /// Starts over at `t` in an interval ending at `t_end` (step sizes kept).
     pub fn restart(&mut self, t: f64, t_end: f64) {
         (self.t, self.t_prev, self.t_end) = (t, t, t_end);
