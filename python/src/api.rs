@@ -140,7 +140,8 @@ pub fn simulate<'py>(
     options: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let stage = inputs::oscillator(oscillator)?;
-    require_oscillator(&stage.unknown, stage.oscillator.axis, "simulate").map_err(|e| value_error(e.to_string()))?;
+    require_oscillator(&stage.unknown, stage.oscillator.axis, "simulate")
+        .map_err(|e| value_error(e.to_string()))?;
     let osc = stage.oscillator;
     let model = inputs::model(model)?.model;
     let times = TimeBase::new(to_f64_vec(t, "t")?).map_err(|e| value_error(format!("t: {e}")))?;
