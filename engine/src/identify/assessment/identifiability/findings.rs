@@ -34,7 +34,7 @@ pub fn findings(names: &[(String, String)], standings: &[Standing]) -> Vec<Findi
 /// A level read as a force (`levels`) beyond the declared bound of its coefficient is no
 /// inconsistency: its bounds are the data's.
 pub fn consistency_findings(model: &dyn FrictionModel, levels: FrictionLevels) -> Vec<Finding> {
-    match model.validate() {
+    match model.check() {
         Ok(warnings) => warnings
             .into_iter()
             .map(|w| Finding::warn(Check::PhysicalConsistency, None, w))
