@@ -588,6 +588,28 @@ mod tests {
     }
 
     #[test]
+    fn check_rejects_a_value_outside_the_bounds_that_the_law_leaves_to_it() {
+        let law = crate::builtin::Coulomb { mu: -0.1 };
+        assert_eq!(law.validate().unwrap(), Vec::<String>::new());
+        let model: &dyn FrictionModel = &law;
+        let e = model.check().unwrap_err();
+        assert!(
+            matches!(&e, ModelError::OutOfBounds { model, param, .. } if model == "coulomb" && param == "mu"),
+            "{e}"
+        );
+        let admissible: &dyn FrictionModel = &crate::builtin::Coulomb { mu: 0.2 };
+        assert_eq!(admissible.check().unwrap(), Vec::<String>::new());
+    }
+
+    #[test]
+    fn a_stateless_law_s_steady_state_is_its_force_by_default() {
+        let law = crate::builtin::Coulomb { mu: 0.2 };
+        for v in [-1.0, -1e-9, 0.0, 1e-9, 0.5] {
+            assert_eq!(law.steady_state(v, 14.5), law.force(v, &[], 14.5));
+        }
+    }
+
+    #[test]
     fn laws_are_smooth_and_unstaged_by_default() {
         let mut law = Quadratic;
         let model: &dyn FrictionModel = &law;
