@@ -5,8 +5,8 @@
 //!
 //! A library user starts from the re-exports at this root: an [`Oscillator`] (m, c, k, N),
 //! a friction law by its registry name ([`default_model`], a `Box<dyn` [`FrictionModel`]`>`),
-//! measured motion as [`Record`]s, then [`simulate`] (with [`SimOptions`], into a
-//! [`Trajectory`]), [`fit`] (with [`FitOptions`], into a [`FitResult`]) or [`compare`] (into a
+//! measured motion as [`Record`]s, then [`simulate()`] (with [`SimOptions`], into a
+//! [`Trajectory`]), [`fit()`] (with [`FitOptions`], into a [`FitResult`]) or [`compare()`] (into a
 //! [`Comparison`]). A [`Spec`] is the serializable description of a whole run (what a config
 //! file holds); the [`jobs`] run one command from it.
 //!

@@ -20,9 +20,9 @@ pub const PROFILE_RESTARTS: usize = 2;
 
 /// Profiles the flat parameters at the best run, settles an iteration limit caused only by
 /// unbounded ones, and returns the runs with one standing per free parameter. A profile
-/// point whose cost lies a [`PROFILE_DELTA`] rise below the best (the fit stopped in a local
-/// minimum or on a plateau the profile stepped off) restarts the solver there, and the
-/// profiles are taken again at the better optimum.
+/// point whose cost lies a [`PROFILE_DELTA`](super::PROFILE_DELTA) rise below the best (the
+/// fit stopped in a local minimum or on a plateau the profile stepped off) restarts the
+/// solver there, and the profiles are taken again at the better optimum.
 pub fn settle<R: Residuals + 'static>(
     reference: &FitProblem<R>,
     mut runs: MultiStart,
