@@ -26,8 +26,8 @@ use crate::param_info::{check_bounds, ParamInfo};
 /// rejected) and register with `#[typetag::serde(name = "...")]` on the `impl` block. That is
 /// all it takes for the registry, the engine, the identifier and the CLI to know the model.
 /// `declare_params!` and `declared_param_methods!` write the name, equation and parameter
-/// methods; a static law then writes [`force`](Self::force) and
-/// [`steady_state`](Self::steady_state).
+/// methods; a static law then writes [`force`](Self::force) (its
+/// [`steady_state`](Self::steady_state) follows from it).
 ///
 /// Sign convention: the force opposes motion, so a positive velocity gives a positive force in
 /// `m x'' + c x' + k x + F = 0`.
@@ -46,15 +46,20 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
     fn params(&self) -> Vec<f64>;
 
     /// Sets all parameters at once (same order as `param_info`). The length is checked; the
-    /// bounds are not (the identifier enforces them, `validate` reports them).
+    /// bounds are not (the identifier enforces them, `check` reports them).
     fn set_params(&mut self, values: &[f64]) -> Result<(), ModelError>;
 
     /// The friction force at velocity `v` with internal states `z` (empty for a law without
     /// [`states`](Self::states)); sgn(0) = 0 for static laws.
     fn force(&self, v: f64, z: &[f64], normal: f64) -> f64;
 
-    /// Steady-state friction curve F_ss(v) (the force at constant sliding velocity).
-    fn steady_state(&self, v: f64, normal: f64) -> f64;
+    /// Steady-state friction curve F_ss(v) (the force at constant sliding velocity). The
+    /// default, `force(v, &[], normal)`, is the curve of a law without
+    /// [`states`](Self::states); a law with states writes its own (the force at the states
+    /// steady sliding reaches).
+    fn steady_state(&self, v: f64, normal: f64) -> f64 {
+        self.force(v, &[], normal)
+    }
 
     /// The internal states and their law, for a dynamic model (`Some(self)`); `None` (the
     /// default) for a static law.
@@ -80,10 +85,11 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
         None
     }
 
-    /// Checks every parameter against its physical bounds; returns warnings for values that
-    /// are admissible but unusual (e.g. mu_s < mu_c).
+    /// The law's own rules beyond its declared bounds: an error for an inadmissible
+    /// combination, warnings for values that are admissible but unusual (e.g. mu_s < mu_c).
+    /// The default has none. The bounds themselves are not checked here: callers use
+    /// `check` (a method of `dyn FrictionModel`), which checks them first and then calls this.
     fn validate(&self) -> Result<Vec<String>, ModelError> {
-        check_bounds(self.name(), &self.param_info(), &self.params())?;
         Ok(Vec::new())
     }
 }
@@ -94,6 +100,14 @@ impl<'a> dyn FrictionModel + 'a {
     /// The number of internal states: 0 for a law without [`FrictionModel::states`].
     pub fn n_states(&self) -> usize {
         self.states().map_or(0, |s| s.n_states())
+    }
+
+    /// Checks the parameters: every value against its declared bounds ([`check_bounds`]),
+    /// then the law's own rules ([`FrictionModel::validate`]); the warnings of the latter.
+    /// Every caller that admits a model goes through here, so no law repeats the bounds.
+    pub fn check(&self) -> Result<Vec<String>, ModelError> {
+        check_bounds(self.name(), &self.param_info(), &self.params())?;
+        self.validate()
     }
 }
 
@@ -571,6 +585,28 @@ mod tests {
     fn laws_are_not_declared_affine_by_default() {
         assert_eq!(Quadratic.affine_slip(1.0, 14.5), None);
         assert_eq!(Quadratic.affine_slip(-1.0, 14.5), None);
+    }
+
+    #[test]
+    fn check_rejects_a_value_outside_the_bounds_that_the_law_leaves_to_it() {
+        let law = crate::builtin::Coulomb { mu: -0.1 };
+        assert_eq!(law.validate().unwrap(), Vec::<String>::new());
+        let model: &dyn FrictionModel = &law;
+        let e = model.check().unwrap_err();
+        assert!(
+            matches!(&e, ModelError::OutOfBounds { model, param, .. } if model == "coulomb" && param == "mu"),
+            "{e}"
+        );
+        let admissible: &dyn FrictionModel = &crate::builtin::Coulomb { mu: 0.2 };
+        assert_eq!(admissible.check().unwrap(), Vec::<String>::new());
+    }
+
+    #[test]
+    fn a_stateless_law_s_steady_state_is_its_force_by_default() {
+        let law = crate::builtin::Coulomb { mu: 0.2 };
+        for v in [-1.0, -1e-9, 0.0, 1e-9, 0.5] {
+            assert_eq!(law.steady_state(v, 14.5), law.force(v, &[], 14.5));
+        }
     }
 
     #[test]

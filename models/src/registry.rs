@@ -114,7 +114,7 @@ pub fn build_json(value: &serde_json::Value) -> Result<Built, ModelError> {
     }
     let model: Box<dyn FrictionModel> =
         serde_json::from_value(value.clone()).map_err(|e| translate(ty, &e.to_string()))?;
-    let warnings = model.validate()?;
+    let warnings = model.check()?;
     Ok(Built { model, warnings })
 }
 

@@ -54,7 +54,8 @@ pub enum Check {
     Declarations,
     /// `set_params` then `params` gives the values back; a wrong length is a `ParamCount` error.
     ParamVector,
-    /// `validate` accepts the model and rejects each value outside its bounds by name.
+    /// `check` (the declared bounds, then the law's `validate`) accepts the model and rejects
+    /// each value outside its bounds by name.
     Bounds,
     /// JSON and TOML round trips (also through `build_toml`) keep every parameter; an unknown
     /// key is rejected by name.
@@ -130,7 +131,7 @@ fn ensure(model: &Model, check: Check, ok: bool, message: impl FnOnce() -> Strin
     }
 }
 
-/// Runs every check on `model` (an admissible instance: `validate` must accept it).
+/// Runs every check on `model` (an admissible instance: `check` must accept it).
 pub fn check_model(model: &Model) -> Outcome {
     check_registered(model)?;
     check_declarations(model)?;
@@ -304,7 +305,7 @@ fn outside(p: &ParamInfo) -> Vec<f64> {
 
 /// [`Check::Bounds`].
 pub fn check_bounds(model: &Model) -> Outcome {
-    if let Err(e) = model.validate() {
+    if let Err(e) = model.check() {
         return fail(
             model,
             Check::Bounds,
@@ -320,12 +321,12 @@ pub fn check_bounds(model: &Model) -> Outcome {
             if m.set_params(&v).is_err() {
                 return fail(model, Check::Bounds, format!("set_params rejects {v:?}"));
             }
-            let r = m.validate();
+            let r = m.check();
             let named =
                 matches!(&r, Err(ModelError::OutOfBounds { param, .. }) if *param == p.name);
             ensure(model, Check::Bounds, named, || {
                 format!(
-                    "`{}` = {bad} outside {}: validate gives {r:?}",
+                    "`{}` = {bad} outside {}: check gives {r:?}",
                     p.name,
                     p.bounds_text()
                 )

@@ -48,7 +48,7 @@ pub(crate) fn run<R: Recorder>(
         opts,
     } = inputs;
     osc.validate()?;
-    model.validate()?;
+    model.check()?;
     let y0 = initial_state(model, init)?;
     check_times(t_end, sample_times)?;
     check_options(opts)?;

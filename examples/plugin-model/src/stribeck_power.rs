@@ -34,8 +34,7 @@
 //! with supplemental fluid dampers", The Structural Design of Tall Buildings 2(2), 93-132, 1993.
 
 use frictionid_models::{
-    check_bounds, mu_s_warning, sgn, FrictionModel, GuessHint, ModelError, Staging, StribeckLevels,
-    SwitchedLaw,
+    mu_s_warning, sgn, FrictionModel, GuessHint, ModelError, Staging, StribeckLevels, SwitchedLaw,
 };
 
 /// The registry name of the model.
@@ -93,12 +92,9 @@ impl FrictionModel for StribeckPower {
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         sgn(v) * (normal * self.coefficient(v) + self.viscous_force(v))
     }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.force(v, &[], normal)
-    }
     frictionid_models::law_groups!(switching, staging);
+    // The bounds are checked before this, from the declarations: only the law's own rule.
     fn validate(&self) -> Result<Vec<String>, ModelError> {
-        check_bounds(NAME, &self.param_info(), &self.params())?;
         Ok(mu_s_warning(NAME, self.mu_s, self.mu_c))
     }
 }

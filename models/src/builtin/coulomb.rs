@@ -29,9 +29,6 @@ impl FrictionModel for Coulomb {
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         self.mu * normal * sgn(v)
     }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.force(v, &[], normal)
-    }
     crate::law_groups!(switching, staging, param_gradients);
 }
 

@@ -43,7 +43,7 @@ use crate::error::ModelError;
 use crate::formula::{self, Formula, Parsed};
 use crate::hints::GuessHint;
 use crate::model::{FrictionModel, Staging, SwitchedLaw};
-use crate::param_info::{check_bounds, check_len, ParamInfo};
+use crate::param_info::{check_len, ParamInfo};
 use crate::params::ParamSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -348,14 +348,7 @@ impl FrictionModel for Expression {
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         self.eval(&self.compiled, v, normal, None)
     }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.force(v, &[], normal)
-    }
     crate::law_groups!(switching, staging);
-    fn validate(&self) -> Result<Vec<String>, ModelError> {
-        check_bounds(self.name(), &self.param_info(), &self.params())?;
-        Ok(Vec::new())
-    }
 }
 
 impl SwitchedLaw for Expression {

@@ -97,7 +97,7 @@ use crate::model::{
     decay, finite_difference_force_gradient, finite_difference_velocity_derivative, sgn,
     FrictionModel, InternalStates, Jacobians, RigidLimit, Staging,
 };
-use crate::param_info::{check_bounds, check_len, ParamInfo};
+use crate::param_info::{check_len, ParamInfo};
 use crate::params::ParamSpec;
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 use serde::de::{self, SeqAccess, Visitor};
@@ -646,7 +646,6 @@ impl FrictionModel for Gms {
                 "the model needs at least one element".into(),
             ));
         }
-        check_bounds(self.name(), &self.param_info(), &self.params())?;
         let mut warnings = mu_s_warning(self.name(), self.mu_s, self.mu_c);
         let total: f64 = self.elements.iter().map(|e| e.weight).sum();
         if (total - 1.0).abs() > 1e-9 {

@@ -31,7 +31,6 @@ use crate::model::{
     decay, sgn, FrictionModel, InternalStates, Jacobians, ParamGradients, Propagator, RigidLimit,
     Staging,
 };
-use crate::param_info::check_bounds;
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 
 crate::declare_params! {
@@ -127,7 +126,6 @@ impl FrictionModel for LuGre {
     }
     crate::law_groups!(states, staging, param_gradients);
     fn validate(&self) -> Result<Vec<String>, ModelError> {
-        check_bounds(self.name(), &self.param_info(), &self.params())?;
         Ok(mu_s_warning(self.name(), self.mu_s, self.mu_c))
     }
 }

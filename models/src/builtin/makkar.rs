@@ -28,7 +28,6 @@
 use crate::error::ModelError;
 use crate::hints::GuessHint;
 use crate::model::{FrictionModel, ParamGradients, Staging};
-use crate::param_info::check_bounds;
 
 crate::declare_params! {
     /// Makkar et al.'s smooth friction law with Stribeck, Coulomb and viscous terms.
@@ -53,12 +52,8 @@ impl FrictionModel for Makkar {
             + self.g4 * (self.g5 * v).tanh()
             + self.g6 * v
     }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.force(v, &[], normal)
-    }
     crate::law_groups!(staging, param_gradients);
     fn validate(&self) -> Result<Vec<String>, ModelError> {
-        check_bounds(self.name(), &self.param_info(), &self.params())?;
         let mut warnings = Vec::new();
         if self.g1 > 0.0 && self.g3 > self.g2 {
             warnings.push(format!(

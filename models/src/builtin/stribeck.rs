@@ -19,7 +19,6 @@
 use crate::error::ModelError;
 use crate::hints::GuessHint;
 use crate::model::{decay, sgn, FrictionModel, ParamGradients, Staging, SwitchedLaw};
-use crate::param_info::check_bounds;
 use crate::start::{StartContext, StribeckLevels};
 
 crate::declare_params! {
@@ -64,12 +63,8 @@ impl FrictionModel for Stribeck {
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         normal * self.coefficient(v) * sgn(v) + self.viscous * v
     }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.force(v, &[], normal)
-    }
     crate::law_groups!(switching, staging, param_gradients);
     fn validate(&self) -> Result<Vec<String>, ModelError> {
-        check_bounds(self.name(), &self.param_info(), &self.params())?;
         Ok(mu_s_warning(self.name(), self.mu_s, self.mu_c))
     }
 }

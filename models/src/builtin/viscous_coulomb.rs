@@ -31,9 +31,6 @@ impl FrictionModel for ViscousCoulomb {
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
         self.mu * normal * sgn(v) + self.viscous * v
     }
-    fn steady_state(&self, v: f64, normal: f64) -> f64 {
-        self.force(v, &[], normal)
-    }
     crate::law_groups!(switching, staging, param_gradients);
 }
 

@@ -56,9 +56,9 @@ impl Layout {
             .collect()
     }
 
-    /// The law's own checks ([`FrictionModel::validate`]) on `model`'s fixed parameters; the
-    /// free ones start projected into their domain, so they are checked at their declared
-    /// defaults.
+    /// The law's checks (`check`: its bounds, then [`FrictionModel::validate`]) on `model`'s
+    /// fixed parameters; the free ones start projected into their domain, so they are checked
+    /// at their declared defaults.
     pub fn validate_fixed(&self, model: &(dyn FrictionModel + 'static)) -> Result<(), EngineError> {
         let mut checked = frictionid_models::clone_model(model);
         let info = checked.param_info();
@@ -71,7 +71,7 @@ impl Layout {
             }
         }
         checked.set_params(&values)?;
-        checked.validate()?;
+        checked.check()?;
         Ok(())
     }
 }

@@ -1,0 +1,263 @@
+//! The profile of the cost along one parameter: stepped outward on each side with the others
+//! re-optimised, and where it crosses the rise that excludes a value at 95 %.
+
+use super::pinned::{merged, pinned_fit, without};
+use super::rigid_limit::Limit;
+use super::Standing;
+use crate::identify::problem::least_squares::FitProblem;
+use crate::identify::problem::residuals::Residuals;
+use crate::identify::search::starts::StartRun;
+use crate::identify::values::options::FitOptions;
+use crate::identify::values::result::Identifiability;
+use nalgebra::DVector;
+
+/// chi²(1 dof, 95 %) / 2 = 3.8415 / 2: the rise of the cost (half the sum of squares), in
+/// residual variances, that excludes a parameter value at 95 %.
+pub const PROFILE_DELTA: f64 = 1.920_729_410_347_062;
+
+/// Profile steps on each side.
+pub const PROFILE_STEPS: usize = 4;
+
+/// Halvings of a first profile step that fails (a simulation too stiff or degenerate).
+pub const PROFILE_HALVINGS: usize = 3;
+
+/// Iterations of the re-optimisation of the other parameters at each profile step.
+pub const PROFILE_ITERATIONS: u64 = 12;
+
+/// The precision a profile step's re-optimisation needs, as a fraction of the profile's
+/// cost rise: it stops when the Gauss-Newton step promises less decrease (a standing turns
+/// on the cost against the rise; the solver's own tests ask about a thousandth of it).
+pub const PROFILE_RESOLUTION: f64 = 0.05;
+
+/// Iterations of the re-optimisation at each step of the profile of a rigid limit's
+/// stiffness: the other parameters move far along it (LuGre's Stribeck levels and bristle
+/// damping change by factors between decades of sigma0), and a profile that stops short of
+/// their optimum overstates the lower bound.
+pub const LIMIT_PROFILE_ITERATIONS: u64 = 40;
+
+/// One profile step: the parameter's internal value, the re-optimised cost, and the whole
+/// point (internal coordinates).
+struct ProfilePoint {
+    u: f64,
+    cost: f64,
+    at: DVector<f64>,
+}
+
+/// A profile of the cost along one parameter at the best run.
+pub(super) struct Profile<'a, R: Residuals> {
+    pub(super) reference: &'a FitProblem<R>,
+    pub(super) best: &'a StartRun,
+    pub(super) opts: &'a FitOptions,
+    /// The model's rigid limit when the records do not reject it: the profile of its
+    /// stiffness (the lower side) also tries the others mapped from the limit law at each
+    /// stiffness (levels and a critically damped contact). A rejected limit leaves the
+    /// stiffness an ordinary parameter.
+    pub(super) limit: Option<&'a Limit>,
+    /// The precision of a step's cost ([`PROFILE_RESOLUTION`] of the rise).
+    pub(super) resolution: f64,
+}
+
+impl<R: Residuals + 'static> Profile<'_, R> {
+    /// Profile points (internal value, cost) on one side (`side` = ±1), stepping outward
+    /// until the cost exceeds `limit` (for the rigid limit's stiffness: at two steps in a
+    /// row, since a re-optimisation near the limit can end in a poorer local minimum), a
+    /// bound is reached or a step fails; a first step that fails is retried at half the
+    /// distance (at most [`PROFILE_HALVINGS`] times).
+    fn side(&self, j: usize, side: f64, limit: f64) -> Vec<ProfilePoint> {
+        let confirmations = if self.limit.is_some_and(|l| l.is_first_stiffness(j)) {
+            2
+        } else {
+            1
+        };
+        let f = &self.reference.layout[j];
+        let (lo, hi) = f.internal_bounds();
+        let centre = self.best.u[j];
+        let mut step = if f.log {
+            std::f64::consts::LN_10
+        } else {
+            centre.abs().max(1.0)
+        };
+        let mut others = without(&self.best.u, &[(j, centre)]);
+        let mut out: Vec<ProfilePoint> = Vec::new();
+        let mut halvings = 0;
+        while out.len() < PROFILE_STEPS {
+            let previous = out.last().map_or(centre, |p| p.u);
+            let u = (previous + side * step).clamp(lo, hi);
+            if u == previous {
+                break;
+            }
+            let pins = [(j, u)];
+            match self.step_fit(&pins, &others) {
+                None if out.is_empty() && halvings < PROFILE_HALVINGS => {
+                    step /= 2.0;
+                    halvings += 1;
+                }
+                None => break,
+                Some(run) => {
+                    others = run.u;
+                    out.push(ProfilePoint {
+                        u,
+                        cost: run.cost,
+                        at: merged(&others, &pins, self.best.u.len()),
+                    });
+                    let above = out.iter().rev().take_while(|p| p.cost > limit).count();
+                    if above >= confirmations {
+                        break;
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The others re-optimised at a profile step `pins` from where the previous step left
+    /// them (`previous`); a step of the rigid limit's stiffness also from the others mapped
+    /// from the limit law at that stiffness (with more iterations), keeping the lower end: the
+    /// cost near a rigid limit has several minima in the levels.
+    fn step_fit(&self, pins: &[(usize, f64)], previous: &DVector<f64>) -> Option<StartRun> {
+        let &[(j, u)] = pins else {
+            return None;
+        };
+        let Some(limit) = self.limit.filter(|l| l.is_first_stiffness(j)) else {
+            return pinned_fit(
+                self.reference,
+                pins,
+                previous,
+                self.opts,
+                (PROFILE_ITERATIONS, Some(self.resolution)),
+            );
+        };
+        let run = |start: &DVector<f64>| {
+            pinned_fit(
+                self.reference,
+                pins,
+                start,
+                self.opts,
+                (LIMIT_PROFILE_ITERATIONS, Some(self.resolution)),
+            )
+        };
+        let Some(mapped) = limit.target_at_stiffness(self.reference, self.best, (j, u)) else {
+            return run(previous);
+        };
+        let mapped = without(&mapped, pins);
+        let (a, b) = if self.opts.parallel {
+            rayon::join(|| run(previous), || run(&mapped))
+        } else {
+            (run(previous), run(&mapped))
+        };
+        [a, b]
+            .into_iter()
+            .flatten()
+            .min_by(|x, y| x.cost.total_cmp(&y.cost))
+    }
+
+    /// The standing of slot `j` for a cost rise `delta` (absolute), and the lowest profile
+    /// point (internal coordinates) when its cost lies more than `delta` below the best.
+    /// `open_above`: the cost the parameter's upper side runs to (a rigid limit the records
+    /// do not exclude): that side is open and not profiled.
+    pub(super) fn standing(
+        &self,
+        j: usize,
+        delta: f64,
+        open_above: Option<f64>,
+    ) -> (Standing, Option<DVector<f64>>) {
+        let best = self.best.cost;
+        // The two sides are independent refits: side by side on two threads.
+        let (below, above) = if open_above.is_some() {
+            (self.side(j, -1.0, best + delta), Vec::new())
+        } else if self.opts.parallel {
+            rayon::join(
+                || self.side(j, -1.0, best + delta),
+                || self.side(j, 1.0, best + delta),
+            )
+        } else {
+            (
+                self.side(j, -1.0, best + delta),
+                self.side(j, 1.0, best + delta),
+            )
+        };
+        let lowest = below
+            .iter()
+            .chain(&above)
+            .min_by(|a, b| a.cost.total_cmp(&b.cost))
+            .filter(|p| p.cost < best - delta)
+            .map(|p| p.at.clone());
+        // A profile that found a lower cost (a parameter still running on) measures from it.
+        let floor = below
+            .iter()
+            .chain(&above)
+            .map(|p| p.cost)
+            .chain(open_above)
+            .fold(best, f64::min);
+        let pairs = |side: &[ProfilePoint]| -> Vec<(f64, f64)> {
+            side.iter().map(|p| (p.u, p.cost)).collect()
+        };
+        let (below, above) = (pairs(&below), pairs(&above));
+        let centre = (self.best.u[j], best);
+        let f = &self.reference.layout[j];
+        // A side that cannot be evaluated at all (too stiff to simulate) counts as open.
+        let low = outer_crossing(centre, &below, floor + delta).map(|u| f.to_physical(u));
+        let high = outer_crossing(centre, &above, floor + delta).map(|u| f.to_physical(u));
+        let (class, bound) = match (low, high) {
+            (Some(_), Some(_)) => (Identifiability::Determined, None),
+            (Some(b), None) => (Identifiability::LowerBound, Some(b)),
+            (None, Some(b)) => (Identifiability::UpperBound, Some(b)),
+            (None, None) => (Identifiability::NotIdentifiable, None),
+        };
+        (Standing { class, bound }, lowest)
+    }
+}
+
+/// Where the profile rises above `limit` for good: [`crossing`] from its last point within
+/// the limit (a point above it followed by one within is a re-optimisation that stopped in a
+/// poorer local minimum, not the edge of the interval).
+fn outer_crossing(centre: (f64, f64), points: &[(f64, f64)], limit: f64) -> Option<f64> {
+    match points.iter().rposition(|&(_, c)| c <= limit) {
+        Some(k) => crossing(points[k], &points[k + 1..], limit),
+        None => crossing(centre, points, limit),
+    }
+}
+
+/// Where the profile first rises above `limit` (linear between its points), from `centre`.
+fn crossing(centre: (f64, f64), points: &[(f64, f64)], limit: f64) -> Option<f64> {
+    let mut previous = centre;
+    for &(u, c) in points {
+        if c > limit {
+            let t = if c > previous.1 {
+                ((limit - previous.1) / (c - previous.1)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            return Some(previous.0 + t * (u - previous.0));
+        }
+        previous = (u, c);
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_crossing_interpolates_between_profile_points() {
+        // From cost 0 at u = 0 to 4 at u = 2: the limit 1.92 is crossed at u = 0.96.
+        let u = crossing((0.0, 0.0), &[(2.0, 4.0)], 1.92).unwrap();
+        assert!((u - 0.96).abs() < 1e-12);
+        assert_eq!(crossing((0.0, 0.0), &[(1.0, 0.5), (2.0, 1.0)], 1.92), None);
+    }
+
+    #[test]
+    fn the_outer_crossing_skips_a_point_above_the_limit_that_a_later_one_undercuts() {
+        // -1 rose to 3 (a poor local minimum), -2 fits again at 1, -3 rises to 5: the
+        // interval ends between -2 and -3, at -2.25.
+        let points = [(-1.0, 3.0), (-2.0, 1.0), (-3.0, 5.0)];
+        let u = outer_crossing((0.0, 0.0), &points, 2.0).unwrap();
+        assert!((u + 2.25).abs() < 1e-12);
+        assert_eq!(outer_crossing((0.0, 0.0), &points[..2], 2.0), None);
+        assert_eq!(
+            outer_crossing((0.0, 0.0), &points[..1], 2.0),
+            crossing((0.0, 0.0), &points[..1], 2.0)
+        );
+    }
+}
