@@ -12,7 +12,9 @@
 //! recover the parameters the runs determine.
 
 use frictionid_engine::axis::Axis;
-use frictionid_engine::identify::{fit, FitDomain, FitOptions, FitResult};
+use frictionid_engine::identify::{
+    fit, FitDomain, FitOptions, FitResult, ParamOptions, TargetOptions,
+};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
@@ -34,9 +36,15 @@ fn axis() -> Oscillator {
 
 fn options(free: &[&str]) -> FitOptions {
     FitOptions {
-        domain: FitDomain::Force,
-        free: Some(free.iter().map(|s| s.to_string()).collect()),
-        unknown_oscillator: vec!["mass".into(), "damping".into(), "stiffness".into()],
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            unknown_oscillator: vec!["mass".into(), "damping".into(), "stiffness".into()],
+            ..TargetOptions::default()
+        },
+        params: ParamOptions {
+            free: Some(free.iter().map(|s| s.to_string()).collect()),
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     }
 }

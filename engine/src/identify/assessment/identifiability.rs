@@ -22,9 +22,9 @@ use crate::identify::problem::least_squares::{FitProblem, ProblemParts};
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::{run_start, MultiStart, RunSlot, StartRun};
 use crate::identify::search::strategy::{fit_simpler, stage_options, FitTarget, Onto};
+use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::ParamKind;
 use crate::identify::values::levels::FrictionLevels;
-use crate::identify::values::options::FitOptions;
 use crate::identify::values::outcome::{Check, Finding, TerminationReason};
 use crate::identify::values::result::Identifiability;
 use frictionid_models::start::TYPICAL_PRESLIDING_DISPLACEMENT;
@@ -94,7 +94,7 @@ pub fn settle<R: Residuals + 'static>(
     opts: &FitOptions,
 ) -> Result<(MultiStart, Vec<Standing>), EngineError> {
     let quiet = FitOptions {
-        progress: None,
+        hooks: opts.hooks.quiet(),
         ..opts.clone()
     };
     let limit = rigid_limit(reference, &runs.best, &quiet);
@@ -189,7 +189,7 @@ fn profile_all<R: Residuals + 'static>(
     };
     // The profiles are independent: in parallel, read in slot order (the first lower point
     // restarts the fit, whichever thread found it first).
-    let profiled: Vec<_> = if opts.parallel {
+    let profiled: Vec<_> = if opts.hooks.parallel {
         slots.par_iter().map(|&j| profile_of(j)).collect()
     } else {
         slots.iter().map(|&j| profile_of(j)).collect()
@@ -372,11 +372,9 @@ fn rigid_limit<R: Residuals + 'static>(
         osc,
         records: &reference.records,
     };
-    let limit_opts = FitOptions {
-        oscillator: opts.oscillator.clone(),
-        free: limit_free(declared.law.as_ref(), &declared.also_free),
-        ..stage_options(opts)
-    };
+    let mut limit_opts = stage_options(opts);
+    limit_opts.params.oscillator = opts.params.oscillator.clone();
+    limit_opts.params.free = limit_free(declared.law.as_ref(), &declared.also_free);
     let fit = fit_simpler(
         &on,
         declared.law.as_ref(),
@@ -420,12 +418,12 @@ fn restart_from<R: Residuals + 'static>(
     let slot = RunSlot {
         start: runs.best_start,
         starts: 1,
-        max_iterations: opts.max_iterations,
+        max_iterations: opts.search.max_iterations,
         pace: None,
         cost_resolution: None,
         explain: false,
     };
-    let Ok(run) = run_start(problem, u, opts, slot) else {
+    let Ok(run) = run_start(problem, u, &opts.search, &opts.hooks, slot) else {
         return false;
     };
     runs.iterations += run.iterations;
@@ -580,7 +578,7 @@ fn pinned_fit<R: Residuals + 'static>(
             cost_resolution,
             explain: false,
         };
-        run_start(sub, others.clone(), opts, slot).ok()?
+        run_start(sub, others.clone(), &opts.search, &opts.hooks, slot).ok()?
     };
     run.cost.is_finite().then_some(run)
 }
@@ -690,7 +688,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
             return run(previous);
         };
         let mapped = without(&mapped, pins);
-        let (a, b) = if self.opts.parallel {
+        let (a, b) = if self.opts.hooks.parallel {
             rayon::join(|| run(previous), || run(&mapped))
         } else {
             (run(previous), run(&mapped))
@@ -715,7 +713,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
         // The two sides are independent refits: side by side on two threads.
         let (below, above) = if open_above.is_some() {
             (self.side(j, -1.0, best + delta), Vec::new())
-        } else if self.opts.parallel {
+        } else if self.opts.hooks.parallel {
             rayon::join(
                 || self.side(j, -1.0, best + delta),
                 || self.side(j, 1.0, best + delta),
@@ -804,7 +802,13 @@ fn settle_convergence<R: Residuals + 'static>(
         return;
     }
     let others = without(&runs.best.u, &pins);
-    let Some(run) = pinned_fit(reference, &pins, &others, opts, (opts.max_iterations, None)) else {
+    let Some(run) = pinned_fit(
+        reference,
+        &pins,
+        &others,
+        opts,
+        (opts.search.max_iterations, None),
+    ) else {
         return;
     };
     if !run.converged() || run.cost > runs.best.cost {
