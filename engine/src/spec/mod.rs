@@ -1,5 +1,5 @@
 //! The run specification: what a front end (the CLI's TOML config, a Python dict) asks the
-//! engine to do, as one serializable value, and every rule that turns it into engine options.
+//! engine to do, as one value, and every rule that turns it into engine options.
 //!
 //! A front end parses its own syntax into a [`Spec`] (serde does the work: unknown keys are
 //! errors, defaults are the parts' own, values are checked by `try_from` conversions), then

@@ -5,10 +5,10 @@
 //! run by [`crate::identify::fit`] with the options [`prefit_options`] gives) needs no
 //! simulation of the mechanics and has no phase errors to trap the optimiser, so its optimum
 //! is a good start for the velocity fit of a model with internal states, whose default
-//! starts often end in a poor local minimum. The velocity fit runs its
-//! usual starts plus this one (planned by [`super::strategy::plan_fit_starts`]); the
-//! report says which start won. Static laws (no internal
-//! states) are not prefitted: their fit stays one start, one run.
+//! starts often end in a poor local minimum. The velocity fit runs its usual starts plus
+//! this one (planned by [`super::strategy::plan_fit_starts`]); the report says which start
+//! won. Static laws (no internal states) are not prefitted: their fit stays one start, one
+//! run.
 
 use crate::error::EngineError;
 use crate::identify::values::fit_options::FitOptions;
