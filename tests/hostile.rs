@@ -3,7 +3,9 @@
 
 use frictionid_cli::config::{Config, MAX_RECORDS};
 use frictionid_engine::data::{read_record, DataError, ReadOptions, MAX_FILE_BYTES};
-use frictionid_engine::identify::{fit, FitOptions};
+use frictionid_engine::identify::{
+    fit, FitOptions, Hooks, ParamOptions, SearchOptions, TargetOptions,
+};
 use frictionid_engine::simulate::{simulate, Initial, SimOptions};
 use frictionid_engine::synthetic::uniform_times;
 use frictionid_engine::{analyze_record, EnergyOptions, EngineError, Oscillator, Record};
@@ -125,13 +127,19 @@ fn an_extreme_friction_coefficient_is_refused_by_simulation_and_fit() {
     assert!(one_line(&e).contains("`mu`"), "{e}");
     let rec = fmm_record(&Coulomb { mu: 0.2 }, 0.02);
     let fixed = FitOptions {
-        free: Some(Vec::new()),
+        params: ParamOptions {
+            free: Some(Vec::new()),
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     let e = fit(&osc, &model, std::slice::from_ref(&rec), &fixed).unwrap_err();
     assert!(one_line(&e).contains("`mu`"), "{e}");
     let projected = FitOptions {
-        guess: false,
+        params: ParamOptions {
+            guess: false,
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     let fitted = fit(&osc, &model, &[rec], &projected).expect("a start projected to the bound");
@@ -209,7 +217,10 @@ fn a_record_of_zeros_is_read_and_analysed_without_panic() {
     // A mass released at rest from x0 = 0 with any friction stays there: the fit either
     // explains the zeros exactly or says why it cannot.
     let opts = FitOptions {
-        parallel: false,
+        hooks: Hooks {
+            parallel: false,
+            ..Hooks::default()
+        },
         ..FitOptions::default()
     };
     match fit(&osc, &Coulomb::default(), &[rec], &opts) {
@@ -236,8 +247,14 @@ fn a_spike_of_1e30_is_read_and_the_fit_does_not_panic() {
         assert_eq!(a.time.len(), read.len());
     }
     let opts = FitOptions {
-        parallel: false,
-        max_iterations: 50,
+        hooks: Hooks {
+            parallel: false,
+            ..Hooks::default()
+        },
+        search: SearchOptions {
+            max_iterations: 50,
+            ..SearchOptions::default()
+        },
         ..FitOptions::default()
     };
     match fit(&osc, &Coulomb::default(), &[read], &opts) {
@@ -358,7 +375,10 @@ fn a_simulation_of_1e18_samples_is_refused_before_allocating() {
 fn an_absurd_number_of_starts_is_refused_before_allocating() {
     let rec = fmm_record(&Coulomb { mu: 0.2 }, 0.014);
     let opts = FitOptions {
-        multistart: Some(usize::MAX),
+        search: SearchOptions {
+            multistart: Some(usize::MAX),
+            ..SearchOptions::default()
+        },
         ..FitOptions::default()
     };
     let e = fit(&Oscillator::fmm(), &Coulomb::default(), &[rec], &opts).unwrap_err();
@@ -401,8 +421,14 @@ fn constant_velocity_run(v: f64, seed: u64) -> Record {
 
 fn force_domain() -> FitOptions {
     FitOptions {
-        domain: frictionid_engine::identify::FitDomain::Force,
-        parallel: false,
+        target: TargetOptions {
+            domain: frictionid_engine::identify::FitDomain::Force,
+            ..TargetOptions::default()
+        },
+        hooks: Hooks {
+            parallel: false,
+            ..Hooks::default()
+        },
         ..FitOptions::default()
     }
 }
@@ -430,7 +456,10 @@ fn a_law_that_is_not_finite_over_part_of_the_data_is_an_error_or_a_failure() {
     for opts in [
         force_domain(),
         FitOptions {
-            parallel: false,
+            hooks: Hooks {
+                parallel: false,
+                ..Hooks::default()
+            },
             ..FitOptions::default()
         },
     ] {
@@ -463,7 +492,10 @@ fn a_record_without_motion_is_refused_with_one_line() {
         (still(noise), "no motion above the noise"),
     ] {
         let opts = FitOptions {
-            parallel: false,
+            hooks: Hooks {
+                parallel: false,
+                ..Hooks::default()
+            },
             ..FitOptions::default()
         };
         let e = fit(&osc, &Coulomb::default(), std::slice::from_ref(&rec), &opts).unwrap_err();
@@ -504,7 +536,10 @@ fn a_parameter_without_effect_on_the_residuals_fails_a_finding() {
         .map(|(i, &v)| constant_velocity_run(v, i as u64))
         .collect();
     let opts = FitOptions {
-        free: Some(vec!["mu_c".into(), "mu_s".into(), "viscous".into()]),
+        params: ParamOptions {
+            free: Some(vec!["mu_c".into(), "mu_s".into(), "viscous".into()]),
+            ..force_domain().params.clone()
+        },
         ..force_domain()
     };
     let r = fit(&osc, &stribeck, &runs, &opts).unwrap();

@@ -6,7 +6,7 @@
 //! force; tighter integration tolerances converge to the same motion; and a fit of noise-free
 //! data recovers the parameters that made it.
 
-use frictionid_engine::identify::{fit, FitOptions};
+use frictionid_engine::identify::{fit, FitOptions, Hooks};
 use frictionid_engine::simulate::{simulate, Initial, SimOptions, Trajectory};
 use frictionid_engine::synthetic::uniform_times;
 use frictionid_engine::{Oscillator, Record};
@@ -284,7 +284,13 @@ proptest! {
         let x0 = x0.max(6.0 * mu * osc.normal_force / osc.stiffness);
         let truth = Coulomb { mu };
         let recs = records(&osc, &truth, &[x0]);
-        let opts = FitOptions { parallel: false, ..FitOptions::default() };
+        let opts = FitOptions {
+            hooks: Hooks {
+                parallel: false,
+                ..Hooks::default()
+            },
+            ..FitOptions::default()
+        };
         let r = fit(&osc, &Coulomb::default(), &recs, &opts).expect("fit");
         let got = r.value("mu").expect("mu is fitted");
         prop_assert!(rel(got, mu) < 1e-5, "mu {got} vs truth {mu} ({})", r.termination);
@@ -300,7 +306,13 @@ proptest! {
         let x0 = 8.0 * mu * osc.normal_force / osc.stiffness + 0.005;
         let truth = ViscousCoulomb { mu, viscous };
         let recs = records(&osc, &truth, &[x0, 1.6 * x0]);
-        let opts = FitOptions { parallel: false, ..FitOptions::default() };
+        let opts = FitOptions {
+            hooks: Hooks {
+                parallel: false,
+                ..Hooks::default()
+            },
+            ..FitOptions::default()
+        };
         let r = fit(&osc, &ViscousCoulomb::default(), &recs, &opts).expect("fit");
         let (m, b) = (r.value("mu").expect("mu"), r.value("viscous").expect("viscous"));
         prop_assert!(rel(m, mu) < 1e-4, "mu {m} vs truth {mu} ({})", r.termination);

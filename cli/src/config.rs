@@ -391,7 +391,7 @@ mod tests {
         assert_eq!(c.spec.oscillator, Oscillator::fmm());
         let m = c.spec.model.unwrap();
         assert_eq!(m.model.params(), vec![0.3]);
-        assert_eq!(c.spec.fit.free, Some(vec!["mu".to_string()]));
+        assert_eq!(c.spec.fit.params.free, Some(vec!["mu".to_string()]));
         let s = c.spec.simulation.unwrap();
         assert_eq!(
             (s.x0, s.sample_rate, s.noise, s.seed),

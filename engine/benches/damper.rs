@@ -14,7 +14,9 @@ mod damper;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use frictionid_engine::data::{RecordSource, RecordUse};
-use frictionid_engine::identify::{compare, Comparison, FitDomain, FitOptions};
+use frictionid_engine::identify::{
+    compare, Comparison, FitDomain, FitOptions, ParamOptions, TargetOptions,
+};
 use frictionid_engine::oscillator::PartialOscillator;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{Coulomb, Dahl, FrictionModel};
@@ -46,10 +48,16 @@ fn damper_records() -> Vec<Record> {
 fn damper_options() -> (Oscillator, FitOptions) {
     let (osc, unknown) = PartialOscillator::default().resolve();
     let opts = FitOptions {
-        domain: FitDomain::Force,
-        force_offset: true,
-        free: Some(vec!["mu".into(), "sigma0".into(), "mu_c".into()]),
-        unknown_oscillator: unknown,
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            force_offset: true,
+            unknown_oscillator: unknown,
+            ..TargetOptions::default()
+        },
+        params: ParamOptions {
+            free: Some(vec!["mu".into(), "sigma0".into(), "mu_c".into()]),
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     (osc, opts)

@@ -17,7 +17,9 @@ mod common;
 use common::{lugre_truth, records, stiff_lugre_truth, stribeck_truth, NOISE};
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use frictionid_engine::data::RecordSource;
-use frictionid_engine::identify::{compare, fit, FitDomain, FitOptions, ForceTarget};
+use frictionid_engine::identify::{
+    compare, fit, FitDomain, FitOptions, ForceTarget, ParamOptions, SearchOptions, TargetOptions,
+};
 use frictionid_engine::identify::{OscillatorParam, Search};
 use frictionid_engine::oscillator::PartialOscillator;
 use frictionid_engine::record::{Channel, TimeBase};
@@ -123,9 +125,15 @@ fn lugre(c: &mut Criterion) {
     let stiff = stiff_lugre_truth();
     let stiff_recs = records(&osc, &stiff, NOISE, 81);
     let at_truth = FitOptions {
-        guess: false,
-        search: Some(Search::Local),
-        multistart: Some(1),
+        params: ParamOptions {
+            guess: false,
+            ..ParamOptions::default()
+        },
+        search: SearchOptions {
+            strategy: Some(Search::Local),
+            multistart: Some(1),
+            ..SearchOptions::default()
+        },
         ..FitOptions::default()
     };
     group.bench_function("from the truth, sigma0 1e7, 3 records of 2 s", |b| {
@@ -139,7 +147,10 @@ fn lugre(c: &mut Criterion) {
 fn force_route(c: &mut Criterion) {
     let osc = Oscillator::fmm();
     let force = FitOptions {
-        domain: FitDomain::Force,
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            ..TargetOptions::default()
+        },
         ..FitOptions::default()
     };
     let velocity = FitOptions::default();
@@ -195,11 +206,17 @@ fn driven_axis_record() -> Record {
 fn inverse_dynamics(c: &mut Criterion) {
     let (osc, unknown) = PartialOscillator::default().resolve();
     let opts = FitOptions {
-        domain: FitDomain::Force,
-        force_target: ForceTarget::InverseDynamics,
-        force_offset: true,
-        oscillator: vec![OscillatorParam::Mass],
-        unknown_oscillator: unknown,
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            force_target: ForceTarget::InverseDynamics,
+            force_offset: true,
+            unknown_oscillator: unknown,
+            ..TargetOptions::default()
+        },
+        params: ParamOptions {
+            oscillator: vec![OscillatorParam::Mass],
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     let record = [driven_axis_record()];
@@ -272,8 +289,11 @@ fn drive_friction_record() -> Record {
 fn drive_compare(c: &mut Criterion) {
     let (osc, unknown) = PartialOscillator::default().resolve();
     let opts = FitOptions {
-        domain: FitDomain::Force,
-        unknown_oscillator: unknown,
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            unknown_oscillator: unknown,
+            ..TargetOptions::default()
+        },
         ..FitOptions::default()
     };
     let models: Vec<Box<dyn FrictionModel>> =

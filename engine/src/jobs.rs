@@ -12,7 +12,7 @@ use crate::energy::{
 };
 use crate::error::EngineError;
 use crate::identify::{
-    compare, fit, require_mechanics, require_oscillator, FitOptions, FitResult, PropertyUncertainty,
+    compare, fit, require_mechanics, require_oscillator, FitResult, PropertyUncertainty,
 };
 use crate::oscillator::Oscillator;
 use crate::record::{channel_list, Channel, Record};
@@ -247,10 +247,8 @@ pub fn reference_model(
     }
     let coulomb = Coulomb::default();
     // Only the fitted values are used: no uncertainty budget.
-    let opts = FitOptions {
-        uncertainty: PropertyUncertainty::default(),
-        ..spec.fit_options(&[], hooks)
-    };
+    let mut opts = spec.fit_options(&[], hooks);
+    opts.uncertainty = PropertyUncertainty::default();
     let fitted: FitResult =
         fit(&spec.oscillator, &coulomb, records, &opts).map_err(JobError::ReferenceFit)?;
     Ok(Some(fitted.fitted_model))

@@ -3,7 +3,7 @@
 //! interferometer alone, and by a vibrometer + accelerometer pair.
 
 use frictionid_engine::exact::coulomb_free_vibration;
-use frictionid_engine::identify::{fit, FitOptions, FitResult};
+use frictionid_engine::identify::{fit, FitOptions, FitResult, ParamOptions};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
 use frictionid_engine::{Oscillator, Record};
@@ -202,7 +202,10 @@ fn eq7_with_measured_displacement_and_acceleration_is_mu_n() {
 #[test]
 fn a_velocity_offset_on_displacement_records_is_named() {
     let opts = FitOptions {
-        velocity_offset: true,
+        params: ParamOptions {
+            velocity_offset: true,
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     let records = fmm_records(&[(Channel::Displacement, X_NOISE)], 3);

@@ -6,7 +6,7 @@
 //! measured input, compare velocities) recovers M, Fv, Fc and the offset F0.
 
 use frictionid_engine::axis::{NoRestoring, Restoring};
-use frictionid_engine::identify::{fit, FitOptions, FitResult, OscillatorParam};
+use frictionid_engine::identify::{fit, FitOptions, FitResult, OscillatorParam, ParamOptions};
 use frictionid_engine::record::Channel;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::ViscousCoulomb;
@@ -135,8 +135,11 @@ fn identify(records: &[Record]) -> FitResult {
         ..Oscillator::fmm()
     };
     let opts = FitOptions {
-        oscillator: vec![OscillatorParam::Mass, OscillatorParam::InputOffset],
-        guess: false,
+        params: ParamOptions {
+            oscillator: vec![OscillatorParam::Mass, OscillatorParam::InputOffset],
+            guess: false,
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     let model = ViscousCoulomb {

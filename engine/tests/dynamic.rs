@@ -5,7 +5,9 @@
 mod common;
 
 use common::{lugre_truth, records, stiff_lugre_truth, NOISE};
-use frictionid_engine::identify::{fit, FitOptions, FitResult, Identifiability, Search};
+use frictionid_engine::identify::{
+    fit, FitOptions, FitResult, Identifiability, Search, SearchOptions,
+};
 use frictionid_engine::Oscillator;
 use frictionid_models::{Coulomb, Dahl, FrictionModel, Gms, LuGre};
 
@@ -102,8 +104,11 @@ fn the_prefit_start_brings_a_local_lugre_fit_to_the_noise_level() {
     let truth = lugre_truth();
     let recs = records(&osc, &truth, NOISE, 41);
     let opts = FitOptions {
-        search: Some(Search::Local),
-        prefit: true,
+        search: SearchOptions {
+            strategy: Some(Search::Local),
+            prefit: true,
+            ..SearchOptions::default()
+        },
         ..FitOptions::default()
     };
     let r = fit(&osc, &LuGre::default(), &recs[1..2], &opts).unwrap();

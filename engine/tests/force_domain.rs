@@ -7,8 +7,8 @@ mod common;
 
 use common::{records, stribeck_truth, NOISE};
 use frictionid_engine::exact::coulomb_free_vibration;
-use frictionid_engine::identify::{fit, FitDomain, FitOptions, ForceTarget};
 use frictionid_engine::oscillator::OscillatorProperty;
+use frictionid_engine::identify::{fit, FitDomain, FitOptions, ForceTarget, TargetOptions};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
@@ -96,13 +96,12 @@ fn force_record(time: Vec<f64>, force: Vec<f64>) -> Record {
 
 fn force_options() -> FitOptions {
     FitOptions {
-        domain: FitDomain::Force,
-        // m, c, k play no part: a measured force needs only the normal force.
-        unknown_oscillator: vec![
-            OscillatorProperty::Mass,
-            OscillatorProperty::Damping,
-            OscillatorProperty::Stiffness,
-        ],
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            // m, c, k play no part: a measured force needs only the normal force.
+            unknown_oscillator: vec![OscillatorProperty::Mass, OscillatorProperty::Damping, OscillatorProperty::Stiffness],
+            ..TargetOptions::default()
+        },
         ..FitOptions::default()
     }
 }
@@ -143,7 +142,10 @@ fn lugre_is_recovered_within_two_percent_from_a_noisy_force_with_a_load_cell_off
     }
     let record = force_record(time, force);
     let opts = FitOptions {
-        force_offset: true,
+        target: TargetOptions {
+            force_offset: true,
+            ..force_options().target.clone()
+        },
         ..force_options()
     };
     let r = fit(&Oscillator::fmm(), &LuGre::default(), &[record], &opts).unwrap();
@@ -180,8 +182,11 @@ fn coulomb_records(osc: &Oscillator, mu: f64, noise: f64) -> Vec<Record> {
 
 fn energy_options() -> FitOptions {
     FitOptions {
-        domain: FitDomain::Force,
-        force_target: ForceTarget::Energy,
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            force_target: ForceTarget::Energy,
+            ..TargetOptions::default()
+        },
         ..FitOptions::default()
     }
 }
@@ -289,7 +294,10 @@ fn min_speed_recovers_the_sliding_level_that_stick_phases_drag_down() {
     assert!(dragged < 0.8 * 0.3, "every sample: mu = {dragged}");
     assert!(all.records[0].sliding.is_none());
     let sliding = FitOptions {
-        min_speed: Some(1e-3),
+        target: TargetOptions {
+            min_speed: Some(1e-3),
+            ..force_options().target.clone()
+        },
         ..force_options()
     };
     let r = fit(&osc, &Coulomb::default(), &[record], &sliding).unwrap();
@@ -327,21 +335,30 @@ fn min_speed_is_a_force_domain_option_and_a_speed() {
     for (opts, says) in [
         (
             FitOptions {
-                min_speed: Some(1e-3),
+                target: TargetOptions {
+                    min_speed: Some(1e-3),
+                    ..TargetOptions::default()
+                },
                 ..FitOptions::default()
             },
             "min_speed applies to force-domain fits only",
         ),
         (
             FitOptions {
-                min_speed: Some(-1.0),
+                target: TargetOptions {
+                    min_speed: Some(-1.0),
+                    ..force_options().target.clone()
+                },
                 ..force_options()
             },
             "min_speed must be a speed >= 0 (m/s), got -1",
         ),
         (
             FitOptions {
-                min_speed: Some(1.0),
+                target: TargetOptions {
+                    min_speed: Some(1.0),
+                    ..force_options().target.clone()
+                },
                 ..force_options()
             },
             "0 samples slide with |v| >= [fit.options] min_speed = 1 m/s; lower it",

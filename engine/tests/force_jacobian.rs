@@ -13,7 +13,8 @@
 use frictionid_engine::identify::problem::{FitProblem, ProblemParts, Residuals};
 use frictionid_engine::identify::search::build_layout;
 use frictionid_engine::identify::{
-    FitDomain, FitOptions, ForceAlongMotion, ForceTarget, OscillatorParam,
+    FitDomain, FitOptions, ForceAlongMotion, ForceTarget, OscillatorParam, ParamOptions,
+    TargetOptions,
 };
 use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::record::{Channel, TimeBase};
@@ -80,31 +81,39 @@ fn driven_record() -> Record {
 
 fn force_options(free: &[&str]) -> FitOptions {
     FitOptions {
-        domain: FitDomain::Force,
-        force_offset: true,
-        min_speed: Some(5e-4),
-        free: Some(free.iter().map(|s| s.to_string()).collect()),
-        unknown_oscillator: vec![
-            OscillatorProperty::Mass,
-            OscillatorProperty::Damping,
-            OscillatorProperty::Stiffness,
-        ],
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            force_offset: true,
+            min_speed: Some(5e-4),
+            unknown_oscillator: vec![OscillatorProperty::Mass, OscillatorProperty::Damping, OscillatorProperty::Stiffness],
+            ..TargetOptions::default()
+        },
+        params: ParamOptions {
+            free: Some(free.iter().map(|s| s.to_string()).collect()),
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     }
 }
 
 fn inverse_options(free: &[&str]) -> FitOptions {
     FitOptions {
-        domain: FitDomain::Force,
-        force_target: ForceTarget::InverseDynamics,
-        force_offset: true,
-        oscillator: vec![
-            OscillatorParam::Mass,
-            OscillatorParam::Damping,
-            OscillatorParam::Stiffness,
-            OscillatorParam::InputOffset,
-        ],
-        free: Some(free.iter().map(|s| s.to_string()).collect()),
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            force_target: ForceTarget::InverseDynamics,
+            force_offset: true,
+            ..TargetOptions::default()
+        },
+        params: ParamOptions {
+            oscillator: vec![
+                OscillatorParam::Mass,
+                OscillatorParam::Damping,
+                OscillatorParam::Stiffness,
+                OscillatorParam::InputOffset,
+            ],
+            free: Some(free.iter().map(|s| s.to_string()).collect()),
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     }
 }
@@ -119,7 +128,15 @@ fn problem(
 ) -> (FitProblem<ForceAlongMotion>, Vec<f64>) {
     let residuals = ForceAlongMotion::new(&records, &osc, opts).expect("a force-domain problem");
     let model: Box<dyn FrictionModel> = frictionid_models::clone_model(model);
-    let layout = build_layout(&osc, model.as_ref(), &records, &residuals, opts).expect("a layout");
+    let layout = build_layout(
+        &osc,
+        model.as_ref(),
+        &records,
+        &residuals,
+        &opts.params,
+        &opts.energy,
+    )
+    .expect("a layout");
     // GMS's sharpness stays where its steps are exact.
     let start: Vec<f64> = layout
         .start

@@ -4,7 +4,7 @@
 mod common;
 
 use common::{lugre_truth, records, stribeck_truth, NOISE};
-use frictionid_engine::identify::{compare, fit, FitOptions, OscillatorParam};
+use frictionid_engine::identify::{compare, fit, FitOptions, OscillatorParam, ParamOptions};
 use frictionid_engine::{Integrator, Oscillator, SimOptions};
 use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre, NoFriction, Stribeck};
 
@@ -18,7 +18,10 @@ fn coulomb_mu_is_recovered_from_any_start() {
     let recs = records(&osc, &Coulomb { mu: 0.24 }, NOISE, 11);
     for start in [0.05, 0.1, 0.24, 0.5, 0.8] {
         let opts = FitOptions {
-            guess: false,
+            params: ParamOptions {
+                guess: false,
+                ..ParamOptions::default()
+            },
             ..FitOptions::default()
         };
         let r = fit(&osc, &Coulomb { mu: start }, &recs, &opts).unwrap();
@@ -99,7 +102,10 @@ fn a_fit_started_at_the_truth_of_stiff_bristles_runs_and_stays_there() {
     let recs = records(&osc, &truth, NOISE, 43);
     let defaults = FitOptions::default();
     let opts = FitOptions {
-        guess: false,
+        params: ParamOptions {
+            guess: false,
+            ..defaults.params.clone()
+        },
         sim: SimOptions {
             integrator: Integrator::Auto,
             ..defaults.sim
@@ -132,7 +138,10 @@ fn oscillator_is_identified_from_friction_free_records() {
         ..truth
     };
     let opts = FitOptions {
-        oscillator: vec![OscillatorParam::Damping, OscillatorParam::Stiffness],
+        params: ParamOptions {
+            oscillator: vec![OscillatorParam::Damping, OscillatorParam::Stiffness],
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     let r = fit(&start, &NoFriction {}, &recs, &opts).unwrap();
@@ -143,11 +152,14 @@ fn oscillator_is_identified_from_friction_free_records() {
 
     // With the mass free too, the report says what the data cannot separate.
     let opts3 = FitOptions {
-        oscillator: vec![
-            OscillatorParam::Mass,
-            OscillatorParam::Damping,
-            OscillatorParam::Stiffness,
-        ],
+        params: ParamOptions {
+            oscillator: vec![
+                OscillatorParam::Mass,
+                OscillatorParam::Damping,
+                OscillatorParam::Stiffness,
+            ],
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     let r3 = fit(&start, &NoFriction {}, &recs, &opts3).unwrap();
@@ -171,7 +183,10 @@ fn nuisance_offset_and_release_shift_are_recovered() {
         }
     }
     let opts = FitOptions {
-        velocity_offset: true,
+        params: ParamOptions {
+            velocity_offset: true,
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     let r = fit(&osc, &Coulomb::default(), &recs, &opts).unwrap();
@@ -186,7 +201,10 @@ fn bad_fit_requests_are_clear_errors() {
     let osc = Oscillator::fmm();
     let recs = records(&osc, &Coulomb { mu: 0.24 }, NOISE, 71);
     let opts = FitOptions {
-        free: Some(vec!["muu".into()]),
+        params: ParamOptions {
+            free: Some(vec!["muu".into()]),
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     let e = fit(&osc, &Coulomb::default(), &recs, &opts)
@@ -321,7 +339,10 @@ fn x0_as_a_nuisance_parameter_recovers_mu_when_x0_is_off() {
         r.x0 /= 1.03;
     }
     let opts = FitOptions {
-        x0: true,
+        params: ParamOptions {
+            x0: true,
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     let r = fit(&osc, &Coulomb::default(), &recs, &opts).unwrap();
@@ -336,7 +357,7 @@ fn x0_as_a_nuisance_parameter_recovers_mu_when_x0_is_off() {
     }
     // Bounds are settable in metres, and a bound that excludes the truth is hit.
     let mut tight = opts.clone();
-    tight.bounds.insert("x0".into(), (0.0, 0.0099));
+    tight.params.bounds.insert("x0".into(), (0.0, 0.0099));
     let r = fit(&osc, &Coulomb::default(), &recs[..1], &tight).unwrap();
     let name = format!("x0[{}]", recs[0].name);
     assert!((r.value(&name).unwrap() - 0.0099).abs() < 1e-9);

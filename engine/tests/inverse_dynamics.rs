@@ -10,7 +10,9 @@
 //! errors a user meets: no input channel, no motion channel, no mass.
 
 use frictionid_engine::identify::OscillatorParam;
-use frictionid_engine::identify::{fit, FitDomain, FitOptions, FitResult, ForceTarget};
+use frictionid_engine::identify::{
+    fit, FitDomain, FitOptions, FitResult, ForceTarget, Hooks, ParamOptions, TargetOptions,
+};
 use frictionid_engine::oscillator::PartialOscillator;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
@@ -172,12 +174,21 @@ struct State {
 fn options() -> (frictionid_engine::Oscillator, FitOptions) {
     let (osc, unknown) = PartialOscillator::default().resolve();
     let opts = FitOptions {
-        domain: FitDomain::Force,
-        force_target: ForceTarget::InverseDynamics,
-        force_offset: true,
-        oscillator: vec![OscillatorParam::Mass],
-        unknown_oscillator: unknown,
-        parallel: false,
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            force_target: ForceTarget::InverseDynamics,
+            force_offset: true,
+            unknown_oscillator: unknown,
+            ..TargetOptions::default()
+        },
+        params: ParamOptions {
+            oscillator: vec![OscillatorParam::Mass],
+            ..ParamOptions::default()
+        },
+        hooks: Hooks {
+            parallel: false,
+            ..Hooks::default()
+        },
         ..FitOptions::default()
     };
     (osc, opts)
@@ -314,7 +325,10 @@ fn inverse_dynamics_without_input_or_motion_or_mass_says_what_to_give() {
          `displacement_column`"
     );
     let no_mass = FitOptions {
-        oscillator: Vec::new(),
+        params: ParamOptions {
+            oscillator: Vec::new(),
+            ..opts.params.clone()
+        },
         ..opts.clone()
     };
     let record = TRUTH.record(200);

@@ -8,8 +8,8 @@
 
 use frictionid_engine::axis::Axis;
 use frictionid_engine::exact::coulomb_free_vibration;
-use frictionid_engine::identify::{fit, FitOptions, FitResult, Status};
 use frictionid_engine::oscillator::OscillatorProperty;
+use frictionid_engine::identify::{fit, FitOptions, FitResult, Status, TargetOptions};
 use frictionid_engine::record::NormalForce;
 use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
 use frictionid_engine::{Oscillator, Record};
@@ -62,7 +62,10 @@ fn fit_without_normal_force(
     record: Record,
 ) -> FitResult {
     let opts = FitOptions {
-        unknown_oscillator: vec![OscillatorProperty::NormalForce],
+        target: TargetOptions {
+            unknown_oscillator: vec![OscillatorProperty::NormalForce],
+            ..TargetOptions::default()
+        },
         ..FitOptions::default()
     };
     let result = fit(osc, model, &[record], &opts).expect("a fit");
@@ -156,7 +159,10 @@ fn a_records_own_normal_force_keeps_the_levels_coefficients() {
     let mut bare = decay(&osc, 3.48, 0.0, (0.022, 1.5, 2e-4));
     bare.name = "bare".into();
     let opts = FitOptions {
-        unknown_oscillator: vec![OscillatorProperty::NormalForce],
+        target: TargetOptions {
+            unknown_oscillator: vec![OscillatorProperty::NormalForce],
+            ..TargetOptions::default()
+        },
         ..FitOptions::default()
     };
     let e = fit(&osc, &Coulomb { mu: 0.2 }, &[own, bare], &opts).unwrap_err();

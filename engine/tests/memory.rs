@@ -12,7 +12,7 @@
 //! binary.
 
 use frictionid_engine::exact::coulomb_free_vibration;
-use frictionid_engine::identify::{fit, FitDomain, FitOptions};
+use frictionid_engine::identify::{fit, FitDomain, FitOptions, Hooks, ParamOptions, TargetOptions};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
@@ -154,10 +154,19 @@ fn a_force_domain_fit_holds_a_bounded_number_of_bytes_per_sample() {
     let (osc, unknown) = frictionid_engine::oscillator::PartialOscillator::default().resolve();
     // One thread: the starts in flight at once would depend on the machine's cores.
     let opts = FitOptions {
-        domain: FitDomain::Force,
-        free: Some(vec!["sigma0".into(), "mu_c".into()]),
-        unknown_oscillator: unknown,
-        parallel: false,
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            unknown_oscillator: unknown,
+            ..TargetOptions::default()
+        },
+        params: ParamOptions {
+            free: Some(vec!["sigma0".into(), "mu_c".into()]),
+            ..ParamOptions::default()
+        },
+        hooks: Hooks {
+            parallel: false,
+            ..Hooks::default()
+        },
         ..FitOptions::default()
     };
     let (result, peak) = peak_over_baseline(|| fit(&osc, &Dahl::default(), &record, &opts));

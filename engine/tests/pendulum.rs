@@ -7,7 +7,7 @@
 
 use frictionid_engine::axis::{Axis, Pendulum, Restoring};
 use frictionid_engine::data::RecordSource;
-use frictionid_engine::identify::{fit, FitOptions, FitResult, OscillatorParam};
+use frictionid_engine::identify::{fit, FitOptions, FitResult, OscillatorParam, ParamOptions};
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::Coulomb;
 use std::f64::consts::PI;
@@ -123,7 +123,10 @@ fn pendulum(gravity_moment: f64, damping: f64) -> Oscillator {
 
 fn fit_with(start: &Oscillator, free: Vec<OscillatorParam>, records: &[Record]) -> FitResult {
     let opts = FitOptions {
-        oscillator: free,
+        params: ParamOptions {
+            oscillator: free,
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     fit(start, &Coulomb { mu: 0.02 }, records, &opts).expect("a fit")

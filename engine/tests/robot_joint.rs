@@ -8,8 +8,10 @@
 //! least-squares objective is found by solving those three normal equations on a dense
 //! logarithmic grid of v_s and refining the best grid point by golden-section search.
 
-use frictionid_engine::identify::{fit, FitDomain, FitOptions, Search};
 use frictionid_engine::oscillator::OscillatorProperty;
+use frictionid_engine::identify::{
+    fit, FitDomain, FitOptions, Search, SearchOptions, TargetOptions,
+};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
@@ -165,12 +167,11 @@ fn joint() -> Oscillator {
 
 fn force_options() -> FitOptions {
     FitOptions {
-        domain: FitDomain::Force,
-        unknown_oscillator: vec![
-            OscillatorProperty::Mass,
-            OscillatorProperty::Damping,
-            OscillatorProperty::Stiffness,
-        ],
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            unknown_oscillator: vec![OscillatorProperty::Mass, OscillatorProperty::Damping, OscillatorProperty::Stiffness],
+            ..TargetOptions::default()
+        },
         ..FitOptions::default()
     }
 }
@@ -207,8 +208,11 @@ fn the_default_stribeck_fit_of_constant_velocity_runs_reaches_the_oracle_optimum
     // The best of 16 spread starts plus the global search's Latin hypercube finds no lower
     // optimum either.
     let wide = FitOptions {
-        multistart: Some(16),
-        search: Some(Search::Global),
+        search: SearchOptions {
+            multistart: Some(16),
+            strategy: Some(Search::Global),
+            ..force_options().search.clone()
+        },
         ..force_options()
     };
     let starts16 = fit(&joint(), &Stribeck::default(), &records, &wide).unwrap();
@@ -228,7 +232,10 @@ fn one_local_start_from_the_guess_stops_in_a_higher_minimum_of_this_set() {
     let (_, best_cost) = oracle(&runs);
     let records: Vec<Record> = runs.iter().map(|(_, r)| r.clone()).collect();
     let local = FitOptions {
-        search: Some(Search::Local),
+        search: SearchOptions {
+            strategy: Some(Search::Local),
+            ..force_options().search.clone()
+        },
         ..force_options()
     };
     let r = fit(&joint(), &Stribeck::default(), &records, &local).unwrap();

@@ -12,8 +12,10 @@
 //! recover the parameters the runs determine.
 
 use frictionid_engine::axis::Axis;
-use frictionid_engine::identify::{fit, FitDomain, FitOptions, FitResult};
 use frictionid_engine::oscillator::OscillatorProperty;
+use frictionid_engine::identify::{
+    fit, FitDomain, FitOptions, FitResult, ParamOptions, TargetOptions,
+};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
@@ -35,13 +37,15 @@ fn axis() -> Oscillator {
 
 fn options(free: &[&str]) -> FitOptions {
     FitOptions {
-        domain: FitDomain::Force,
-        free: Some(free.iter().map(|s| s.to_string()).collect()),
-        unknown_oscillator: vec![
-            OscillatorProperty::Mass,
-            OscillatorProperty::Damping,
-            OscillatorProperty::Stiffness,
-        ],
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            unknown_oscillator: vec![OscillatorProperty::Mass, OscillatorProperty::Damping, OscillatorProperty::Stiffness],
+            ..TargetOptions::default()
+        },
+        params: ParamOptions {
+            free: Some(free.iter().map(|s| s.to_string()).collect()),
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     }
 }

@@ -8,7 +8,9 @@
 mod common;
 
 use common::{records, NOISE};
-use frictionid_engine::identify::{fit, FitDomain, FitOptions, Search};
+use frictionid_engine::identify::{
+    fit, FitDomain, FitOptions, ParamOptions, Search, SearchOptions, TargetOptions,
+};
 use frictionid_engine::oscillator::PartialOscillator;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
@@ -23,7 +25,10 @@ fn a_start_below_the_domain_is_projected_and_the_fit_succeeds() {
     let osc = Oscillator::fmm();
     let recs = records(&osc, &Coulomb { mu: 0.24 }, NOISE, 100);
     let opts = FitOptions {
-        guess: false,
+        params: ParamOptions {
+            guess: false,
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     let result = fit(&osc, &Coulomb { mu: -0.3 }, &recs, &opts).expect("the projected start fits");
@@ -65,15 +70,27 @@ fn a_start_and_bounds_beyond_the_domain_are_projected_into_it() {
     let record = [damper_stroke()];
     let (osc, unknown) = PartialOscillator::default().resolve();
     let base = FitOptions {
-        domain: FitDomain::Force,
-        free: Some(vec!["sigma0".into(), "mu_c".into()]),
-        unknown_oscillator: unknown,
-        guess: false,
-        search: Some(Search::Local),
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            unknown_oscillator: unknown,
+            ..TargetOptions::default()
+        },
+        params: ParamOptions {
+            free: Some(vec!["sigma0".into(), "mu_c".into()]),
+            guess: false,
+            ..ParamOptions::default()
+        },
+        search: SearchOptions {
+            strategy: Some(Search::Local),
+            ..SearchOptions::default()
+        },
         ..FitOptions::default()
     };
     let wide = FitOptions {
-        bounds: [("sigma0".to_string(), (-1e6, 1e7))].into_iter().collect(),
+        params: ParamOptions {
+            bounds: [("sigma0".to_string(), (-1e6, 1e7))].into_iter().collect(),
+            ..base.params.clone()
+        },
         ..base.clone()
     };
     let start = Dahl {
@@ -131,10 +148,16 @@ fn a_start_whose_residuals_are_not_finite_names_the_record_and_sample() {
     ];
     let (osc, unknown) = PartialOscillator::default().resolve();
     let opts = FitOptions {
-        domain: FitDomain::Force,
-        free: Some(vec!["mu".into()]),
-        unknown_oscillator: unknown,
-        guess: false,
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            unknown_oscillator: unknown,
+            ..TargetOptions::default()
+        },
+        params: ParamOptions {
+            free: Some(vec!["mu".into()]),
+            guess: false,
+            ..ParamOptions::default()
+        },
         ..FitOptions::default()
     };
     let law = BreaksDown {

@@ -5,7 +5,6 @@ use super::{hooks, load_inputs, progress_bar, publish, warn, Outcome, REPORT_FIL
 use crate::args::OutputArgs;
 use crate::plots::sets::{fit_record_plots, input_plots, steady_state_plot};
 use crate::report::OutputDir;
-use frictionid_engine::identify::FitOptions;
 use frictionid_engine::jobs::fit_job;
 use std::path::Path;
 
@@ -14,11 +13,7 @@ pub fn run(config: &Path, output: &OutputArgs) -> anyhow::Result<Outcome> {
     let inputs = load_inputs(config, "fit")?;
     let cfg = &inputs.config;
     let model = cfg.require_model("fit")?;
-    let iterations = cfg
-        .spec
-        .fit
-        .max_iterations
-        .unwrap_or(FitOptions::default().max_iterations);
+    let iterations = cfg.spec.fit.search.max_iterations;
     let bar = progress_bar(
         output,
         iterations,

@@ -2,9 +2,8 @@
 
 use super::fit::fit;
 use crate::error::EngineError;
+use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::is_friction_level;
-use crate::identify::values::nuisance::non_model_bound_keys;
-use crate::identify::values::options::FitOptions;
 use crate::identify::values::outcome::{Check, Finding};
 use crate::identify::values::result::FitResult;
 use crate::oscillator::Oscillator;
@@ -66,7 +65,7 @@ impl Comparison {
 /// A model's name and its fit.
 type ModelFit = (String, Result<FitResult, EngineError>);
 
-/// Fits every model in `models` to `records` (in parallel when `opts.parallel`) and ranks
+/// Fits every model in `models` to `records` (in parallel when `opts.hooks.parallel`) and ranks
 /// them by AIC. Each model is fitted with `opts` (its free list, bounds and initial values
 /// apply only to parameters the model has; others are ignored).
 pub fn compare(
@@ -81,18 +80,13 @@ pub fn compare(
     }
     let run = |m: &(dyn FrictionModel + 'static)| -> ModelFit {
         let names: Vec<String> = m.param_info().into_iter().map(|p| p.name).collect();
-        let mut o = opts.clone();
-        o.free = opts
-            .free
-            .as_ref()
-            .map(|f| f.iter().filter(|n| names.contains(n)).cloned().collect());
-        let other_keys = non_model_bound_keys();
-        o.bounds
-            .retain(|k, _| names.contains(k) || other_keys.contains(&k.as_str()));
-        o.keep_initial.retain(|k| names.contains(k));
+        let o = FitOptions {
+            params: opts.params.for_model(&names),
+            ..opts.clone()
+        };
         (m.name().to_string(), fit(osc, m, records, &o))
     };
-    let results: Vec<ModelFit> = if opts.parallel {
+    let results: Vec<ModelFit> = if opts.hooks.parallel {
         let order = heaviest_first(models);
         let mut done: Vec<(usize, ModelFit)> = order
             .par_iter()

@@ -31,9 +31,10 @@ pub use problem::{guess_hint, require_mechanics, require_oscillator, ForceAlongM
 pub use problem::{Evaluation, Residuals, Segment, SimulatedResponse};
 pub use search::LevenbergMarquardt;
 pub use values::{
-    check_min_speed, non_model_bound_keys, worst_status, Check, Derived, EnergyForce, Finding,
-    FitDomain, FitOptions, FitResult, FitSeries, FittedParam, ForceBalance, ForceTarget,
-    FrictionLevels, Identifiability, NuisanceKind, NuisanceValues, OscillatorParam, Progress,
-    ProgressFn, PropertyUncertainty, Rank, RecordFit, Search, SlidingSamples, StartOutcome, Status,
-    StdErrorComponents, TerminationReason, Verdict,
+    check_min_speed, fit_sim_options, non_model_bound_keys, worst_status, Check, Derived,
+    EnergyForce, Finding, FitDomain, FitOptions, FitResult, FitSeries, FittedParam, ForceBalance,
+    ForceTarget, FrictionLevels, Hooks, Identifiability, NuisanceKind, NuisanceValues, OptionKeys,
+    OscillatorParam, ParamOptions, Progress, ProgressFn, PropertyUncertainty, Rank, RecordFit,
+    Search, SearchOptions, SlidingSamples, StartOutcome, Status, StdErrorComponents, TargetOptions,
+    TerminationReason, Verdict, DEFAULT_MAX_ITERATIONS,
 };

@@ -12,9 +12,10 @@
 
 use super::stats::t_quantile_975;
 use crate::error::EngineError;
-use crate::identify::values::options::{FitDomain, FitOptions};
+use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::result::{FitResult, FittedParam};
-use crate::identify::values::search::{fits_directly, Search};
+use crate::identify::values::search::fits_directly;
+use crate::identify::values::target_options::FitDomain;
 use crate::identify::values::uncertainty::{PropertyUncertainty, StdErrorComponents};
 use crate::oscillator::Oscillator;
 use frictionid_models::FrictionModel;
@@ -37,17 +38,7 @@ pub(crate) fn add_property_uncertainty(
 ) -> Result<(), EngineError> {
     let sigma = opts_in.uncertainty;
     sigma.validate()?;
-    let mut opts = opts_in.clone();
-    opts.uncertainty = PropertyUncertainty::default();
-    opts.guess = false;
-    opts.multistart = Some(1);
-    // A refit starts at the optimum: a static law along the measured motion needs no global
-    // search from there (its default, see `Search::resolve`).
-    let simulated = opts.domain != FitDomain::Force;
-    if opts.search.is_none() && fits_directly(result.fitted_model.as_ref(), simulated) {
-        opts.search = Some(Search::Local);
-    }
-    opts.progress = None;
+    let opts = refit_options(opts_in, result.fitted_model.as_ref());
     let mut components: Vec<StdErrorComponents> = result
         .parameters
         .iter()
@@ -57,7 +48,7 @@ pub(crate) fn add_property_uncertainty(
         })
         .collect();
     for (property, s) in sigma.properties() {
-        if s <= 0.0 || opts_in.oscillator.contains(&property) {
+        if s <= 0.0 || opts_in.params.oscillator.contains(&property) {
             continue;
         }
         let at = |by: f64| {
@@ -81,6 +72,20 @@ pub(crate) fn add_property_uncertainty(
         }
     }
     Ok(())
+}
+
+/// The options of a refit of `fitted` from its optimum: no uncertainty budget, no guess, one
+/// start, no progress; a static law along the measured motion needs no global search from
+/// there (its default, see `Search::resolve`), so it searches locally.
+fn refit_options(opts: &FitOptions, fitted: &dyn FrictionModel) -> FitOptions {
+    let simulated = opts.target.domain != FitDomain::Force;
+    let local = opts.search.strategy.is_none() && fits_directly(fitted, simulated);
+    let mut refit = opts.clone();
+    refit.uncertainty = PropertyUncertainty::default();
+    refit.params.guess = false;
+    refit.search = opts.search.one_start(local);
+    refit.hooks = opts.hooks.quiet();
+    refit
 }
 
 fn set_total(p: &mut FittedParam, c: StdErrorComponents, tq: f64) {

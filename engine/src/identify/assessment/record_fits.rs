@@ -4,13 +4,15 @@
 use super::diagnostics;
 use super::energy_check::{energy_force_check, ForceReference};
 use crate::axis::Axis;
-use crate::energy::{analyze_record, forces_from_states, states_along, MeasuredMotion};
+use crate::energy::{
+    analyze_record, forces_from_states, states_along, EnergyOptions, MeasuredMotion,
+};
 use crate::error::EngineError;
 use crate::identify::problem::{
     AnalysisRequest, FitProblem, Realised, RecordCase, Residuals, Segment,
 };
 use crate::identify::values::{
-    ChannelFit, Check, EnergyForce, Finding, FitOptions, FitSeries, NuisanceValues, RecordFit,
+    ChannelFit, Check, EnergyForce, Finding, FitSeries, NuisanceValues, RecordFit,
 };
 use crate::record::{Channel, NormalForce, Record};
 use std::sync::Arc;
@@ -32,7 +34,7 @@ pub struct RecordFits {
 pub fn record_fits<R: Residuals>(
     problem: &FitProblem<R>,
     world: &Realised,
-    opts: &FitOptions,
+    energy: &EnergyOptions,
 ) -> Result<RecordFits, EngineError> {
     let mut out = RecordFits {
         records: Vec::new(),
@@ -41,7 +43,7 @@ pub fn record_fits<R: Residuals>(
         findings: Vec::new(),
     };
     for (ri, rec) in problem.records.iter().enumerate() {
-        let (record, sum_sq, finding) = record_fit(problem, world, opts, ri, rec)?;
+        let (record, sum_sq, finding) = record_fit(problem, world, energy, ri, rec)?;
         out.sum_sq += sum_sq;
         out.n_total += record.series.measured.len();
         out.findings.extend(finding);
@@ -55,13 +57,13 @@ pub fn record_fits<R: Residuals>(
 fn record_fit<R: Residuals>(
     problem: &FitProblem<R>,
     world: &Realised,
-    opts: &FitOptions,
+    energy: &EnergyOptions,
     ri: usize,
     rec: &Record,
 ) -> Result<(RecordFit, f64, Option<Finding>), EngineError> {
     // The energy check first: its analysis is freed before the fitted series are made (on a
     // long record each is as large as the record).
-    let checked = record_energy_check(problem, world, opts, ri, rec);
+    let checked = record_energy_check(problem, world, energy, ri, rec);
     let mut predicted = problem.predict_record(world, ri)?;
     let stacked = problem.residuals.measured(ri, rec);
     let segments = problem.residuals.segments(ri, rec);
@@ -118,7 +120,7 @@ struct CheckedRecord {
 fn record_energy_check<R: Residuals>(
     problem: &FitProblem<R>,
     world: &Realised,
-    opts: &FitOptions,
+    energy: &EnergyOptions,
     ri: usize,
     rec: &Record,
 ) -> CheckedRecord {
@@ -133,7 +135,7 @@ fn record_energy_check<R: Residuals>(
         };
     }
     let nuisance = &world.nuisance[ri];
-    match energy_check(problem.residuals.as_ref(), ri, rec, nuisance, world, opts) {
+    match energy_check(problem.residuals.as_ref(), ri, rec, nuisance, world, energy) {
         Ok((ef, ebf, mf)) => CheckedRecord {
             finding: Some(diagnostics::energy_balance(
                 &rec.name,
@@ -216,7 +218,7 @@ fn energy_check<R: Residuals + ?Sized>(
     rec: &Record,
     nuisance: &NuisanceValues,
     world: &Realised,
-    opts: &FitOptions,
+    energy: &EnergyOptions,
 ) -> Result<(EnergyForce, Vec<f64>, Vec<f64>), EngineError> {
     // The energy analysis sees the measured velocity corrected by the fitted offset, from the
     // fitted release displacement.
@@ -229,7 +231,7 @@ fn energy_check<R: Residuals + ?Sized>(
             index,
             record: rec,
             osc,
-            options: &opts.energy,
+            options: energy,
         })?
     } else {
         let mut corrected = rec.clone();
@@ -237,7 +239,7 @@ fn energy_check<R: Residuals + ?Sized>(
         for v in corrected.velocity_mut() {
             *v -= nuisance.offset;
         }
-        Arc::new(analyze_record(&corrected, osc, &opts.energy)?)
+        Arc::new(analyze_record(&corrected, osc, energy)?)
     };
     let model = world.model.as_ref();
     let normal = NormalForce::Constant(rec.oscillator_for(osc).normal_force);

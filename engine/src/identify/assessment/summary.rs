@@ -6,13 +6,15 @@ use super::diagnostics::{self, starts_at_best};
 use super::identifiability::{self, covariance_of_determined, Standing};
 use super::record_fits::{record_fits, RecordFits};
 use super::stats::{self, aic, bic, t_quantile_975, Covariance};
+use crate::energy::EnergyOptions;
 use crate::error::EngineError;
 use crate::identify::problem::{FitProblem, Realised, Residuals};
 use crate::identify::search::starts::{MultiStart, StartRun};
 use crate::identify::search::Layout;
+use crate::identify::values::ParamOptions;
 use crate::identify::values::{
-    Check, Derived, Finding, FitOptions, FitResult, FittedParam, FreeParam, FrictionLevels,
-    OscillatorParam, ParamKind, Search, StartOutcome, Status,
+    Check, Derived, Finding, FitResult, FittedParam, FreeParam, FrictionLevels, OscillatorParam,
+    ParamKind, Search, StartOutcome, Status,
 };
 use crate::oscillator::Oscillator;
 use nalgebra::DMatrix;
@@ -23,8 +25,10 @@ pub const CORRELATION_WARNING: f64 = 0.95;
 
 /// What the final phase needs besides the runs.
 pub struct FinishContext<'a, R: Residuals> {
-    /// The fit's options.
-    pub opts: &'a FitOptions,
+    /// Which parameters are free (the oscillator's among them).
+    pub params: &'a ParamOptions,
+    /// The energy-analysis options (the energy checks).
+    pub energy: &'a EnergyOptions,
     /// Its free parameters.
     pub layout: &'a Layout,
     /// The problem at the fit's start, which evaluates the optimum.
@@ -184,7 +188,7 @@ pub fn summarise<R: Residuals>(
     let params = &ctx.layout.params;
     let stats = statistics(ctx.reference, &runs.best, ctx.standings)?;
     let mut simulations = runs.simulations + ctx.reference.simulations();
-    let fits = record_fits(ctx.reference, &stats.world, ctx.opts)?;
+    let fits = record_fits(ctx.reference, &stats.world, ctx.energy)?;
     simulations += ctx.reference.records.len() as u64;
     let levels = ctx.reference.residuals.friction_levels();
     let parameters = parameter_entries(&stats, params, ctx.standings, levels);
@@ -206,7 +210,12 @@ pub fn summarise<R: Residuals>(
             .map(|a| (0..k).map(|b| stats.cov.correlation[(a, b)]).collect())
             .collect(),
         derived: if ctx.reference.residuals.simulates_response() {
-            derived_ratios(&stats.world.oscillator, params, &stats.cov.matrix, ctx.opts)
+            derived_ratios(
+                &stats.world.oscillator,
+                params,
+                &stats.cov.matrix,
+                ctx.params,
+            )
         } else {
             // The ratios a free response fixes; a force balance fixes the properties.
             Vec::new()
@@ -272,7 +281,7 @@ fn diagnose<R: Residuals>(
     findings.extend(stats.widening.clone());
     if ctx.reference.residuals.simulates_response() {
         findings.extend(identifiability_findings(
-            ctx.opts,
+            ctx.params,
             ctx.layout.n_model_free(),
         ));
     }
@@ -292,7 +301,7 @@ fn diagnose<R: Residuals>(
         findings.push(diagnostics::residual_structure(
             &fits.records,
             &stats.world.oscillator,
-            ctx.opts.energy.velocity_threshold,
+            ctx.energy.velocity_threshold,
         ));
     }
     findings
@@ -396,7 +405,7 @@ fn correlation_findings(params: &[FreeParam], cov: &Covariance) -> Vec<Finding> 
 
 /// A warning for a free mass with anything that scales with it (a fit of the free response:
 /// a measured input force fixes the scale).
-fn identifiability_findings(opts: &FitOptions, n_model_free: usize) -> Vec<Finding> {
+fn identifiability_findings(opts: &ParamOptions, n_model_free: usize) -> Vec<Finding> {
     let mut out = Vec::new();
     let osc_free = |q: OscillatorParam| opts.oscillator.contains(&q);
     if osc_free(OscillatorParam::Mass)
@@ -418,7 +427,7 @@ fn derived_ratios(
     osc: &Oscillator,
     layout: &[FreeParam],
     cov: &DMatrix<f64>,
-    opts: &FitOptions,
+    opts: &ParamOptions,
 ) -> Vec<Derived> {
     if opts.oscillator.is_empty() {
         return Vec::new();

@@ -38,13 +38,14 @@ use crate::energy::forces_at;
 use crate::energy::model_force::{
     check_motion, force_derivatives_checked, states_along_checked, CheckedMotion,
 };
-use crate::energy::{analyze_record, record_motion};
+use crate::energy::{analyze_record, record_motion, EnergyOptions};
 use crate::error::EngineError;
+use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::{FreeParam, ParamKind};
 use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::nuisance::NuisanceKind;
-use crate::identify::values::options::{FitDomain, FitOptions, ForceTarget};
 use crate::identify::values::result::{ForceBalance, SampleAxes, SlidingSamples};
+use crate::identify::values::target_options::{FitDomain, ForceTarget};
 use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::noise::noise_floor_level;
 use crate::record::{channel_list, Channel, NormalForce, Record};
@@ -166,15 +167,15 @@ impl ForceAlongMotion {
         osc: &Oscillator,
         opts: &FitOptions,
     ) -> Result<Self, EngineError> {
-        let unit_normal = FrictionLevels::read_as_forces(&opts.unknown_oscillator, records);
+        let unit_normal = FrictionLevels::read_as_forces(&opts.target.unknown_oscillator, records);
         let mut tracks = Vec::with_capacity(records.len());
         for record in records {
             let err = |reason: String| EngineError::Record {
                 record: record.name.clone(),
                 reason,
             };
-            let source = target_source(record, opts.force_target).map_err(err)?;
-            if opts.force_offset && source == TargetSource::EnergyBased {
+            let source = target_source(record, opts.target.force_target).map_err(err)?;
+            if opts.target.force_offset && source == TargetSource::EnergyBased {
                 return Err(err(
                     "[fit.options] force_offset = true needs a measured force channel or \
                      force_target = \"inverse_dynamics\" (this record is fitted to the \
@@ -184,7 +185,7 @@ impl ForceAlongMotion {
             }
             tracks.push(ForceTrack::new(record, source, osc, opts, unit_normal)?);
         }
-        let nuisance = if opts.force_offset {
+        let nuisance = if opts.target.force_offset {
             vec![NuisanceKind::ForceOffset]
         } else {
             Vec::new()
@@ -196,8 +197,8 @@ impl ForceAlongMotion {
             start: None,
             states: StateCache::default(),
         };
-        if opts.force_target == ForceTarget::InverseDynamics {
-            producer.start = producer.linear_start(osc, &opts.oscillator);
+        if opts.target.force_target == ForceTarget::InverseDynamics {
+            producer.start = producer.linear_start(osc, &opts.params.oscillator);
         }
         if unit_normal {
             let at = producer.start.as_ref().map_or(osc, |s| &s.oscillator);
@@ -343,9 +344,13 @@ impl ForceTrack {
                 channel_list(&record.channels())
             ))
         })?;
-        let normal =
-            FrictionLevels::record_normal_force(record, osc, &opts.unknown_oscillator, unit_normal)
-                .map_err(err)?;
+        let normal = FrictionLevels::record_normal_force(
+            record,
+            osc,
+            &opts.target.unknown_oscillator,
+            unit_normal,
+        )
+        .map_err(err)?;
         let mut balance = None;
         let (used, target) = match source {
             TargetSource::Measured => {
@@ -354,11 +359,11 @@ impl ForceTrack {
             }
             TargetSource::EnergyBased => {
                 require_mechanics(
-                    &opts.unknown_oscillator,
+                    &opts.target.unknown_oscillator,
                     osc.axis,
                     "the energy-based force (Eq. 7)",
                 )?;
-                energy_target(record, osc, opts)?
+                energy_target(record, osc, &opts.energy)?
             }
             TargetSource::InverseDynamics => {
                 let threshold = opts.energy.velocity_threshold;
@@ -373,12 +378,12 @@ impl ForceTrack {
             }
         };
         check_motion(record.time(), &motion.v, &normal).map_err(|e| err(e.to_string()))?;
-        let (used, target, sliding) = keep_sliding(used, target, &motion.v, opts.min_speed);
+        let (used, target, sliding) = keep_sliding(used, target, &motion.v, opts.target.min_speed);
         if sliding.is_some_and(|s| s.kept < 2) {
             return Err(err(format!(
                 "{} samples slide with |v| >= [fit.options] min_speed = {} m/s; lower it",
                 target.len(),
-                opts.min_speed.unwrap_or_default()
+                opts.target.min_speed.unwrap_or_default()
             )));
         }
         if target.len() < 2 {
@@ -505,10 +510,8 @@ fn keep_sliding(
 /// (an axis without a spring gives no `stiffness`).
 fn has_restoring(osc: &Oscillator, opts: &FitOptions) -> bool {
     !osc.restoring.is_linear_spring()
-        || opts.oscillator.contains(&OscillatorProperty::Stiffness)
-        || !opts
-            .unknown_oscillator
-            .contains(&OscillatorProperty::Stiffness)
+        || opts.params.oscillator.contains(&OscillatorProperty::Stiffness)
+        || !opts.target.is_unknown(OscillatorProperty::Stiffness)
 }
 
 /// The target of a record under `force_target`.
@@ -536,9 +539,9 @@ fn target_source(record: &Record, wanted: ForceTarget) -> Result<TargetSource, S
 fn energy_target(
     record: &Record,
     osc: &Oscillator,
-    opts: &FitOptions,
+    energy: &EnergyOptions,
 ) -> Result<(Vec<usize>, Vec<f64>), EngineError> {
-    let analysed = analyze_record(record, osc, &opts.energy)?;
+    let analysed = analyze_record(record, osc, energy)?;
     Ok(analysed
         .friction
         .iter()
@@ -685,7 +688,7 @@ impl Residuals for ForceAlongMotion {
     /// The friction level from the target (mean |F| over the compared samples over the mean
     /// normal force; for inverse dynamics the linear estimate's Coulomb level), the typical
     /// speed from the motion.
-    fn hint(&self, osc: &Oscillator, _records: &[Record], _opts: &FitOptions) -> GuessHint {
+    fn hint(&self, osc: &Oscillator, _records: &[Record], _energy: &EnergyOptions) -> GuessHint {
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
         let levels: Vec<f64> = match &self.start {
             Some(start) => vec![start.coulomb],
@@ -743,11 +746,12 @@ impl Residuals for ForceAlongMotion {
 fn velocity_only_options(opts: &FitOptions) -> Vec<&'static str> {
     let mut keys = Vec::new();
     for (on, key) in [
-        (opts.velocity_offset, "velocity_offset"),
-        (opts.time_shift, "time_shift"),
-        (opts.x0, "x0"),
+        (opts.params.velocity_offset, "velocity_offset"),
+        (opts.params.time_shift, "time_shift"),
+        (opts.params.x0, "x0"),
         (
-            !opts.oscillator.is_empty() && opts.force_target != ForceTarget::InverseDynamics,
+            !opts.params.oscillator.is_empty()
+                && opts.target.force_target != ForceTarget::InverseDynamics,
             "oscillator",
         ),
     ] {
@@ -769,7 +773,7 @@ pub fn check_force_domain(opts: &FitOptions) -> Result<(), EngineError> {
             velocity_keys.join(", ")
         )));
     }
-    if opts.domain != FitDomain::Force {
+    if opts.target.domain != FitDomain::Force {
         return Err(EngineError::InvalidInput(
             "fit_force needs [fit.options] domain = \"force\"".into(),
         ));
@@ -779,9 +783,9 @@ pub fn check_force_domain(opts: &FitOptions) -> Result<(), EngineError> {
 
 /// Inverse dynamics knows the mass (the inertia): given in `[oscillator]` or fitted.
 fn check_inverse_dynamics(opts: &FitOptions) -> Result<(), EngineError> {
-    let mass_unknown = opts.unknown_oscillator.contains(&OscillatorProperty::Mass)
-        && !opts.oscillator.contains(&OscillatorProperty::Mass);
-    if opts.force_target == ForceTarget::InverseDynamics && mass_unknown {
+    let mass_unknown = opts.target.is_unknown(OscillatorProperty::Mass)
+        && !opts.params.oscillator.contains(&OscillatorProperty::Mass);
+    if opts.target.force_target == ForceTarget::InverseDynamics && mass_unknown {
         return Err(EngineError::InvalidInput(
             "[oscillator]: force_target = \"inverse_dynamics\" needs the mass (the inertia): \
              give `mass`, or fit it with [fit.options] oscillator = [\"mass\"]"
@@ -794,6 +798,7 @@ fn check_inverse_dynamics(opts: &FitOptions) -> Result<(), EngineError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::identify::values::target_options::TargetOptions;
     use crate::record::TimeBase;
 
     fn record(channels: &[(Channel, Vec<f64>)]) -> Record {
@@ -814,7 +819,10 @@ mod tests {
         ]);
         let osc = Oscillator::fmm();
         let opts = FitOptions {
-            domain: FitDomain::Force,
+            target: TargetOptions {
+                domain: FitDomain::Force,
+                ..TargetOptions::default()
+            },
             ..FitOptions::default()
         };
         let t = ForceAlongMotion::new(std::slice::from_ref(&with_force), &osc, &opts)
@@ -827,7 +835,10 @@ mod tests {
         assert_eq!(t.velocity, v);
         let bare = record(&[(Channel::Displacement, x)]);
         let measured = FitOptions {
-            force_target: ForceTarget::Measured,
+            target: TargetOptions {
+                force_target: ForceTarget::Measured,
+                ..opts.target.clone()
+            },
             ..opts.clone()
         };
         let e = ForceAlongMotion::new(std::slice::from_ref(&bare), &osc, &measured).unwrap_err();
@@ -837,7 +848,10 @@ mod tests {
              channel (it has: displacement; name its column with `force_column`)"
         );
         let no_mechanics = FitOptions {
-            unknown_oscillator: vec![OscillatorProperty::Mass, OscillatorProperty::Stiffness],
+            target: TargetOptions {
+                unknown_oscillator: vec![OscillatorProperty::Mass, OscillatorProperty::Stiffness],
+                ..opts.target.clone()
+            },
             ..opts.clone()
         };
         let e = ForceAlongMotion::new(std::slice::from_ref(&bare), &osc, &no_mechanics)

@@ -3,17 +3,18 @@
 //! velocity fit without a normal force puts on the levels it reads as forces.
 
 use crate::energy::differentiate::central_difference;
-use crate::energy::{analyze_record, half_cycle_force, record_motion, EnergyAnalysis};
+use crate::energy::{
+    analyze_record, half_cycle_force, record_motion, EnergyAnalysis, EnergyOptions,
+};
 use crate::identify::values::levels::FrictionLevels;
-use crate::identify::values::options::FitOptions;
 use crate::oscillator::Oscillator;
 use crate::record::{Channel, Record};
 use frictionid_models::GuessHint;
 use std::borrow::Borrow;
 
 /// Data-driven hints: the friction level from the half-cycle energy estimate, a typical speed.
-pub fn guess_hint(osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
-    let level = |_, rec: &Record| friction_level(rec, osc, opts);
+pub fn guess_hint(osc: &Oscillator, records: &[Record], energy: &EnergyOptions) -> GuessHint {
+    let level = |_, rec: &Record| friction_level(rec, osc, energy);
     guess_hint_with(osc, records, FrictionLevels::Coefficients, level)
 }
 
@@ -58,10 +59,14 @@ pub fn guess_hint_with<B: Borrow<Record>>(
 
 /// A record's friction level: its half-cycle energy estimate, else (no complete half-cycle
 /// with a positive loss) the mean |F| of Eq. 7 along it.
-pub(crate) fn friction_level(record: &Record, osc: &Oscillator, opts: &FitOptions) -> Option<f64> {
-    let half_cycles = half_cycle_force(record, osc, &opts.energy).ok()?;
+pub(crate) fn friction_level(
+    record: &Record,
+    osc: &Oscillator,
+    energy: &EnergyOptions,
+) -> Option<f64> {
+    let half_cycles = half_cycle_force(record, osc, energy).ok()?;
     half_cycles.and_then(usable_level).or_else(|| {
-        let analysis = analyze_record(record, osc, &opts.energy).ok()?;
+        let analysis = analyze_record(record, osc, energy).ok()?;
         usable_level(analysis.mean_abs_force)
     })
 }

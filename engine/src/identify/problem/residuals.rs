@@ -12,9 +12,8 @@
 
 use super::analysis_cache::{AnalysisCache, AnalysisRequest};
 use super::step_allowance::StepAllowance;
-use crate::energy::EnergyAnalysis;
+use crate::energy::{EnergyAnalysis, EnergyOptions};
 use crate::error::EngineError;
-use crate::identify::values::options::FitOptions;
 use crate::identify::values::{
     ForceBalance, FreeParam, FrictionLevels, NuisanceKind, NuisanceValues, SampleAxes,
     SlidingSamples,
@@ -150,9 +149,9 @@ pub trait Residuals: Send + Sync {
     }
 
     /// Data-driven hints for the starting values (default: from the energy analysis of the
-    /// velocity, [`super::guess::guess_hint`]).
-    fn hint(&self, osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
-        super::guess::guess_hint(osc, records, opts)
+    /// velocity with `energy`'s options, [`super::guess::guess_hint`]).
+    fn hint(&self, osc: &Oscillator, records: &[Record], energy: &EnergyOptions) -> GuessHint {
+        super::guess::guess_hint(osc, records, energy)
     }
 
     /// Where the producer keeps the energy analyses of its records (default: nowhere, every

@@ -16,11 +16,10 @@
 
 use super::analysis_cache::{AnalysisCache, AnalysisRequest};
 use super::residuals::{Evaluation, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE};
-use crate::energy::record_motion;
+use crate::energy::{record_motion, EnergyOptions};
 use crate::error::EngineError;
 use crate::identify::values::levels::{FrictionLevels, UNIT_NORMAL_FORCE};
 use crate::identify::values::nuisance::{NuisanceKind, NuisanceValues};
-use crate::identify::values::options::FitOptions;
 use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::{channel_list, Channel, Record};
 use crate::simulate::{
@@ -442,7 +441,7 @@ impl Residuals for SimulatedResponse {
 
     /// Hints from the energy analysis of the velocity; a record without one lends it the
     /// differentiated displacement ([`record_motion`]).
-    fn hint(&self, osc: &Oscillator, records: &[Record], opts: &FitOptions) -> GuessHint {
+    fn hint(&self, osc: &Oscillator, records: &[Record], energy: &EnergyOptions) -> GuessHint {
         let with_velocity: Vec<Cow<'_, Record>> = records
             .iter()
             .map(|r| match r.channel(Channel::Velocity) {
@@ -461,13 +460,13 @@ impl Residuals for SimulatedResponse {
                     index,
                     record: rec,
                     osc,
-                    options: &opts.energy,
+                    options: energy,
                 })
                 .ok()
             });
             match analysed {
                 Some(analysis) => super::guess::level_of_analysis(&analysis),
-                None => super::guess::friction_level(rec, osc, opts),
+                None => super::guess::friction_level(rec, osc, energy),
             }
         };
         super::guess::guess_hint_with(osc, &with_velocity, self.levels, level)

@@ -3,12 +3,13 @@
 //! oscillator and nuisance parameters with their bounds and starting values.
 
 use crate::axis::Axis;
+use crate::energy::EnergyOptions;
 use crate::error::EngineError;
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::values::layout::{FreeParam, ParamKind};
 use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::nuisance::{non_model_bound_keys, NuisanceKind};
-use crate::identify::values::options::FitOptions;
+use crate::identify::values::param_options::ParamOptions;
 use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::Record;
 use frictionid_models::{FrictionModel, GuessHint, ParamInfo};
@@ -76,14 +77,16 @@ impl Layout {
     }
 }
 
-/// Builds the starting model and the free-parameter layout from the options, with the
-/// nuisance parameters `residuals` adds to every record.
+/// Builds the starting model and the free-parameter layout from the options (the guess
+/// analysing the records with `energy`), with the nuisance parameters `residuals` adds to
+/// every record.
 pub fn build_layout<R: Residuals + ?Sized>(
     osc: &Oscillator,
     model: &(dyn FrictionModel + 'static),
     records: &[Record],
     residuals: &R,
-    opts: &FitOptions,
+    opts: &ParamOptions,
+    energy: &EnergyOptions,
 ) -> Result<Layout, EngineError> {
     let info = model.param_info();
     let names: Vec<String> = info.iter().map(|p| p.name.clone()).collect();
@@ -93,7 +96,7 @@ pub fn build_layout<R: Residuals + ?Sized>(
         return Err(unknown_name("initial value", k, &names));
     }
     let mut layout = Layout {
-        start_model: starting_model(model, opts, &free, || residuals.hint(osc, records, opts))?,
+        start_model: starting_model(model, opts, &free, || residuals.hint(osc, records, energy))?,
         params: Vec::new(),
         start: Vec::new(),
     };
@@ -118,7 +121,7 @@ pub fn build_layout<R: Residuals + ?Sized>(
 }
 
 /// Every bound names a parameter (model, oscillator or nuisance) and has lower < upper.
-fn check_bounds(opts: &FitOptions, model_names: &[String]) -> Result<(), EngineError> {
+fn check_bounds(opts: &ParamOptions, model_names: &[String]) -> Result<(), EngineError> {
     let mut valid = model_names.to_vec();
     valid.extend(non_model_bound_keys().into_iter().map(String::from));
     if let Some(b) = opts.bounds.keys().find(|b| !valid.contains(b)) {
@@ -139,7 +142,7 @@ fn check_bounds(opts: &FitOptions, model_names: &[String]) -> Result<(), EngineE
 fn free_model_indices(
     info: &[ParamInfo],
     names: &[String],
-    opts: &FitOptions,
+    opts: &ParamOptions,
 ) -> Result<Vec<usize>, EngineError> {
     let Some(list) = &opts.free else {
         return Ok((0..info.len())
@@ -163,7 +166,7 @@ fn free_model_indices(
 /// parameters (unless kept), the given values for the others.
 fn starting_model(
     model: &(dyn FrictionModel + 'static),
-    opts: &FitOptions,
+    opts: &ParamOptions,
     free: &[usize],
     hint: impl FnOnce() -> GuessHint,
 ) -> Result<Box<dyn FrictionModel>, EngineError> {
@@ -192,7 +195,7 @@ fn model_param(
     p: &ParamInfo,
     index: usize,
     value: f64,
-    opts: &FitOptions,
+    opts: &ParamOptions,
     (levels, axis): (FrictionLevels, Axis),
 ) -> Result<(FreeParam, f64), EngineError> {
     let (lo, hi) = match opts.bounds.get(&p.name) {
@@ -272,7 +275,7 @@ fn check_property_exists(osc: &Oscillator, q: OscillatorProperty) -> Result<(), 
 fn oscillator_param(
     osc: &Oscillator,
     q: OscillatorProperty,
-    opts: &FitOptions,
+    opts: &ParamOptions,
 ) -> (FreeParam, f64) {
     let current = q.value(osc).unwrap_or(f64::NAN);
     let log = q.log_coordinates();
@@ -302,7 +305,7 @@ fn nuisance_param(
     r: usize,
     rec: &Record,
     osc: &Oscillator,
-    opts: &FitOptions,
+    opts: &ParamOptions,
 ) -> (FreeParam, f64) {
     let b = opts
         .bounds

@@ -2,16 +2,20 @@
 //!
 //! Eq. 7 gives the friction force along the measured motion without any fit. Fitting a
 //! model's force along that motion to it (a force-domain fit with the energy-based target,
-//! run by [`crate::identify::fit`] with the options [`prefit_options`] gives) needs no simulation of the mechanics and has no phase errors to trap the
-//! optimiser, so its optimum is a good start for the velocity fit of a model with internal
-//! states, whose default starts often end in a poor local minimum. The velocity fit runs its
-//! usual starts plus this one; the report says which start won. Static laws (no internal
-//! states) are not prefitted: their fit stays one start, one run.
+//! run by [`crate::identify::fit`] with the options [`prefit_options`] gives) needs no
+//! simulation of the mechanics and has no phase errors to trap the optimiser, so its optimum
+//! is a good start for the velocity fit of a model with internal states, whose default
+//! starts often end in a poor local minimum. The velocity fit runs its usual starts plus
+//! this one (planned by [`super::strategy::plan_fit_starts`]); the report says which start
+//! won. Static laws (no internal states) are not prefitted: their fit stays one start, one
+//! run.
 
 use crate::error::EngineError;
-use crate::identify::values::options::{FitDomain, FitOptions, ForceTarget};
+use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::outcome::{Check, Finding, Status};
+use crate::identify::values::param_options::ParamOptions;
 use crate::identify::values::result::FitResult;
+use crate::identify::values::target_options::{FitDomain, ForceTarget, TargetOptions};
 use frictionid_models::FrictionModel;
 
 /// The prefit's optimum and what it cost.
@@ -39,20 +43,26 @@ impl Prefit {
 /// states (`None` otherwise): the force domain against the energy-based force, nothing but
 /// the model's parameters free, no uncertainty refits, no progress.
 pub fn prefit_options(model: &dyn FrictionModel, opts: &FitOptions) -> Option<FitOptions> {
-    if !opts.prefit || model.n_states() == 0 {
+    if !opts.search.prefit || model.n_states() == 0 {
         return None;
     }
     Some(FitOptions {
-        domain: FitDomain::Force,
-        force_target: ForceTarget::Energy,
-        force_offset: false,
-        min_speed: None,
-        velocity_offset: false,
-        time_shift: false,
-        x0: false,
-        oscillator: Vec::new(),
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            force_target: ForceTarget::Energy,
+            force_offset: false,
+            min_speed: None,
+            ..opts.target.clone()
+        },
+        params: ParamOptions {
+            velocity_offset: false,
+            time_shift: false,
+            x0: false,
+            oscillator: Vec::new(),
+            ..opts.params.clone()
+        },
         uncertainty: Default::default(),
-        progress: None,
+        hooks: opts.hooks.quiet(),
         ..opts.clone()
     })
 }

@@ -8,10 +8,13 @@ use super::lm::{
 use crate::error::EngineError;
 use crate::identify::problem::least_squares::{FitProblem, Realised};
 use crate::identify::problem::residuals::{RecordCase, Residuals};
+use crate::identify::values::fit_options::Hooks;
 use crate::identify::values::layout::{FreeParam, ParamKind};
-use crate::identify::values::options::{FitOptions, Progress, ProgressFn};
+use crate::identify::values::options::{Progress, ProgressFn};
 use crate::identify::values::outcome::{StartOutcome, TerminationReason};
+use crate::identify::values::param_options::ParamOptions;
 use crate::identify::values::search::fits_directly;
+use crate::identify::values::search::SearchOptions;
 use crate::record::Record;
 use argmin::core::observers::{Observe, ObserverMode};
 use argmin::core::{Error, Executor, Jacobian, Operator, State, KV};
@@ -79,11 +82,11 @@ impl StartRun {
 /// the fit is `direct` (a static law along the measured motion, see
 /// [`crate::identify::values::fits_directly`]).
 pub fn start_count(
-    opts: &FitOptions,
+    search: &SearchOptions,
     n_model_free: usize,
     direct: bool,
 ) -> Result<usize, EngineError> {
-    let n = opts
+    let n = search
         .multistart
         .unwrap_or(if n_model_free > 2 && !direct {
             DEFAULT_STARTS
@@ -146,11 +149,11 @@ pub fn fit_starting_points(
     layout: &[FreeParam],
     start: &[f64],
     configured_model: &dyn FrictionModel,
-    opts: &FitOptions,
+    params: &ParamOptions,
     n_starts: usize,
 ) -> Vec<Vec<f64>> {
     let mut points = starting_points(layout, start, n_starts);
-    if n_starts > 1 && opts.guess {
+    if n_starts > 1 && params.guess {
         let given = configured_model.params();
         let configured: Vec<f64> = layout
             .iter()
@@ -191,7 +194,7 @@ impl Observe<LmState> for ProgressObserver {
 }
 
 /// The solver for `problem`'s bounds with the fit's step cap and tolerance.
-fn solver_for<R: Residuals>(problem: &FitProblem<R>, opts: &FitOptions) -> LevenbergMarquardt {
+fn solver_for<R: Residuals>(problem: &FitProblem<R>, search: &SearchOptions) -> LevenbergMarquardt {
     let bounds: Vec<(f64, f64)> = problem
         .layout
         .iter()
@@ -209,7 +212,7 @@ fn solver_for<R: Residuals>(problem: &FitProblem<R>, opts: &FitOptions) -> Leven
         problem.model.as_ref(),
         problem.residuals.simulates_response(),
     );
-    if let Some(t) = opts.tolerance {
+    if let Some(t) = search.tolerance {
         solver.ftol = t;
     }
     solver
@@ -237,15 +240,17 @@ pub struct RunSlot {
     pub explain: bool,
 }
 
-/// Runs the solver on `problem` from `u0`. A start whose residuals are not finite is dropped
-/// at once, with the error [`non_finite_start`] writes.
+/// Runs the solver on `problem` from `u0` (with `search`'s tolerance, reporting to `hooks`'
+/// progress). A start whose residuals are not finite is dropped at once, with the error
+/// [`non_finite_start`] writes.
 pub fn run_start<R: Residuals + 'static>(
     problem: FitProblem<R>,
     u0: DVector<f64>,
-    opts: &FitOptions,
+    search: &SearchOptions,
+    hooks: &Hooks,
     slot: RunSlot,
 ) -> Result<StartRun, EngineError> {
-    let mut solver = solver_for(&problem, opts);
+    let mut solver = solver_for(&problem, search);
     solver.pace = slot.pace.clone();
     solver.cost_resolution = slot.cost_resolution;
     let model_name = problem.model.name().to_string();
@@ -253,7 +258,7 @@ pub fn run_start<R: Residuals + 'static>(
         .configure(|s| s.param(u0.clone()).max_iters(slot.max_iterations))
         .ctrlc(false)
         .timer(false);
-    if let Some(cb) = &opts.progress {
+    if let Some(cb) = &hooks.progress {
         exec = exec.add_observer(
             ProgressObserver {
                 model: model_name,
@@ -481,7 +486,8 @@ pub fn run_starts<R, F>(
     make_problem: F,
     reference: &FitProblem<R>,
     points: &[Vec<f64>],
-    opts: &FitOptions,
+    search: &SearchOptions,
+    hooks: &Hooks,
     promote: usize,
     reachable: Option<f64>,
 ) -> Result<MultiStart, EngineError>
@@ -491,9 +497,9 @@ where
 {
     let n_starts = points.len();
     let screen = if n_starts > 1 {
-        SCREEN_ITERATIONS.min(opts.max_iterations)
+        SCREEN_ITERATIONS.min(search.max_iterations)
     } else {
-        opts.max_iterations
+        search.max_iterations
     };
     let screen_pace = reachable.filter(|_| n_starts > 1).map(|cost| {
         let pace = Pace::with_grace(SCREEN_GRACE);
@@ -512,24 +518,31 @@ where
             cost_resolution: None,
             explain: true,
         };
-        let mut run = run_start(problem, u0, opts, slot)?;
+        let mut run = run_start(problem, u0, search, hooks, slot)?;
         best.offer(s, &mut run);
         Ok(run)
     };
-    let runs: Vec<Result<StartRun, EngineError>> = if opts.parallel && n_starts > 1 {
+    let runs: Vec<Result<StartRun, EngineError>> = if hooks.parallel && n_starts > 1 {
         points.par_iter().enumerate().map(run).collect()
     } else {
         points.iter().enumerate().map(run).collect()
     };
     let mut screened = classify(runs);
     best.restore(&mut screened.ok);
-    if n_starts > 1 && screen < opts.max_iterations {
+    if n_starts > 1 && screen < search.max_iterations {
         let phase = Phase {
             screen,
             n_starts,
             promote,
         };
-        continue_best(&make_problem, &mut screened, opts, phase, reachable);
+        continue_best(
+            &make_problem,
+            &mut screened,
+            search,
+            hooks,
+            phase,
+            reachable,
+        );
     }
     let first_error = screened.first_error.take();
     pick_best(screened).ok_or_else(|| total_failure(first_error, reference, points))
@@ -549,7 +562,8 @@ struct Phase {
 fn continue_best<R, F>(
     make_problem: &F,
     screened: &mut Screened,
-    opts: &FitOptions,
+    search: &SearchOptions,
+    hooks: &Hooks,
     phase: Phase,
     reachable: Option<f64>,
 ) where
@@ -579,13 +593,17 @@ fn continue_best<R, F>(
     let slot = |start| RunSlot {
         start,
         starts: n_starts,
-        max_iterations: opts.max_iterations - screen,
+        max_iterations: search.max_iterations - screen,
         pace: Some(pace.clone()),
         cost_resolution: None,
         explain: true,
     };
-    let finish =
-        |(s, u): &(usize, DVector<f64>)| (*s, run_start(make_problem(), u.clone(), opts, slot(*s)));
+    let finish = |(s, u): &(usize, DVector<f64>)| {
+        (
+            *s,
+            run_start(make_problem(), u.clone(), search, hooks, slot(*s)),
+        )
+    };
     // One after the other, best screened first: which start is abandoned then depends on the
     // costs alone, never on which thread ran faster (each run still simulates its records
     // and Jacobian columns in parallel).
@@ -600,7 +618,7 @@ fn continue_best<R, F>(
             Ok(mut o) if o.cost.is_finite() => {
                 best.offer(start, &mut o);
                 if let Some(slot) = screened.ok.iter_mut().find(|(t, _)| *t == start) {
-                    merge_continuation(&mut slot.1, o, opts.max_iterations);
+                    merge_continuation(&mut slot.1, o, search.max_iterations);
                 }
             }
             Ok(_) => {}

@@ -9,14 +9,18 @@
 //!   starts.
 //! - `global`: the staged starts, plus a seeded Latin hypercube over the physical box in the
 //!   solver's (log) coordinates; all are screened and the best few refined.
+//!
+//! A velocity fit seeded by the force-domain prefit ([`super::prefit`]) has its optimum as
+//! one more start, the last ([`plan_fit_starts`]).
 
 use super::free_params::{build_layout, Layout};
+use super::prefit::PREFIT_ORIGIN;
 use super::starts::{fit_starting_points, run_starts};
 use crate::identify::problem::least_squares::{FitProblem, ProblemParts};
 use crate::identify::problem::residuals::Residuals;
+use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::{FreeParam, ParamKind};
-use crate::identify::values::nuisance::non_model_bound_keys;
-use crate::identify::values::options::FitOptions;
+use crate::identify::values::param_options::ParamOptions;
 use crate::identify::values::search::Search;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -62,6 +66,39 @@ pub struct StartPlan<'a, R: Residuals> {
     pub opts: &'a FitOptions,
 }
 
+/// Every start of a fit: the starts of `search` ([`plan_starts`]) and, last (where the
+/// prefit finding looks for it), the prefit's optimum when there is one.
+pub fn plan_fit_starts<R: Residuals + 'static>(
+    plan: &StartPlan<'_, R>,
+    search: Search,
+    n_starts: usize,
+    prefit: Option<&dyn FrictionModel>,
+) -> Planned {
+    let mut planned = plan_starts(plan, search, n_starts);
+    if let Some(prefit) = prefit {
+        planned.seeded.push(Seeded {
+            point: seeded_point(plan.layout, prefit),
+            origin: PREFIT_ORIGIN.into(),
+        });
+    }
+    planned
+}
+
+/// The layout's starting point with the free model parameters at `seeded`'s values (clipped
+/// to their bounds).
+fn seeded_point(layout: &Layout, seeded: &dyn FrictionModel) -> Vec<f64> {
+    let values = seeded.params();
+    layout
+        .params
+        .iter()
+        .zip(&layout.start)
+        .map(|(f, &x)| match f.kind {
+            ParamKind::Model(i) => values.get(i).copied().unwrap_or(x).clamp(f.lower, f.upper),
+            _ => x,
+        })
+        .collect()
+}
+
 /// Every starting point of `search`: staged ones first, then the local ones, then (global)
 /// the Latin hypercube; duplicates dropped; with the cost of the target's nested limit law
 /// when a stage fitted it.
@@ -81,7 +118,7 @@ pub fn plan_starts<R: Residuals + 'static>(
         &plan.layout.params,
         &plan.layout.start,
         plan.model,
-        plan.opts,
+        &plan.opts.params,
         n_local,
     );
     for (i, point) in local.into_iter().enumerate() {
@@ -153,22 +190,11 @@ fn stages<R: Residuals + 'static>(plan: &StartPlan<'_, R>) -> Vec<SimplerFit> {
 /// The options of a stage: one start, one local run, the model's own parameters and
 /// bounds, the oscillator fixed, no uncertainty budget, no progress.
 pub fn stage_options(opts: &FitOptions) -> FitOptions {
-    let keys = non_model_bound_keys();
     FitOptions {
-        free: None,
-        bounds: opts
-            .bounds
-            .iter()
-            .filter(|(k, _)| keys.contains(&k.as_str()))
-            .map(|(k, b)| (k.clone(), *b))
-            .collect(),
-        guess: true,
-        keep_initial: Vec::new(),
-        oscillator: Vec::new(),
+        params: opts.params.for_simpler_law(),
+        search: opts.search.one_start(true),
         uncertainty: Default::default(),
-        multistart: Some(1),
-        search: Some(Search::Local),
-        progress: None,
+        hooks: opts.hooks.quiet(),
         ..opts.clone()
     }
 }
@@ -215,7 +241,15 @@ pub fn fit_simpler<R: Residuals + 'static>(
     opts: &FitOptions,
     also_from: &[(&dyn FrictionModel, StartContext)],
 ) -> Option<SimplerFit> {
-    let layout = build_layout(on.osc, law, on.records, on.residuals.as_ref(), opts).ok()?;
+    let layout = build_layout(
+        on.osc,
+        law,
+        on.records,
+        on.residuals.as_ref(),
+        &opts.params,
+        &opts.energy,
+    )
+    .ok()?;
     if layout.params.is_empty() {
         return None;
     }
@@ -228,16 +262,19 @@ pub fn fit_simpler<R: Residuals + 'static>(
                 records: on.records.clone(),
                 layout: layout.params.clone(),
                 sim: opts.sim,
-                parallel: opts.parallel,
+                parallel: opts.hooks.parallel,
             },
         )
     };
     let mut points = vec![layout.start.clone()];
     for (fitted, ctx) in also_from {
-        points.extend(mapped_point(&layout, *fitted, ctx, opts).filter(|p| !points.contains(p)));
+        points.extend(
+            mapped_point(&layout, *fitted, ctx, &opts.params).filter(|p| !points.contains(p)),
+        );
     }
     let reference = make();
-    let runs = run_starts(make, &reference, &points, opts, points.len(), None).ok()?;
+    let (search, hooks) = (&opts.search, &opts.hooks);
+    let runs = run_starts(make, &reference, &points, search, hooks, points.len(), None).ok()?;
     let p = reference.physical(&runs.best.u);
     let model = reference.realise(&p).ok()?.model;
     Some(SimplerFit {
@@ -266,7 +303,9 @@ fn staged_points<R: Residuals + 'static>(
                 presliding_displacement: s * TYPICAL_PRESLIDING_DISPLACEMENT,
                 ..base
             };
-            if let Some(point) = mapped_point(plan.layout, stage.model.as_ref(), &ctx, plan.opts) {
+            if let Some(point) =
+                mapped_point(plan.layout, stage.model.as_ref(), &ctx, &plan.opts.params)
+            {
                 out.push(Seeded {
                     point,
                     origin: format!("staged from {}", stage.model.name()),
@@ -284,13 +323,13 @@ fn mapped_point(
     layout: &Layout,
     fitted: &dyn FrictionModel,
     ctx: &StartContext,
-    opts: &FitOptions,
+    params: &ParamOptions,
 ) -> Option<Vec<f64>> {
     let onto = Onto {
         model: layout.start_model.as_ref(),
         params: &layout.params,
         base: &layout.start,
-        keep: &opts.keep_initial,
+        keep: &params.keep_initial,
     };
     onto.started_from(fitted, ctx)
 }

@@ -1,29 +1,35 @@
-//! The values of the identifier: what a fit is asked ([`FitOptions`], the [`Search`] it
-//! asks for, the [`PropertyUncertainty`] of the oscillator), the parameter layout
+//! The values of the identifier: what a fit is asked ([`FitOptions`] in its parts:
+//! [`ParamOptions`], [`TargetOptions`], [`SearchOptions`] with the [`Search`] it asks for,
+//! the [`PropertyUncertainty`] of the oscillator, [`Hooks`]), the parameter layout
 //! ([`FreeParam`]) and the per-record nuisance parameters ([`NuisanceKind`]), and what a fit
 //! returns ([`FitResult`], its typed outcomes and findings). Nothing here imports from the
 //! floors above (problem, search, assessment).
 
+pub mod fit_options;
 pub mod layout;
 pub mod levels;
 pub mod nuisance;
+pub mod option_keys;
 pub mod options;
 pub mod outcome;
+pub mod param_options;
 pub mod result;
 pub mod search;
+pub mod target_options;
 pub mod uncertainty;
 
+pub use fit_options::{fit_sim_options, FitOptions, Hooks};
 pub use layout::{BoundSide, FreeParam, ParamKind};
 pub use levels::FrictionLevels;
 pub use nuisance::{non_model_bound_keys, NuisanceKind, NuisanceValues, X0_RELATIVE_BOUND};
-pub use options::{
-    check_min_speed, FitDomain, FitOptions, ForceTarget, OscillatorParam, Progress, ProgressFn,
-    FIT_MAX_STEPS,
-};
+pub use option_keys::OptionKeys;
+pub use options::{OscillatorParam, Progress, ProgressFn, FIT_MAX_STEPS};
 pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
+pub use param_options::ParamOptions;
 pub use result::{
     ChannelFit, Derived, EnergyForce, EnergySkip, FitResult, FitSeries, FittedParam, ForceBalance,
     Identifiability, Rank, RecordFit, SampleAxes, SlidingSamples, Verdict,
 };
-pub use search::{fits_directly, Search, PROMOTED_STARTS};
+pub use search::{fits_directly, Search, SearchOptions, DEFAULT_MAX_ITERATIONS, PROMOTED_STARTS};
+pub use target_options::{check_min_speed, FitDomain, ForceTarget, TargetOptions};
 pub use uncertainty::{PropertyUncertainty, StdErrorComponents};

@@ -1,6 +1,9 @@
-//! The search strategy a fit asks for (`[fit.options] search`) and the rule that picks one
-//! when it asks for none (the strategies themselves: [`crate::identify::search::strategy`]).
+//! How a fit searches for its optimum: the options the search floor reads (`[fit]
+//! max_iterations`, `tolerance`; `[fit.options] multistart`, `search`, `prefit`), the
+//! strategy a fit asks for and the rule that picks one when it asks for none (the strategies
+//! themselves: [`crate::identify::search::strategy`]).
 
+use super::option_keys::option_keys;
 use frictionid_models::FrictionModel;
 use serde::{Deserialize, Serialize};
 
@@ -15,6 +18,64 @@ pub enum Search {
     Staged,
     /// Staged starts plus a Latin hypercube over the physical box.
     Global,
+}
+
+/// How a fit searches for its optimum (the search floor reads it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SearchOptions {
+    /// Number of starts; `None`: 1 when at most two model parameters are free, else
+    /// [`crate::identify::search::starts::DEFAULT_STARTS`].
+    pub multistart: Option<usize>,
+    /// Search strategy (`search`); `None`: `staged` for models with internal states or more
+    /// than two free parameters, `local` otherwise (see [`Search::resolve`]).
+    pub strategy: Option<Search>,
+    /// Iteration limit of each start.
+    pub max_iterations: u64,
+    /// Convergence tolerance on the relative cost reduction of a step (solver default 1e-9).
+    pub tolerance: Option<f64>,
+    /// Velocity fits of models with internal states start also from the optimum of a
+    /// force-domain fit to the energy-based force (the prefit).
+    pub prefit: bool,
+}
+
+/// Iteration limit of each start when `[fit] max_iterations` is not given.
+pub const DEFAULT_MAX_ITERATIONS: u64 = 200;
+
+impl Default for SearchOptions {
+    fn default() -> Self {
+        Self {
+            multistart: None,
+            strategy: None,
+            max_iterations: DEFAULT_MAX_ITERATIONS,
+            tolerance: None,
+            prefit: false,
+        }
+    }
+}
+
+option_keys!(SearchOptions {
+    fit: ["max_iterations" => max_iterations, "tolerance" => tolerance],
+    options: [
+        "multistart" => multistart,
+        "search" => strategy,
+        "prefit" => prefit,
+    ],
+});
+
+impl SearchOptions {
+    /// The options of a fit that starts once where it is told (a refit from an optimum, a
+    /// stage): one start, a local search when `local`, else the strategy asked for.
+    pub fn one_start(&self, local: bool) -> Self {
+        Self {
+            multistart: Some(1),
+            strategy: if local {
+                Some(Search::Local)
+            } else {
+                self.strategy
+            },
+            ..self.clone()
+        }
+    }
 }
 
 /// Starts continued to convergence after the screening phase by a local search (the best

@@ -5,7 +5,7 @@ use crate::identify::problem::least_squares::{FitProblem, ProblemParts};
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::{run_start, RunSlot, StartRun};
 use crate::identify::values::layout::ParamKind;
-use crate::identify::values::options::FitOptions;
+use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::outcome::TerminationReason;
 use frictionid_models::FrictionModel;
 use nalgebra::DVector;
@@ -92,7 +92,7 @@ pub(super) fn pinned_fit<R: Residuals + 'static>(
             cost_resolution,
             explain: false,
         };
-        run_start(sub, others.clone(), opts, slot).ok()?
+        run_start(sub, others.clone(), &opts.search, &opts.hooks, slot).ok()?
     };
     run.cost.is_finite().then_some(run)
 }

@@ -7,7 +7,7 @@ use super::Standing;
 use crate::identify::problem::least_squares::FitProblem;
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::StartRun;
-use crate::identify::values::options::FitOptions;
+use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::result::Identifiability;
 use nalgebra::DVector;
 
@@ -140,7 +140,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
             return run(previous);
         };
         let mapped = without(&mapped, pins);
-        let (a, b) = if self.opts.parallel {
+        let (a, b) = if self.opts.hooks.parallel {
             rayon::join(|| run(previous), || run(&mapped))
         } else {
             (run(previous), run(&mapped))
@@ -165,7 +165,7 @@ impl<R: Residuals + 'static> Profile<'_, R> {
         // The two sides are independent refits: side by side on two threads.
         let (below, above) = if open_above.is_some() {
             (self.side(j, -1.0, best + delta), Vec::new())
-        } else if self.opts.parallel {
+        } else if self.opts.hooks.parallel {
             rayon::join(
                 || self.side(j, -1.0, best + delta),
                 || self.side(j, 1.0, best + delta),

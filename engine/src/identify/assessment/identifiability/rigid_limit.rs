@@ -8,7 +8,7 @@ use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::StartRun;
 use crate::identify::search::strategy::{fit_simpler, stage_options, FitTarget, Onto};
 use crate::identify::values::layout::ParamKind;
-use crate::identify::values::options::FitOptions;
+use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::result::Identifiability;
 use frictionid_models::start::TYPICAL_PRESLIDING_DISPLACEMENT;
 use frictionid_models::{FrictionModel, StartContext, StribeckLevels};
@@ -188,11 +188,9 @@ pub(super) fn rigid_limit<R: Residuals + 'static>(
         osc,
         records: &reference.records,
     };
-    let limit_opts = FitOptions {
-        oscillator: opts.oscillator.clone(),
-        free: limit_free(declared.law.as_ref(), &declared.also_free),
-        ..stage_options(opts)
-    };
+    let mut limit_opts = stage_options(opts);
+    limit_opts.params.oscillator = opts.params.oscillator.clone();
+    limit_opts.params.free = limit_free(declared.law.as_ref(), &declared.also_free);
     let fit = fit_simpler(
         &on,
         declared.law.as_ref(),

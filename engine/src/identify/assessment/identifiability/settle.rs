@@ -10,7 +10,7 @@ use crate::error::EngineError;
 use crate::identify::problem::least_squares::FitProblem;
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::{run_start, MultiStart, RunSlot, StartRun};
-use crate::identify::values::options::FitOptions;
+use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::outcome::TerminationReason;
 use nalgebra::DVector;
 use rayon::prelude::*;
@@ -29,7 +29,7 @@ pub fn settle<R: Residuals + 'static>(
     opts: &FitOptions,
 ) -> Result<(MultiStart, Vec<Standing>), EngineError> {
     let quiet = FitOptions {
-        progress: None,
+        hooks: opts.hooks.quiet(),
         ..opts.clone()
     };
     let limit = rigid_limit(reference, &runs.best, &quiet);
@@ -105,7 +105,7 @@ fn profile_all<R: Residuals + 'static>(
     };
     // The profiles are independent: in parallel, read in slot order (the first lower point
     // restarts the fit, whichever thread found it first).
-    let profiled: Vec<_> = if opts.parallel {
+    let profiled: Vec<_> = if opts.hooks.parallel {
         slots.par_iter().map(|&j| profile_of(j)).collect()
     } else {
         slots.iter().map(|&j| profile_of(j)).collect()
@@ -132,12 +132,12 @@ fn restart_from<R: Residuals + 'static>(
     let slot = RunSlot {
         start: runs.best_start,
         starts: 1,
-        max_iterations: opts.max_iterations,
+        max_iterations: opts.search.max_iterations,
         pace: None,
         cost_resolution: None,
         explain: false,
     };
-    let Ok(run) = run_start(problem, u, opts, slot) else {
+    let Ok(run) = run_start(problem, u, &opts.search, &opts.hooks, slot) else {
         return false;
     };
     runs.iterations += run.iterations;
@@ -173,7 +173,7 @@ fn settle_convergence<R: Residuals + 'static>(
         return;
     }
     let others = without(&runs.best.u, &pins);
-    let Some(run) = pinned_fit(reference, &pins, &others, opts, (opts.max_iterations, None)) else {
+    let Some(run) = pinned_fit(reference, &pins, &others, opts, (opts.search.max_iterations, None)) else {
         return;
     };
     if !run.converged() || run.cost > runs.best.cost {

@@ -1,0 +1,142 @@
+//! The run specification: what a front end (the CLI's TOML config, a Python dict) asks the
+//! engine to do, as one value, and every rule that turns it into engine options.
+//!
+//! A front end parses its own syntax into a [`Spec`] (serde does the work: unknown keys are
+//! errors, defaults are the parts' own, values are checked by `try_from` conversions), then
+//! asks the spec for engine options ([`Spec::fit_options`], [`SimulationSpec::sim_options`],
+//! [`EnergySpec::options`]). Run-time hooks (progress, parallelism) are not part of the spec:
+//! they travel apart in [`Hooks`].
+//!
+//! One file per table: [`oscillator`], [`model`], [`fit`] (`[fit]` and `[fit.options]`, made
+//! of the fit options' parts), [`simulation`], [`energy`]; [`resolve`] turns a spec into the
+//! run's values; [`error`] says why a spec cannot be built.
+//!
+//! The measured records are not part of this value yet: front ends read them and hand them
+//! to the jobs in [`crate::jobs`].
+
+pub mod energy;
+pub mod error;
+pub mod fit;
+pub mod model;
+pub mod oscillator;
+pub mod resolve;
+pub mod simulation;
+
+pub use self::energy::{DifferentiatorMethod, EnergySpec};
+pub use self::error::SpecError;
+pub use self::fit::{FitSpec, RunChoices};
+pub use self::model::ModelSpec;
+pub use self::oscillator::{OscillatorSpec, OscillatorTable};
+pub use self::simulation::{
+    IntegratorMethod, IntegratorSpec, SimulationInput, SimulationSpec, DEFAULT_SAMPLE_RATE,
+    EULER_STEPS_PER_PERIOD,
+};
+pub use crate::identify::Hooks;
+
+use crate::data::RecordUse;
+use crate::identify::{check_min_speed, FitDomain, PropertyUncertainty};
+use crate::oscillator::{Oscillator, OscillatorProperty};
+
+/// Everything but the records: oscillator, model, fit, simulation and energy settings.
+#[derive(Debug, Clone)]
+pub struct Spec {
+    /// The oscillator.
+    pub oscillator: Oscillator,
+    /// One standard deviation of each oscillator property (the uncertainty budget).
+    pub uncertainty: PropertyUncertainty,
+    /// The friction model, if given.
+    pub model: Option<ModelSpec>,
+    /// Fit settings (defaults when absent).
+    pub fit: FitSpec,
+    /// Simulation settings, if given.
+    pub simulation: Option<SimulationSpec>,
+    /// Energy-analysis settings (defaults when absent).
+    pub energy: EnergySpec,
+    /// `[oscillator]` keys not given (their values in `oscillator` are placeholders): a
+    /// force-domain fit on a measured force needs only the normal force.
+    pub unknown_oscillator: Vec<OscillatorProperty>,
+}
+
+impl Spec {
+    /// A spec with `oscillator`, `model` and the other settings, checked against each other.
+    pub fn new(
+        oscillator: impl Into<OscillatorSpec>,
+        model: Option<ModelSpec>,
+        fit: FitSpec,
+        simulation: Option<SimulationSpec>,
+        energy: EnergySpec,
+    ) -> Result<Self, SpecError> {
+        let oscillator: OscillatorSpec = oscillator.into();
+        oscillator.validate()?;
+        if let Some(m) = &model {
+            fit.check_against(m.model.as_ref())?;
+        }
+        check_min_speed(fit.target.min_speed, fit.target.domain).map_err(SpecError::FitOption)?;
+        Ok(Self {
+            oscillator: oscillator.oscillator,
+            uncertainty: oscillator.uncertainty,
+            model,
+            fit,
+            simulation,
+            energy,
+            unknown_oscillator: oscillator.unknown,
+        })
+    }
+
+    /// How the fit uses its records: simulated (velocity domain) or replayed as measured
+    /// (force domain), which decides whether a `[[records]]` entry needs `x0`.
+    pub fn record_use(&self) -> RecordUse {
+        match self.fit.target.domain {
+            FitDomain::Velocity => RecordUse::Simulated,
+            FitDomain::Force => RecordUse::Replayed,
+        }
+    }
+
+    /// The model, or an error naming the command that needs it.
+    pub fn require_model(&self, purpose: &str) -> Result<&ModelSpec, SpecError> {
+        self.model.as_ref().ok_or_else(|| SpecError::MissingModel {
+            purpose: purpose.into(),
+        })
+    }
+
+    /// The simulation settings, or an error naming the command that needs them.
+    pub fn require_simulation(&self, purpose: &str) -> Result<&SimulationSpec, SpecError> {
+        self.simulation
+            .as_ref()
+            .ok_or_else(|| SpecError::MissingSimulation {
+                purpose: purpose.into(),
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identify::OscillatorParam;
+
+    /// A Python front end builds the same spec from JSON dicts: defaults filled, values checked.
+    #[test]
+    fn simulation_and_fit_specs_deserialize_from_json_with_defaults() {
+        let s: SimulationSpec =
+            serde_json::from_value(serde_json::json!({"x0": 0.01, "duration": 1.0})).unwrap();
+        assert_eq!(
+            (s.v0, s.sample_rate, s.noise, s.seed),
+            (0.0, DEFAULT_SAMPLE_RATE, None, 0)
+        );
+        let e = serde_json::from_value::<SimulationSpec>(serde_json::json!({"duration": 1.0}))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("[simulation]: missing `x0`"), "{e}");
+        let e = serde_json::from_value::<FitSpec>(
+            serde_json::json!({"options": {"velocity_ofset": true}}),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("unknown field `velocity_ofset`"), "{e}");
+        let f: FitSpec = serde_json::from_value(
+            serde_json::json!({"options": {"oscillator": ["mass"], "multistart": 3}}),
+        )
+        .unwrap();
+        assert_eq!(f.params.oscillator, vec![OscillatorParam::Mass]);
+    }
+}
