@@ -130,22 +130,7 @@ impl Oscillator {
     /// Checks that every property is finite, m > 0 (and k > 0 where the restoring law reads
     /// it), c and N >= 0, and the restoring law's own parameters.
     pub fn validate(&self) -> Result<(), EngineError> {
-        let law = self.restoring.law();
-        let checks = [
-            OscillatorProperty::Mass,
-            OscillatorProperty::Damping,
-            OscillatorProperty::Stiffness,
-            OscillatorProperty::NormalForce,
-        ]
-        .map(|p| {
-            let positive = p.domain() == PropertyDomain::Positive
-                && (p != OscillatorProperty::Stiffness || law.reads_stiffness());
-            (
-                p.name_on(self.axis),
-                p.value(self).unwrap_or(f64::NAN),
-                positive,
-            )
-        });
+        let checks = self.sign_checks();
         if !self.input_offset.is_finite() {
             return Err(EngineError::InvalidOscillator(format!(
                 "`input_offset` must be finite, got {}",
@@ -173,6 +158,24 @@ impl Oscillator {
             }
         }
         Ok(())
+    }
+
+    /// The name, value and whether it must be > 0 (else >= 0) of m, c, k and N: m > 0, k > 0
+    /// where the restoring law reads it ([`OscillatorProperty::domain`]).
+    fn sign_checks(&self) -> [(&'static str, f64, bool); 4] {
+        let law = self.restoring.law();
+        [
+            OscillatorProperty::Mass,
+            OscillatorProperty::Damping,
+            OscillatorProperty::Stiffness,
+            OscillatorProperty::NormalForce,
+        ]
+        .map(|p| {
+            let positive = p.domain() == PropertyDomain::Positive
+                && (p != OscillatorProperty::Stiffness || law.reads_stiffness());
+            let value = p.value(self).unwrap_or(f64::NAN);
+            (p.name_on(self.axis), value, positive)
+        })
     }
 
     /// The restoring force (torque) R(q) [N or N m].

@@ -162,6 +162,15 @@ impl OscillatorProperty {
         matches!(self, Self::Stiffness | Self::GravityMoment)
     }
 
+    /// Where it is a parameter of a restoring law other than the spring: the
+    /// `[oscillator] restoring` table of a law that has it.
+    pub fn restoring_table(self) -> Option<&'static str> {
+        match self {
+            Self::GravityMoment => Some(r#"{ type = "pendulum", gravity_moment = ... }"#),
+            _ => None,
+        }
+    }
+
     /// Its value on `osc`; `None` for a restoring law's parameter the law does not have.
     pub fn value(self, osc: &Oscillator) -> Option<f64> {
         match self {

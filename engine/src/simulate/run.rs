@@ -112,7 +112,7 @@ fn time_scale(osc: &Oscillator, t_end: f64) -> f64 {
 }
 
 /// The multipliers of Rodas4's absolute tolerance for the `dim` components [x, v, z...]: 1
-/// for x and v, the model's [`InternalStates::state_tolerance_scales`](frictionid_models::InternalStates::state_tolerance_scales) for its states (1 in
+/// for x and v, the model's [`InternalStates::state_tolerance_scales`] for its states (1 in
 /// place of a declared scale that is not finite and > 0). Dahl at sigma0 = 1e7 N/m: 17 394 ->
 /// 10 056 RHS evaluations with them alone, 1e-8 m of x kept.
 ///
@@ -122,6 +122,8 @@ fn time_scale(osc: &Oscillator, t_end: f64) -> f64 {
 /// pin down, stay as they were (with the scales Dahl at the default 1e5 took 16 % fewer RHS
 /// evaluations, but its force no longer matched a three-element Dahl held in newtons to the
 /// 1e-5 N of `simulate_custom`'s test).
+///
+/// [`InternalStates::state_tolerance_scales`]: frictionid_models::InternalStates
 fn component_tolerance_scales(model: &dyn FrictionModel, dim: usize) -> Vec<f64> {
     let mut scales = vec![1.0, 1.0];
     if let Some(states) = model.states().filter(|s| s.n_states() > 0) {

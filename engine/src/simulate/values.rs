@@ -11,8 +11,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 #[serde(tag = "method", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Integrator {
-    /// Adaptive Dormand-Prince 5(4) with dense output and event location ([`Dopri5`](super::Dopri5)), the
-    /// default.
+    /// Adaptive Dormand-Prince 5(4) with dense output and event location
+    /// ([`Dopri5`](super::Dopri5)), the default.
     #[default]
     Dopri5,
     /// The paper's fixed-step explicit Euler with step T_n / `steps_per_period` (paper: 1e6).
@@ -20,15 +20,16 @@ pub enum Integrator {
         /// Steps per undamped natural period T_n.
         steps_per_period: f64,
     },
-    /// The exact propagator ([`ClosedForm`](super::ClosedForm)) for laws affine in v within each sliding mode
-    /// (coulomb, viscous_coulomb, none) on an underdamped oscillator; an error otherwise.
+    /// The exact propagator ([`ClosedForm`](super::ClosedForm)) for laws affine in v within
+    /// each sliding mode (coulomb, viscous_coulomb, none) on an underdamped oscillator; an
+    /// error otherwise.
     Exact,
     /// The exact propagator where it applies; Rodas4 where a stiffness estimate (spectral
     /// radius of the Jacobian times Dopri5's accuracy step) says an explicit method would be
     /// stability-limited; Dopri5 otherwise (see `auto.rs`).
     Auto,
-    /// The stiff Rosenbrock method Rodas4 ([`Rodas4`](super::Rodas4)) with the model's Jacobian, for
-    /// bristle and element models with stiff contacts (sigma0 of 1e6..1e9 N/m).
+    /// The stiff Rosenbrock method Rodas4 ([`Rodas4`](super::Rodas4)) with the model's
+    /// Jacobian, for bristle and element models with stiff contacts (sigma0 of 1e6..1e9 N/m).
     Rodas,
 }
 

@@ -249,19 +249,20 @@ fn within_domain(
 }
 
 /// A fitted property is one a fit may vary, and a restoring law's parameter (the gravity
-/// moment) needs a law that has one (the pendulum): otherwise its start would be undefined.
+/// moment) needs a law that has it (the pendulum): otherwise its start would be undefined.
 fn check_property_exists(osc: &Oscillator, q: OscillatorProperty) -> Result<(), EngineError> {
     if !q.is_fitted() {
+        let fitted: Vec<&str> = OscillatorProperty::FITTED.map(|p| p.key()).to_vec();
         return Err(EngineError::InvalidInput(format!(
-            "[fit.options] oscillator: `{}` is not fitted",
-            q.key()
+            "[fit.options] oscillator: `{}` cannot be fitted; fitted properties: {}",
+            q.key(),
+            fitted.join(", ")
         )));
     }
-    if q.value(osc).is_none() {
-        const PENDULUM: &str = r#"{ type = "pendulum", gravity_moment = ... }"#;
+    if let (None, Some(table)) = (q.value(osc), q.restoring_table()) {
         return Err(EngineError::InvalidInput(format!(
             "[fit.options] oscillator: `{}` is fitted, but the restoring law `{}` has \
-             none; set [oscillator] restoring = {PENDULUM}",
+             none; set [oscillator] restoring = {table}",
             q.key(),
             osc.restoring.name()
         )));
@@ -345,5 +346,14 @@ mod tests {
             ..Oscillator::fmm()
         };
         assert!(check_property_exists(&osc, OscillatorProperty::GravityMoment).is_ok());
+    }
+
+    /// The normal force is an oscillator property a fit reads but never varies.
+    #[test]
+    fn the_normal_force_is_refused_as_a_fitted_property() {
+        let e = check_property_exists(&Oscillator::fmm(), OscillatorProperty::NormalForce)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`normal_force` cannot be fitted"), "{e}");
     }
 }

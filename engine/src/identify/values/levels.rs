@@ -39,8 +39,8 @@ pub enum FrictionLevels {
 
 impl FrictionLevels {
     /// Whether a fit of `records` reads the levels as forces: the configuration gives no
-    /// normal force (`unknown`, the `[oscillator]` properties not given, holds the normal force) and
-    /// no record has one of its own (a constant or a channel). One record's own normal force
+    /// normal force (`unknown`, the `[oscillator]` properties not given, holds it) and no
+    /// record has one of its own (a constant or a channel). One record's own normal force
     /// keeps them coefficients, and then every record needs one
     /// ([`FrictionLevels::record_normal_force`]).
     pub fn read_as_forces(unknown: &[OscillatorProperty], records: &[Record]) -> bool {

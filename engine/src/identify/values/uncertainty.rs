@@ -75,7 +75,7 @@ impl StdErrorComponents {
             OscillatorProperty::Damping => self.damping = value,
             OscillatorProperty::Stiffness => self.stiffness = value,
             OscillatorProperty::NormalForce => self.normal_force = value,
-            OscillatorProperty::GravityMoment | OscillatorProperty::InputOffset => {}
+            _ => {}
         }
     }
 
