@@ -152,7 +152,7 @@ pub enum Command {
         report: PathBuf,
         /// The target: c, rust, python or table.
         #[arg(long, value_name = "LANG")]
-        lang: frictionid_engine::export::Lang,
+        lang: String,
         /// The output file [default: standard output].
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,

@@ -72,7 +72,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
             out,
             prefix,
             normal_force,
-        } => commands::export::run(&report, lang, out.as_deref(), prefix, normal_force),
+        } => commands::export::run(&report, &lang, out.as_deref(), prefix, normal_force),
     }
 }
 

@@ -21,11 +21,14 @@ fn report_path(path: &Path) -> PathBuf {
 /// Runs `frictionid export REPORT --lang LANG [--out FILE] [--prefix P] [--normal-force N]`.
 pub fn run(
     report: &Path,
-    lang: Lang,
+    lang: &str,
     out: Option<&Path>,
     prefix: String,
     normal_force: Option<f64>,
 ) -> anyhow::Result<Outcome> {
+    let lang: Lang = lang
+        .parse()
+        .map_err(|e: String| anyhow::anyhow!("--lang: {e}"))?;
     let path = report_path(report);
     let text = std::fs::read_to_string(&path)
         .with_context(|| format!("cannot read {}", path.display()))?;

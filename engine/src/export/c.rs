@@ -46,6 +46,9 @@ impl Syntax for C {
     fn braces(&self) -> bool {
         true
     }
+    fn repeat_head(&self, count: &str) -> String {
+        format!("for (long k = 0; k < (long)({count}); ++k) {{")
+    }
     fn if_head(&self, c: &str) -> String {
         format!("if ({c}) {{")
     }

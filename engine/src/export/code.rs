@@ -27,6 +27,8 @@ pub enum Func {
     Sinh,
     Cosh,
     Tanh,
+    /// The least whole number >= x.
+    Ceil,
     /// x^y.
     Pow,
     Min,
@@ -56,6 +58,7 @@ impl Func {
             Func::Sinh => "sinh",
             Func::Cosh => "cosh",
             Func::Tanh => "tanh",
+            Func::Ceil => "ceil",
             Func::Pow => "pow",
             Func::Min => "fmin",
             Func::Max => "fmax",
@@ -160,6 +163,8 @@ pub enum Stmt {
     Comment(String),
     /// Statements whose locals end with them (one GMS element's step).
     Block(Vec<Stmt>),
+    /// Runs the statements `count` times (`count` a whole number >= 0).
+    Repeat(Expr, Vec<Stmt>),
 }
 
 /// The code of one law: its states, the body of `update` (v, n, dt in; states set) and of

@@ -326,6 +326,7 @@ fn stmt_uses(s: &Stmt, f: &dyn Fn(&Expr) -> bool) -> bool {
         Stmt::Return(e) => e.as_ref().is_some_and(|e| expr_uses(e, f)),
         Stmt::If(c, a, b) => cond_uses(c, f) || a.iter().chain(b).any(|s| stmt_uses(s, f)),
         Stmt::Block(b) => b.iter().any(|s| stmt_uses(s, f)),
+        Stmt::Repeat(n, b) => expr_uses(n, f) || b.iter().any(|s| stmt_uses(s, f)),
         Stmt::Comment(_) => false,
     }
 }

@@ -26,6 +26,8 @@ pub trait Syntax {
     fn braces(&self) -> bool;
     /// The head of an `if`.
     fn if_head(&self, c: &str) -> String;
+    /// The head of a loop run `count` times.
+    fn repeat_head(&self, count: &str) -> String;
 }
 
 /// An expression, fully parenthesised.
@@ -89,7 +91,7 @@ fn assigned(stmts: &[Stmt], out: &mut Vec<String>) {
                 assigned(a, out);
                 assigned(b, out);
             }
-            Stmt::Block(b) => assigned(b, out),
+            Stmt::Block(b) | Stmt::Repeat(_, b) => assigned(b, out),
             _ => {}
         }
     }
@@ -154,5 +156,12 @@ fn write_stmt(s: &dyn Syntax, st: &Stmt, depth: usize, mutable: &[String], out: 
             line(out, depth, "}");
         }
         Stmt::Block(b) => write_stmts(s, b, depth, mutable, out),
+        Stmt::Repeat(count, b) => {
+            line(out, depth, &s.repeat_head(bare(&expr(s, count))));
+            write_stmts(s, b, depth + 1, mutable, out);
+            if s.braces() {
+                line(out, depth, "}");
+            }
+        }
     }
 }

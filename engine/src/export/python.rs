@@ -48,6 +48,9 @@ impl Syntax for Python {
     fn braces(&self) -> bool {
         false
     }
+    fn repeat_head(&self, count: &str) -> String {
+        format!("for _ in range(int({count})):")
+    }
     fn if_head(&self, c: &str) -> String {
         format!("if {c}:")
     }

@@ -51,6 +51,13 @@ impl Syntax for Rust {
     fn braces(&self) -> bool {
         true
     }
+    fn repeat_head(&self, count: &str) -> String {
+        if count.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            format!("for _ in 0..({count} as u64) {{")
+        } else {
+            format!("for _ in 0..(({count}) as u64) {{")
+        }
+    }
     fn if_head(&self, c: &str) -> String {
         format!("if {c} {{")
     }
