@@ -482,11 +482,13 @@ fn load_rate(y: Expr, m: Expr) -> Expr {
 fn gms_element_substeps(i: usize, k: Expr, w: Expr, m: Expr) -> Vec<Stmt> {
     let z = state(i);
     let h = local("h");
-    let at = |share: f64, slope: &str| {
-        load_rate(
-            add(local("y"), mul(mul(num(share), h.clone()), local(slope))),
-            m.clone(),
-        )
+    let at = |half: bool, slope: &str| {
+        let step = if half {
+            mul(num(0.5), h.clone())
+        } else {
+            h.clone()
+        };
+        load_rate(add(local("y"), mul(step, local(slope))), m.clone())
     };
     let stiffness = mul(
         m.clone(),
@@ -498,9 +500,9 @@ fn gms_element_substeps(i: usize, k: Expr, w: Expr, m: Expr) -> Vec<Stmt> {
     );
     let substeps = vec![
         let_("k1", load_rate(local("y"), m.clone())),
-        let_("k2", at(0.5, "k1")),
-        let_("k3", at(0.5, "k2")),
-        let_("k4", at(1.0, "k3")),
+        let_("k2", at(true, "k1")),
+        let_("k3", at(true, "k2")),
+        let_("k4", at(false, "k3")),
         assign(
             "y",
             add(
@@ -533,7 +535,11 @@ fn gms_element_substeps(i: usize, k: Expr, w: Expr, m: Expr) -> Vec<Stmt> {
             "count",
             call2(
                 Func::Min,
-                call(Func::Ceil, div(mul(local("rest"), stiffness), num(0.5))),
+                call2(
+                    Func::Max,
+                    call(Func::Ceil, div(mul(local("rest"), stiffness), num(0.5))),
+                    num(1.0),
+                ),
                 num(MAX_SUBSTEPS),
             ),
         ),

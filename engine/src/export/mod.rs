@@ -157,3 +157,83 @@ pub fn emit(desc: &LawDescription, opts: &ExportOptions) -> Result<String, Expor
         Lang::Table => table::emit(desc, opts.normal_force),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn fit(model: serde_json::Value) -> serde_json::Value {
+        json!({
+            "command": "fit",
+            "model": model["type"],
+            "model_parameters": model,
+            "parameters": [],
+            "records": [{ "file": "a.csv", "max_speed": 0.1 }],
+            "oscillator": { "normal_force": 14.5 },
+            "compared": "velocity",
+        })
+    }
+
+    /// A comparison exports the verdict's simplest law, not the best-ranked one.
+    #[test]
+    fn a_comparison_exports_its_recommended_law() {
+        let report = json!({
+            "command": "compare",
+            "ranking": [
+                fit(json!({ "type": "stribeck" })),
+                fit(json!({ "type": "coulomb", "mu": 0.25 })),
+            ],
+            "verdict": { "simplest": "coulomb" },
+        });
+        let desc = LawDescription::from_report(&report, "r.json").unwrap();
+        assert_eq!(desc.model, "coulomb");
+        assert!(desc.source.contains("recommended"));
+        let opts = ExportOptions {
+            lang: Lang::Python,
+            ..ExportOptions::default()
+        };
+        let text = emit(&desc, &opts).unwrap();
+        assert!(text.contains("MU = 0.25  # [1]"), "{text}");
+    }
+
+    /// Levels given in N mark a law fitted without a normal force; its header says n = 1.
+    #[test]
+    fn levels_in_newtons_ask_for_a_unit_normal_force() {
+        let mut report = fit(json!({ "type": "coulomb", "mu": 2.5 }));
+        report["parameters"] =
+            json!([{ "name": "mu", "value": 2.5, "unit": "N", "free": true, "std_error": 0.1 }]);
+        let desc = LawDescription::from_report(&report, "r.json").unwrap();
+        assert!(desc.levels_as_forces);
+        let text = emit(&desc, &ExportOptions::default()).unwrap();
+        assert!(text.contains("n = 1"), "{text}");
+        assert!(
+            text.contains("#define FID_MU 2.5 /* [N] std error 1.000e-1, fitted"),
+            "{text}"
+        );
+    }
+
+    /// Literals read back to the same double in every target.
+    #[test]
+    fn literals_round_trip() {
+        for x in [0.2, 1e5, 1e-7, 1e16, 123456.789, 5e-324, 0.0] {
+            let text = description::literal(x);
+            assert_eq!(text.parse::<f64>(), Ok(x), "{text}");
+            assert!(text.contains(['.', 'e']), "{text}");
+        }
+    }
+
+    #[test]
+    fn unknown_languages_and_laws_are_refused() {
+        assert!("fortran".parse::<Lang>().is_err());
+        assert_eq!("PY".parse::<Lang>(), Ok(Lang::Python));
+        let err = LawDescription::from_report(&fit(json!({ "type": "mine" })), "r").unwrap_err();
+        assert_eq!(err, ExportError::NotExportable("mine".into()));
+        let bad_prefix = ExportOptions {
+            prefix: "9x".into(),
+            ..ExportOptions::default()
+        };
+        let desc = LawDescription::from_report(&fit(json!({ "type": "none" })), "r").unwrap();
+        assert!(emit(&desc, &bad_prefix).is_err());
+    }
+}
