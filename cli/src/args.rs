@@ -142,6 +142,27 @@ pub enum Command {
         #[command(flatten)]
         output: OutputArgs,
     },
+    /// Write the fitted law of a `fit` report (or a `compare` report's recommended law) as
+    /// C, Rust or Python source, or as a steady-state compensation table.
+    #[command(
+        after_help = "Examples:\n  frictionid export fit/ --lang c --out lugre.c\n  frictionid export fit/report.json --lang rust --out law.rs\n  frictionid export compare/ --lang table --out table.csv --normal-force 14.5"
+    )]
+    Export {
+        /// A report's directory or its report.json.
+        report: PathBuf,
+        /// The target: c, rust, python or table.
+        #[arg(long, value_name = "LANG")]
+        lang: String,
+        /// The output file [default: standard output].
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+        /// The prefix of the C identifiers (several laws in one program).
+        #[arg(long, default_value = "fid_", value_name = "PREFIX")]
+        prefix: String,
+        /// The normal force of the compensation table [N] [default: the report's].
+        #[arg(long, value_name = "N")]
+        normal_force: Option<f64>,
+    },
 }
 
 /// An axis as `[oscillator] axis` spells it: `linear` or `rotary`.

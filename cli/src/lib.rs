@@ -66,6 +66,13 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
             resume,
             output,
         } => commands::campaign::run(&config, jobs.map(usize::from), resume, &output),
+        Command::Export {
+            report,
+            lang,
+            out,
+            prefix,
+            normal_force,
+        } => commands::export::run(&report, &lang, out.as_deref(), prefix, normal_force),
     }
 }
 

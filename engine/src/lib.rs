@@ -44,6 +44,7 @@ pub mod data;
 pub mod energy;
 pub mod error;
 pub mod exact;
+pub mod export;
 pub mod identify;
 pub mod jobs;
 pub mod oscillator;

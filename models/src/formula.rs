@@ -103,7 +103,7 @@ impl MakeOperators<f64> for FormulaOps {
 
 /// A function callable in a formula.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Func {
+pub enum Func {
     Sign,
     Abs,
     Exp,
@@ -172,8 +172,8 @@ impl Func {
         }
     }
 
-    /// The operator name registered with exmex.
-    fn exmex_name(self) -> &'static str {
+    /// The function's canonical name (the one registered with exmex).
+    pub fn exmex_name(self) -> &'static str {
         match self {
             Func::Sign => "sign",
             Func::Abs => "abs",
@@ -210,8 +210,9 @@ pub fn is_identifier(name: &str) -> bool {
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
+/// A binary operator of a formula.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum BinKind {
+pub enum BinKind {
     Add,
     Sub,
     Mul,
@@ -231,9 +232,9 @@ impl BinKind {
     }
 }
 
-/// The syntax tree of a formula.
+/// The syntax tree of a formula (read by translators of a formula into other languages).
 #[derive(Debug, Clone, PartialEq)]
-enum Node {
+pub enum Node {
     Num(f64),
     /// A variable, by name.
     Var(String),
@@ -731,6 +732,11 @@ impl Parsed {
     /// The formula as written.
     pub fn text(&self) -> &str {
         &self.text
+    }
+
+    /// The syntax tree.
+    pub fn root(&self) -> &Node {
+        &self.root
     }
 
     /// The variables the formula uses, in order of first appearance, with that column.

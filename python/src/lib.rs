@@ -11,6 +11,7 @@
 //! - [`errors`]: `ValueError` for bad input, `frictionid.FitError` for a failed fit.
 //! - [`api`]: the module's functions.
 //! - [`campaign`]: campaigns, one group a task for any executor.
+//! - [`export`]: a fitted law as C, Rust or Python source, or a compensation table.
 
 /// mimalloc, as the `frictionid` binary uses: glibc's malloc gave the fits' buffers back to
 /// the system and faulted them in again at every evaluation (a sixth of a Coulomb fit).
@@ -21,6 +22,7 @@ pub mod api;
 pub mod campaign;
 pub mod convert;
 pub mod errors;
+pub mod export;
 pub mod inputs;
 pub mod outputs;
 
@@ -36,6 +38,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(api::compare, m)?)?;
     m.add_function(wrap_pyfunction!(api::energy, m)?)?;
     m.add_function(wrap_pyfunction!(api::run, m)?)?;
+    m.add_function(wrap_pyfunction!(export::export, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::campaign_plan, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::campaign_group, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::campaign_assemble, m)?)?;

@@ -66,6 +66,10 @@ fn add_record_series(fit_dict: &Bound<'_, PyDict>, fit: &FitResult) -> PyResult<
     let records = list_at(fit_dict, "records")?;
     for (item, r) in records.iter().zip(&fit.records) {
         let d = item.cast_into::<PyDict>()?;
+        // report.json's `series` lists: the arrays below hold them.
+        if d.contains("series")? {
+            d.del_item("series")?;
+        }
         let FitSeries {
             measured,
             fitted,

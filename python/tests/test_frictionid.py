@@ -290,3 +290,24 @@ def test_channel_noise_keys_weight_a_vibrometer_accelerometer_fit():
         frictionid.fit(FMM, {"type": "coulomb"}, [dict(record, acceleration_noise=-1.0)])
     with pytest.raises(ValueError, match="unknown key `speed_noise`"):
         frictionid.fit(FMM, {"type": "coulomb"}, [dict(record, speed_noise=1.0)])
+
+
+def test_a_fit_exports_its_law_as_source():
+    """The exported Python law is the fitted Coulomb law, mu n sgn(v), evaluated at the
+    fitted mu (the closed form is the oracle); the C and Rust texts name the same constant."""
+    result = frictionid.fit(FMM, {"type": "coulomb", "mu": 0.2}, fixture_records())
+    mu = result["model_parameters"]["mu"]
+    namespace = {}
+    exec(result.export("python"), namespace)
+    law = namespace["Law"]()
+    for v in (-0.3, -1e-6, 0.0, 2e-3, 0.1):
+        expected = mu * 14.5 * ((v > 0) - (v < 0))
+        assert law.force(v, 14.5) == pytest.approx(expected, rel=1e-15, abs=0.0)
+    forces = namespace["replay"]([0.0, 0.001, 0.002], [0.1, 0.2, -0.1], 14.5)
+    assert forces == pytest.approx([mu * 14.5, mu * 14.5, -mu * 14.5], rel=1e-15)
+    c = result.export("c", prefix="axis_")
+    assert "void axis_update(axis_state *s, double v, double n, double dt)" in c
+    assert "#define AXIS_MU " in c
+    assert "pub struct Law" in result.export("rust")
+    with pytest.raises(ValueError, match="fortran"):
+        result.export("fortran")

@@ -4,6 +4,7 @@
 pub mod campaign;
 pub mod compare;
 pub mod energy;
+pub mod export;
 pub mod fit;
 pub mod models;
 pub mod simulate;

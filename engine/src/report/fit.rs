@@ -7,6 +7,7 @@ use super::format::{
 use super::{render_files, render_opening, Render, Role, Sink, Status, Table, Verdict};
 use crate::axis::Axis;
 use crate::identify::values::EnergyForce;
+use crate::identify::values::RecordFit;
 use crate::identify::{FitResult, FittedParam};
 use serde::{Serialize, Serializer};
 
@@ -33,12 +34,60 @@ pub fn fit_json(fit: &FitResult) -> Result<serde_json::Value, serde_json::Error>
             serde_json::to_value(&fit.fitted_model)?,
         );
     }
+    for_each_record(&mut v, fit, |record, r| {
+        let top = r.axes.velocity.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if top > 0.0 && top.is_finite() {
+            record.insert("max_speed".into(), top.into());
+        }
+    });
     Ok(v)
+}
+
+/// Calls `add` with each record's JSON object and its fit.
+fn for_each_record(
+    v: &mut serde_json::Value,
+    fit: &FitResult,
+    mut add: impl FnMut(&mut serde_json::Map<String, serde_json::Value>, &RecordFit),
+) {
+    let Some(records) = v.get_mut("records").and_then(|r| r.as_array_mut()) else {
+        return;
+    };
+    for (record, r) in records.iter_mut().zip(&fit.records) {
+        if let Some(obj) = record.as_object_mut() {
+            add(obj, r);
+        }
+    }
+}
+
+/// A record's compared series as report.json's `series` object: the compared samples'
+/// `time` and `velocity` (the measured motion), the `measured` and `fitted` series of the
+/// compared quantity (the first of `channels`: the model force along the motion, offset
+/// applied, in the force domain; the simulated response in the velocity domain) and, where
+/// the energy check ran, the `model_force` along the measured motion.
+fn series_json(r: &RecordFit) -> serde_json::Value {
+    let mut series = serde_json::Map::new();
+    let axes = &r.axes;
+    let s = &r.series;
+    for (key, values) in [
+        ("time", &axes.time),
+        ("velocity", &axes.velocity),
+        ("measured", &s.measured),
+        ("fitted", &s.fitted),
+        ("model_force", &s.model_force),
+    ] {
+        if !values.is_empty() {
+            series.insert(key.into(), values.clone().into());
+        }
+    }
+    series.into()
 }
 
 impl Serialize for FitReport {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         let mut v = fit_json(&self.fit).map_err(serde::ser::Error::custom)?;
+        for_each_record(&mut v, &self.fit, |record, r| {
+            record.insert("series".into(), series_json(r));
+        });
         if let Some(obj) = v.as_object_mut() {
             obj.insert("command".into(), "fit".into());
             obj.insert("config".into(), self.config.clone().into());
