@@ -39,7 +39,7 @@ LAYERS = [
     ["identify"],
     ["campaign"],
     ["spec", "report"],
-    ["jobs"],
+    ["jobs", "export"],
 ]
 
 # The floors of identify/, lowest first; identify's root (mod.rs) re-exports them all.
