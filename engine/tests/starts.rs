@@ -5,9 +5,7 @@
 //! sample where the residuals stop being finite. The law that breaks down is local to this
 //! test binary (the registry's "every built-in model" tests do not see it).
 
-mod common;
-
-use common::{records, NOISE};
+use crate::util::{records, NOISE};
 use frictionid_engine::identify::{fit, FitDomain, FitOptions, Search};
 use frictionid_engine::oscillator::OscillatorInput;
 use frictionid_engine::record::{Channel, TimeBase};
