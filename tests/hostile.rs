@@ -404,19 +404,13 @@ fn driven_record() -> Record {
 /// A run at constant speed `v` (1 s at 100 Hz): 3 N Coulomb and 2 N s/m viscous friction
 /// plus 0.05 N noise (seed `seed`).
 fn constant_velocity_run(v: f64, seed: u64) -> Record {
-    use frictionid_engine::record::{Channel, TimeBase};
-    let time = uniform_times(1.0, 100.0);
-    let x: Vec<f64> = time.iter().map(|t| v * t).collect();
-    let mut f = vec![3.0 * v.signum() + 2.0 * v; time.len()];
-    frictionid_engine::synthetic::add_gaussian_noise(&mut f, 0.05, seed);
-    let n = time.len();
-    Record::from_time_base(
-        format!("run{seed}"),
-        TimeBase::new(time).expect("time base"),
+    let force = 3.0 * v.signum() + 2.0 * v;
+    frictionid_engine::testing::constant_velocity_run(
+        uniform_times(1.0, 100.0),
+        v,
+        (0.05, seed),
+        |_| force,
     )
-    .with_channel(Channel::Displacement, x)
-    .with_channel(Channel::Velocity, vec![v; n])
-    .with_channel(Channel::Force, f)
 }
 
 fn force_domain() -> FitOptions {

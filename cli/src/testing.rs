@@ -51,6 +51,28 @@ pub fn read_report(out: &Path) -> serde_json::Value {
         .unwrap_or(serde_json::Value::Null)
 }
 
+/// The report of a run that must succeed: checks that `output` (a finished run of a command
+/// that wrote its report into `out`) exited successfully, the failure message showing its
+/// stderr, and returns report.json with the run's stderr.
+///
+/// # Panics
+/// When the command could not run, exited unsuccessfully, or wrote no readable report.json.
+pub fn runs_ok(
+    output: std::io::Result<std::process::Output>,
+    out: &Path,
+) -> (serde_json::Value, String) {
+    let o = output.unwrap_or_else(|e| panic!("cannot run the command: {e}"));
+    let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(o.status.success(), "exit {:?}: {stderr}", o.status.code());
+    let report = read_report(out);
+    assert!(
+        !report.is_null(),
+        "no report.json in {}: {stderr}",
+        out.display()
+    );
+    (report, stderr)
+}
+
 /// Runs `command` and checks that it exits successfully; returns its output.
 ///
 /// # Panics

@@ -4,7 +4,7 @@
 
 use assert_cmd::Command;
 use frictionid_cli::testing::Says::Contains;
-use frictionid_cli::testing::{assert_bad_inputs, scratch_dir, BadInput};
+use frictionid_cli::testing::{assert_bad_inputs, runs_ok, scratch_dir, BadInput};
 use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
 use frictionid_engine::Oscillator;
@@ -31,6 +31,18 @@ fn interferometer_csv() -> String {
 const RECORD: &str = "[[records]]\nfile = \"x.csv\"\nx0 = 0.014\ntime_column = \"t\"\n\
                       displacement_column = \"x_um\"\ndisplacement_scale = 1e-6\n";
 
+/// Runs `fit` on `dir`/c.toml into `dir`/out and returns its report.json.
+fn fit(dir: &Path) -> serde_json::Value {
+    let out = dir.join("out");
+    let run = Command::new(env!("CARGO_BIN_EXE_frictionid"))
+        .arg("fit")
+        .arg(dir.join("c.toml"))
+        .arg("--out")
+        .arg(&out)
+        .output();
+    runs_ok(run, &out).0
+}
+
 #[test]
 fn a_displacement_only_record_is_fitted_from_a_config() {
     let dir = scratch_dir("channels", "interferometer");
@@ -38,17 +50,7 @@ fn a_displacement_only_record_is_fitted_from_a_config() {
     let config = format!("{FMM}[model]\ntype = \"coulomb\"\n{RECORD}");
     std::fs::write(dir.join("c.toml"), config).unwrap();
     let out = dir.join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_frictionid"))
-        .arg("fit")
-        .arg(dir.join("c.toml"))
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(o.status.success(), "{stderr}");
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let r = fit(&dir);
     let mu = r["parameters"][0]["value"].as_f64().unwrap();
     assert!(((mu - 0.24) / 0.24).abs() < 1e-3, "mu = {mu}");
     assert_eq!(r["compared"], "displacement");
@@ -81,18 +83,7 @@ fn a_record_with_a_displacement_channel_needs_no_x0() {
     std::fs::write(dir.join("xv.csv"), csv).unwrap();
     let config = format!("{FMM}[model]\ntype = \"coulomb\"\n[[records]]\nfile = \"xv.csv\"\n");
     std::fs::write(dir.join("c.toml"), config).unwrap();
-    let out = dir.join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_frictionid"))
-        .arg("fit")
-        .arg(dir.join("c.toml"))
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(o.status.success(), "{stderr}");
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let r = fit(&dir);
     let first: f64 = format!("{:.9}", x[0]).parse().unwrap();
     assert_eq!(r["records"][0]["x0"].as_f64(), Some(first));
     let mu = r["parameters"][0]["value"].as_f64().unwrap();

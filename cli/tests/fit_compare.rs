@@ -4,7 +4,7 @@
 use assert_cmd::Command;
 use frictionid_cli::testing::Says::Contains;
 use frictionid_cli::testing::{
-    assert_bad_inputs, fixture_config, fixtures_dir, read_report, scratch_dir, BadInput,
+    assert_bad_inputs, fixture_config, fixtures_dir, read_report, runs_ok, scratch_dir, BadInput,
     FMM_OSCILLATOR,
 };
 use std::path::Path;
@@ -163,8 +163,7 @@ fn a_fit_without_a_normal_force_gives_the_level_in_newtons() {
         .arg(out.join("out"))
         .output()
         .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let r = read_report(&out.join("out"));
+    let (r, _) = runs_ok(Ok(o.clone()), &out.join("out"));
     let p = &r["parameters"][0];
     assert_eq!(
         (p["name"].as_str(), p["unit"].as_str()),

@@ -4,7 +4,7 @@
 //! against their CSV record.
 
 use assert_cmd::Command;
-use frictionid_cli::testing::{fixtures_dir, read_report, scratch_dir};
+use frictionid_cli::testing::{fixtures_dir, read_report, runs_ok, scratch_dir};
 use frictionid_engine::data::{read_record, Channel, DataFormat, ReadOptions};
 use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::Oscillator;
@@ -281,9 +281,8 @@ fn energy_recovers_the_true_friction_force() {
         .arg("--quiet")
         .output()
         .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (r, _) = runs_ok(Ok(o.clone()), &out);
     assert!(o.stdout.is_empty(), "--quiet prints nothing");
-    let r: serde_json::Value = read_report(&out);
     assert_eq!(r["command"], "energy");
     let recs = r["records"].as_array().unwrap();
     let names: Vec<&str> = recs.iter().map(|x| x["file"].as_str().unwrap()).collect();

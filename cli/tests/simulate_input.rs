@@ -3,7 +3,7 @@
 //! closed form of m v' = F - F_c - c v from rest, v(t) = (F - F_c) / c (1 - exp(-c t / m));
 //! the input is plotted (input.svg) as `fit` plots a record's, and named in the report.
 
-use frictionid_cli::testing::{assert_bad_inputs, run_ok, scratch_dir, BadInput, Says};
+use frictionid_cli::testing::{assert_bad_inputs, runs_ok, scratch_dir, BadInput, Says};
 use std::path::Path;
 use std::process::Command;
 
@@ -31,6 +31,20 @@ fn drive_csv() -> String {
     csv
 }
 
+/// Runs `simulate` on `cfg` into `out` and returns its report.json.
+fn simulate(cfg: &Path, out: &Path) -> serde_json::Value {
+    let run = Command::new(env!("CARGO_BIN_EXE_frictionid"))
+        .args([
+            "simulate",
+            cfg.to_str().unwrap_or_default(),
+            "--quiet",
+            "--out",
+        ])
+        .arg(out)
+        .output();
+    runs_ok(run, out).0
+}
+
 #[test]
 fn a_driven_simulation_follows_the_closed_form_and_plots_its_input() {
     let dir = scratch_dir("simulate-input", "push");
@@ -39,16 +53,7 @@ fn a_driven_simulation_follows_the_closed_form_and_plots_its_input() {
     let input = "input = { file = \"drive.csv\", input_force_column = \"u\" }\n";
     std::fs::write(&cfg, config(input)).unwrap();
     let out = dir.join("out");
-    run_ok(
-        Command::new(env!("CARGO_BIN_EXE_frictionid"))
-            .args([
-                "simulate",
-                cfg.to_str().unwrap_or_default(),
-                "--quiet",
-                "--out",
-            ])
-            .arg(&out),
-    );
+    let report = simulate(&cfg, &out);
     let trajectory = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
     let mut lines = trajectory.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -63,8 +68,6 @@ fn a_driven_simulation_follows_the_closed_form_and_plots_its_input() {
     assert!(worst < 1e-7, "worst velocity error {worst} m/s");
     let svg = std::fs::read_to_string(out.join("input.svg")).unwrap();
     assert!(svg.contains("input u [N]") && svg.contains("measured input"));
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["input_file"], "drive.csv");
     let files: Vec<&str> = report["files"]
         .as_array()
@@ -88,16 +91,7 @@ fn a_free_vibration_has_no_input_plot() {
     )
     .unwrap();
     let out = dir.join("out");
-    run_ok(
-        Command::new(env!("CARGO_BIN_EXE_frictionid"))
-            .args([
-                "simulate",
-                cfg.to_str().unwrap_or_default(),
-                "--quiet",
-                "--out",
-            ])
-            .arg(&out),
-    );
+    simulate(&cfg, &out);
     assert!(!out.join("input.svg").exists());
     let report = std::fs::read_to_string(out.join("report.json")).unwrap();
     assert!(!report.contains("input_file"));

@@ -11,7 +11,7 @@
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../tests/util.rs"]
 mod common;
 
 use common::{lugre_truth, records, stiff_lugre_truth, stribeck_truth, NOISE};

@@ -2,9 +2,7 @@
 //! noise, the oracle): the
 //! default configuration names only the model; the truths are independent of the fit.
 
-mod common;
-
-use common::{lugre_truth, records, stiff_lugre_truth, NOISE};
+use crate::util::{lugre_truth, records, stiff_lugre_truth, NOISE};
 use frictionid_engine::identify::{
     fit, FitOptions, FitResult, Identifiability, Search, SearchOptions,
 };

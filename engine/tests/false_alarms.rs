@@ -16,8 +16,6 @@
 //! - Dahl, whose presliding the old half-cycle comparison misjudged: clean and AR(1) at
 //!   1 kHz, white at 100 kHz, an interferometer's and an encoder's records (5).
 
-mod common;
-
 use frictionid_engine::identify::{fit, FitOptions, FitResult, Status};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::{add_coloured_noise, add_gaussian_noise, uniform_times};
@@ -270,9 +268,9 @@ fn truths() -> Vec<Box<dyn FrictionModel>> {
             mu: 0.2,
             viscous: 2.0,
         }),
-        Box::new(common::stribeck_truth()),
+        Box::new(crate::util::stribeck_truth()),
         Box::new(Makkar::default()),
-        Box::new(common::lugre_truth()),
+        Box::new(crate::util::lugre_truth()),
         Box::new(dahl()),
         Box::new(Gms::default()),
         Box::new(

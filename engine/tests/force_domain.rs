@@ -3,9 +3,7 @@
 //! classical Runge-Kutta scheme (not the engine's stepper); and the energy-based route
 //! (Eq. 7, no force sensor) on the exact Coulomb free vibration and on Stribeck records.
 
-mod common;
-
-use common::{records, stribeck_truth, NOISE};
+use crate::util::{records, stribeck_truth, NOISE};
 use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::identify::{fit, FitDomain, FitOptions, ForceTarget, TargetOptions};
 use frictionid_engine::oscillator::OscillatorProperty;

@@ -1,9 +1,7 @@
 //! The identifier against known truths: synthetic FMM records made by the engine from a known
 //! model, with Gaussian noise of 2e-4 m/s and fixed seeds.
 
-mod common;
-
-use common::{lugre_truth, records, stribeck_truth, NOISE};
+use crate::util::{lugre_truth, records, stribeck_truth, NOISE};
 use frictionid_engine::identify::{compare, fit, FitOptions, OscillatorParam, ParamOptions};
 use frictionid_engine::{Integrator, Oscillator, SimOptions};
 use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre, NoFriction, Stribeck};

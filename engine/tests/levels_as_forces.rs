@@ -102,20 +102,27 @@ fn a_coulomb_level_without_normal_force_is_fitted_in_newtons() {
     assert!((mu / 20.0 - 1.0).abs() < 5e-3, "{mu}");
 }
 
+/// The level and the viscous coefficient, each with its unit, of a viscous + Coulomb fit
+/// (from mu 0.2, viscous 0.5) of `record` without a normal force.
+fn viscous_coulomb_fit(osc: &Oscillator, record: Record) -> ((f64, String), (f64, String)) {
+    let model = ViscousCoulomb {
+        mu: 0.2,
+        viscous: 0.5,
+    };
+    let result = fit_without_normal_force(osc, &model, record);
+    let (mu, mu_unit) = value_and_unit(&result, "mu");
+    let (viscous, viscous_unit) = value_and_unit(&result, "viscous");
+    eprintln!("mu = {mu} {mu_unit}, viscous = {viscous} {viscous_unit}");
+    ((mu, mu_unit), (viscous, viscous_unit))
+}
+
 /// A viscous + Coulomb law: the level (3.48 N) in N within 0.5 %, the viscous coefficient
 /// (2 N s/m) in N s/m within 5 %.
 #[test]
 fn a_viscous_coulomb_law_without_normal_force_is_fitted_in_newtons() {
     let osc = linear_stage();
     let record = decay(&osc, 3.48, 2.0, (0.022, 2.0, 2e-4));
-    let model = ViscousCoulomb {
-        mu: 0.2,
-        viscous: 0.5,
-    };
-    let result = fit_without_normal_force(&osc, &model, record);
-    let (mu, mu_unit) = value_and_unit(&result, "mu");
-    let (viscous, viscous_unit) = value_and_unit(&result, "viscous");
-    eprintln!("mu = {mu} {mu_unit}, viscous = {viscous} {viscous_unit}");
+    let ((mu, mu_unit), (viscous, viscous_unit)) = viscous_coulomb_fit(&osc, record);
     assert_eq!((mu_unit.as_str(), viscous_unit.as_str()), ("N", "N s/m"));
     assert!((mu / 3.48 - 1.0).abs() < 5e-3, "{mu}");
     assert!((viscous / 2.0 - 1.0).abs() < 0.05, "{viscous}");
@@ -127,14 +134,7 @@ fn a_viscous_coulomb_law_without_normal_force_is_fitted_in_newtons() {
 fn on_a_rotary_axis_the_levels_are_torques_in_newton_metres() {
     let osc = rotary_stage();
     let record = decay(&osc, 0.3, 0.02, (0.2, 3.0, 1e-3));
-    let model = ViscousCoulomb {
-        mu: 0.2,
-        viscous: 0.5,
-    };
-    let result = fit_without_normal_force(&osc, &model, record);
-    let (mu, mu_unit) = value_and_unit(&result, "mu");
-    let (viscous, viscous_unit) = value_and_unit(&result, "viscous");
-    eprintln!("mu = {mu} {mu_unit}, viscous = {viscous} {viscous_unit}");
+    let ((mu, mu_unit), (viscous, viscous_unit)) = viscous_coulomb_fit(&osc, record);
     assert_eq!(
         (mu_unit.as_str(), viscous_unit.as_str()),
         ("N m", "N m s/rad")

@@ -15,6 +15,7 @@ use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::identify::{fit, FitDomain, FitOptions, Hooks, ParamOptions, TargetOptions};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
+use frictionid_engine::testing::DamperStroke;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{Coulomb, Dahl};
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -121,28 +122,15 @@ fn a_velocity_fit_holds_a_bounded_number_of_bytes_per_sample() {
 /// A friction damper's stroke: 2 mm at 3 Hz, `samples` at 1 kHz, Dahl's force (alpha 1,
 /// sigma0 5e5 N/m, level 60 N) in closed form along it, 0.5 N noise on the force.
 fn damper_stroke(samples: usize) -> Record {
-    use std::f64::consts::TAU;
-    let (sigma0, level) = (5e5, 60.0);
-    let time: Vec<f64> = (0..samples).map(|i| i as f64 * 1e-3).collect();
-    let x: Vec<f64> = time
-        .iter()
-        .map(|&t| 0.002 * (TAU * 3.0 * t).sin())
-        .collect();
-    let mut force = Vec::with_capacity(samples);
-    let mut f = 0.0;
-    for (i, &xi) in x.iter().enumerate() {
-        // The sampled path, linear between samples.
-        let dx = if i == 0 { 0.0 } else { xi - x[i - 1] };
-        if dx != 0.0 {
-            let s = dx.signum();
-            f = s * level + (f - s * level) * (-sigma0 * dx.abs() / level).exp();
-        }
-        force.push(f);
+    DamperStroke {
+        amplitude: 0.002,
+        frequency: 3.0,
+        sigma0: 5e5,
+        level: 60.0,
+        noise: 0.5,
+        seed: 11,
     }
-    add_gaussian_noise(&mut force, 0.5, 11);
-    Record::from_time_base("stroke", TimeBase::new(time).expect("uniform time"))
-        .with_channel(Channel::Displacement, x)
-        .with_channel(Channel::Force, force)
+    .record(samples)
 }
 
 #[test]

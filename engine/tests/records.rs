@@ -1,5 +1,6 @@
 //! Records as a laboratory writes them, read through the engine's record source: the real
-//! tribometer record with its own column names and units, pre-trigger rests found by
+//! tribometer record (where the developers keep it) and the simulated one in its export
+//! format, with their own column names and units, pre-trigger rests found by
 //! `release = "auto"` against the known release of synthetic records, `[record_defaults]`, and
 //! unit mistakes caught before any fit.
 
@@ -7,6 +8,7 @@ use frictionid_engine::data::DataError;
 use frictionid_engine::data::RecordSource;
 use frictionid_engine::record::{Channel, NormalForce, Release, ScaleError};
 use frictionid_engine::synthetic::{defective_record, Defects};
+use frictionid_engine::testing::real_tribometer_slice;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::Coulomb;
 use std::fmt::Write;
@@ -25,7 +27,7 @@ fn scratch(name: &str) -> PathBuf {
 
 fn tribometer_source() -> RecordSource {
     RecordSource {
-        file: Some("tribometer/tribometer-slice.txt".into()),
+        file: Some("tribometer/tribometer-sim.txt".into()),
         x0: Some(0.0),
         time_column: Some("Time [s]".into()),
         displacement_column: Some("Position [mm]".into()),
@@ -46,16 +48,23 @@ fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * b.abs()
 }
 
-/// Oracle: Python's `csv` module on the same file (see fixtures/tribometer/README.md):
-/// 1200 rows, t = 7.894 ... 13.889 s; means N = 5.00018268916667 N,
-/// x = -0.10992864041666539 m, F (negated) = 0.35316973424999976 N; x in
+/// Oracle: Python's `csv` module on the same six seconds of the real record
+/// (`frictionid_engine::testing::real_tribometer_slice`): 1200 rows, t = 7.894 ... 13.889 s;
+/// means N = 5.00018268916667 N, x = -0.10992864041666539 m, F (negated) = 0.35316973424999976 N; x in
 /// [-0.1100356, -0.1097962] m, F in [-2.509324, 2.5265442] N; row 500 is
 /// (10.394, 5000010.3, -109.7965, -2315632.4).
 #[test]
 fn the_tribometer_record_reads_with_its_own_columns_and_units() {
-    let r = tribometer_source()
-        .load(&fixtures())
-        .expect("tribometer slice");
+    let dir = scratch("real-tribometer");
+    let slice = match real_tribometer_slice(&dir) {
+        Ok(slice) => slice,
+        Err(skipped) => return eprintln!("{skipped}"),
+    };
+    let source = RecordSource {
+        file: Some(slice.display().to_string()),
+        ..tribometer_source()
+    };
+    let r = source.load(&dir).expect("tribometer slice");
     assert_eq!(r.len(), 1200);
     assert_eq!(
         r.channels(),
@@ -106,7 +115,7 @@ fn a_constant_normal_force_key_replaces_the_channel_and_names_clash() {
     let e = both.load(&fixtures()).unwrap_err().to_string();
     assert_eq!(
         e,
-        "[[records]] entry 1 (`tribometer/tribometer-slice.txt`): give either `normal_force` \
+        "[[records]] entry 1 (`tribometer/tribometer-sim.txt`): give either `normal_force` \
          (a constant) or `normal_force_column`, not both"
     );
 }
@@ -120,7 +129,7 @@ fn a_named_column_missing_from_the_header_names_file_and_column() {
     let e = source.load(&fixtures()).unwrap_err().to_string();
     assert!(
         e.ends_with(
-            "tribometer-slice.txt: line 1: no column `Friction [N]` (did you mean `Friction [uN]`?); \
+            "tribometer-sim.txt: line 1: no column `Friction [N]` (did you mean `Friction [uN]`?); \
              the header has: Time [s], Normal [uN], Position [mm], Friction [uN]"
         ),
         "{e}"

@@ -14,6 +14,7 @@ use frictionid_engine::identify::{
 use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
+use frictionid_engine::testing::constant_velocity_run;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{FrictionModel, Stribeck};
 
@@ -57,17 +58,8 @@ fn torque(p: &[f64; 4], v: f64) -> f64 {
 /// stated so that the objective is known exactly.
 fn run(v: f64, seed: u64) -> Record {
     let time: Vec<f64> = (0..SAMPLES).map(|i| i as f64 * 1e-2).collect();
-    let x: Vec<f64> = time.iter().map(|t| v * t).collect();
-    let mut f = vec![torque(&TRUTH, v); SAMPLES];
-    add_gaussian_noise(&mut f, SIGMA, seed);
-    Record::from_time_base(
-        format!("run{seed}"),
-        TimeBase::new(time).expect("time base"),
-    )
-    .with_channel(Channel::Displacement, x)
-    .with_channel(Channel::Velocity, vec![v; SAMPLES])
-    .with_channel(Channel::Force, f)
-    .with_noise(Channel::Force, SIGMA)
+    let torque = torque(&TRUTH, v);
+    constant_velocity_run(time, v, (SIGMA, seed), |_| torque).with_noise(Channel::Force, SIGMA)
 }
 
 /// Per run: its speed and its measured torques.

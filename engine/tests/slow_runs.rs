@@ -18,6 +18,7 @@ use frictionid_engine::identify::{
 use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
+use frictionid_engine::testing::constant_velocity_run;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{Dahl, FrictionModel, LuGre};
 
@@ -59,17 +60,7 @@ fn options(free: &[&str]) -> FitOptions {
 fn run(v: f64, duration: f64, seed: u64, torque: impl Fn(f64) -> f64) -> Record {
     let n = (duration * RATE).round() as usize + 1;
     let time: Vec<f64> = (0..n).map(|i| i as f64 / RATE).collect();
-    let angle = time.iter().map(|t| v * t).collect();
-    let mut f: Vec<f64> = time.iter().map(|&t| torque(t)).collect();
-    add_gaussian_noise(&mut f, SIGMA, seed);
-    Record::from_time_base(
-        format!("run{seed}"),
-        TimeBase::new(time).expect("time base"),
-    )
-    .with_channel(Channel::Displacement, angle)
-    .with_channel(Channel::Velocity, vec![v; n])
-    .with_channel(Channel::Force, f)
-    .with_noise(Channel::Force, SIGMA)
+    constant_velocity_run(time, v, (SIGMA, seed), torque).with_noise(Channel::Force, SIGMA)
 }
 
 /// The fit converged and each of `names` lies within four of its standard errors of the

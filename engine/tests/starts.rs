@@ -5,15 +5,13 @@
 //! sample where the residuals stop being finite. The law that breaks down is local to this
 //! test binary (the registry's "every built-in model" tests do not see it).
 
-mod common;
-
-use common::{records, NOISE};
+use crate::util::{records, NOISE};
 use frictionid_engine::identify::{
     fit, FitDomain, FitOptions, ParamOptions, Search, SearchOptions, TargetOptions,
 };
 use frictionid_engine::oscillator::PartialOscillator;
 use frictionid_engine::record::{Channel, TimeBase};
-use frictionid_engine::synthetic::add_gaussian_noise;
+use frictionid_engine::testing::DamperStroke;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{sgn, Coulomb, Dahl, FrictionModel};
 use std::f64::consts::TAU;
@@ -40,26 +38,15 @@ fn a_start_below_the_domain_is_projected_and_the_fit_succeeds() {
 /// A friction damper's stroke: 3 mm at 2 Hz, 4 000 samples at 1 kHz, Dahl's force (alpha 1,
 /// sigma0 4e5 N/m, level 50 N) in closed form along the sampled path, with 0.2 N noise.
 fn damper_stroke() -> Record {
-    let (sigma0, level) = (4e5, 50.0);
-    let time: Vec<f64> = (0..4000).map(|i| i as f64 * 1e-3).collect();
-    let x: Vec<f64> = time
-        .iter()
-        .map(|&t| 0.003 * (TAU * 2.0 * t).sin())
-        .collect();
-    let mut force = Vec::with_capacity(x.len());
-    let mut f = 0.0;
-    for (i, &xi) in x.iter().enumerate() {
-        let dx = if i == 0 { 0.0 } else { xi - x[i - 1] };
-        if dx != 0.0 {
-            let s = dx.signum();
-            f = s * level + (f - s * level) * (-sigma0 * dx.abs() / level).exp();
-        }
-        force.push(f);
+    DamperStroke {
+        amplitude: 0.003,
+        frequency: 2.0,
+        sigma0: 4e5,
+        level: 50.0,
+        noise: 0.2,
+        seed: 17,
     }
-    add_gaussian_noise(&mut force, 0.2, 17);
-    Record::from_time_base("stroke", TimeBase::new(time).expect("uniform time"))
-        .with_channel(Channel::Displacement, x)
-        .with_channel(Channel::Force, force)
+    .record(4000)
 }
 
 /// Dahl along a damper's stroke, started at a negative rest stiffness (no value near it is

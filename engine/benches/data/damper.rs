@@ -82,13 +82,7 @@ pub fn damper_cases() -> Vec<DamperCase> {
 
 /// Dahl's force (alpha = 1) after moving `dx` from force `f`, at rest stiffness `sigma0` and
 /// level `level`.
-pub fn dahl_step(f: f64, dx: f64, sigma0: f64, level: f64) -> f64 {
-    if dx == 0.0 {
-        return f;
-    }
-    let s = dx.signum();
-    s * level + (f - s * level) * (-sigma0 * dx.abs() / level).exp()
-}
+pub use frictionid_engine::testing::dahl_step;
 
 /// The exact Dahl force at every sample time along the true stroke of `case`, from F = 0:
 /// each interval is split at the reversals of the sine that fall inside it.

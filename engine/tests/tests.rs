@@ -1,0 +1,23 @@
+//! The integration tests of the engine, one module per subject, built into one binary (one
+//! link instead of one per file); `util` holds the synthetic records they share.
+//! Two files stand apart: `memory.rs`, whose counting global allocator would count every
+//! other test running beside it, and `test_laws.rs`, whose modules register friction laws of
+//! their own that would join this binary's "every registered model" tests.
+
+mod calibration;
+mod channels;
+mod driven_axis;
+mod dynamic;
+mod false_alarms;
+mod force_domain;
+mod force_jacobian;
+mod identify;
+mod inverse_dynamics;
+mod levels_as_forces;
+mod pendulum;
+mod records;
+mod replay;
+mod robot_joint;
+mod simulate;
+mod slow_runs;
+mod util;
