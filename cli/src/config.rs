@@ -339,7 +339,8 @@ impl Config {
         self.records
             .iter()
             .map(|r| {
-                r.load()
+                let record = r
+                    .load()
                     .and_then(|record| {
                         self.spec.check_units(&record)?;
                         Ok(record)
@@ -348,7 +349,9 @@ impl Config {
                         // An entry's own error names the entry: the file is the config.
                         DataError::Source(entry) => self.error(entry),
                         other => CliError::from(other),
-                    })
+                    })?;
+                self.spec.check_law_on(&record).map_err(|e| self.error(e))?;
+                Ok(record)
             })
             .collect()
     }

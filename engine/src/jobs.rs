@@ -417,6 +417,7 @@ fn load_group(spec: &Spec, task: &GroupTask) -> Result<Vec<Record>, String> {
                 .map_err(|e| e.to_string())?;
             let record = resolved.load().map_err(|e| e.to_string())?;
             spec.check_units(&record).map_err(|e| e.to_string())?;
+            spec.check_law_on(&record).map_err(|e| e.to_string())?;
             Ok(record)
         })
         .collect()

@@ -110,6 +110,15 @@ impl Spec {
         }
     }
 
+    /// Checks that the `[model]`'s force is finite along `record` at its start values
+    /// ([`ModelSpec::check_finite_on`]); nothing to check without a model.
+    pub fn check_law_on(&self, record: &Record) -> Result<(), SpecError> {
+        match &self.model {
+            Some(m) => m.check_finite_on(record, &self.oscillator),
+            None => Ok(()),
+        }
+    }
+
     /// The configured mass (inertia) as a fit uses it: fixed, the start of a fitted one, or
     /// `None` when it is not given.
     fn mass_reference(&self) -> Option<MassReference> {
