@@ -6,8 +6,10 @@
 //! pendulum's angle in degrees is named whether its properties are known or not.
 
 use frictionid_engine::axis::{NoRestoring, Pendulum};
-use frictionid_engine::record::balance::{balance_scale, implied_inertia, MassReference};
-use frictionid_engine::record::{check_swing, Channel, TimeBase};
+use frictionid_engine::identify::problem::unit_check::{
+    balance_scale, check_driven_balance, check_swing, implied_inertia, MassReference,
+};
+use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid};
 use frictionid_engine::{Axis, Initial, Oscillator, Record, Restoring, SimOptions};
 use frictionid_models::{Coulomb, ViscousCoulomb};
@@ -31,7 +33,6 @@ fn slide(mass: f64, axis: Axis) -> Oscillator {
         restoring: Restoring::None(NoRestoring),
         input_offset: 0.5 * mass / 12.0,
         axis,
-        ..Oscillator::fmm()
     }
 }
 
@@ -200,7 +201,7 @@ fn a_driven_motion_in_the_wrong_unit_names_its_channel_and_scale() {
     let found = balance_scale(&r, &osc, MassReference::Start(0.04)).expect("degrees");
     assert_eq!(found.words, "degrees read as radians");
     assert!((found.scale - PI / 180.0).abs() < 1e-12);
-    let msg = frictionid_engine::record::check_driven_balance(&r, &osc, MassReference::Fixed(0.05))
+    let msg = check_driven_balance(&r, &osc, MassReference::Fixed(0.05))
         .unwrap_err()
         .to_string();
     assert!(

@@ -7,7 +7,6 @@
 //! - [`release`]: the release instant, given or found in the pre-trigger rest.
 //! - [`sanity`]: units checked against the oscillator (mm/s, milliseconds, x0 in mm).
 
-pub mod balance;
 pub mod channel;
 pub mod checked;
 pub mod noise;
@@ -17,7 +16,7 @@ pub mod time;
 
 pub use channel::{Channel, NormalForce};
 pub use release::{detect_release, Release};
-pub use sanity::{check_driven_balance, check_scales, check_swing, ScaleError};
+pub use sanity::{check_scales, ScaleError};
 pub use time::{check_sorted, check_time, TimeBase, TimeError};
 
 use crate::error::EngineError;

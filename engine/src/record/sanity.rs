@@ -16,16 +16,15 @@
 //!   scales with the angle, so its records cannot tell.
 //! - Swings: a free pendulum turns back only within a turn of its hanging equilibrium, so two
 //!   consecutive reversals of its motion lie less than 2 pi apart, whatever its inertia and
-//!   gravity moment (fitted or not). Swings wider than that ([`check_swing`]) are an angle in
-//!   the wrong unit: degrees read as radians widen every swing 57.3 times.
-//! - Balance: a driven record's input balances J a + c v + ... ([`super::balance`]); the
-//!   inertia that balance implies, against the configured one, names a motion read in the
-//!   wrong unit ([`check_driven_balance`]).
+//!   gravity moment (fitted or not). Swings wider than that are an angle in the wrong unit:
+//!   degrees read as radians widen every swing 57.3 times
+//!   ([`crate::identify::problem::unit_check::check_swing`], which reads the motion as the
+//!   energy analysis does).
+//! - Balance: a driven record's input balances J a + c v + ...; the inertia that balance
+//!   implies, against the configured one, names a motion read in the wrong unit
+//!   ([`crate::identify::problem::unit_check::check_driven_balance`]).
 
-use super::balance::{balance_scale, MassReference};
 use super::{Channel, Record};
-use crate::axis::Restoring;
-use crate::energy::record_motion;
 use crate::oscillator::Oscillator;
 use thiserror::Error;
 
@@ -141,113 +140,6 @@ pub fn check_scales(record: &Record, osc: &Oscillator) -> Result<(), ScaleError>
     check_period(record, osc)
 }
 
-/// How much wider than 2 pi two consecutive reversals of a free pendulum may lie (the
-/// angle's noise at the reversals).
-const SWING_MARGIN: f64 = 1.1;
-
-/// Checks that a free pendulum's consecutive reversals lie within a turn of each other (see
-/// the module docs): the second-widest swing decides, so one spike does not. Records of other
-/// axes, driven records and records with fewer than two swings are not checked.
-pub fn check_swing(record: &Record, osc: &Oscillator) -> Result<(), ScaleError> {
-    if !matches!(osc.restoring, Restoring::Pendulum(_))
-        || record.channel(Channel::InputForce).is_some()
-    {
-        return Ok(());
-    }
-    let Some(motion) = record_motion(record) else {
-        return Ok(());
-    };
-    let time = record.time();
-    let turns = reversals(time, &motion.v);
-    let mut swings: Vec<(f64, usize, usize)> = turns
-        .windows(2)
-        .map(|w| ((motion.x[w[1]] - motion.x[w[0]]).abs(), w[0], w[1]))
-        .filter(|s| s.0.is_finite())
-        .collect();
-    swings.sort_by(|a, b| b.0.total_cmp(&a.0));
-    let Some(&(swing, a, b)) = swings.get(1) else {
-        return Ok(());
-    };
-    let turn = 2.0 * std::f64::consts::PI;
-    if swing <= SWING_MARGIN * turn {
-        return Ok(());
-    }
-    let channel = if motion.displacement == crate::energy::SeriesSource::Measured {
-        "displacement"
-    } else {
-        "velocity"
-    };
-    let advice = if swing.to_radians() <= SWING_MARGIN * turn {
-        format!("is the angle in degrees? set {channel}_scale = 0.0174533 (pi/180)")
-    } else {
-        format!("the angle is not in radians: set {channel}_scale to the radians of one unit")
-    };
-    Err(ScaleError::Swing {
-        record: record.name.clone(),
-        swing,
-        from: time[a],
-        to: time[b],
-        advice,
-    })
-}
-
-/// The samples where the motion turns back: the start when it is at rest there, and the last
-/// sign change of the velocity between its leaving a tenth of the peak speed on one side and
-/// reaching it on the other (as [`oscillation_period`] counts crossings).
-fn reversals(time: &[f64], v: &[f64]) -> Vec<usize> {
-    let band = 0.1 * robust_peak(v);
-    let n = time.len().min(v.len());
-    let mut turns = Vec::new();
-    if v.first().is_some_and(|v0| v0.abs() <= band) {
-        turns.push(0);
-    }
-    let mut side = 0.0;
-    let mut last_change = None;
-    for i in 1..n {
-        if v[i - 1].signum() != v[i].signum() {
-            last_change = Some(i);
-        }
-        if v[i].abs() <= band {
-            continue;
-        }
-        if side != 0.0 && v[i].signum() != side {
-            turns.extend(last_change);
-        }
-        side = v[i].signum();
-    }
-    turns
-}
-
-/// Checks a driven record's balance against the configured inertia (see
-/// [`super::balance`]): a ratio near a unit's factor names the channel and the scale to set.
-pub fn check_driven_balance(
-    record: &Record,
-    osc: &Oscillator,
-    reference: MassReference,
-) -> Result<(), ScaleError> {
-    match balance_scale(record, osc, reference) {
-        None => Ok(()),
-        Some(found) => Err(ScaleError::Balance {
-            record: record.name.clone(),
-            channel: found.channel,
-            words: found.words,
-            implied: found.implied,
-            configured: found.configured,
-            scale: scale_text(found.scale),
-        }),
-    }
-}
-
-/// A scale as a key value: `0.001`, `1e-6`, `1000`, `0.0174533`.
-fn scale_text(scale: f64) -> String {
-    let rounded = format!("{scale:.6e}").parse::<f64>().unwrap_or(scale);
-    if (1e-4..1e5).contains(&rounded) {
-        format!("{}", (rounded * 1e7).round() / 1e7)
-    } else {
-        format!("{rounded:e}")
-    }
-}
-
 /// Samples of the potential over the swing in [`check_angle`].
 const SWING_SAMPLES: usize = 400;
 
@@ -355,7 +247,7 @@ fn check_period(record: &Record, osc: &Oscillator) -> Result<(), ScaleError> {
 }
 
 /// The peak |v| ignoring the largest 0.1 % of the samples (a spike is not the motion).
-fn robust_peak(v: &[f64]) -> f64 {
+pub(crate) fn robust_peak(v: &[f64]) -> f64 {
     let mut abs: Vec<f64> = v
         .iter()
         .map(|x| x.abs())

@@ -34,10 +34,10 @@ pub use self::simulation::{
 pub use crate::identify::Hooks;
 
 use crate::data::RecordUse;
+use crate::identify::problem::unit_check::{check_driven_balance, check_swing, MassReference};
 use crate::identify::{check_min_speed, FitDomain, PropertyUncertainty};
 use crate::oscillator::{Oscillator, OscillatorProperty};
-use crate::record::balance::MassReference;
-use crate::record::{check_driven_balance, check_scales, check_swing, Record, ScaleError};
+use crate::record::{check_scales, Record, ScaleError};
 
 /// Everything but the records: oscillator, model, fit, simulation and energy settings.
 #[derive(Debug, Clone)]

@@ -1,4 +1,9 @@
-//! The units of a driven record from its balance: along a driven axis the measured input u
+//! Units checked from a record's motion before any fit, whatever the fit varies.
+//!
+//! A free pendulum turns back only within a turn of its hanging equilibrium: two consecutive
+//! reversals farther apart than 2 pi are an angle in the wrong unit ([`check_swing`]).
+//!
+//! A driven record's balance ([`check_driven_balance`]): along a driven axis the measured input u
 //! balances J a + c v + F_c sgn(v) + F_0 (+ R(q)). Integrated over consecutive chunks of the
 //! record (no derivative of a noisy motion is needed),
 //!
@@ -13,9 +18,11 @@
 //! ratio the record does not determine (J below [`MIN_T_RATIO`] standard errors, or a
 //! balance explaining less than [`MIN_EXPLAINED`] of the input) decides nothing.
 
-use super::{Channel, Record};
-use crate::energy::record_motion;
+use crate::axis::Restoring;
+use crate::energy::{record_motion, SeriesSource};
 use crate::oscillator::Oscillator;
+use crate::record::sanity::robust_peak;
+use crate::record::{Channel, Record, ScaleError};
 use nalgebra::{DMatrix, DVector};
 
 /// The fewest chunks the balance is integrated over.
@@ -239,6 +246,113 @@ fn solve_inertia(rows: &[[f64; 6]], columns: usize) -> Option<f64> {
     let se = (variance * inverse[(0, 0)]).sqrt();
     let j = beta[0];
     (j > MIN_T_RATIO * se && j.is_finite()).then(|| j / rms[0])
+}
+
+/// How much wider than 2 pi two consecutive reversals of a free pendulum may lie (the
+/// angle's noise at the reversals).
+const SWING_MARGIN: f64 = 1.1;
+
+/// Checks that a free pendulum's consecutive reversals lie within a turn of each other (see
+/// the module docs): the second-widest swing decides, so one spike does not. Records of other
+/// axes, driven records and records with fewer than two swings are not checked.
+pub fn check_swing(record: &Record, osc: &Oscillator) -> Result<(), ScaleError> {
+    if !matches!(osc.restoring, Restoring::Pendulum(_))
+        || record.channel(Channel::InputForce).is_some()
+    {
+        return Ok(());
+    }
+    let Some(motion) = record_motion(record) else {
+        return Ok(());
+    };
+    let time = record.time();
+    let turns = reversals(time, &motion.v);
+    let mut swings: Vec<(f64, usize, usize)> = turns
+        .windows(2)
+        .map(|w| ((motion.x[w[1]] - motion.x[w[0]]).abs(), w[0], w[1]))
+        .filter(|s| s.0.is_finite())
+        .collect();
+    swings.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let Some(&(swing, a, b)) = swings.get(1) else {
+        return Ok(());
+    };
+    let turn = 2.0 * std::f64::consts::PI;
+    if swing <= SWING_MARGIN * turn {
+        return Ok(());
+    }
+    let channel = if motion.displacement == SeriesSource::Measured {
+        "displacement"
+    } else {
+        "velocity"
+    };
+    let advice = if swing.to_radians() <= SWING_MARGIN * turn {
+        format!("is the angle in degrees? set {channel}_scale = 0.0174533 (pi/180)")
+    } else {
+        format!("the angle is not in radians: set {channel}_scale to the radians of one unit")
+    };
+    Err(ScaleError::Swing {
+        record: record.name.clone(),
+        swing,
+        from: time[a],
+        to: time[b],
+        advice,
+    })
+}
+
+/// The samples where the motion turns back: the start when it is at rest there, and the last
+/// sign change of the velocity between its leaving a tenth of the peak speed on one side and
+/// reaching it on the other (as the period check of [`crate::record::sanity`] counts crossings).
+fn reversals(time: &[f64], v: &[f64]) -> Vec<usize> {
+    let band = 0.1 * robust_peak(v);
+    let n = time.len().min(v.len());
+    let mut turns = Vec::new();
+    if v.first().is_some_and(|v0| v0.abs() <= band) {
+        turns.push(0);
+    }
+    let mut side = 0.0;
+    let mut last_change = None;
+    for i in 1..n {
+        if v[i - 1].signum() != v[i].signum() {
+            last_change = Some(i);
+        }
+        if v[i].abs() <= band {
+            continue;
+        }
+        if side != 0.0 && v[i].signum() != side {
+            turns.extend(last_change);
+        }
+        side = v[i].signum();
+    }
+    turns
+}
+
+/// Checks a driven record's balance against the configured inertia (see the module docs): a
+/// ratio near a unit's factor names the channel and the scale to set.
+pub fn check_driven_balance(
+    record: &Record,
+    osc: &Oscillator,
+    reference: MassReference,
+) -> Result<(), ScaleError> {
+    match balance_scale(record, osc, reference) {
+        None => Ok(()),
+        Some(found) => Err(ScaleError::Balance {
+            record: record.name.clone(),
+            channel: found.channel,
+            words: found.words,
+            implied: found.implied,
+            configured: found.configured,
+            scale: scale_text(found.scale),
+        }),
+    }
+}
+
+/// A scale as a key value: `0.001`, `1e-6`, `1000`, `0.0174533`.
+fn scale_text(scale: f64) -> String {
+    let rounded = format!("{scale:.6e}").parse::<f64>().unwrap_or(scale);
+    if (1e-4..1e5).contains(&rounded) {
+        format!("{}", (rounded * 1e7).round() / 1e7)
+    } else {
+        format!("{rounded:e}")
+    }
 }
 
 #[cfg(test)]
