@@ -339,17 +339,19 @@ impl Config {
         self.records
             .iter()
             .map(|r| {
-                // Units are checked against k/m only when the oscillator is known.
-                if self.spec.unknown_oscillator.is_empty() {
-                    r.load_checked(&self.spec.oscillator)
-                } else {
-                    r.load()
-                }
-                .map_err(|e| match e {
-                    // An entry's own error names the entry: the file is the config.
-                    DataError::Source(entry) => self.error(entry),
-                    other => CliError::from(other),
-                })
+                let record = r
+                    .load()
+                    .and_then(|record| {
+                        self.spec.check_units(&record)?;
+                        Ok(record)
+                    })
+                    .map_err(|e| match e {
+                        // An entry's own error names the entry: the file is the config.
+                        DataError::Source(entry) => self.error(entry),
+                        other => CliError::from(other),
+                    })?;
+                self.spec.check_law_on(&record).map_err(|e| self.error(e))?;
+                Ok(record)
             })
             .collect()
     }

@@ -415,13 +415,10 @@ fn load_group(spec: &Spec, task: &GroupTask) -> Result<Vec<Record>, String> {
             let resolved = source
                 .resolve_for(line, &task.base_dir, spec.record_use())
                 .map_err(|e| e.to_string())?;
-            // Units are checked against k/m only when the oscillator is known.
-            if spec.unknown_oscillator.is_empty() {
-                resolved.load_checked(&spec.oscillator)
-            } else {
-                resolved.load()
-            }
-            .map_err(|e| e.to_string())
+            let record = resolved.load().map_err(|e| e.to_string())?;
+            spec.check_units(&record).map_err(|e| e.to_string())?;
+            spec.check_law_on(&record).map_err(|e| e.to_string())?;
+            Ok(record)
         })
         .collect()
 }

@@ -14,6 +14,15 @@
 //!   [`MAX_SPEED_RATIO`] times that is an angle read in the wrong unit: degrees read as
 //!   radians make it 57.3 times the truth while the potential stays bounded. A linear spring
 //!   scales with the angle, so its records cannot tell.
+//! - Swings: a free pendulum turns back only within a turn of its hanging equilibrium, so two
+//!   consecutive reversals of its motion lie less than 2 pi apart, whatever its inertia and
+//!   gravity moment (fitted or not). Swings wider than that are an angle in the wrong unit:
+//!   degrees read as radians widen every swing 57.3 times
+//!   ([`crate::identify::problem::unit_check::check_swing`], which reads the motion as the
+//!   energy analysis does).
+//! - Balance: a driven record's input balances J a + c v + ...; the inertia that balance
+//!   implies, against the configured one, names a motion read in the wrong unit
+//!   ([`crate::identify::problem::unit_check::check_driven_balance`]).
 
 use super::{Channel, Record};
 use crate::oscillator::Oscillator;
@@ -67,6 +76,30 @@ pub enum ScaleError {
         expected: f64,
         swing: f64,
         ratio: f64,
+    },
+    /// A free pendulum swings wider than a turn between two reversals.
+    #[error(
+        "{record}: the angle swings {swing:.4e} rad between the reversals at t = {from:.4} s and t = {to:.4} s, wider than a pendulum can turn back within (2 pi): {advice}"
+    )]
+    Swing {
+        record: String,
+        swing: f64,
+        from: f64,
+        to: f64,
+        advice: String,
+    },
+    /// A driven record's balance implies an inertia a unit's factor away from the configured one.
+    #[error(
+        "{record}: the {channel} looks like {words}: the input balances J a with J = {implied:.4e} against the configured {configured:.4e} ({}): set {channel}_scale = {scale}",
+        ratio_words(*implied / *configured)
+    )]
+    Balance {
+        record: String,
+        channel: &'static str,
+        words: &'static str,
+        implied: f64,
+        configured: f64,
+        scale: String,
     },
 }
 
@@ -214,7 +247,7 @@ fn check_period(record: &Record, osc: &Oscillator) -> Result<(), ScaleError> {
 }
 
 /// The peak |v| ignoring the largest 0.1 % of the samples (a spike is not the motion).
-fn robust_peak(v: &[f64]) -> f64 {
+pub(crate) fn robust_peak(v: &[f64]) -> f64 {
     let mut abs: Vec<f64> = v
         .iter()
         .map(|x| x.abs())

@@ -66,6 +66,18 @@ pub enum SpecError {
     /// An oscillator property or its standard deviation out of range.
     #[error("[oscillator]: {0}")]
     Oscillator(String),
+    /// A static law whose force at its start values is not finite on the data.
+    #[error(
+        "{key}: the force is {value} {place}, not a finite number: the law cannot be fitted there"
+    )]
+    NotFinite {
+        /// The model's key and value as written.
+        key: String,
+        /// The force there (inf or NaN).
+        value: f64,
+        /// Where: at rest, or a record's velocity and time.
+        place: String,
+    },
     /// A model error.
     #[error(transparent)]
     Model(#[from] ModelError),

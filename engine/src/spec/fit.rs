@@ -202,6 +202,23 @@ impl FitSpec {
         Ok(())
     }
 
+    /// Checks that the search can run: `[fit] max_iterations` allows at least one iteration
+    /// (0 would report the start as the fit) and `tolerance` is a finite number >= 0.
+    pub fn check_search(&self) -> Result<(), SpecError> {
+        if self.search.max_iterations == 0 {
+            return Err(SpecError::FitOption(
+                "[fit] max_iterations = 0 allows no iteration: give at least 1 (default 200)"
+                    .into(),
+            ));
+        }
+        match self.search.tolerance {
+            Some(t) if !(t.is_finite() && t >= 0.0) => Err(SpecError::FitOption(format!(
+                "[fit] tolerance must be a finite number >= 0, got {t}"
+            ))),
+            _ => Ok(()),
+        }
+    }
+
     /// The free parameter names for `model`: `free` as written, or else every parameter not
     /// marked fixed by default (such as the Stribeck shape exponent).
     pub fn free_names(&self, model: &dyn FrictionModel) -> Vec<String> {
@@ -276,6 +293,19 @@ mod tests {
             e.contains("`x0` = [0.011, 0.009] is not an interval"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn no_iteration_and_a_bad_tolerance_are_refused_naming_the_key() {
+        let mut fit = FitSpec::default();
+        fit.check_search().unwrap();
+        fit.search.max_iterations = 0;
+        let e = fit.check_search().unwrap_err().to_string();
+        assert!(e.starts_with("[fit] max_iterations = 0"), "{e}");
+        fit.search.max_iterations = 1;
+        fit.search.tolerance = Some(f64::NAN);
+        let e = fit.check_search().unwrap_err().to_string();
+        assert!(e.starts_with("[fit] tolerance"), "{e}");
     }
 
     /// Each key of `[fit]` and `[fit.options]` is read by one part, and the tables list every

@@ -34,8 +34,10 @@ pub use self::simulation::{
 pub use crate::identify::Hooks;
 
 use crate::data::RecordUse;
+use crate::identify::problem::unit_check::{check_driven_balance, check_swing, MassReference};
 use crate::identify::{check_min_speed, FitDomain, PropertyUncertainty};
 use crate::oscillator::{Oscillator, OscillatorProperty};
+use crate::record::{check_scales, Record, ScaleError};
 
 /// Everything but the records: oscillator, model, fit, simulation and energy settings.
 #[derive(Debug, Clone)]
@@ -71,6 +73,7 @@ impl Spec {
         if let Some(m) = &model {
             fit.check_against(m.model.as_ref())?;
         }
+        fit.check_search()?;
         check_min_speed(fit.target.min_speed, fit.target.domain).map_err(SpecError::FitOption)?;
         Ok(Self {
             oscillator: oscillator.oscillator,
@@ -89,6 +92,43 @@ impl Spec {
         match self.fit.target.domain {
             FitDomain::Velocity => RecordUse::Simulated,
             FitDomain::Force => RecordUse::Replayed,
+        }
+    }
+
+    /// Checks the units of a read record against the oscillator: the speed, period and angle
+    /// checks where every property is given ([`check_scales`]), a free pendulum's swings
+    /// ([`check_swing`]) and a driven record's balance against the mass, given or the start
+    /// of a fitted one ([`check_driven_balance`]; not judged when the mass is not given).
+    pub fn check_units(&self, record: &Record) -> Result<(), ScaleError> {
+        if self.unknown_oscillator.is_empty() {
+            check_scales(record, &self.oscillator)?;
+        }
+        check_swing(record, &self.oscillator)?;
+        match self.mass_reference() {
+            Some(reference) => check_driven_balance(record, &self.oscillator, reference),
+            None => Ok(()),
+        }
+    }
+
+    /// Checks that the `[model]`'s force is finite along `record` at its start values
+    /// ([`ModelSpec::check_finite_on`]); nothing to check without a model.
+    pub fn check_law_on(&self, record: &Record) -> Result<(), SpecError> {
+        match &self.model {
+            Some(m) => m.check_finite_on(record, &self.oscillator),
+            None => Ok(()),
+        }
+    }
+
+    /// The configured mass (inertia) as a fit uses it: fixed, the start of a fitted one, or
+    /// `None` when it is not given.
+    fn mass_reference(&self) -> Option<MassReference> {
+        let mass = OscillatorProperty::Mass;
+        if self.unknown_oscillator.contains(&mass) {
+            None
+        } else if self.fit.params.oscillator.contains(&mass) {
+            Some(MassReference::Start(self.oscillator.mass))
+        } else {
+            Some(MassReference::Fixed(self.oscillator.mass))
         }
     }
 

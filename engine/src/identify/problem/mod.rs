@@ -14,6 +14,7 @@ pub mod residuals;
 pub mod simulated_response;
 pub mod state_cache;
 pub mod step_allowance;
+pub mod unit_check;
 
 pub use analysis_cache::AnalysisRequest;
 pub use force_along_motion::{
