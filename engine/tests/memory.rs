@@ -13,7 +13,7 @@
 
 use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::identify::{fit, FitDomain, FitOptions, Hooks, ParamOptions, TargetOptions};
-use frictionid_engine::record::{Channel, TimeBase};
+
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::testing::DamperStroke;
 use frictionid_engine::{Oscillator, Record};

@@ -12,8 +12,7 @@ use frictionid_engine::identify::{
     fit, FitDomain, FitOptions, Search, SearchOptions, TargetOptions,
 };
 use frictionid_engine::oscillator::OscillatorProperty;
-use frictionid_engine::record::{Channel, TimeBase};
-use frictionid_engine::synthetic::add_gaussian_noise;
+use frictionid_engine::record::Channel;
 use frictionid_engine::testing::constant_velocity_run;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{FrictionModel, Stribeck};

@@ -16,8 +16,7 @@ use frictionid_engine::identify::{
     fit, FitDomain, FitOptions, FitResult, ParamOptions, TargetOptions,
 };
 use frictionid_engine::oscillator::OscillatorProperty;
-use frictionid_engine::record::{Channel, TimeBase};
-use frictionid_engine::synthetic::add_gaussian_noise;
+use frictionid_engine::record::Channel;
 use frictionid_engine::testing::constant_velocity_run;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{Dahl, FrictionModel, LuGre};

@@ -20,4 +20,5 @@ mod replay;
 mod robot_joint;
 mod simulate;
 mod slow_runs;
+mod units;
 mod util;
