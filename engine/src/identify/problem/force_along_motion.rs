@@ -510,7 +510,10 @@ fn keep_sliding(
 /// (an axis without a spring gives no `stiffness`).
 fn has_restoring(osc: &Oscillator, opts: &FitOptions) -> bool {
     !osc.restoring.is_linear_spring()
-        || opts.params.oscillator.contains(&OscillatorProperty::Stiffness)
+        || opts
+            .params
+            .oscillator
+            .contains(&OscillatorProperty::Stiffness)
         || !opts.target.is_unknown(OscillatorProperty::Stiffness)
 }
 
