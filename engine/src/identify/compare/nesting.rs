@@ -1,6 +1,6 @@
-//! Nesting: a law that holds another as a limit (it can be started exactly, or for a law
-//! with presliding states nearly, at the simpler law's optimum: `Staging::start_from`) must
-//! end at least as low. A law that ends above a law it holds is refitted from that law's
+//! Nesting: a law that holds a static law with fewer parameters as a limit (it can be
+//! started exactly, or for a law with presliding states nearly, at the static law's
+//! optimum: `Staging::start_from`) must end at least as low. A law that ends above a law it holds is refitted from that law's
 //! optimum; if it still ends above, its search failed and it is not ranked on that cost.
 
 use super::super::assessment::property_refits::refit_options;
@@ -53,7 +53,10 @@ pub fn enforce_nesting(
         let held: Vec<&(String, usize, f64, Box<dyn FrictionModel>)> = snapshot
             .iter()
             .filter(|(name, free, _, sub)| {
-                *name != f.model && *free < model_free(&f) && holds(&f, sub.as_ref(), osc)
+                *name != f.model
+                    && *free < model_free(&f)
+                    && sub.n_states() == 0
+                    && holds(&f, sub.as_ref(), osc)
             })
             .collect();
         let slack = if f.fitted_model.n_states() > 0 {

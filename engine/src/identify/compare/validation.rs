@@ -19,6 +19,7 @@ use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::result::FitResult;
 use crate::identify::values::target_options::FitDomain;
 use crate::record::Record;
+use frictionid_models::{clone_model, FrictionModel};
 use serde::Serialize;
 
 /// The most folds a comparison scores (each costs one local refit and one evaluation per law).
@@ -249,12 +250,36 @@ fn held_out(
         }
     }
     let world = &trained.world;
-    let evaluated = lean_fit(&world.oscillator, world.model.as_ref(), &test, &eval)?;
+    let model = within_bounds(world.model.as_ref())?;
+    let evaluated = lean_fit(&world.oscillator, model.as_ref(), &test, &eval)?;
     Ok(evaluated
         .records
         .iter()
         .map(|(r, t)| scored(r, t, fold.scored_from))
         .fold((0.0, 0), |(s, n), (a, b)| (s + a, n + b)))
+}
+
+/// `model` with every parameter clipped into its physical bounds (the solver's mapping can
+/// leave a parameter at its bound a rounding error outside it, which a fixed parameter's
+/// check refuses).
+fn within_bounds(
+    model: &(dyn FrictionModel + 'static),
+) -> Result<Box<dyn FrictionModel>, EngineError> {
+    let mut m = clone_model(model);
+    let values: Vec<f64> = m
+        .params()
+        .iter()
+        .zip(m.param_info())
+        .map(|(&v, p)| {
+            if p.lower <= p.upper {
+                v.clamp(p.lower, p.upper)
+            } else {
+                v
+            }
+        })
+        .collect();
+    m.set_params(&values)?;
+    Ok(m)
 }
 
 /// The options that evaluate a fitted law: no model parameter or oscillator property free

@@ -97,8 +97,8 @@ fn velocity_resolution(fit: &FitResult) -> f64 {
 }
 
 /// Whether `law`'s held-out error is within the folds' noise of `best`'s: the mean of their
-/// fold-wise differences is at most twice its standard error, or within
-/// [`VALIDATION_FLOOR`] of the best.
+/// fold-wise differences is at most its standard error (the one-standard-error rule, on
+/// paired folds), or within [`VALIDATION_FLOOR`] of the best.
 pub fn within_noise(law: &LawValidation, best: &LawValidation) -> bool {
     let (Some(l), Some(b)) = (law.validation_rms, best.validation_rms) else {
         return false;
@@ -116,7 +116,7 @@ pub fn within_noise(law: &LawValidation, best: &LawValidation) -> bool {
         return false;
     }
     let mean = diffs.iter().sum::<f64>() / diffs.len() as f64;
-    mean <= 2.0 * spread(&diffs) / (diffs.len() as f64).sqrt()
+    mean <= spread(&diffs) / (diffs.len() as f64).sqrt()
 }
 
 /// Why the information criteria are shown only as information: the lag-one correlation of
