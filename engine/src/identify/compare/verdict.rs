@@ -142,3 +142,41 @@ pub fn information_note(best: &FitResult) -> String {
         best.samples
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scored(model: &str, folds: &[f64]) -> LawValidation {
+        let n = folds.len() as f64;
+        let rms = (folds.iter().map(|f| f * f).sum::<f64>() / n).sqrt();
+        LawValidation {
+            model: model.into(),
+            validation_rms: Some(rms),
+            validation_rms_spread: Some(spread(folds)),
+            folds: folds.to_vec(),
+            error: None,
+        }
+    }
+
+    #[test]
+    fn a_law_worse_on_every_fold_by_more_than_the_folds_scatter_is_not_within_noise() {
+        let best = scored("best", &[1.0, 2.0, 3.0]);
+        // Paired differences 0.5, 0.6, 0.4: mean 0.5, standard error 0.058.
+        assert!(!within_noise(&scored("worse", &[1.5, 2.6, 3.4]), &best));
+        // Differences -0.3, 0.6, 0.0: mean 0.1, standard error 0.26.
+        assert!(within_noise(&scored("scattered", &[0.7, 2.6, 3.0]), &best));
+        // Within 1 % of the best's RMS whatever the folds say.
+        assert!(within_noise(&scored("close", &[1.01, 2.01, 3.01]), &best));
+    }
+
+    #[test]
+    fn a_law_without_a_score_is_never_within_noise() {
+        let best = scored("best", &[1.0, 2.0]);
+        let unscored = LawValidation {
+            validation_rms: None,
+            ..scored("x", &[1.0, 2.0])
+        };
+        assert!(!within_noise(&unscored, &best));
+    }
+}
