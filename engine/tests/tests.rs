@@ -6,6 +6,7 @@
 
 mod calibration;
 mod channels;
+mod compare_verdict;
 mod driven_axis;
 mod dynamic;
 mod false_alarms;

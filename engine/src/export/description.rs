@@ -67,7 +67,7 @@ fn missing(key: &str, reason: &str) -> ExportError {
 }
 
 /// The fit a report holds: a fit report's own object, or a comparison's recommended law
-/// (the verdict's `simplest`, else the best-ranked), with how it was chosen.
+/// (the verdict's `recommended`, else its `simplest`, else the best-ranked), with how it was chosen.
 fn chosen_fit(report: &Value) -> Result<(&Value, String), ExportError> {
     let Some(ranking) = report.get("ranking") else {
         return Ok((report, String::new()));
@@ -78,8 +78,9 @@ fn chosen_fit(report: &Value) -> Result<(&Value, String), ExportError> {
         .ok_or_else(|| missing("ranking", "no fitted law (the ranking is empty)"))?;
     let model_of = |f: &Value| f.get("model").and_then(Value::as_str).map(str::to_string);
     let simplest = report
-        .pointer("/verdict/simplest")
+        .pointer("/verdict/recommended")
         .and_then(Value::as_str)
+        .or_else(|| report.pointer("/verdict/simplest").and_then(Value::as_str))
         .and_then(|name| {
             ranking
                 .iter()

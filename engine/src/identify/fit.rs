@@ -16,7 +16,9 @@ use super::assessment::identifiability;
 use super::assessment::property_refits::add_property_uncertainty;
 use super::assessment::summary::{summarise, FinishContext};
 use super::problem::{check_force_domain, check_moves, require_mechanics, ForceAlongMotion};
-use super::problem::{simulated_levels, FitProblem, ProblemParts, Residuals, SimulatedResponse};
+use super::problem::{
+    simulated_levels, FitProblem, ProblemParts, Realised, Residuals, SimulatedResponse,
+};
 use super::search::build_layout;
 use super::search::prefit::{prefit_finding, prefit_options, Prefit};
 use super::search::starts::{run_starts, start_count, MultiStart, StartRun};
@@ -165,6 +167,91 @@ fn fit_seeded<R: Residuals + 'static>(
         result.wall_time_s = clock.elapsed().as_secs_f64();
     }
     Ok(result)
+}
+
+/// A fit without its assessment (no identifiability, no diagnostics, no property refits):
+/// the realised optimum and each record's residuals at its compared samples, for the
+/// held-out validation of a comparison, where only these count.
+pub(crate) struct LeanFit {
+    /// The oscillator, model and nuisance values at the optimum.
+    pub world: Realised,
+    /// Each record's residuals (measured minus predicted, its first channel) and their times.
+    pub records: Vec<(Vec<f64>, Vec<f64>)>,
+}
+
+/// [`fit`] without the prefit and the assessment: the optimum of `model` on `records` from
+/// the starts `opts` plan (see [`LeanFit`]).
+pub(crate) fn lean_fit(
+    osc: &Oscillator,
+    model: &(dyn FrictionModel + 'static),
+    records: &[Record],
+    opts: &FitOptions,
+) -> Result<LeanFit, EngineError> {
+    check_min_speed(opts.target.min_speed, opts.target.domain)
+        .map_err(EngineError::InvalidInput)?;
+    if opts.target.domain == FitDomain::Force {
+        check_force_domain(opts)?;
+        let producer = ForceAlongMotion::new(records, osc, opts)?;
+        let start = producer.starting_oscillator(osc, &opts.params.oscillator);
+        return lean_with(Arc::new(producer), &start, model, records, opts);
+    }
+    let (residuals, simulated) = simulated_response(osc, records, opts)?;
+    lean_with(residuals, &simulated, model, records, opts)
+}
+
+fn lean_with<R: Residuals + 'static>(
+    residuals: Arc<R>,
+    osc: &Oscillator,
+    model: &(dyn FrictionModel + 'static),
+    records: &[Record],
+    opts: &FitOptions,
+) -> Result<LeanFit, EngineError> {
+    check_inputs(osc, records, residuals.as_ref())?;
+    let layout = build_layout(
+        osc,
+        model,
+        records,
+        residuals.as_ref(),
+        &opts.params,
+        &opts.energy,
+    )?;
+    layout.validate_fixed(model)?;
+    let plan = StartPlan {
+        residuals: &residuals,
+        osc,
+        model,
+        records,
+        layout: &layout,
+        opts,
+    };
+    let found = search_optimum(&plan, None)?;
+    let reference = &found.reference;
+    let world = reference.realise(&reference.physical(&found.runs.best.u))?;
+    let per_record = records
+        .iter()
+        .enumerate()
+        .map(|(ri, rec)| {
+            let predicted = reference.predict_record(&world, ri)?;
+            let measured = residuals.measured(ri, rec);
+            let time = residuals.sample_axes(ri, rec).time;
+            let first = match time.len() {
+                0 => measured.len(),
+                n => n,
+            }
+            .min(measured.len())
+            .min(predicted.len());
+            let r = measured[..first]
+                .iter()
+                .zip(&predicted[..first])
+                .map(|(m, p)| m - p)
+                .collect();
+            Ok((r, time))
+        })
+        .collect::<Result<Vec<_>, EngineError>>()?;
+    Ok(LeanFit {
+        world,
+        records: per_record,
+    })
 }
 
 /// The optimum a search found: its runs (the best with its Jacobian adopted by

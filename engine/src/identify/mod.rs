@@ -25,7 +25,9 @@ pub mod search;
 pub mod values;
 
 pub use assessment::{energy_force_check, ForceReference};
-pub use compare::{compare, Comparison, ComparisonVerdict, FailedFit};
+pub use compare::{
+    compare, Comparison, ComparisonVerdict, FailedFit, LawValidation, SetAside, ValidationScheme,
+};
 pub use fit::{fit, fit_force, fit_with};
 pub use problem::{guess_hint, require_mechanics, require_oscillator, ForceAlongMotion};
 pub use problem::{Evaluation, Residuals, Segment, SimulatedResponse};

@@ -297,6 +297,25 @@ impl Record {
         }
     }
 
+    /// The record's first `len` samples: the same channels, release state and weight.
+    pub fn ending_at(&self, len: usize) -> Self {
+        let head = |v: &Vec<f64>| v[..len.min(v.len())].to_vec();
+        Self {
+            time: self.time.head(len),
+            channels: self
+                .channels
+                .iter()
+                .map(|(&c, v)| (c, Arc::new(head(v))))
+                .collect(),
+            normal_force: self.normal_force.as_ref().map(|n| match n {
+                NormalForce::Sampled(v) => NormalForce::Sampled(head(v)),
+                constant => constant.clone(),
+            }),
+            derived: SampleFacts::default(),
+            ..self.clone()
+        }
+    }
+
     /// The record with `sigma` as the given noise level of `channel` (in its unit).
     pub fn with_noise(mut self, channel: Channel, sigma: f64) -> Self {
         self.noise.insert(channel, sigma);

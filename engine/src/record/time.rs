@@ -122,6 +122,13 @@ impl TimeBase {
         check_count(&self.samples, min_samples)
     }
 
+    /// The first `len` samples (all of them if there are fewer).
+    pub(crate) fn head(&self, len: usize) -> Self {
+        Self {
+            samples: Arc::new(self.samples[..len.min(self.samples.len())].to_vec()),
+        }
+    }
+
     /// The samples from index `first` on (none if `first` is past the end).
     pub(crate) fn tail(&self, first: usize) -> Self {
         Self {

@@ -1,13 +1,16 @@
-//! The report of `compare`: several models fitted to the same records, ranked by AIC.
+//! The report of `compare`: several models fitted to the same records, the law to use
+//! first, then the ranking by AIC with each law's held-out score.
 
 use super::fit::{fit_json, parameter_table, sliding_column, verdict_line};
 use super::format::{fmt_criterion, fmt_num, fmt_opt};
 use super::{render_files, render_opening, Render, Role, Sink, Status, Table};
 use crate::identify::{Check, Comparison, FitResult};
+
 use serde::ser::SerializeMap;
 use serde::{Serialize, Serializer};
 
-/// A model comparison. report.json holds `ranking` (each fit as in the fit report),
+/// A model comparison. report.json holds `recommended` (the law to use, or null),
+/// `validation_scheme`, `ranking` (each fit as in the fit report, with its held-out score),
 /// `verdict` (see [`crate::identify::ComparisonVerdict`]), `failed`, `wall_time_s`, `command`,
 /// `config` and `files`.
 #[derive(Debug, Clone)]
@@ -28,35 +31,67 @@ impl Serialize for CompareReport {
         let ranking = c
             .ranking
             .iter()
-            .map(fit_json)
+            .map(|f| ranked_json(c, f))
             .collect::<Result<Vec<_>, _>>()
             .map_err(serde::ser::Error::custom)?;
-        let mut map = serializer.serialize_map(Some(8))?;
+        let recommended = c.verdict.as_ref().and_then(|v| v.recommended.as_deref());
+        let mut map = serializer.serialize_map(Some(12))?;
         map.serialize_entry("command", "compare")?;
         map.serialize_entry("config", &self.config)?;
+        map.serialize_entry("recommended", &recommended)?;
+        map.serialize_entry("validation_scheme", &c.validation_scheme)?;
         map.serialize_entry("ranking", &ranking)?;
         map.serialize_entry("verdict", &c.verdict)?;
         map.serialize_entry("failed", &c.failed)?;
         map.serialize_entry("warnings", &c.warnings)?;
         map.serialize_entry("wall_time_s", &c.wall_time_s)?;
+        map.serialize_entry("validation_wall_time_s", &c.validation_wall_time_s)?;
         map.serialize_entry("files", &self.files)?;
         map.end()
     }
 }
 
+/// A ranked fit as in the fit report, with its held-out score: `validation_rms`,
+/// `validation_rms_spread` (the folds' standard deviation) and `validation_folds`.
+fn ranked_json(c: &Comparison, f: &FitResult) -> Result<serde_json::Value, serde_json::Error> {
+    let mut v = fit_json(f)?;
+    let score = c.validation.iter().find(|s| s.model == f.model);
+    if let Some(obj) = v.as_object_mut() {
+        obj.insert(
+            "validation_rms".into(),
+            serde_json::to_value(score.and_then(|s| s.validation_rms))?,
+        );
+        obj.insert(
+            "validation_rms_spread".into(),
+            serde_json::to_value(score.and_then(|s| s.validation_rms_spread))?,
+        );
+        obj.insert(
+            "validation_folds".into(),
+            serde_json::to_value(score.map(|s| s.folds.clone()).unwrap_or_default())?,
+        );
+    }
+    Ok(v)
+}
+
 impl CompareReport {
-    /// The comparison's verdict sentence, with the status of the best fit (`None` when no
-    /// model could be fitted).
+    /// The comparison's verdict sentence (the law to use first), with the status of the
+    /// recommended fit, else the best (`None` when no model could be fitted).
     pub fn verdict_line(&self) -> Option<(Status, String)> {
-        let best = self.best()?;
-        let (status, best_text) = verdict_line(best);
+        let shown = self.recommended().or_else(|| self.best())?;
+        let (status, fit_text) = verdict_line(shown);
         let ranking = self.comparison.verdict.as_ref().map_or(String::new(), |v| {
             format!("{}. ", v.message.trim_end_matches('.'))
         });
         Some((
             status,
-            format!("{ranking}The best fit (`{}`): {best_text}", best.model),
+            format!("{ranking}The fit of `{}`: {fit_text}", shown.model),
         ))
+    }
+
+    /// The recommended fit, if the verdict names one.
+    pub fn recommended(&self) -> Option<&FitResult> {
+        let name = self.comparison.verdict.as_ref()?.recommended.as_deref()?;
+        self.comparison.ranking.iter().find(|f| f.model == name)
     }
 
     /// The best fit (lowest AIC), if any model could be fitted.
@@ -81,6 +116,7 @@ impl CompareReport {
                     fmt_opt(f.rank.as_ref().map(|r| r.akaike_weight)),
                     fmt_criterion(f.bic),
                     fmt_num(f.rms_residual),
+                    validation_cell(&self.comparison, f),
                     f.free_parameters.to_string(),
                     converged_cell(f),
                 ]
@@ -97,6 +133,7 @@ impl CompareReport {
                 "Akaike weight",
                 "BIC",
                 &rms,
+                "held-out rms (spread)",
                 "free",
                 "converged",
             ],
@@ -116,6 +153,15 @@ fn sliding_table(fit: &FitResult) -> Option<Table> {
         .map(|(r, cell)| vec![r.file.clone(), cell])
         .collect();
     Some(Table::new(&["record", &header], rows))
+}
+
+/// A law's held-out RMS and the folds' spread, or `-` when it has none.
+fn validation_cell(c: &Comparison, f: &FitResult) -> String {
+    let score = c.validation.iter().find(|s| s.model == f.model);
+    match score.and_then(|s| s.validation_rms.zip(s.validation_rms_spread)) {
+        Some((rms, spread)) => format!("{} ({})", fmt_num(rms), fmt_num(spread)),
+        None => "-".into(),
+    }
 }
 
 /// `yes`, `no`, or `yes, no model parameter settled` when the convergence finding warns.
@@ -143,23 +189,35 @@ impl Render for CompareReport {
         if let Some((status, text)) = self.verdict_line() {
             sink.verdict(status, &text);
         }
+        if let Some(verdict) = &c.verdict {
+            let law = verdict.recommended.as_deref().unwrap_or("none");
+            sink.paragraph(&format!("recommended: {law}"), Role::Brief);
+            sink.paragraph(&format!("verdict: {}", verdict.message), Role::Brief);
+        }
         sink.table(&self.ranking_table(), Role::Summary);
         if let Some(table) = self.best().and_then(sliding_table) {
             sink.table(&table, Role::Summary);
         }
-        if let Some(best) = self.best() {
+        if let Some(scheme) = c.validation_scheme {
             sink.paragraph(
-                &format!(
-                    "best: {} (wall time {} s)",
-                    best.model,
-                    fmt_num(c.wall_time_s)
-                ),
-                Role::Brief,
+                &format!("held-out validation: {}", scheme.describe()),
+                Role::Summary,
             );
         }
         if let Some(verdict) = &c.verdict {
-            sink.paragraph(&format!("verdict: {}", verdict.message), Role::Brief);
+            sink.paragraph(
+                &format!("information criteria: {}", verdict.information_criteria),
+                Role::Detail,
+            );
         }
+        sink.paragraph(
+            &format!(
+                "wall time {} s (held-out validation {} s)",
+                fmt_num(c.wall_time_s),
+                fmt_num(c.validation_wall_time_s)
+            ),
+            Role::Brief,
+        );
         sink.heading(2, "Parameters", Role::Detail);
         for f in &c.ranking {
             sink.heading(3, &f.model, Role::Detail);

@@ -77,7 +77,7 @@ pub(crate) fn add_property_uncertainty(
 /// The options of a refit of `fitted` from its optimum: no uncertainty budget, no guess, one
 /// start, no progress; a static law along the measured motion needs no global search from
 /// there (its default, see `Search::resolve`), so it searches locally.
-fn refit_options(opts: &FitOptions, fitted: &dyn FrictionModel) -> FitOptions {
+pub(crate) fn refit_options(opts: &FitOptions, fitted: &dyn FrictionModel) -> FitOptions {
     let simulated = opts.target.domain != FitDomain::Force;
     let local = opts.search.strategy.is_none() && fits_directly(fitted, simulated);
     let mut refit = opts.clone();

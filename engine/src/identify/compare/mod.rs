@@ -1,4 +1,13 @@
-//! Fitting several models to the same records and ranking them.
+//! Fitting several models to the same records, ranking them, scoring each on data its fit
+//! did not see ([`validation`]), holding nested laws to their sub-laws' optimum
+//! ([`nesting`]) and naming the law to use ([`verdict`]).
+
+mod nesting;
+pub mod validation;
+pub mod verdict;
+
+pub use validation::{LawValidation, ValidationScheme};
+pub use verdict::SetAside;
 
 use super::fit::fit;
 use crate::error::EngineError;
@@ -36,14 +45,30 @@ pub struct Comparison {
     pub verdict: Option<ComparisonVerdict>,
     /// Models that did not converge, and failed fits, as sentences.
     pub warnings: Vec<String>,
+    /// How the held-out validation split the records (`None` when they were too short).
+    pub validation_scheme: Option<ValidationScheme>,
+    /// Each ranked law's held-out score, in ranking order.
+    pub validation: Vec<LawValidation>,
+    /// Wall time of the held-out validation [s] (part of `wall_time_s`).
+    pub validation_wall_time_s: f64,
     /// Wall time of the whole comparison [s].
     pub wall_time_s: f64,
 }
 
-/// The verdict of a comparison: the best model, those the data cannot tell from it, and
-/// the simplest of these (fewest free parameters, then lowest AIC).
+/// The verdict of a comparison: the law to use (`recommended`), the laws set aside and why,
+/// and the information criteria's view (the best model by AIC, those it cannot tell from
+/// it, and the simplest of these: fewest free parameters, then lowest AIC).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ComparisonVerdict {
+    /// The law to use: the simplest whose held-out error is within the folds' noise of the
+    /// best held-out error, with nothing set against it (`None` when every law is set aside).
+    pub recommended: Option<String>,
+    /// The law with the lowest held-out error.
+    pub best_validated: Option<String>,
+    /// Laws not recommended, and why.
+    pub set_aside: Vec<SetAside>,
+    /// Why the information criteria are shown only as information.
+    pub information_criteria: String,
     /// The model with the lowest AIC.
     pub best: String,
     /// Every model within [`INDISTINGUISHABLE_DELTA_AIC`] of the best, best included.
@@ -108,14 +133,36 @@ pub fn compare(
             }),
         }
     }
+    let (mut ranking, nested) = nesting::enforce_nesting(ranking, osc, records, opts);
+    failed.extend(nested.into_iter().map(|n| FailedFit {
+        model: n.model,
+        error: n.reason,
+    }));
     ranking.sort_by(|a, b| a.aic.total_cmp(&b.aic));
     rank(&mut ranking);
-    let warnings = comparison_warnings(&ranking, &failed);
+    let validation_clock = std::time::Instant::now();
+    let (validation_scheme, validation) =
+        match validation::validate(&ranking, records, opts, opts.hooks.parallel) {
+            Some((scheme, scores)) => (Some(scheme), scores),
+            None => (None, Vec::new()),
+        };
+    let mut warnings = comparison_warnings(&ranking, &failed);
+    warnings.extend(validation.iter().filter_map(|v| {
+        v.error.as_ref().map(|e| {
+            format!(
+                "model `{}` could not be validated on held-out data: {e}",
+                v.model
+            )
+        })
+    }));
     Ok(Comparison {
-        verdict: verdict(&ranking),
+        verdict: verdict(&ranking, &validation),
         ranking,
         failed,
         warnings,
+        validation_scheme,
+        validation,
+        validation_wall_time_s: validation_clock.elapsed().as_secs_f64(),
         wall_time_s: clock.elapsed().as_secs_f64(),
     })
 }
@@ -157,8 +204,8 @@ fn is_indistinguishable(fit: &FitResult) -> bool {
     fit.rank.is_some_and(|r| r.indistinguishable)
 }
 
-/// The best model, its indistinguishable rivals and the simplest of them.
-fn verdict(ranking: &[FitResult]) -> Option<ComparisonVerdict> {
+/// The law to use, the laws set aside, and the information criteria's view.
+fn verdict(ranking: &[FitResult], validation: &[LawValidation]) -> Option<ComparisonVerdict> {
     let best = ranking.first()?;
     let close: Vec<&FitResult> = ranking.iter().filter(|f| is_indistinguishable(f)).collect();
     let simplest = close
@@ -170,19 +217,17 @@ fn verdict(ranking: &[FitResult]) -> Option<ComparisonVerdict> {
         })
         .map_or(best, |f| *f);
     let names: Vec<String> = close.iter().map(|f| f.model.clone()).collect();
-    let message = if names.len() > 1 {
-        format!(
-            "{} are indistinguishable on this data (AIC within {INDISTINGUISHABLE_DELTA_AIC} of the best); the simplest is `{}`",
-            names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", "),
-            simplest.model
-        )
-    } else {
-        let margin = ranking
-            .get(1)
-            .map(|f| format!(" (next: `{}`, delta AIC {:.1})", f.model, f.aic - best.aic))
-            .unwrap_or_default();
-        format!("best: `{}`{margin}", best.model)
-    };
+    let set_aside: Vec<SetAside> = ranking
+        .iter()
+        .filter_map(|f| {
+            verdict::set_aside_reason(f).map(|reason| SetAside {
+                model: f.model.clone(),
+                reason,
+            })
+        })
+        .collect();
+    let choice = recommend(ranking, validation, &set_aside, simplest);
+    let message = verdict_message(&choice, &set_aside, validation.is_empty());
     let mut named = vec![best];
     if simplest.model != best.model {
         named.push(simplest);
@@ -194,11 +239,149 @@ fn verdict(ranking: &[FitResult]) -> Option<ComparisonVerdict> {
         format!("{message}; but {}", caveats.join("; "))
     };
     Some(ComparisonVerdict {
+        recommended: choice.recommended.clone(),
+        best_validated: choice.best_validated.clone(),
+        set_aside,
+        information_criteria: verdict::information_note(best),
         best: best.model.clone(),
         indistinguishable: names,
         simplest: simplest.model.clone(),
         message,
     })
+}
+
+/// The verdict's choice: the law to use and the best held-out law.
+struct Choice {
+    recommended: Option<String>,
+    best_validated: Option<String>,
+    /// Laws within the folds' noise of the best held-out error (the recommended among them).
+    within: Vec<String>,
+    /// A better held-out law that was set aside.
+    better_set_aside: Option<String>,
+}
+
+/// The simplest law with nothing against it whose held-out error is within the folds' noise
+/// of the best (without validation: the simplest of the AIC-indistinguishable laws with
+/// nothing against it, else the best such law by AIC).
+fn recommend(
+    ranking: &[FitResult],
+    validation: &[LawValidation],
+    set_aside: &[SetAside],
+    simplest: &FitResult,
+) -> Choice {
+    let clean = |f: &FitResult| !set_aside.iter().any(|s| s.model == f.model);
+    let score = |f: &FitResult| {
+        validation
+            .iter()
+            .find(|v| v.model == f.model && v.validation_rms.is_some())
+    };
+    let best_validated = ranking
+        .iter()
+        .filter_map(|f| score(f).map(|v| (f, v)))
+        .min_by(|a, b| {
+            a.1.validation_rms
+                .unwrap_or(f64::INFINITY)
+                .total_cmp(&b.1.validation_rms.unwrap_or(f64::INFINITY))
+        });
+    let Some((top, top_score)) = best_validated else {
+        let recommended = if clean(simplest) {
+            Some(simplest)
+        } else {
+            ranking.iter().find(|f| clean(f))
+        };
+        return Choice {
+            recommended: recommended.map(|f| f.model.clone()),
+            best_validated: None,
+            within: Vec::new(),
+            better_set_aside: None,
+        };
+    };
+    let within: Vec<&FitResult> = ranking
+        .iter()
+        .filter(|f| score(f).is_some_and(|v| verdict::within_noise(v, top_score)))
+        .collect();
+    let clean_within: Vec<&FitResult> = within.iter().copied().filter(|f| clean(f)).collect();
+    let (recommended, better_set_aside) = if clean_within.is_empty() {
+        let fallback = ranking
+            .iter()
+            .filter(|f| clean(f) && score(f).is_some())
+            .min_by(|a, b| {
+                let r = |f: &FitResult| {
+                    score(f)
+                        .and_then(|v| v.validation_rms)
+                        .unwrap_or(f64::INFINITY)
+                };
+                r(a).total_cmp(&r(b))
+            });
+        (fallback, Some(top.model.clone()))
+    } else {
+        let rms = |f: &FitResult| {
+            score(f)
+                .and_then(|v| v.validation_rms)
+                .unwrap_or(f64::INFINITY)
+        };
+        let simplest_within = clean_within.into_iter().min_by(|a, b| {
+            a.free_parameters
+                .cmp(&b.free_parameters)
+                .then(rms(a).total_cmp(&rms(b)))
+        });
+        (simplest_within, None)
+    };
+    Choice {
+        recommended: recommended.map(|f| f.model.clone()),
+        best_validated: Some(top.model.clone()),
+        within: within.iter().map(|f| f.model.clone()).collect(),
+        better_set_aside,
+    }
+}
+
+/// The verdict's sentence: the law to use first, then why.
+fn verdict_message(choice: &Choice, set_aside: &[SetAside], unvalidated: bool) -> String {
+    let reasons = |name: &str| {
+        set_aside
+            .iter()
+            .find(|s| s.model == name)
+            .map(|s| s.reason.clone())
+            .unwrap_or_default()
+    };
+    let Some(law) = &choice.recommended else {
+        let why: Vec<String> = set_aside
+            .iter()
+            .map(|s| format!("`{}`: {}", s.model, s.reason))
+            .collect();
+        return format!("no law can be recommended: {}", why.join("; "));
+    };
+    let mut text = format!("use `{law}`");
+    if unvalidated || choice.best_validated.is_none() {
+        text.push_str(" (the records were too short to hold data out: chosen by AIC)");
+    } else if let Some(better) = &choice.better_set_aside {
+        text.push_str(&format!(
+            ": `{better}` scores better on held-out data but is set aside ({})",
+            reasons(better)
+        ));
+    } else if choice.within.len() > 1 {
+        let others: Vec<String> = choice
+            .within
+            .iter()
+            .filter(|n| *n != law)
+            .map(|n| format!("`{n}`"))
+            .collect();
+        text.push_str(&format!(
+            ": the simplest law whose held-out error is within the folds' noise of the best (also within: {})",
+            others.join(", ")
+        ));
+    } else {
+        text.push_str(": the lowest held-out error");
+    }
+    let others: Vec<String> = set_aside
+        .iter()
+        .filter(|s| Some(&s.model) != choice.better_set_aside.as_ref())
+        .map(|s| format!("`{}` is set aside: {}", s.model, s.reason))
+        .collect();
+    if !others.is_empty() {
+        text.push_str(&format!("; {}", others.join("; ")));
+    }
+    text
 }
 
 /// The findings of `fit` that say a friction level is at its bound (a viscous coefficient at
