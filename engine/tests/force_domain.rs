@@ -7,8 +7,8 @@ mod common;
 
 use common::{records, stribeck_truth, NOISE};
 use frictionid_engine::exact::coulomb_free_vibration;
-use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::identify::{fit, FitDomain, FitOptions, ForceTarget, TargetOptions};
+use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
@@ -99,7 +99,11 @@ fn force_options() -> FitOptions {
         target: TargetOptions {
             domain: FitDomain::Force,
             // m, c, k play no part: a measured force needs only the normal force.
-            unknown_oscillator: vec![OscillatorProperty::Mass, OscillatorProperty::Damping, OscillatorProperty::Stiffness],
+            unknown_oscillator: vec![
+                OscillatorProperty::Mass,
+                OscillatorProperty::Damping,
+                OscillatorProperty::Stiffness,
+            ],
             ..TargetOptions::default()
         },
         ..FitOptions::default()

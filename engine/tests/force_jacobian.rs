@@ -85,7 +85,11 @@ fn force_options(free: &[&str]) -> FitOptions {
             domain: FitDomain::Force,
             force_offset: true,
             min_speed: Some(5e-4),
-            unknown_oscillator: vec![OscillatorProperty::Mass, OscillatorProperty::Damping, OscillatorProperty::Stiffness],
+            unknown_oscillator: vec![
+                OscillatorProperty::Mass,
+                OscillatorProperty::Damping,
+                OscillatorProperty::Stiffness,
+            ],
             ..TargetOptions::default()
         },
         params: ParamOptions {

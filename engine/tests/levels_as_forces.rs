@@ -8,8 +8,8 @@
 
 use frictionid_engine::axis::Axis;
 use frictionid_engine::exact::coulomb_free_vibration;
-use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::identify::{fit, FitOptions, FitResult, Status, TargetOptions};
+use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::record::NormalForce;
 use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
 use frictionid_engine::{Oscillator, Record};

@@ -8,10 +8,10 @@
 //! least-squares objective is found by solving those three normal equations on a dense
 //! logarithmic grid of v_s and refining the best grid point by golden-section search.
 
-use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::identify::{
     fit, FitDomain, FitOptions, Search, SearchOptions, TargetOptions,
 };
+use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
@@ -169,7 +169,11 @@ fn force_options() -> FitOptions {
     FitOptions {
         target: TargetOptions {
             domain: FitDomain::Force,
-            unknown_oscillator: vec![OscillatorProperty::Mass, OscillatorProperty::Damping, OscillatorProperty::Stiffness],
+            unknown_oscillator: vec![
+                OscillatorProperty::Mass,
+                OscillatorProperty::Damping,
+                OscillatorProperty::Stiffness,
+            ],
             ..TargetOptions::default()
         },
         ..FitOptions::default()

@@ -12,10 +12,10 @@
 //! recover the parameters the runs determine.
 
 use frictionid_engine::axis::Axis;
-use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::identify::{
     fit, FitDomain, FitOptions, FitResult, ParamOptions, TargetOptions,
 };
+use frictionid_engine::oscillator::OscillatorProperty;
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
@@ -39,7 +39,11 @@ fn options(free: &[&str]) -> FitOptions {
     FitOptions {
         target: TargetOptions {
             domain: FitDomain::Force,
-            unknown_oscillator: vec![OscillatorProperty::Mass, OscillatorProperty::Damping, OscillatorProperty::Stiffness],
+            unknown_oscillator: vec![
+                OscillatorProperty::Mass,
+                OscillatorProperty::Damping,
+                OscillatorProperty::Stiffness,
+            ],
             ..TargetOptions::default()
         },
         params: ParamOptions {

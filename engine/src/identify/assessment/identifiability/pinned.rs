@@ -4,8 +4,8 @@
 use crate::identify::problem::least_squares::{FitProblem, ProblemParts};
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::{run_start, RunSlot, StartRun};
-use crate::identify::values::layout::ParamKind;
 use crate::identify::values::fit_options::FitOptions;
+use crate::identify::values::layout::ParamKind;
 use crate::identify::values::outcome::TerminationReason;
 use frictionid_models::FrictionModel;
 use nalgebra::DVector;

@@ -173,7 +173,13 @@ fn settle_convergence<R: Residuals + 'static>(
         return;
     }
     let others = without(&runs.best.u, &pins);
-    let Some(run) = pinned_fit(reference, &pins, &others, opts, (opts.search.max_iterations, None)) else {
+    let Some(run) = pinned_fit(
+        reference,
+        &pins,
+        &others,
+        opts,
+        (opts.search.max_iterations, None),
+    ) else {
         return;
     };
     if !run.converged() || run.cost > runs.best.cost {
