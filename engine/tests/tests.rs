@@ -19,6 +19,7 @@ mod pendulum;
 mod records;
 mod replay;
 mod robot_joint;
+mod robust_targets;
 mod simulate;
 mod slow_runs;
 mod units;

@@ -357,6 +357,52 @@ pub fn savitzky_golay_derivative(
     Ok(out)
 }
 
+/// The noise gain of [`savitzky_golay_derivative`] at each of `n` samples with the same
+/// `window`, `order` and `breaks`: the norm of the sample's weights (unit spacing) over that
+/// of a centred window, so 1 where the window is centred and more where it slides inwards
+/// near a break (a one-sided fit amplifies the velocity's noise most at the run's end
+/// sample). Computed in sample offsets: on an uneven grid it is the gain on the grid's
+/// average spacing.
+pub fn savitzky_golay_noise_gains(
+    n: usize,
+    window: usize,
+    order: usize,
+    breaks: &[usize],
+) -> Result<Vec<f64>, EngineError> {
+    Differentiator::SavitzkyGolay { window, order }.validate()?;
+    let mut gains = vec![1.0; n];
+    if n < 2 {
+        return Ok(gains);
+    }
+    let centre = centre_weight_norm(window, order)?;
+    let mut bounds: Vec<usize> = Vec::with_capacity(breaks.len() + 2);
+    bounds.push(0);
+    bounds.extend(breaks.iter().copied().filter(|&b| b > 0 && b < n));
+    bounds.push(n);
+    bounds.sort_unstable();
+    bounds.dedup();
+    for seg in bounds.windows(2) {
+        let (s, e) = if seg[1] - seg[0] < 2 {
+            (0, n)
+        } else {
+            (seg[0], seg[1])
+        };
+        let len = e - s;
+        let (w, p) = if len >= window {
+            (window, order)
+        } else {
+            (len, order.min(len - 1))
+        };
+        let table = unit_weights(w, p)?;
+        let norm = |row: &[f64]| row.iter().map(|x| x * x).sum::<f64>().sqrt();
+        for (i, gain) in gains.iter_mut().enumerate().take(seg[1]).skip(seg[0]) {
+            let lo = i.saturating_sub(w / 2).clamp(s, e - w);
+            *gain = norm(&table[i - lo]) / centre;
+        }
+    }
+    Ok(gains)
+}
+
 /// The slopes at the samples `at` of a window centred on each, from the centre row `weights`
 /// of the unit-spacing table: out\[i\] = sum_k weights\[k\] v\[i - h + k\] / dt (h = half the
 /// window), summed tap after tap over all samples at once (contiguous sweeps the compiler

@@ -74,8 +74,8 @@ mod numerical_replay;
 pub use crate::simulate::MechanicalEnergy;
 pub use differentiate::{
     auto_window, central_difference, centre_weight_norm, derivative_weights, moving_average,
-    paper_derivative, savitzky_golay_derivative, Differentiator, WindowInputs, AUTO_ORDER,
-    PAPER_SPAN,
+    paper_derivative, savitzky_golay_derivative, savitzky_golay_noise_gains, Differentiator,
+    WindowInputs, AUTO_ORDER, PAPER_SPAN,
 };
 pub use halfcycle::{HalfCycle, MIN_RUN};
 pub use model_force::{

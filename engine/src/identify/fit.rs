@@ -23,6 +23,7 @@ use super::search::build_layout;
 use super::search::prefit::{prefit_finding, prefit_options, Prefit};
 use super::search::starts::{run_starts, start_count, MultiStart, StartRun};
 use super::search::strategy::{plan_fit_starts, Planned, StartPlan};
+use super::values::search::check_f_scale;
 use super::values::{
     check_min_speed, fits_directly, FitDomain, FitOptions, FitResult, Search, TerminationReason,
 };
@@ -50,6 +51,7 @@ pub fn fit(
 ) -> Result<FitResult, EngineError> {
     let target = &opts.target;
     check_min_speed(target.min_speed, target.domain).map_err(EngineError::InvalidInput)?;
+    check_f_scale(opts.search.f_scale).map_err(EngineError::InvalidInput)?;
     if target.domain == FitDomain::Force {
         return fit_force(osc, model, records, opts);
     }
@@ -289,6 +291,7 @@ fn search_optimum<R: Residuals + 'static>(
                 parallel: opts.hooks.parallel,
             },
         )
+        .with_loss(opts.search.robust_loss())
     };
     let reference = make_problem();
     let search = Search::resolve(opts.search.strategy, plan.model, n_model_free, simulated);

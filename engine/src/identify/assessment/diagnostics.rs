@@ -630,6 +630,7 @@ mod tests {
             release_time: None,
             samples: time.len(),
             sliding: None,
+            unreliable_target: None,
             channel: "velocity".into(),
             rms_residual: 0.0,
             channels: Vec::new(),

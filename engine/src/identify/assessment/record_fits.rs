@@ -8,6 +8,7 @@ use crate::energy::{
     analyze_record, forces_from_states, states_along, EnergyOptions, MeasuredMotion,
 };
 use crate::error::EngineError;
+use crate::identify::problem::inverse_dynamics::unreliable_target_finding;
 use crate::identify::problem::{
     AnalysisRequest, FitProblem, Realised, RecordCase, Residuals, Segment,
 };
@@ -47,6 +48,12 @@ pub fn record_fits<R: Residuals>(
         out.sum_sq += sum_sq;
         out.n_total += record.series.measured.len();
         out.findings.extend(finding);
+        out.findings.extend(
+            record
+                .unreliable_target
+                .as_ref()
+                .and_then(|u| unreliable_target_finding(&record.file, u)),
+        );
         out.records.push(record);
     }
     Ok(out)
@@ -89,6 +96,7 @@ fn record_fit<R: Residuals>(
         release_time: rec.release_time,
         samples: rec.len(),
         sliding: problem.residuals.sliding_samples(ri),
+        unreliable_target: problem.residuals.unreliable_samples(ri),
         channel: problem.residuals.record_channel(ri).to_string(),
         rms_residual: (sum_sq / measured.len() as f64).sqrt(),
         channels,

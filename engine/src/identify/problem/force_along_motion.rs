@@ -44,7 +44,9 @@ use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::{FreeParam, ParamKind};
 use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::nuisance::NuisanceKind;
-use crate::identify::values::result::{ForceBalance, SampleAxes, SlidingSamples};
+use crate::identify::values::result::{
+    ForceBalance, SampleAxes, SlidingSamples, UnreliableSamples,
+};
 use crate::identify::values::target_options::{FitDomain, ForceTarget};
 use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::noise::noise_floor_level;
@@ -78,6 +80,8 @@ pub struct ForceTrack {
     target: Vec<f64>,
     /// The samples kept by `min_speed`, when it is given.
     sliding: Option<SlidingSamples>,
+    /// The sliding samples left out because their target is unreliable.
+    unreliable: Option<UnreliableSamples>,
     /// Noise level of the target \[N\].
     pub noise: f64,
     /// The oscillator's terms of an inverse-dynamics target.
@@ -352,6 +356,7 @@ impl ForceTrack {
         )
         .map_err(err)?;
         let mut balance = None;
+        let mut unreliable = None;
         let (used, target) = match source {
             TargetSource::Measured => {
                 let f = record.channel(Channel::Force).unwrap_or_default().to_vec();
@@ -367,12 +372,13 @@ impl ForceTrack {
             }
             TargetSource::InverseDynamics => {
                 let threshold = opts.energy.velocity_threshold;
-                balance = Some(
-                    Balance::new(record, &motion.v, threshold, has_restoring(osc, opts))
-                        .map_err(|e| err(e.to_string()))?,
-                );
+                let axis = Balance::new(record, &motion.v, has_restoring(osc, opts))
+                    .map_err(|e| err(e.to_string()))?;
                 let u = record.channel(Channel::InputForce).unwrap_or_default();
-                let used = sliding_samples(&motion.v, threshold);
+                let sliding = sliding_samples(&motion.v, threshold);
+                unreliable = axis.left_out(&sliding, record.time());
+                let used = axis.reliable(sliding);
+                balance = Some(axis);
                 let target = used.iter().map(|&i| u[i]).collect();
                 (used, target)
             }
@@ -412,6 +418,7 @@ impl ForceTrack {
             target,
             balance,
             sliding,
+            unreliable,
         })
     }
 
@@ -727,6 +734,10 @@ impl Residuals for ForceAlongMotion {
 
     fn sliding_samples(&self, index: usize) -> Option<SlidingSamples> {
         self.tracks.get(index).and_then(|t| t.sliding)
+    }
+
+    fn unreliable_samples(&self, index: usize) -> Option<UnreliableSamples> {
+        self.tracks.get(index).and_then(|t| t.unreliable.clone())
     }
 
     fn sample_axes(&self, index: usize, record: &Record) -> SampleAxes {

@@ -16,6 +16,7 @@ use super::step_allowance::StepAllowance;
 use crate::error::{EngineError, IntegrationFailure};
 use crate::identify::values::layout::{FreeParam, ParamKind};
 use crate::identify::values::nuisance::NuisanceValues;
+use crate::identify::values::search::RobustLoss;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use crate::simulate::SimOptions;
@@ -47,6 +48,9 @@ pub struct FitProblem<R: Residuals = SimulatedResponse> {
     pub sim: SimOptions,
     /// Simulate records (and Jacobian columns) in parallel.
     pub parallel: bool,
+    /// The loss the solver minimises: its residuals and Jacobian rows are the loss's
+    /// transform of the producer's ([`RobustLoss`]; least squares unless told).
+    loss: RobustLoss,
     simulations: AtomicU64,
     last_error: Mutex<Option<String>>,
     /// The step allowance of the simulations, per record ([`StepAllowance`]).
@@ -100,11 +104,37 @@ impl<R: Residuals> FitProblem<R> {
             residuals,
             sim: parts.sim,
             parallel: parts.parallel,
+            loss: RobustLoss::linear(),
             simulations: AtomicU64::new(0),
             last_error: Mutex::new(None),
             cache: Mutex::new(None),
             physical_cache: Mutex::new(None),
         }
+    }
+
+    /// The same problem minimising `loss` (`[fit.options] loss`).
+    pub fn with_loss(self, loss: RobustLoss) -> Self {
+        Self { loss, ..self }
+    }
+
+    /// `r` through the loss's transform.
+    fn robust(&self, mut r: DVector<f64>) -> DVector<f64> {
+        if !self.loss.is_linear() {
+            r.iter_mut().for_each(|x| *x = self.loss.residual(*x));
+        }
+        r
+    }
+
+    /// The Jacobian `j` of the residuals `r0` as the loss's transform sees it: each row times
+    /// the transform's derivative there (the weights at the point, as iteratively reweighted
+    /// least squares).
+    fn robust_rows(&self, mut j: DMatrix<f64>, r0: &DVector<f64>) -> DMatrix<f64> {
+        if !self.loss.is_linear() {
+            for (i, &r) in r0.iter().enumerate() {
+                j.row_mut(i).scale_mut(self.loss.derivative(r));
+            }
+        }
+        j
     }
 
     /// Number of residuals (over all records).
@@ -419,8 +449,8 @@ impl<R: Residuals> FitProblem<R> {
     ) -> Result<(DMatrix<f64>, DVector<f64>), EngineError> {
         let r0 = self.residuals_at(p)?;
         let u = self.internal(p);
-        let j = self.jacobian_internal(&u, &r0);
-        Ok((self.to_physical_columns(j, p), r0))
+        let j = self.robust_rows(self.jacobian_internal(&u, &r0), &r0);
+        Ok((self.to_physical_columns(j, p), self.robust(r0)))
     }
 }
 
@@ -432,7 +462,7 @@ impl<R: Residuals> Operator for FitProblem<R> {
         if let Ok(mut c) = self.cache.lock() {
             *c = Some((u.clone(), r.clone()));
         }
-        Ok(r)
+        Ok(self.robust(r))
     }
 }
 
@@ -446,7 +476,7 @@ impl<R: Residuals> Jacobian for FitProblem<R> {
             .ok()
             .and_then(|c| c.as_ref().filter(|(cu, _)| cu == u).map(|(_, r)| r.clone()));
         let r0 = cached.unwrap_or_else(|| self.residuals_or_nan(u));
-        Ok(self.jacobian_internal(u, &r0))
+        Ok(self.robust_rows(self.jacobian_internal(u, &r0), &r0))
     }
 }
 

@@ -16,7 +16,7 @@ use crate::energy::{EnergyAnalysis, EnergyOptions};
 use crate::error::EngineError;
 use crate::identify::values::{
     ForceBalance, FreeParam, FrictionLevels, NuisanceKind, NuisanceValues, SampleAxes,
-    SlidingSamples,
+    SlidingSamples, UnreliableSamples,
 };
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -219,6 +219,12 @@ pub trait Residuals: Send + Sync {
     /// The sliding samples record `index` compares, when only those are (`None`: every
     /// sample the residuals define).
     fn sliding_samples(&self, _index: usize) -> Option<SlidingSamples> {
+        None
+    }
+
+    /// The samples of record `index` left out because their target is unreliable (`None`:
+    /// none are).
+    fn unreliable_samples(&self, _index: usize) -> Option<UnreliableSamples> {
         None
     }
 

@@ -265,6 +265,7 @@ pub fn fit_simpler<R: Residuals + 'static>(
                 parallel: opts.hooks.parallel,
             },
         )
+        .with_loss(opts.search.robust_loss())
     };
     let mut points = vec![layout.start.clone()];
     for (fitted, ctx) in also_from {

@@ -216,6 +216,8 @@ pub enum Check {
     Prefit,
     /// The fitted model is physically doubtful (e.g. mu_s < mu_c).
     PhysicalConsistency,
+    /// Samples whose target is unreliable, left out of the fit.
+    UnreliableTarget,
 }
 
 /// One diagnostic of a fit: a check, its status, the value it judged and a plain message.

@@ -54,6 +54,10 @@ pub struct RecordFit {
     /// domain).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sliding: Option<SlidingSamples>,
+    /// The sliding samples not compared because their target is unreliable (an inverse-dynamics
+    /// acceleration differentiated one-sided at a run's end or across a reversal).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unreliable_target: Option<UnreliableSamples>,
     /// The quantity compared (`velocity`, `force`, `energy_based_force`).
     pub channel: String,
     /// RMS of fitted - measured, in the unit of the compared quantity (m/s for velocity).
@@ -68,6 +72,17 @@ pub struct RecordFit {
     /// The measured and fitted series and the forces along the motion (for plots).
     #[serde(skip)]
     pub series: FitSeries,
+}
+
+/// The samples of a record whose target is unreliable and which the fit does not compare.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct UnreliableSamples {
+    /// Samples left out.
+    pub count: usize,
+    /// Sliding samples the target had before (those left out included).
+    pub of: usize,
+    /// The time ranges \[s\] of the samples left out, \[first, last\] of each contiguous run.
+    pub ranges: Vec<[f64; 2]>,
 }
 
 /// The samples of a force-domain record compared under `[fit.options] min_speed`: those

@@ -1,5 +1,6 @@
 //! How a fit searches for its optimum: the options the search floor reads (`[fit]
-//! max_iterations`, `tolerance`; `[fit.options] multistart`, `search`, `prefit`), the
+//! max_iterations`, `tolerance`; `[fit.options] multistart`, `search`, `prefit`, `loss`,
+//! `f_scale`), the
 //! strategy a fit asks for and the rule that picks one when it asks for none (the strategies
 //! themselves: [`crate::identify::search::strategy`]).
 
@@ -36,6 +37,41 @@ pub struct SearchOptions {
     /// Velocity fits of models with internal states start also from the optimum of a
     /// force-domain fit to the energy-based force (the prefit).
     pub prefit: bool,
+    /// The loss of the residuals (`loss`).
+    pub loss: Loss,
+    /// The loss's scale C in units of each record's noise level (`f_scale`); `None`:
+    /// [`DEFAULT_F_SCALE`].
+    pub f_scale: Option<f64>,
+}
+
+/// The loss of the residuals (`[fit.options] loss`), with SciPy `least_squares`'s meaning:
+/// the fit minimises 1/2 C^2 sum rho((r_i / C)^2), r_i the residuals in units of their
+/// record's noise level and C = `f_scale`. A robust loss (`huber`, `soft_l1`) grows only
+/// linearly beyond C, so a few samples with a wrong target (spikes) pull the fit less.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Loss {
+    /// rho(z) = z: least squares.
+    #[default]
+    Linear,
+    /// rho(z) = z for z <= 1, 2 sqrt(z) - 1 beyond.
+    Huber,
+    /// rho(z) = 2 (sqrt(1 + z) - 1).
+    SoftL1,
+}
+
+/// The loss's default scale in units of the record's noise level: Huber's constant of 95 %
+/// efficiency under Gaussian noise.
+pub const DEFAULT_F_SCALE: f64 = 1.345;
+
+/// `[fit.options] f_scale` is a finite number > 0; the message otherwise.
+pub fn check_f_scale(f_scale: Option<f64>) -> Result<(), String> {
+    match f_scale {
+        Some(c) if !(c.is_finite() && c > 0.0) => Err(format!(
+            "[fit.options] f_scale must be a number > 0 (in units of the record's noise), got {c}"
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Iteration limit of each start when `[fit] max_iterations` is not given.
@@ -49,6 +85,8 @@ impl Default for SearchOptions {
             max_iterations: DEFAULT_MAX_ITERATIONS,
             tolerance: None,
             prefit: false,
+            loss: Loss::Linear,
+            f_scale: None,
         }
     }
 }
@@ -59,10 +97,20 @@ option_keys!(SearchOptions {
         "multistart" => multistart,
         "search" => strategy,
         "prefit" => prefit,
+        "loss" => loss,
+        "f_scale" => f_scale,
     ],
 });
 
 impl SearchOptions {
+    /// The loss the fit minimises, at its scale.
+    pub fn robust_loss(&self) -> RobustLoss {
+        RobustLoss {
+            loss: self.loss,
+            scale: self.f_scale.unwrap_or(DEFAULT_F_SCALE),
+        }
+    }
+
     /// The options of a fit that starts once where it is told (a refit from an optimum, a
     /// stage): one start, a local search when `local`, else the strategy asked for.
     pub fn one_start(&self, local: bool) -> Self {
@@ -75,6 +123,66 @@ impl SearchOptions {
             },
             ..self.clone()
         }
+    }
+}
+
+/// A loss at its scale C: the residual transform r -> C sgn(r) sqrt(rho((r / C)^2)), whose
+/// half sum of squares is the loss's cost, so that a least-squares solver minimises it (the
+/// Jacobian's rows scale by the transform's derivative).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RobustLoss {
+    /// The loss.
+    pub loss: Loss,
+    /// Its scale C (in the residuals' unit).
+    pub scale: f64,
+}
+
+impl RobustLoss {
+    /// Least squares.
+    pub fn linear() -> Self {
+        Self {
+            loss: Loss::Linear,
+            scale: DEFAULT_F_SCALE,
+        }
+    }
+
+    /// Whether the transform is the identity.
+    pub fn is_linear(&self) -> bool {
+        self.loss == Loss::Linear
+    }
+
+    /// rho(z) and rho'(z).
+    fn rho(&self, z: f64) -> (f64, f64) {
+        match self.loss {
+            Loss::Linear => (z, 1.0),
+            Loss::Huber if z <= 1.0 => (z, 1.0),
+            Loss::Huber => (2.0 * z.sqrt() - 1.0, 1.0 / z.sqrt()),
+            // 2 (sqrt(1 + z) - 1) without its cancellation at small z.
+            Loss::SoftL1 => (2.0 * z / ((1.0 + z).sqrt() + 1.0), 1.0 / (1.0 + z).sqrt()),
+        }
+    }
+
+    /// The transformed residual C sgn(r) sqrt(rho((r / C)^2)) (NaN stays NaN).
+    pub fn residual(&self, r: f64) -> f64 {
+        if self.is_linear() {
+            return r;
+        }
+        let z = (r / self.scale).powi(2);
+        self.scale * r.signum() * self.rho(z).0.sqrt()
+    }
+
+    /// The transform's derivative at `r`: rho'(z) |r| / (C sqrt(rho(z))), 1 at r = 0 (the
+    /// weight of the residual's Jacobian row).
+    pub fn derivative(&self, r: f64) -> f64 {
+        if self.is_linear() {
+            return 1.0;
+        }
+        let z = (r / self.scale).powi(2);
+        let (rho, slope) = self.rho(z);
+        if rho <= 0.0 {
+            return 1.0;
+        }
+        slope * z.sqrt() / rho.sqrt()
     }
 }
 
@@ -128,4 +236,39 @@ impl Search {
 /// and, with more than two free parameters, a `global` search ([`Search::resolve`]).
 pub fn fits_directly(model: &dyn FrictionModel, simulated: bool) -> bool {
     !simulated && model.n_states() == 0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The transformed residuals' half square is the loss's cost 1/2 C^2 rho((r / C)^2)
+    /// (SciPy's `least_squares`), and the derivative is the transform's slope.
+    #[test]
+    fn the_transform_carries_the_loss_and_its_slope() {
+        let c = 0.7;
+        for loss in [Loss::Linear, Loss::Huber, Loss::SoftL1] {
+            let robust = RobustLoss { loss, scale: c };
+            for r in [-5.0, -0.3, 0.0, 0.2, 0.69, 3.0, 40.0] {
+                let z: f64 = (r / c) * (r / c);
+                let rho = match loss {
+                    Loss::Linear => z,
+                    Loss::Huber if z <= 1.0 => z,
+                    Loss::Huber => 2.0 * z.sqrt() - 1.0,
+                    Loss::SoftL1 => 2.0 * ((1.0 + z).sqrt() - 1.0),
+                };
+                let t = robust.residual(r);
+                assert!(
+                    (t * t - c * c * rho).abs() <= 1e-12 * (1.0 + c * c * rho),
+                    "{loss:?} {r}"
+                );
+                assert!(t * r >= 0.0);
+                let h = 1e-6;
+                let slope = (robust.residual(r + h) - robust.residual(r - h)) / (2.0 * h);
+                assert!((robust.derivative(r) - slope).abs() < 1e-5, "{loss:?} {r}");
+            }
+        }
+        assert!(RobustLoss::linear().is_linear());
+        assert!(check_f_scale(Some(0.0)).is_err() && check_f_scale(Some(2.0)).is_ok());
+    }
 }
