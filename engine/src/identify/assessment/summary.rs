@@ -3,6 +3,7 @@
 //! parameter's entry, the per-record fits and the findings, in report order.
 
 use super::diagnostics::{self, starts_at_best};
+use super::goodness;
 use super::identifiability::{self, covariance_of_determined, Standing};
 use super::record_fits::{record_fits, RecordFits};
 use super::stats::{self, aic, bic, t_quantile_975, Covariance};
@@ -17,6 +18,7 @@ use crate::identify::values::{
     ParamKind, Search, StartOutcome, Status,
 };
 use crate::oscillator::Oscillator;
+use crate::record::Channel;
 use nalgebra::DMatrix;
 use std::time::Instant;
 
@@ -297,6 +299,7 @@ fn diagnose<R: Residuals>(
     findings.extend(diagnostics::parameters_at_bounds(params, &stats.p_best));
     findings.extend(stats.without_effect.clone());
     findings.extend(fits.findings.iter().cloned());
+    findings.push(goodness_findings(ctx, fits));
     if ctx.reference.residuals.simulates_response() {
         findings.push(diagnostics::residual_structure(
             &fits.records,
@@ -305,6 +308,21 @@ fn diagnose<R: Residuals>(
         ));
     }
     findings
+}
+
+/// The goodness of fit over the records, each judged against its noise floor (raised to
+/// the noise level the record gives for its compared channel).
+fn goodness_findings<R: Residuals>(ctx: &FinishContext<'_, R>, fits: &RecordFits) -> Finding {
+    let judged: Vec<_> = fits
+        .records
+        .iter()
+        .zip(ctx.reference.records.iter())
+        .map(|(fit, rec)| {
+            let given = Channel::from_name(&fit.channel).and_then(|c| rec.given_noise(c));
+            goodness::judged_record(fit, given)
+        })
+        .collect();
+    goodness::goodness_of_fit(&judged)
 }
 
 /// A warning per failed start: screening failures first, then failed continuations.

@@ -216,6 +216,9 @@ pub enum Check {
     Prefit,
     /// The fitted model is physically doubtful (e.g. mu_s < mu_c).
     PhysicalConsistency,
+    /// The residual RMS against the records' noise floor: a law that follows the records
+    /// leaves only their noise.
+    GoodnessOfFit,
 }
 
 /// One diagnostic of a fit: a check, its status, the value it judged and a plain message.
