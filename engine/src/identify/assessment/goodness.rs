@@ -13,8 +13,12 @@
 //!
 //! The ratio passes up to [`FIT_WARN_RATIO`], warns up to [`FIT_FAIL_RATIO`] and fails
 //! above; residuals at the simulations' numerical floor pass (a noise-free record).
+//! Residuals smoother than any noise at the sample scale (low-pass filtered records, or a
+//! misfit that hides the noise: [`SMOOTH_RESIDUALS`]) give only a lower bound of the floor,
+//! so their ratio warns at most.
 
 use super::diagnostics::{self, NUMERICAL_FLOOR};
+use super::summary::SMOOTH_RESIDUALS;
 use crate::identify::values::outcome::{Check, Finding, Status};
 use crate::identify::values::result::RecordFit;
 use crate::record::noise::{difference_noise, quantisation_step, rms_difference_noise};
@@ -39,6 +43,8 @@ pub enum RecordGoodness {
         floor: f64,
         /// The noise's lag-1 correlation granted.
         phi: f64,
+        /// Whether the residuals are smoother than noise (the floor is a lower bound).
+        smooth: bool,
     },
     /// Residuals at the simulations' numerical floor (this share of the response).
     Numerical(f64),
@@ -78,7 +84,12 @@ pub fn record_goodness(fit: &RecordFit, given: Option<f64>) -> RecordGoodness {
         return RecordGoodness::Numerical(rms / response);
     }
     match noise_floor(&residual, measured, given) {
-        Some((floor, phi)) => RecordGoodness::Ratio { rms, floor, phi },
+        Some((floor, phi)) => RecordGoodness::Ratio {
+            rms,
+            floor,
+            phi,
+            smooth: diagnostics::residual_smoothness(&[&residual]) >= SMOOTH_RESIDUALS,
+        },
         None => RecordGoodness::Unknown(format!(
             "{} residuals, too few (or too uniform) to estimate a noise floor",
             residual.len()
@@ -90,8 +101,8 @@ fn root_mean_square(values: &[f64]) -> f64 {
     (values.iter().map(|v| v * v).sum::<f64>() / values.len().max(1) as f64).sqrt()
 }
 
-fn status_of(ratio: f64) -> Status {
-    if ratio > FIT_FAIL_RATIO {
+fn status_of(ratio: f64, smooth: bool) -> Status {
+    if ratio > FIT_FAIL_RATIO && !smooth {
         Status::Fail
     } else if ratio > FIT_WARN_RATIO {
         Status::Warn
@@ -100,26 +111,43 @@ fn status_of(ratio: f64) -> Status {
     }
 }
 
+/// A judged record: its name, compared channel and unit, and its [`RecordGoodness`].
+pub type JudgedRecord = (String, String, String, RecordGoodness);
+
 /// The goodness-of-fit finding over the records: `judged` holds each record's name, its
 /// compared channel and unit, and its [`RecordGoodness`]. The worst judged record decides;
 /// with none judged, the finding is skipped with the reasons.
-pub fn goodness_of_fit(judged: &[(String, String, String, RecordGoodness)]) -> Finding {
-    let mut worst: Option<(f64, String)> = None;
+pub fn goodness_of_fit(judged: &[JudgedRecord]) -> Finding {
+    let mut worst: Option<(f64, Status, String)> = None;
     let mut flagged = Vec::new();
     let mut skipped = Vec::new();
     let mut numerical = None::<f64>;
     for (record, channel, unit, g) in judged {
         match g {
-            RecordGoodness::Ratio { rms, floor, phi } => {
+            RecordGoodness::Ratio {
+                rms,
+                floor,
+                phi,
+                smooth,
+            } => {
                 let ratio = rms / floor;
+                let status = status_of(ratio, *smooth);
+                let bound = if *smooth {
+                    ", a lower bound: the residuals are smoother than noise at the sample scale (filtered data, or a misfit that hides the noise), so it warns at most"
+                } else {
+                    ""
+                };
                 let line = format!(
-                    "record `{record}`: {channel} residual RMS {rms:.3e} {unit} is {ratio:.2} times its noise floor {floor:.3e} {unit} (noise lag-1 correlation {phi:.2} allowed)"
+                    "record `{record}`: {channel} residual RMS {rms:.3e} {unit} is {ratio:.2} times its noise floor {floor:.3e} {unit} (noise lag-1 correlation {phi:.2} allowed{bound})"
                 );
-                if status_of(ratio) != Status::Pass {
+                if status != Status::Pass {
                     flagged.push(line.clone());
                 }
-                if worst.as_ref().is_none_or(|(w, _)| ratio > *w) {
-                    worst = Some((ratio, line));
+                if worst
+                    .as_ref()
+                    .is_none_or(|(w, s, _)| (status, ratio) > (*s, *w))
+                {
+                    worst = Some((ratio, status, line));
                 }
             }
             RecordGoodness::Numerical(share) => {
@@ -133,7 +161,7 @@ pub fn goodness_of_fit(judged: &[(String, String, String, RecordGoodness)]) -> F
     } else {
         format!(" (not judged: {})", skipped.join("; "))
     };
-    let Some((ratio, line)) = worst else {
+    let Some((ratio, status, line)) = worst else {
         if let Some(share) = numerical {
             return Finding::new(
                 Check::GoodnessOfFit,
@@ -152,7 +180,6 @@ pub fn goodness_of_fit(judged: &[(String, String, String, RecordGoodness)]) -> F
             ),
         );
     };
-    let status = status_of(ratio);
     let message = match status {
         Status::Pass => format!("residuals are at the noise floor: worst {line}{not_judged}"),
         Status::Warn => format!(
@@ -169,10 +196,7 @@ pub fn goodness_of_fit(judged: &[(String, String, String, RecordGoodness)]) -> F
 
 /// The judged record of `fit`: its name, channel, unit and goodness, with `given` the noise
 /// level the record gives for its channel.
-pub fn judged_record(
-    fit: &RecordFit,
-    given: Option<f64>,
-) -> (String, String, String, RecordGoodness) {
+pub fn judged_record(fit: &RecordFit, given: Option<f64>) -> JudgedRecord {
     let unit = fit
         .channels
         .first()
@@ -277,6 +301,24 @@ mod tests {
         assert_eq!(f.status, Status::Warn, "{}", f.message);
         let f = goodness_of_fit(&[judged_record(&three, Some(1e-3))]);
         assert_eq!(f.status, Status::Pass, "{}", f.message);
+    }
+
+    /// Low-pass filtered noise around a misfit of 10 floors: smoother than noise, so the
+    /// floor is a lower bound and the finding warns, not fails; the same misfit on white
+    /// noise fails.
+    #[test]
+    fn residuals_smoother_than_noise_warn_at_most() {
+        let signal = sine(3000, 0.3, 3.0);
+        let white = ar1(3000, 2e-4, 0.0, 12);
+        let filtered: Vec<f64> = (0..3000)
+            .map(|i: usize| white[i.saturating_sub(15)..=i].iter().sum::<f64>() / 16.0)
+            .collect();
+        let misfit = sine(3000, 10.0 * 2e-4, 6.0);
+        let f = goodness_of_fit(&[judged_record(&fit_of(&signal, &filtered, &misfit), None)]);
+        assert_eq!(f.status, Status::Warn, "{}", f.message);
+        assert!(f.message.contains("lower bound"), "{}", f.message);
+        let f = goodness_of_fit(&[judged_record(&fit_of(&signal, &white, &misfit), None)]);
+        assert_eq!(f.status, Status::Fail, "{}", f.message);
     }
 
     /// A quantised channel (counts of 5 um, long rests) is judged against its step; a
