@@ -17,8 +17,7 @@
 //! misfit that hides the noise: [`SMOOTH_RESIDUALS`]) give only a lower bound of the floor,
 //! so their ratio warns at most.
 
-use super::diagnostics::{self, NUMERICAL_FLOOR};
-use super::summary::SMOOTH_RESIDUALS;
+use super::diagnostics::{self, NUMERICAL_FLOOR, SMOOTH_RESIDUALS};
 use crate::identify::values::outcome::{Check, Finding, Status};
 use crate::identify::values::result::RecordFit;
 use crate::record::noise::{difference_noise, quantisation_step, rms_difference_noise};
