@@ -16,7 +16,7 @@
 //! - Dahl, whose presliding the old half-cycle comparison misjudged: clean and AR(1) at
 //!   1 kHz, white at 100 kHz, an interferometer's and an encoder's records (5).
 
-use frictionid_engine::identify::{fit, FitOptions, FitResult, Status};
+use frictionid_engine::identify::{fit, Check, FitOptions, FitResult, Status};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::{add_coloured_noise, add_gaussian_noise, uniform_times};
 use frictionid_engine::{Oscillator, Record};
@@ -354,8 +354,13 @@ fn correct_fits_raise_no_failed_diagnostic() {
                 .iter()
                 .filter(|d| d.status == Status::Warn)
                 .count();
+            let goodness = result
+                .diagnostics
+                .iter()
+                .find(|d| d.check == Check::GoodnessOfFit)
+                .map(|d| format!("{:?} {:.2?}", d.status, d.value));
             let label = format!(
-                "{} (rms residual {:.2e})",
+                "{} (rms residual {:.2e}, goodness of fit {goodness:?})",
                 case.label(),
                 result.rms_residual
             );
@@ -379,13 +384,10 @@ fn correct_fits_raise_no_failed_diagnostic() {
 
 /// The other side of the alarm: Coulomb friction fitted to records of laws it cannot follow
 /// exactly (a viscous term, a Stribeck dip, Makkar's smooth bump, Dahl's presliding, LuGre)
-/// at 1 kHz with white noise. Each of the first four is flagged by at least one warning or
-/// failure. The LuGre truth (sigma2 = 1 N s/m, a Stribeck rise of 0.08 N over 0.01 m/s)
-/// leaves residuals 6 times the noise level that no check flags yet: the energy balance
-/// cannot see it (the fitted level dissipates the energy the record loses) and the residual
-/// structure does not reach significance; its outcome is printed, not asserted, until a
-/// goodness-of-fit check (the residual RMS against the record's own noise level, allowing
-/// for the noise's colour) catches it.
+/// at 1 kHz with white noise. Each is flagged by at least one warning or failure; the LuGre
+/// truth (sigma2 = 1 N s/m, a Stribeck rise of 0.08 N over 0.01 m/s), whose residuals sit 6
+/// times above the noise while the energy balance and the residual structure see nothing,
+/// fails the goodness of fit.
 #[test]
 fn a_wrong_law_is_flagged() {
     use rayon::prelude::*;
@@ -424,8 +426,13 @@ fn a_wrong_law_is_flagged() {
     eprintln!("{flagged} of {} wrong fits flagged", outcomes.len());
     let missed: Vec<&String> = outcomes
         .iter()
-        .filter(|(label, _, f)| f.is_empty() && label != "coulomb on lugre")
+        .filter(|(_, _, f)| f.is_empty())
         .map(|(l, _, _)| l)
         .collect();
     assert!(missed.is_empty(), "not flagged: {missed:?}");
+    let lugre = outcomes.iter().find(|(l, _, _)| l == "coulomb on lugre");
+    assert!(
+        lugre.is_some_and(|(_, _, f)| f.contains(&"GoodnessOfFit Fail".to_string())),
+        "{lugre:?}"
+    );
 }

@@ -22,6 +22,7 @@ use crate::identify::values::outcome::{Check, Finding, StartOutcome, Status, Ter
 use crate::identify::values::result::EnergyForce;
 use crate::identify::values::result::{FittedParam, RecordFit};
 use crate::oscillator::Oscillator;
+use crate::record::noise::quantisation_step;
 
 /// An energy-balance difference above this many percent warns.
 pub const ENERGY_WARN_PERCENT: f64 = 5.0;
@@ -111,6 +112,11 @@ fn energy_skips(ef: &EnergyForce) -> Vec<String> {
     .collect()
 }
 
+/// Lag-1 correlation (from the residuals' differences, [`residual_smoothness`]) at or above
+/// which the residuals are smoother than measurement noise: a model error (or low-pass
+/// filtered data), reported as such instead of corrected for.
+pub const SMOOTH_RESIDUALS: f64 = 0.98;
+
 /// Lag-`lag` autocorrelation of the residual segments (pairs within a segment only).
 fn autocorrelation<S: AsRef<[f64]>>(segments: &[S], lag: usize) -> f64 {
     let (mut num, mut den) = (0.0, 0.0);
@@ -191,32 +197,104 @@ struct Moving {
     period_samples: usize,
 }
 
-fn moving_part(r: &RecordFit, osc: &Oscillator, threshold: f64) -> Option<Moving> {
-    if r.channel != "velocity" {
-        // The statistics read the fitted series as a velocity.
-        return None;
-    }
-    let end = r.series.fitted.iter().rposition(|v| v.abs() > threshold)? + 1;
+fn moving_part(r: &RecordFit, osc: &Oscillator, threshold: f64) -> Result<Moving, String> {
+    let (v, x) = motion_of(r)?;
+    let Some(last) = v.iter().rposition(|v| v.abs() > threshold) else {
+        return Err(format!(
+            "record `{}` never moves faster than {threshold:e}",
+            r.file
+        ));
+    };
+    let end = last + 1;
     if end < 3 || r.axes.time.len() < end || r.series.measured.len() < end {
-        return None;
+        return Err(format!("record `{}` moves over too few samples", r.file));
     }
     let residual: Vec<f64> = (0..end)
         .map(|i| r.series.fitted[i] - r.series.measured[i])
         .collect();
-    let x = cumulative_trapezoid(&r.axes.time[..end], &r.series.fitted[..end], r.x0);
+    within_quantisation(r, &residual)?;
     let dt = (r.axes.time[end - 1] - r.axes.time[0]) / (end - 1) as f64;
     let wd = osc.omega_n() * (1.0 - osc.damping_ratio().powi(2)).max(0.0).sqrt();
     let period = 2.0 * std::f64::consts::PI / wd / dt;
-    Some(Moving {
+    Ok(Moving {
         residual: demeaned(residual),
-        sign: demeaned(r.series.fitted[..end].iter().map(|v| v.signum()).collect()),
-        x: demeaned(x),
+        sign: demeaned(v[..end].iter().map(|v| v.signum()).collect()),
+        x: demeaned(x[..end].to_vec()),
         period_samples: if period.is_finite() && period >= 1.0 {
             period.round() as usize
         } else {
             0
         },
     })
+}
+
+/// The reason a record's residuals cannot be judged when they lie within its channel's
+/// quantisation step (an encoder's counts): the rounding error of a noise-free channel is
+/// locked to the motion by construction.
+fn within_quantisation(r: &RecordFit, residual: &[f64]) -> Result<(), String> {
+    let Some(step) = quantisation_step(&r.series.measured) else {
+        return Ok(());
+    };
+    let rms = (residual.iter().map(|e| e * e).sum::<f64>() / residual.len().max(1) as f64).sqrt();
+    if rms <= step {
+        return Err(format!(
+            "record `{}`: its residuals (RMS {rms:.3e}) lie within the channel's quantisation step {step:.3e}, whose rounding error follows the motion by construction",
+            r.file
+        ));
+    }
+    Ok(())
+}
+
+/// The velocity and displacement of a record fit's motion, sample by sample: the fitted
+/// series where it is the velocity (with its integral) or the displacement (with its
+/// derivative), else the motion the record's sample axes give (a fit along the measured
+/// motion); the reason when none is known.
+fn motion_of(r: &RecordFit) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let n = r.series.fitted.len();
+    let time = &r.axes.time;
+    if time.len() < n {
+        return Err(format!("record `{}` has no time for its samples", r.file));
+    }
+    match r.channel.as_str() {
+        "velocity" => {
+            let x = cumulative_trapezoid(&time[..n], &r.series.fitted, r.x0);
+            return Ok((r.series.fitted.clone(), x));
+        }
+        "displacement" => {
+            let v = derivative(&time[..n], &r.series.fitted);
+            return Ok((v, r.series.fitted.clone()));
+        }
+        _ => {}
+    }
+    let axes = &r.axes;
+    if axes.velocity.len() != n {
+        return Err(format!(
+            "record `{}` compares `{}` without the motion's velocity",
+            r.file, r.channel
+        ));
+    }
+    let x = if axes.displacement.len() == n {
+        axes.displacement.clone()
+    } else {
+        cumulative_trapezoid(&time[..n], &axes.velocity, 0.0)
+    };
+    Ok((axes.velocity.clone(), x))
+}
+
+/// The derivative of `x` at `time`: central differences inside, one-sided at the ends.
+fn derivative(time: &[f64], x: &[f64]) -> Vec<f64> {
+    let n = x.len().min(time.len());
+    (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+            let dt = time[b] - time[a];
+            if dt > 0.0 {
+                (x[b] - x[a]) / dt
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }
 
 /// One statistic of the residual-structure check.
@@ -230,18 +308,25 @@ struct Statistic {
 /// at one oscillation period (on the moving parts), and the residual mean (whole records).
 /// `threshold` is the speed below which the mass counts as at rest.
 pub fn residual_structure(records: &[RecordFit], osc: &Oscillator, threshold: f64) -> Finding {
-    let moving: Vec<Moving> = records
-        .iter()
-        .filter_map(|r| moving_part(r, osc, threshold))
-        .collect();
+    let mut moving = Vec::new();
+    let mut unjudged = Vec::new();
+    for r in records {
+        match moving_part(r, osc, threshold) {
+            Ok(m) => moving.push(m),
+            Err(why) => unjudged.push(why),
+        }
+    }
     let residuals: Vec<&[f64]> = moving.iter().map(|m| m.residual.as_slice()).collect();
     let n = residuals.iter().map(|r| r.len()).sum::<usize>() as f64;
     if n < 10.0 {
-        return Finding::new(
+        let why = if unjudged.is_empty() {
+            String::new()
+        } else {
+            format!(": {}", unjudged.join("; "))
+        };
+        return Finding::skipped(
             Check::ResidualStructure,
-            Status::Pass,
-            None,
-            "too few moving samples to judge the residual structure".into(),
+            format!("{n} moving samples, too few to judge the residual structure{why}"),
         );
     }
     if let Some(share) = at_numerical_floor(&moving, records) {
@@ -679,6 +764,49 @@ mod tests {
         let offset = structure(&[record_fit(0.24, 0.24, &noise, 3e-3)]);
         assert_eq!(offset.status, Status::Fail, "{}", offset.message);
         assert!(offset.message.contains("mean"), "{}", offset.message);
+    }
+
+    /// The same record compared as a displacement, or as a force along the measured motion,
+    /// is judged, not passed for want of a velocity (a wrong level's smooth displacement
+    /// misfit is the goodness of fit's to catch: the structure statistics grant smooth
+    /// residuals few effective samples); a record without a known motion is skipped with the
+    /// reason.
+    #[test]
+    fn displacement_and_force_records_are_judged_and_unknown_motion_is_skipped() {
+        let noise = ar1_noise(2000, NOISE, 0.0, 9);
+        let as_displacement = |mu_fit: f64| {
+            let mut r = record_fit(0.24, mu_fit, &noise, 0.0);
+            let time = r.axes.time.clone();
+            let x = |v: &[f64]| cumulative_trapezoid(&time, v, 0.014);
+            let truth = exact_v(&Oscillator::fmm(), 0.24, &time);
+            r.series.fitted = x(&r.series.fitted);
+            r.series.measured = x(&truth)
+                .iter()
+                .zip(&noise)
+                .map(|(x, e)| x + 1e-3 * e)
+                .collect();
+            r.channel = "displacement".into();
+            r
+        };
+        let right = structure(&[as_displacement(0.24)]);
+        assert_eq!(right.status, Status::Pass, "{}", right.message);
+        assert!(right.value.is_some(), "{}", right.message);
+        let wrong = structure(&[as_displacement(0.20)]);
+        assert_ne!(wrong.status, Status::Skipped, "{}", wrong.message);
+        assert!(wrong.value.is_some(), "{}", wrong.message);
+        let mut force = record_fit(0.24, 0.20, &noise, 0.0);
+        force.axes.velocity = force.series.measured.clone();
+        force.channel = "force".into();
+        let f = structure(&[force.clone()]);
+        assert_ne!(f.status, Status::Pass, "{}", f.message);
+        force.axes.velocity.clear();
+        let f = structure(&[force]);
+        assert_eq!(f.status, Status::Skipped, "{}", f.message);
+        assert!(
+            f.message.contains("without the motion's velocity"),
+            "{}",
+            f.message
+        );
     }
 
     fn energy_force(eq7: f64, energies: f64) -> EnergyForce {

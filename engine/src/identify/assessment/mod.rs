@@ -1,11 +1,13 @@
 //! What a fit's optimum is worth, on the search's floor: the statistics ([`stats`]), which
 //! parameters the records determine ([`identifiability`]), the checks that become findings
-//! ([`diagnostics`]), the energy-balance check ([`energy_check`]), the per-record fits
+//! ([`diagnostics`]), the energy-balance check ([`energy_check`]), the residual against the noise floor
+//! ([`goodness`]), the per-record fits
 //! ([`record_fits`]), the sum-up into a `FitResult` ([`summary`]) and the refits under the
 //! oscillator's property uncertainties ([`property_refits`], handed the refit by the fit).
 
 pub mod diagnostics;
 pub mod energy_check;
+pub mod goodness;
 pub mod identifiability;
 pub mod property_refits;
 pub mod record_fits;

@@ -3,6 +3,7 @@
 //! parameter's entry, the per-record fits and the findings, in report order.
 
 use super::diagnostics::{self, starts_at_best};
+use super::goodness;
 use super::identifiability::{self, covariance_of_determined, Standing};
 use super::record_fits::{record_fits, RecordFits};
 use super::stats::{self, aic, bic, t_quantile_975, Covariance};
@@ -17,6 +18,7 @@ use crate::identify::values::{
     ParamKind, Search, StartOutcome, Status,
 };
 use crate::oscillator::Oscillator;
+use crate::record::Channel;
 use nalgebra::DMatrix;
 use std::time::Instant;
 
@@ -92,10 +94,7 @@ fn statistics<R: Residuals>(
 /// noise gives about 1/sqrt(n), far below).
 pub const AUTOCORRELATION_THRESHOLD: f64 = 0.1;
 
-/// Lag-1 correlation (from the residuals' differences, [`diagnostics::residual_smoothness`])
-/// at or above which the residuals are smoother than measurement noise: a model error (or
-/// low-pass filtered data), reported as such instead of corrected for.
-pub const SMOOTH_RESIDUALS: f64 = 0.98;
+pub use super::diagnostics::SMOOTH_RESIDUALS;
 
 /// Widens the covariance when the residuals are autocorrelated noise: each standard error
 /// becomes the larger of the classical and the Newey-West one, after AR(1) prewhitening with
@@ -278,11 +277,23 @@ fn diagnose<R: Residuals>(
     ));
     findings.extend(correlation_findings(params, &stats.cov));
     findings.push(diagnostics::standard_errors(parameters, stats.cov.singular));
-    findings.extend(stats.widening.clone());
+    let judged = judged_records(ctx, fits);
+    findings.extend(
+        stats
+            .widening
+            .clone()
+            .map(|w| at_numerical_floor(w, &judged)),
+    );
     if ctx.reference.residuals.simulates_response() {
+        let driven = ctx
+            .reference
+            .records
+            .iter()
+            .any(|r| r.channel(Channel::InputForce).is_some());
         findings.extend(identifiability_findings(
             ctx.params,
             ctx.layout.n_model_free(),
+            driven,
         ));
     }
     let names: Vec<(String, String)> = params
@@ -297,14 +308,47 @@ fn diagnose<R: Residuals>(
     findings.extend(diagnostics::parameters_at_bounds(params, &stats.p_best));
     findings.extend(stats.without_effect.clone());
     findings.extend(fits.findings.iter().cloned());
-    if ctx.reference.residuals.simulates_response() {
-        findings.push(diagnostics::residual_structure(
-            &fits.records,
-            &stats.world.oscillator,
-            ctx.energy.velocity_threshold,
-        ));
-    }
+    findings.push(goodness::goodness_of_fit(&judged));
+    findings.push(diagnostics::residual_structure(
+        &fits.records,
+        &stats.world.oscillator,
+        ctx.energy.velocity_threshold,
+    ));
     findings
+}
+
+/// Each record's goodness of fit against its noise floor (raised to the noise level the
+/// record gives for its compared channel).
+fn judged_records<R: Residuals>(
+    ctx: &FinishContext<'_, R>,
+    fits: &RecordFits,
+) -> Vec<goodness::JudgedRecord> {
+    fits.records
+        .iter()
+        .zip(ctx.reference.records.iter())
+        .map(|(fit, rec)| {
+            let given = Channel::from_name(&fit.channel).and_then(|c| rec.given_noise(c));
+            goodness::judged_record(fit, given)
+        })
+        .collect()
+}
+
+/// The autocorrelation finding `widening`, but a pass where every record's residuals are
+/// at the simulations' numerical floor: round-off is smooth, not a misfit to warn about.
+fn at_numerical_floor(widening: Finding, judged: &[goodness::JudgedRecord]) -> Finding {
+    let floor = !judged.is_empty()
+        && judged
+            .iter()
+            .all(|j| matches!(j.3, goodness::RecordGoodness::Numerical(_)));
+    if !floor || widening.status != Status::Warn {
+        return widening;
+    }
+    Finding::new(
+        Check::NoiseCorrelation,
+        Status::Pass,
+        widening.value,
+        "the residuals are at the simulations' numerical floor (a noise-free record): their correlation is round-off's, neither noise to correct for nor a misfit".into(),
+    )
 }
 
 /// A warning per failed start: screening failures first, then failed continuations.
@@ -403,12 +447,17 @@ fn correlation_findings(params: &[FreeParam], cov: &Covariance) -> Vec<Finding> 
     out
 }
 
-/// A warning for a free mass with anything that scales with it (a fit of the free response:
-/// a measured input force fixes the scale).
-fn identifiability_findings(opts: &ParamOptions, n_model_free: usize) -> Vec<Finding> {
+/// A warning for a free mass with anything that scales with it in a fit of the free
+/// response; none when a record is `driven` (its measured input force fixes the scale).
+fn identifiability_findings(
+    opts: &ParamOptions,
+    n_model_free: usize,
+    driven: bool,
+) -> Vec<Finding> {
     let mut out = Vec::new();
     let osc_free = |q: OscillatorParam| opts.oscillator.contains(&q);
-    if osc_free(OscillatorParam::Mass)
+    if !driven
+        && osc_free(OscillatorParam::Mass)
         && (osc_free(OscillatorParam::Stiffness)
             || osc_free(OscillatorParam::Damping)
             || n_model_free > 0)
@@ -469,4 +518,54 @@ fn derived_ratios(
         });
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A free mass beside a free damping warns on a free response, where velocity fixes only
+    /// the ratios, and not on a driven record, whose measured input force fixes the mass.
+    #[test]
+    fn the_mass_warning_is_for_free_responses_only() {
+        let opts = ParamOptions {
+            oscillator: vec![OscillatorParam::Mass, OscillatorParam::Damping],
+            ..ParamOptions::default()
+        };
+        let free = identifiability_findings(&opts, 1, false);
+        assert_eq!(free.len(), 1);
+        assert!(free[0].message.contains("not m"), "{}", free[0].message);
+        assert!(identifiability_findings(&opts, 1, true).is_empty());
+        let mass_only = ParamOptions {
+            oscillator: vec![OscillatorParam::Mass],
+            ..ParamOptions::default()
+        };
+        assert!(identifiability_findings(&mass_only, 0, false).is_empty());
+    }
+
+    fn judged(goodness: goodness::RecordGoodness) -> goodness::JudgedRecord {
+        ("r".into(), "velocity".into(), "m/s".into(), goodness)
+    }
+
+    /// Smooth residuals warn, unless every record's residuals are at the numerical floor.
+    #[test]
+    fn smooth_residuals_at_the_numerical_floor_do_not_warn() {
+        let warning = smooth_residuals_finding(0.999);
+        let floor = [judged(goodness::RecordGoodness::Numerical(3e-11))];
+        let f = at_numerical_floor(warning.clone(), &floor);
+        assert_eq!(f.status, Status::Pass, "{}", f.message);
+        assert!(f.message.contains("numerical floor"), "{}", f.message);
+        let noisy = goodness::RecordGoodness::Ratio {
+            rms: 6.0,
+            floor: 1.0,
+            phi: 0.0,
+            smooth: false,
+        };
+        let mixed = [floor[0].clone(), judged(noisy)];
+        assert_eq!(
+            at_numerical_floor(warning.clone(), &mixed).status,
+            Status::Warn
+        );
+        assert_eq!(at_numerical_floor(warning, &[]).status, Status::Warn);
+    }
 }

@@ -218,6 +218,9 @@ pub enum Check {
     PhysicalConsistency,
     /// Samples whose target is unreliable, left out of the fit.
     UnreliableTarget,
+    /// The residual RMS against the records' noise floor: a law that follows the records
+    /// leaves only their noise.
+    GoodnessOfFit,
 }
 
 /// One diagnostic of a fit: a check, its status, the value it judged and a plain message.
