@@ -28,17 +28,20 @@
 //! few milliseconds per evaluation and has no phase errors to trap the optimiser: it is also
 //! the prefit of velocity fits of dynamic models (run by [`crate::identify::fit::fit`]).
 
-use super::inverse_dynamics::{
-    linear_start, sliding_samples, Balance, BalanceSamples, LinearStart,
-};
+mod checks;
+mod guards;
+mod track;
+
+pub use checks::check_force_domain;
+pub use guards::{require_mechanics, require_oscillator};
+use track::target_source;
+
+use super::inverse_dynamics::{linear_start, Balance, BalanceSamples, LinearStart};
 use super::residuals::{Evaluation, JacobianColumns, RecordCase, Residuals, Segment};
 use super::state_cache::StateCache;
-use crate::axis::Axis;
 use crate::energy::forces_at;
-use crate::energy::model_force::{
-    check_motion, force_derivatives_checked, states_along_checked, CheckedMotion,
-};
-use crate::energy::{analyze_record, record_motion, EnergyOptions};
+use crate::energy::model_force::{force_derivatives_checked, states_along_checked};
+use crate::energy::EnergyOptions;
 use crate::error::EngineError;
 use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::{FreeParam, ParamKind};
@@ -47,10 +50,9 @@ use crate::identify::values::nuisance::NuisanceKind;
 use crate::identify::values::result::{
     ForceBalance, SampleAxes, SlidingSamples, UnreliableSamples,
 };
-use crate::identify::values::target_options::{FitDomain, ForceTarget};
+use crate::identify::values::target_options::ForceTarget;
 use crate::oscillator::{Oscillator, OscillatorProperty};
-use crate::record::noise::noise_floor_level;
-use crate::record::{channel_list, Channel, NormalForce, Record};
+use crate::record::{NormalForce, Record};
 use frictionid_models::GuessHint;
 use std::sync::Arc;
 
@@ -99,67 +101,6 @@ pub struct ForceAlongMotion {
     start: Option<LinearStart>,
     /// States of recent predictions: a force-only parameter's column reuses them.
     states: StateCache,
-}
-
-/// The oscillator properties a force-domain fit on the energy-based force, a velocity fit or
-/// an energy analysis needs, and the message (naming them on `axis`) when `missing` holds
-/// any of them. The one place of this rule.
-pub fn require_mechanics(
-    missing: &[OscillatorProperty],
-    axis: Axis,
-    purpose: &str,
-) -> Result<(), EngineError> {
-    use OscillatorProperty::{Damping, Mass, Stiffness};
-    require_properties(missing, axis, &[Mass, Damping, Stiffness], purpose)
-}
-
-/// Every oscillator property, the normal force included, is given: what a simulation of the
-/// oscillator needs (a placeholder N = 0 would silently simulate no friction at all).
-pub fn require_oscillator(
-    missing: &[OscillatorProperty],
-    axis: Axis,
-    purpose: &str,
-) -> Result<(), EngineError> {
-    use OscillatorProperty::{Damping, Mass, NormalForce, Stiffness};
-    require_properties(
-        missing,
-        axis,
-        &[Mass, Damping, Stiffness, NormalForce],
-        purpose,
-    )
-}
-
-/// `a, b and c`.
-fn spoken_list(items: &[&str]) -> String {
-    match items.split_last() {
-        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
-        _ => items.join(""),
-    }
-}
-
-/// None of the `needed` properties is among the `missing` ones; otherwise an error naming
-/// those that are, as `axis` names them.
-fn require_properties(
-    missing: &[OscillatorProperty],
-    axis: Axis,
-    needed: &[OscillatorProperty],
-    purpose: &str,
-) -> Result<(), EngineError> {
-    let absent: Vec<&str> = needed
-        .iter()
-        .filter(|p| missing.contains(p))
-        .map(|p| p.name_on(axis))
-        .collect();
-    if absent.is_empty() {
-        return Ok(());
-    }
-    let needed: Vec<&str> = needed.iter().map(|p| p.name_on(axis)).collect();
-    Err(EngineError::InvalidInput(format!(
-        "[oscillator]: {purpose} needs {}; `{}` not given (only a force-domain fit on a \
-         measured force channel does without mass, damping and stiffness)",
-        spoken_list(&needed),
-        absent.join("`, `")
-    )))
 }
 
 impl ForceAlongMotion {
@@ -323,242 +264,6 @@ impl ForceAlongMotion {
             track.used.iter().copied(),
         ))
     }
-}
-
-impl ForceTrack {
-    /// Prepares `record`: its motion, its normal force (1 N when `unit_normal`: no normal
-    /// force given anywhere) and its target from `source`.
-    fn new(
-        record: &Record,
-        source: TargetSource,
-        osc: &Oscillator,
-        opts: &FitOptions,
-        unit_normal: bool,
-    ) -> Result<Self, EngineError> {
-        let err = |reason: String| EngineError::Record {
-            record: record.name.clone(),
-            reason,
-        };
-        record.validate_channels(3)?;
-        let motion = record_motion(record).ok_or_else(|| {
-            err(format!(
-                "a force-domain fit needs the motion: a velocity or displacement channel (the \
-                 record has: {}); name its column with `velocity_column` or \
-                 `displacement_column`",
-                channel_list(&record.channels())
-            ))
-        })?;
-        let normal = FrictionLevels::record_normal_force(
-            record,
-            osc,
-            &opts.target.unknown_oscillator,
-            unit_normal,
-        )
-        .map_err(err)?;
-        let mut balance = None;
-        let mut unreliable = None;
-        let (used, target) = match source {
-            TargetSource::Measured => {
-                let f = record.channel(Channel::Force).unwrap_or_default().to_vec();
-                ((0..f.len()).collect(), f)
-            }
-            TargetSource::EnergyBased => {
-                require_mechanics(
-                    &opts.target.unknown_oscillator,
-                    osc.axis,
-                    "the energy-based force (Eq. 7)",
-                )?;
-                energy_target(record, osc, &opts.energy)?
-            }
-            TargetSource::InverseDynamics => {
-                let threshold = opts.energy.velocity_threshold;
-                let axis = Balance::new(record, &motion.v, has_restoring(osc, opts))
-                    .map_err(|e| err(e.to_string()))?;
-                let u = record.channel(Channel::InputForce).unwrap_or_default();
-                let sliding = sliding_samples(&motion.v, threshold);
-                unreliable = axis.left_out(&sliding, record.time());
-                let used = axis.reliable(sliding);
-                balance = Some(axis);
-                let target = used.iter().map(|&i| u[i]).collect();
-                (used, target)
-            }
-        };
-        check_motion(record.time(), &motion.v, &normal).map_err(|e| err(e.to_string()))?;
-        let (used, target, sliding) = keep_sliding(used, target, &motion.v, opts.target.min_speed);
-        if sliding.is_some_and(|s| s.kept < 2) {
-            return Err(err(format!(
-                "{} samples slide with |v| >= [fit.options] min_speed = {} m/s; lower it",
-                target.len(),
-                opts.target.min_speed.unwrap_or_default()
-            )));
-        }
-        if target.len() < 2 {
-            return Err(err(format!(
-                "{} samples to compare the model force with (Eq. 7 and the inverse-dynamics \
-                 force are masked where |v| <= [energy] velocity_threshold = {} m/s)",
-                target.len(),
-                opts.energy.velocity_threshold
-            )));
-        }
-        let noise_channel = match source {
-            TargetSource::Measured => Some(Channel::Force),
-            TargetSource::InverseDynamics => Some(Channel::InputForce),
-            TargetSource::EnergyBased => None,
-        };
-        Ok(Self {
-            source,
-            time: record.time().to_vec(),
-            velocity: motion.v,
-            displacement: motion.x,
-            normal,
-            noise: noise_channel
-                .and_then(|c| record.given_noise(c))
-                .unwrap_or_else(|| noise_floor_level(&target, 1)),
-            used,
-            target,
-            balance,
-            sliding,
-            unreliable,
-        })
-    }
-
-    /// The record's motion and normal force, checked when the track was prepared.
-    fn motion(&self) -> CheckedMotion<'_> {
-        CheckedMotion {
-            time: &self.time,
-            v: &self.velocity,
-            normal: &self.normal,
-        }
-    }
-
-    /// The derivative of the prediction at the compared samples with respect to the
-    /// oscillator property or nuisance parameter `kind` at `osc`: the balance's terms are
-    /// linear in J, c, the input offset and a linear spring's k, the force offset adds
-    /// itself to record `index` only. `None` for what is not that simple (a restoring law's
-    /// own parameters, another law's stiffness).
-    fn balance_column(&self, kind: ParamKind, index: usize, osc: &Oscillator) -> Option<Vec<f64>> {
-        let pick = |f: &dyn Fn(usize) -> f64| Some(self.used.iter().map(|&i| f(i)).collect());
-        let zeros = || Some(vec![0.0; self.used.len()]);
-        match (kind, &self.balance) {
-            (
-                ParamKind::Nuisance {
-                    kind: NuisanceKind::ForceOffset,
-                    record,
-                },
-                _,
-            ) => {
-                if record == index {
-                    Some(vec![1.0; self.used.len()])
-                } else {
-                    zeros()
-                }
-            }
-            (ParamKind::Nuisance { record, .. }, _) if record != index => zeros(),
-            (ParamKind::Nuisance { .. } | ParamKind::Model(_), _) => None,
-            (_, None) => zeros(),
-            (ParamKind::Property(p), Some(b)) if p.is_restoring() && !b.restoring => zeros(),
-            (ParamKind::Property(p), Some(b)) if p.balance_column_exact(osc) => pick(&|i| {
-                p.balance_column(b.acceleration[i], self.velocity[i], self.displacement[i])
-            }),
-            (ParamKind::Property(_), Some(_)) => None,
-        }
-    }
-
-    /// The oscillator's terms J a + c v + R(q) at the compared samples (inverse dynamics;
-    /// empty otherwise).
-    fn axis_forces(&self, osc: &Oscillator) -> Vec<f64> {
-        let Some(balance) = &self.balance else {
-            return Vec::new();
-        };
-        self.used
-            .iter()
-            .map(|&i| balance.axis_force(osc, i, self.velocity[i], self.displacement[i]))
-            .collect()
-    }
-
-    /// The friction force the target implies at `osc`: the target itself, or for inverse
-    /// dynamics u - J a - c v - R(q).
-    fn friction_target(&self, osc: &Oscillator) -> Vec<f64> {
-        let axis = self.axis_forces(osc);
-        if axis.is_empty() {
-            return self.target.clone();
-        }
-        self.target.iter().zip(&axis).map(|(u, a)| u - a).collect()
-    }
-}
-
-/// The compared samples `used` (with their `target`) where |v| >= `min_speed`, and how many
-/// were kept; all of them without a `min_speed`.
-fn keep_sliding(
-    used: Vec<usize>,
-    target: Vec<f64>,
-    velocity: &[f64],
-    min_speed: Option<f64>,
-) -> (Vec<usize>, Vec<f64>, Option<SlidingSamples>) {
-    let Some(min_speed) = min_speed else {
-        return (used, target, None);
-    };
-    let of = used.len();
-    let (used, target): (Vec<usize>, Vec<f64>) = used
-        .into_iter()
-        .zip(target)
-        .filter(|&(i, _)| velocity.get(i).is_some_and(|v| v.abs() >= min_speed))
-        .unzip();
-    let sliding = SlidingSamples {
-        min_speed,
-        kept: used.len(),
-        of,
-    };
-    (used, target, Some(sliding))
-}
-
-/// Whether an inverse-dynamics balance has a restoring force: a restoring law other than the
-/// linear spring carries its own parameters; the spring needs its stiffness given or fitted
-/// (an axis without a spring gives no `stiffness`).
-fn has_restoring(osc: &Oscillator, opts: &FitOptions) -> bool {
-    !osc.restoring.is_linear_spring()
-        || opts
-            .params
-            .oscillator
-            .contains(&OscillatorProperty::Stiffness)
-        || !opts.target.is_unknown(OscillatorProperty::Stiffness)
-}
-
-/// The target of a record under `force_target`.
-fn target_source(record: &Record, wanted: ForceTarget) -> Result<TargetSource, String> {
-    let has_force = record.channel(Channel::Force).is_some();
-    match (wanted, has_force) {
-        (ForceTarget::Measured, false) => Err(format!(
-            "[fit.options] force_target = \"measured\" but the record has no force channel \
-             (it has: {}; name its column with `force_column`)",
-            channel_list(&record.channels())
-        )),
-        (ForceTarget::Measured, true) | (ForceTarget::Auto, true) => Ok(TargetSource::Measured),
-        (ForceTarget::Energy, _) | (ForceTarget::Auto, false) => Ok(TargetSource::EnergyBased),
-        (ForceTarget::InverseDynamics, _) if record.channel(Channel::InputForce).is_none() => {
-            Err(format!(
-                "[fit.options] force_target = \"inverse_dynamics\" but the record has no input \
-                 force channel (it has: {}; name its column with `input_force_column`)",
-                channel_list(&record.channels())
-            ))
-        }
-        (ForceTarget::InverseDynamics, _) => Ok(TargetSource::InverseDynamics),
-    }
-}
-
-fn energy_target(
-    record: &Record,
-    osc: &Oscillator,
-    energy: &EnergyOptions,
-) -> Result<(Vec<usize>, Vec<f64>), EngineError> {
-    let analysed = analyze_record(record, osc, energy)?;
-    Ok(analysed
-        .friction
-        .iter()
-        .enumerate()
-        .filter(|(_, f)| f.is_finite())
-        .map(|(i, &f)| (i, f))
-        .unzip())
 }
 
 impl Residuals for ForceAlongMotion {
@@ -756,63 +461,11 @@ impl Residuals for ForceAlongMotion {
     }
 }
 
-/// Options that only a velocity fit has, as the `[fit.options]` keys they are.
-fn velocity_only_options(opts: &FitOptions) -> Vec<&'static str> {
-    let mut keys = Vec::new();
-    for (on, key) in [
-        (opts.params.velocity_offset, "velocity_offset"),
-        (opts.params.time_shift, "time_shift"),
-        (opts.params.x0, "x0"),
-        (
-            !opts.params.oscillator.is_empty()
-                && opts.target.force_target != ForceTarget::InverseDynamics,
-            "oscillator",
-        ),
-    ] {
-        if on {
-            keys.push(key);
-        }
-    }
-    keys
-}
-
-/// The options fit the force domain: `domain = "force"`, and none of the options only a
-/// velocity fit has (the oscillator properties are fitted in the force domain by inverse
-/// dynamics only).
-pub fn check_force_domain(opts: &FitOptions) -> Result<(), EngineError> {
-    let velocity_keys = velocity_only_options(opts);
-    if !velocity_keys.is_empty() {
-        return Err(EngineError::InvalidInput(format!(
-            "[fit.options] {} apply to velocity fits only, not with domain = \"force\"",
-            velocity_keys.join(", ")
-        )));
-    }
-    if opts.target.domain != FitDomain::Force {
-        return Err(EngineError::InvalidInput(
-            "fit_force needs [fit.options] domain = \"force\"".into(),
-        ));
-    }
-    check_inverse_dynamics(opts)
-}
-
-/// Inverse dynamics knows the mass (the inertia): given in `[oscillator]` or fitted.
-fn check_inverse_dynamics(opts: &FitOptions) -> Result<(), EngineError> {
-    let mass_unknown = opts.target.is_unknown(OscillatorProperty::Mass)
-        && !opts.params.oscillator.contains(&OscillatorProperty::Mass);
-    if opts.target.force_target == ForceTarget::InverseDynamics && mass_unknown {
-        return Err(EngineError::InvalidInput(
-            "[oscillator]: force_target = \"inverse_dynamics\" needs the mass (the inertia): \
-             give `mass`, or fit it with [fit.options] oscillator = [\"mass\"]"
-                .into(),
-        ));
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::identify::values::target_options::TargetOptions;
+    use crate::identify::values::target_options::{FitDomain, TargetOptions};
+    use crate::record::Channel;
     use crate::record::TimeBase;
 
     fn record(channels: &[(Channel, Vec<f64>)]) -> Record {
