@@ -19,10 +19,10 @@ use super::problem::{check_force_domain, check_moves, require_mechanics, ForceAl
 use super::problem::{
     simulated_levels, FitProblem, ProblemParts, Realised, Residuals, SimulatedResponse,
 };
-use super::search::build_layout;
 use super::search::prefit::{prefit_finding, prefit_options, Prefit};
 use super::search::starts::{run_starts, start_count, MultiStart, StartRun};
 use super::search::strategy::{plan_fit_starts, Planned, StartPlan};
+use super::search::{build_layout, Layout};
 use super::values::search::check_f_scale;
 use super::values::{
     check_min_speed, fits_directly, FitDomain, FitOptions, FitResult, Search, TerminationReason,
@@ -130,26 +130,8 @@ fn fit_seeded<R: Residuals + 'static>(
     seed: Option<&Result<Prefit, EngineError>>,
 ) -> Result<FitResult, EngineError> {
     let clock = Instant::now();
-    check_inputs(osc, records, residuals.as_ref())?;
-    let layout = build_layout(
-        osc,
-        model,
-        records,
-        residuals.as_ref(),
-        &opts.params,
-        &opts.energy,
-    )?;
-    layout.validate_fixed(model)?;
-    let plan = StartPlan {
-        residuals: &residuals,
-        osc,
-        model,
-        records,
-        layout: &layout,
-        opts,
-    };
     let seed_model = seed.and_then(|s| s.as_ref().ok()).map(|p| p.model.as_ref());
-    let found = search_optimum(&plan, seed_model)?;
+    let (layout, found) = laid_out_optimum(&residuals, osc, model, records, opts, seed_model)?;
     let (runs, standings) = identifiability::settle(&found.reference, found.runs, opts)?;
     let context = FinishContext {
         params: &opts.params,
@@ -169,6 +151,39 @@ fn fit_seeded<R: Residuals + 'static>(
         result.wall_time_s = clock.elapsed().as_secs_f64();
     }
     Ok(result)
+}
+
+/// The checked inputs, the layout of the free parameters (the law's fixed ones checked) and
+/// the optimum over it ([`search_optimum`], with the prefit's optimum `seed` as one more
+/// start): the part of a fit that [`fit_seeded`] and [`lean_fit`] share.
+fn laid_out_optimum<R: Residuals + 'static>(
+    residuals: &Arc<R>,
+    osc: &Oscillator,
+    model: &(dyn FrictionModel + 'static),
+    records: &[Record],
+    opts: &FitOptions,
+    seed: Option<&dyn FrictionModel>,
+) -> Result<(Layout, Found<R>), EngineError> {
+    check_inputs(osc, records, residuals.as_ref())?;
+    let layout = build_layout(
+        osc,
+        model,
+        records,
+        residuals.as_ref(),
+        &opts.params,
+        &opts.energy,
+    )?;
+    layout.validate_fixed(model)?;
+    let plan = StartPlan {
+        residuals,
+        osc,
+        model,
+        records,
+        layout: &layout,
+        opts,
+    };
+    let found = search_optimum(&plan, seed)?;
+    Ok((layout, found))
 }
 
 /// A fit without its assessment (no identifiability, no diagnostics, no property refits):
@@ -208,25 +223,7 @@ fn lean_with<R: Residuals + 'static>(
     records: &[Record],
     opts: &FitOptions,
 ) -> Result<LeanFit, EngineError> {
-    check_inputs(osc, records, residuals.as_ref())?;
-    let layout = build_layout(
-        osc,
-        model,
-        records,
-        residuals.as_ref(),
-        &opts.params,
-        &opts.energy,
-    )?;
-    layout.validate_fixed(model)?;
-    let plan = StartPlan {
-        residuals: &residuals,
-        osc,
-        model,
-        records,
-        layout: &layout,
-        opts,
-    };
-    let found = search_optimum(&plan, None)?;
+    let (_, found) = laid_out_optimum(&residuals, osc, model, records, opts, None)?;
     let reference = &found.reference;
     let world = reference.realise(&reference.physical(&found.runs.best.u))?;
     let per_record = records
