@@ -14,14 +14,14 @@ static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 #[path = "../tests/util.rs"]
 mod common;
 
-use common::{lugre_truth, records, stiff_lugre_truth, stribeck_truth, NOISE};
+use common::{
+    force_route_options, inverse_dynamics_options, lugre_truth, no_oscillator_force_options,
+    records, stiff_lugre_truth, stribeck_truth, NOISE,
+};
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use frictionid_engine::data::RecordSource;
-use frictionid_engine::identify::{
-    compare, fit, FitDomain, FitOptions, ForceTarget, ParamOptions, SearchOptions, TargetOptions,
-};
-use frictionid_engine::identify::{OscillatorParam, Search};
-use frictionid_engine::oscillator::PartialOscillator;
+use frictionid_engine::identify::Search;
+use frictionid_engine::identify::{compare, fit, FitOptions, ParamOptions, SearchOptions};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre, ViscousCoulomb};
@@ -146,13 +146,7 @@ fn lugre(c: &mut Criterion) {
 /// velocity fit of the same law on the same noisy records.
 fn force_route(c: &mut Criterion) {
     let osc = Oscillator::fmm();
-    let force = FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            ..TargetOptions::default()
-        },
-        ..FitOptions::default()
-    };
+    let force = force_route_options();
     let velocity = FitOptions::default();
     let coulomb = Coulomb { mu: 0.24 };
     let stribeck = stribeck_truth();
@@ -204,21 +198,7 @@ fn driven_axis_record() -> Record {
 /// Inverse dynamics (`force_target = "inverse_dynamics"`): the mass, a viscous+Coulomb law
 /// (its level a force: no normal force given) and an offset, on 25 000 samples.
 fn inverse_dynamics(c: &mut Criterion) {
-    let (osc, unknown) = PartialOscillator::default().resolve();
-    let opts = FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            force_target: ForceTarget::InverseDynamics,
-            force_offset: true,
-            unknown_oscillator: unknown,
-            ..TargetOptions::default()
-        },
-        params: ParamOptions {
-            oscillator: vec![OscillatorParam::Mass],
-            ..ParamOptions::default()
-        },
-        ..FitOptions::default()
-    };
+    let (osc, opts) = inverse_dynamics_options();
     let record = [driven_axis_record()];
     let mut group = c.benchmark_group("inverse dynamics");
     group.sample_size(20);
@@ -287,15 +267,7 @@ fn drive_friction_record() -> Record {
 /// coulomb, viscous_coulomb, stribeck, dahl and lugre compared in the force domain on the
 /// driven axis's measured friction force (no oscillator given: the levels are forces in N).
 fn drive_compare(c: &mut Criterion) {
-    let (osc, unknown) = PartialOscillator::default().resolve();
-    let opts = FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            unknown_oscillator: unknown,
-            ..TargetOptions::default()
-        },
-        ..FitOptions::default()
-    };
+    let (osc, opts) = no_oscillator_force_options();
     let models: Vec<Box<dyn FrictionModel>> =
         ["coulomb", "viscous_coulomb", "stribeck", "dahl", "lugre"]
             .iter()

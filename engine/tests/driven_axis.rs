@@ -5,10 +5,10 @@
 //! bisection on the piecewise-linear input. The velocity route (simulate the axis under the
 //! measured input, compare velocities) recovers M, Fv, Fc and the offset F0.
 
-use frictionid_engine::axis::{NoRestoring, Restoring};
+use crate::util::driven_slide;
 use frictionid_engine::identify::{fit, FitOptions, FitResult, OscillatorParam, ParamOptions};
 use frictionid_engine::record::Channel;
-use frictionid_engine::{Oscillator, Record};
+use frictionid_engine::Record;
 use frictionid_models::ViscousCoulomb;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
@@ -126,14 +126,7 @@ fn record(name: &str, phase: f64, noise: f64, seed: u64) -> Record {
 }
 
 fn identify(records: &[Record]) -> FitResult {
-    let start = Oscillator {
-        mass: 1.5,
-        damping: 0.0,
-        stiffness: 1.0,
-        normal_force: 1.0,
-        restoring: Restoring::None(NoRestoring),
-        ..Oscillator::fmm()
-    };
+    let start = driven_slide(1.5, 0.0);
     let opts = FitOptions {
         params: ParamOptions {
             oscillator: vec![OscillatorParam::Mass, OscillatorParam::InputOffset],
@@ -263,36 +256,13 @@ fn standard_errors_cover_the_truth_over_400_noise_draws() {
 
 #[test]
 fn the_engine_follows_the_reference_under_the_input() {
-    use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid};
-    use frictionid_engine::{Initial, SimOptions};
     let (t, u) = multisine(0.0);
     let reference = reference(&t, &u);
-    let truth = Oscillator {
-        mass: MASS,
-        damping: 0.0,
-        stiffness: 1.0,
-        normal_force: 1.0,
-        restoring: Restoring::None(NoRestoring),
-        input_offset: OFFSET,
-        ..Oscillator::fmm()
-    };
     let model = ViscousCoulomb {
         mu: COULOMB,
         viscous: VISCOUS,
     };
-    let input = Input::new(t.clone(), u).expect("an input");
-    let sim = simulate_driven(RunInputs {
-        osc: &truth,
-        model: &model,
-        init: &Initial::at_rest(0.0),
-        input: Some(&input),
-        grid: SampleGrid {
-            t_end: DURATION,
-            sample_times: &t,
-        },
-        opts: &SimOptions::default(),
-    })
-    .expect("a simulation");
+    let sim = crate::util::driven_from_rest(&driven_slide(MASS, OFFSET), &model, &t, &u);
     let worst = sim
         .v
         .iter()

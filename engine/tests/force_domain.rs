@@ -3,10 +3,9 @@
 //! classical Runge-Kutta scheme (not the engine's stepper); and the energy-based route
 //! (Eq. 7, no force sensor) on the exact Coulomb free vibration and on Stribeck records.
 
-use crate::util::{records, stribeck_truth, NOISE};
+use crate::util::{force_route_options, measured_force_options, records, stribeck_truth, NOISE};
 use frictionid_engine::exact::coulomb_free_vibration;
-use frictionid_engine::identify::{fit, FitDomain, FitOptions, ForceTarget, TargetOptions};
-use frictionid_engine::oscillator::OscillatorProperty;
+use frictionid_engine::identify::{fit, FitOptions, ForceTarget, TargetOptions};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
@@ -92,20 +91,9 @@ fn force_record(time: Vec<f64>, force: Vec<f64>) -> Record {
         .with_channel(Channel::Force, force)
 }
 
+/// m, c, k play no part: a measured force needs only the normal force.
 fn force_options() -> FitOptions {
-    FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            // m, c, k play no part: a measured force needs only the normal force.
-            unknown_oscillator: vec![
-                OscillatorProperty::Mass,
-                OscillatorProperty::Damping,
-                OscillatorProperty::Stiffness,
-            ],
-            ..TargetOptions::default()
-        },
-        ..FitOptions::default()
-    }
+    measured_force_options()
 }
 
 fn lugre_errors(fitted: &dyn FrictionModel) -> Vec<(String, f64)> {
@@ -183,14 +171,9 @@ fn coulomb_records(osc: &Oscillator, mu: f64, noise: f64) -> Vec<Record> {
 }
 
 fn energy_options() -> FitOptions {
-    FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            force_target: ForceTarget::Energy,
-            ..TargetOptions::default()
-        },
-        ..FitOptions::default()
-    }
+    let mut opts = force_route_options();
+    opts.target.force_target = ForceTarget::Energy;
+    opts
 }
 
 #[test]

@@ -10,13 +10,10 @@
 //! weight and normal force, one of them compared only where it slides, and a driven axis on a
 //! linear spring fitted by inverse dynamics with its mass, damping, stiffness and input offset.
 
+use crate::util::{force_route_options, free, measured_force_options};
 use frictionid_engine::identify::problem::{FitProblem, ProblemParts, Residuals};
 use frictionid_engine::identify::search::build_layout;
-use frictionid_engine::identify::{
-    FitDomain, FitOptions, ForceAlongMotion, ForceTarget, OscillatorParam, ParamOptions,
-    TargetOptions,
-};
-use frictionid_engine::oscillator::OscillatorProperty;
+use frictionid_engine::identify::{FitOptions, ForceAlongMotion, ForceTarget, OscillatorParam};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::simulate::SimOptions;
 use frictionid_engine::{Oscillator, Record};
@@ -79,47 +76,26 @@ fn driven_record() -> Record {
         .with_noise(Channel::InputForce, 0.05)
 }
 
-fn force_options(free: &[&str]) -> FitOptions {
-    FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            force_offset: true,
-            min_speed: Some(5e-4),
-            unknown_oscillator: vec![
-                OscillatorProperty::Mass,
-                OscillatorProperty::Damping,
-                OscillatorProperty::Stiffness,
-            ],
-            ..TargetOptions::default()
-        },
-        params: ParamOptions {
-            free: Some(free.iter().map(|s| s.to_string()).collect()),
-            ..ParamOptions::default()
-        },
-        ..FitOptions::default()
-    }
+fn force_options(names: &[&str]) -> FitOptions {
+    let mut opts = measured_force_options();
+    opts.target.force_offset = true;
+    opts.target.min_speed = Some(5e-4);
+    opts.params.free = free(names);
+    opts
 }
 
-fn inverse_options(free: &[&str]) -> FitOptions {
-    FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            force_target: ForceTarget::InverseDynamics,
-            force_offset: true,
-            ..TargetOptions::default()
-        },
-        params: ParamOptions {
-            oscillator: vec![
-                OscillatorParam::Mass,
-                OscillatorParam::Damping,
-                OscillatorParam::Stiffness,
-                OscillatorParam::InputOffset,
-            ],
-            free: Some(free.iter().map(|s| s.to_string()).collect()),
-            ..ParamOptions::default()
-        },
-        ..FitOptions::default()
-    }
+fn inverse_options(names: &[&str]) -> FitOptions {
+    let mut opts = force_route_options();
+    opts.target.force_target = ForceTarget::InverseDynamics;
+    opts.target.force_offset = true;
+    opts.params.oscillator = vec![
+        OscillatorParam::Mass,
+        OscillatorParam::Damping,
+        OscillatorParam::Stiffness,
+        OscillatorParam::InputOffset,
+    ];
+    opts.params.free = free(names);
+    opts
 }
 
 /// The fit problem of `model` on `records` under `opts`, at its starting point moved off the

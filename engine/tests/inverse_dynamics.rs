@@ -9,11 +9,8 @@
 //! within 0.5 % noise-free, and within three standard errors with noise on u. Also the
 //! errors a user meets: no input channel, no motion channel, no mass.
 
-use frictionid_engine::identify::OscillatorParam;
-use frictionid_engine::identify::{
-    fit, FitDomain, FitOptions, FitResult, ForceTarget, Hooks, ParamOptions, TargetOptions,
-};
-use frictionid_engine::oscillator::PartialOscillator;
+use crate::util::{estimate, inverse_dynamics_options, serial};
+use frictionid_engine::identify::{fit, FitOptions, FitResult, ParamOptions};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::Record;
@@ -170,28 +167,11 @@ struct State {
     s: f64,
 }
 
-/// The inverse-dynamics options: the mass and an offset fitted, no normal force, no spring.
+/// The inverse-dynamics options on one thread: the mass and an offset fitted, no normal
+/// force, no spring.
 fn options() -> (frictionid_engine::Oscillator, FitOptions) {
-    let (osc, unknown) = PartialOscillator::default().resolve();
-    let opts = FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            force_target: ForceTarget::InverseDynamics,
-            force_offset: true,
-            unknown_oscillator: unknown,
-            ..TargetOptions::default()
-        },
-        params: ParamOptions {
-            oscillator: vec![OscillatorParam::Mass],
-            ..ParamOptions::default()
-        },
-        hooks: Hooks {
-            parallel: false,
-            ..Hooks::default()
-        },
-        ..FitOptions::default()
-    };
-    (osc, opts)
+    let (osc, opts) = inverse_dynamics_options();
+    (osc, serial(opts))
 }
 
 fn inverse_dynamics(record: &Record) -> FitResult {
@@ -203,16 +183,6 @@ fn inverse_dynamics(record: &Record) -> FitResult {
         &opts,
     )
     .unwrap()
-}
-
-/// (value, standard error) of `name`.
-fn estimate(result: &FitResult, name: &str) -> (f64, f64) {
-    let p = result
-        .parameters
-        .iter()
-        .find(|p| p.name == name || p.name.starts_with(&format!("{name}[")))
-        .unwrap_or_else(|| panic!("no parameter {name}"));
-    (p.value, p.std_error.unwrap_or(f64::NAN))
 }
 
 fn truths() -> [(&'static str, f64); 4] {

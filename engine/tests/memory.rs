@@ -11,8 +11,10 @@
 //! after the other (one lock), as the allocator's counters are shared by the whole test
 //! binary.
 
+mod util;
+
 use frictionid_engine::exact::coulomb_free_vibration;
-use frictionid_engine::identify::{fit, FitDomain, FitOptions, Hooks, ParamOptions, TargetOptions};
+use frictionid_engine::identify::{fit, FitOptions};
 
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::testing::DamperStroke;
@@ -139,24 +141,10 @@ fn a_force_domain_fit_holds_a_bounded_number_of_bytes_per_sample() {
     let samples = 20_000;
     let record = [damper_stroke(samples)];
     // No oscillator given: the levels are forces in N.
-    let (osc, unknown) = frictionid_engine::oscillator::PartialOscillator::default().resolve();
+    let (osc, mut opts) = util::no_oscillator_force_options();
+    opts.params.free = util::free(&["sigma0", "mu_c"]);
     // One thread: the starts in flight at once would depend on the machine's cores.
-    let opts = FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            unknown_oscillator: unknown,
-            ..TargetOptions::default()
-        },
-        params: ParamOptions {
-            free: Some(vec!["sigma0".into(), "mu_c".into()]),
-            ..ParamOptions::default()
-        },
-        hooks: Hooks {
-            parallel: false,
-            ..Hooks::default()
-        },
-        ..FitOptions::default()
-    };
+    let opts = util::serial(opts);
     let (result, peak) = peak_over_baseline(|| fit(&osc, &Dahl::default(), &record, &opts));
     let result = result.expect("the fit");
     let level = result.fitted_model.params()[1];

@@ -8,10 +8,7 @@
 //! least-squares objective is found by solving those three normal equations on a dense
 //! logarithmic grid of v_s and refining the best grid point by golden-section search.
 
-use frictionid_engine::identify::{
-    fit, FitDomain, FitOptions, Search, SearchOptions, TargetOptions,
-};
-use frictionid_engine::oscillator::OscillatorProperty;
+use frictionid_engine::identify::{fit, FitOptions, Search, SearchOptions};
 use frictionid_engine::record::Channel;
 use frictionid_engine::testing::constant_velocity_run;
 use frictionid_engine::{Oscillator, Record};
@@ -157,18 +154,7 @@ fn joint() -> Oscillator {
 }
 
 fn force_options() -> FitOptions {
-    FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            unknown_oscillator: vec![
-                OscillatorProperty::Mass,
-                OscillatorProperty::Damping,
-                OscillatorProperty::Stiffness,
-            ],
-            ..TargetOptions::default()
-        },
-        ..FitOptions::default()
-    }
+    crate::util::measured_force_options()
 }
 
 fn fitted_point(model: &dyn FrictionModel) -> [f64; 4] {

@@ -4,17 +4,12 @@
 //! input. The inverse-dynamics target differentiates the quantised position twice: across a
 //! reversal a few samples' accelerations are wrong by tens of m/s^2.
 
-use frictionid_engine::axis::{NoRestoring, Restoring};
+use crate::util::{driven_from_rest, driven_slide, estimate, inverse_dynamics_options, serial};
 use frictionid_engine::identify::values::search::Loss;
-use frictionid_engine::identify::{
-    compare, fit, Check, FitDomain, FitOptions, FitResult, ForceTarget, Hooks, OscillatorParam,
-    ParamOptions, Status, TargetOptions,
-};
-use frictionid_engine::oscillator::PartialOscillator;
+use frictionid_engine::identify::{compare, fit, Check, FitOptions, FitResult, Status};
 use frictionid_engine::record::{Channel, TimeBase};
-use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid};
 use frictionid_engine::synthetic::add_gaussian_noise;
-use frictionid_engine::{Initial, Oscillator, Record, SimOptions};
+use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{default_model, FrictionModel, ViscousCoulomb};
 use std::f64::consts::PI;
 
@@ -68,67 +63,24 @@ fn simulated(seconds: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let n = (seconds * RATE) as usize + 1;
     let t: Vec<f64> = (0..n).map(|i| i as f64 / RATE).collect();
     let u: Vec<f64> = t.iter().map(|&t| input(t)).collect();
-    let truth = Oscillator {
-        mass: MASS,
-        damping: 0.0,
-        stiffness: 1.0,
-        normal_force: 1.0,
-        restoring: Restoring::None(NoRestoring),
-        input_offset: OFFSET,
-        ..Oscillator::fmm()
-    };
     let model = ViscousCoulomb {
         mu: COULOMB,
         viscous: VISCOUS,
     };
-    let drive = Input::new(t.clone(), u.clone()).expect("an input");
-    let sim = simulate_driven(RunInputs {
-        osc: &truth,
-        model: &model,
-        init: &Initial::at_rest(0.0),
-        input: Some(&drive),
-        grid: SampleGrid {
-            t_end: t[n - 1],
-            sample_times: &t,
-        },
-        opts: &SimOptions::default(),
-    })
-    .expect("a simulation");
+    let sim = driven_from_rest(&driven_slide(MASS, OFFSET), &model, &t, &u);
     (t, sim.x, u)
 }
 
-/// The inverse-dynamics options: mass and offset fitted, no normal force, no spring.
+/// The inverse-dynamics options on one thread: mass and offset fitted, no normal force, no
+/// spring.
 fn options() -> (Oscillator, FitOptions) {
-    let (osc, unknown) = PartialOscillator::default().resolve();
-    let opts = FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            force_target: ForceTarget::InverseDynamics,
-            force_offset: true,
-            unknown_oscillator: unknown,
-            ..TargetOptions::default()
-        },
-        params: ParamOptions {
-            oscillator: vec![OscillatorParam::Mass],
-            ..ParamOptions::default()
-        },
-        hooks: Hooks {
-            parallel: false,
-            ..Hooks::default()
-        },
-        ..FitOptions::default()
-    };
-    (osc, opts)
+    let (osc, opts) = inverse_dynamics_options();
+    (osc, serial(opts))
 }
 
 /// The value of parameter `name`.
 fn value(result: &FitResult, name: &str) -> f64 {
-    result
-        .parameters
-        .iter()
-        .find(|p| p.name == name || p.name.starts_with(&format!("{name}[")))
-        .unwrap_or_else(|| panic!("no parameter {name}"))
-        .value
+    estimate(result, name).0
 }
 
 /// The largest |measured - fitted| of a fit's first record.
@@ -270,16 +222,6 @@ fn drive_record_noisy(seconds: f64, seed: u64) -> Record {
     Record::from_time_base("drive.csv", TimeBase::new(t).unwrap())
         .with_channel(Channel::Displacement, x)
         .with_channel(Channel::InputForce, u)
-}
-
-/// (value, standard error) of `name`.
-fn estimate(result: &FitResult, name: &str) -> (f64, f64) {
-    let p = result
-        .parameters
-        .iter()
-        .find(|p| p.name == name || p.name.starts_with(&format!("{name}[")))
-        .unwrap_or_else(|| panic!("no parameter {name}"));
-    (p.value, p.std_error.unwrap_or(f64::NAN))
 }
 
 /// On a record without spikes a robust loss does not bias the fit: with `huber` and

@@ -12,10 +12,7 @@
 //! recover the parameters the runs determine.
 
 use frictionid_engine::axis::Axis;
-use frictionid_engine::identify::{
-    fit, FitDomain, FitOptions, FitResult, ParamOptions, TargetOptions,
-};
-use frictionid_engine::oscillator::OscillatorProperty;
+use frictionid_engine::identify::{fit, FitOptions, FitResult};
 use frictionid_engine::record::Channel;
 use frictionid_engine::testing::constant_velocity_run;
 use frictionid_engine::{Oscillator, Record};
@@ -35,23 +32,10 @@ fn axis() -> Oscillator {
     }
 }
 
-fn options(free: &[&str]) -> FitOptions {
-    FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            unknown_oscillator: vec![
-                OscillatorProperty::Mass,
-                OscillatorProperty::Damping,
-                OscillatorProperty::Stiffness,
-            ],
-            ..TargetOptions::default()
-        },
-        params: ParamOptions {
-            free: Some(free.iter().map(|s| s.to_string()).collect()),
-            ..ParamOptions::default()
-        },
-        ..FitOptions::default()
-    }
+fn options(names: &[&str]) -> FitOptions {
+    let mut opts = crate::util::measured_force_options();
+    opts.params.free = crate::util::free(names);
+    opts
 }
 
 /// A run at constant velocity `v` for `duration` seconds from relaxed bristles, its torque

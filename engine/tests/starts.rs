@@ -5,11 +5,8 @@
 //! sample where the residuals stop being finite. The law that breaks down is local to this
 //! test binary (the registry's "every built-in model" tests do not see it).
 
-use crate::util::{records, NOISE};
-use frictionid_engine::identify::{
-    fit, FitDomain, FitOptions, ParamOptions, Search, SearchOptions, TargetOptions,
-};
-use frictionid_engine::oscillator::PartialOscillator;
+use crate::util::{free, no_oscillator_force_options, records, NOISE};
+use frictionid_engine::identify::{fit, FitOptions, ParamOptions, Search};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::testing::DamperStroke;
 use frictionid_engine::{Oscillator, Record};
@@ -55,24 +52,10 @@ fn damper_stroke() -> Record {
 #[test]
 fn a_start_and_bounds_beyond_the_domain_are_projected_into_it() {
     let record = [damper_stroke()];
-    let (osc, unknown) = PartialOscillator::default().resolve();
-    let base = FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            unknown_oscillator: unknown,
-            ..TargetOptions::default()
-        },
-        params: ParamOptions {
-            free: Some(vec!["sigma0".into(), "mu_c".into()]),
-            guess: false,
-            ..ParamOptions::default()
-        },
-        search: SearchOptions {
-            strategy: Some(Search::Local),
-            ..SearchOptions::default()
-        },
-        ..FitOptions::default()
-    };
+    let (osc, mut base) = no_oscillator_force_options();
+    base.params.free = free(&["sigma0", "mu_c"]);
+    base.params.guess = false;
+    base.search.strategy = Some(Search::Local);
     let wide = FitOptions {
         params: ParamOptions {
             bounds: [("sigma0".to_string(), (-1e6, 1e7))].into_iter().collect(),
@@ -133,20 +116,9 @@ fn a_start_whose_residuals_are_not_finite_names_the_record_and_sample() {
             .with_channel(Channel::Velocity, v)
             .with_channel(Channel::Force, force),
     ];
-    let (osc, unknown) = PartialOscillator::default().resolve();
-    let opts = FitOptions {
-        target: TargetOptions {
-            domain: FitDomain::Force,
-            unknown_oscillator: unknown,
-            ..TargetOptions::default()
-        },
-        params: ParamOptions {
-            free: Some(vec!["mu".into()]),
-            guess: false,
-            ..ParamOptions::default()
-        },
-        ..FitOptions::default()
-    };
+    let (osc, mut opts) = no_oscillator_force_options();
+    opts.params.free = free(&["mu"]);
+    opts.params.guess = false;
     let law = BreaksDown {
         mu: 0.4,
         v_max: 0.05,

@@ -10,7 +10,6 @@ use frictionid_engine::identify::problem::unit_check::{
     balance_scale, check_driven_balance, check_swing, implied_inertia, MassReference,
 };
 use frictionid_engine::record::{Channel, TimeBase};
-use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid};
 use frictionid_engine::{Axis, Initial, Oscillator, Record, Restoring, SimOptions};
 use frictionid_models::{Coulomb, ViscousCoulomb};
 use rand::rngs::StdRng;
@@ -61,19 +60,7 @@ fn drive(osc: &Oscillator) -> [Vec<f64>; 5] {
         mu: 8.0,
         viscous: 30.0 * scale,
     };
-    let input = Input::new(t.clone(), u.clone()).expect("an input");
-    let sim = simulate_driven(RunInputs {
-        osc,
-        model: &law,
-        init: &Initial::at_rest(0.0),
-        input: Some(&input),
-        grid: SampleGrid {
-            t_end: DURATION,
-            sample_times: &t,
-        },
-        opts: &SimOptions::default(),
-    })
-    .expect("a simulation");
+    let sim = crate::util::driven_from_rest(osc, &law, &t, &u);
     [t, sim.x, sim.v, sim.a, u]
 }
 

@@ -2,8 +2,14 @@
 //! identifier's recovery tests.
 #![allow(dead_code)]
 
+use frictionid_engine::axis::{NoRestoring, Restoring};
+use frictionid_engine::identify::{
+    FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam, TargetOptions,
+};
+use frictionid_engine::oscillator::{OscillatorProperty, PartialOscillator};
+use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid, Trajectory};
 use frictionid_engine::synthetic::release_records;
-use frictionid_engine::{Oscillator, Record};
+use frictionid_engine::{Initial, Oscillator, Record, SimOptions};
 use frictionid_models::{FrictionModel, LuGre, Stribeck};
 
 /// The releases of the paper: 10, 14 and 22 mm.
@@ -53,4 +59,105 @@ pub fn stribeck_truth() -> Stribeck {
         delta: 2.0,
         viscous: 3.0,
     }
+}
+
+/// The force route (`domain = "force"`), every other option at its default.
+pub fn force_route_options() -> FitOptions {
+    FitOptions {
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            ..TargetOptions::default()
+        },
+        ..FitOptions::default()
+    }
+}
+
+/// The force route on a measured friction force, where only the normal force plays a part:
+/// the mass, damping and stiffness unknown.
+pub fn measured_force_options() -> FitOptions {
+    let mut opts = force_route_options();
+    opts.target.unknown_oscillator = vec![
+        OscillatorProperty::Mass,
+        OscillatorProperty::Damping,
+        OscillatorProperty::Stiffness,
+    ];
+    opts
+}
+
+/// The force route with no oscillator given (every property unknown, the levels forces in N):
+/// the placeholder oscillator and the options.
+pub fn no_oscillator_force_options() -> (Oscillator, FitOptions) {
+    let (osc, unknown) = PartialOscillator::default().resolve();
+    let mut opts = force_route_options();
+    opts.target.unknown_oscillator = unknown;
+    (osc, opts)
+}
+
+/// Inverse dynamics of a driven axis (`force_target = "inverse_dynamics"`): the mass and an
+/// input offset fitted, no normal force and no spring given.
+pub fn inverse_dynamics_options() -> (Oscillator, FitOptions) {
+    let (osc, mut opts) = no_oscillator_force_options();
+    opts.target.force_target = ForceTarget::InverseDynamics;
+    opts.target.force_offset = true;
+    opts.params.oscillator = vec![OscillatorParam::Mass];
+    (osc, opts)
+}
+
+/// `opts` run on one thread (results that must not depend on the machine's cores).
+pub fn serial(mut opts: FitOptions) -> FitOptions {
+    opts.hooks.parallel = false;
+    opts
+}
+
+/// `names` as the free-parameter list of [`ParamOptions::free`](frictionid_engine::identify::ParamOptions).
+pub fn free(names: &[&str]) -> Option<Vec<String>> {
+    Some(names.iter().map(|s| s.to_string()).collect())
+}
+
+/// A slide of mass `mass` with no spring, unit stiffness and normal force (friction levels in
+/// N) and an input offset of `offset` N: the driven axis of the inverse-dynamics tests.
+pub fn driven_slide(mass: f64, offset: f64) -> Oscillator {
+    Oscillator {
+        mass,
+        damping: 0.0,
+        stiffness: 1.0,
+        normal_force: 1.0,
+        restoring: Restoring::None(NoRestoring),
+        input_offset: offset,
+        ..Oscillator::fmm()
+    }
+}
+
+/// The motion of `osc` with friction `model` from rest at t = 0 under the input `u` sampled at
+/// the times `t` (linear between samples), sampled at the same times.
+pub fn driven_from_rest(
+    osc: &Oscillator,
+    model: &dyn FrictionModel,
+    t: &[f64],
+    u: &[f64],
+) -> Trajectory {
+    let input = Input::new(t.to_vec(), u.to_vec()).expect("an input");
+    simulate_driven(RunInputs {
+        osc,
+        model,
+        init: &Initial::at_rest(0.0),
+        input: Some(&input),
+        grid: SampleGrid {
+            t_end: *t.last().expect("samples"),
+            sample_times: t,
+        },
+        opts: &SimOptions::default(),
+    })
+    .expect("a simulation")
+}
+
+/// (value, standard error) of the fitted parameter `name` (or of its first per-record copy
+/// `name[...]`); the standard error NaN where there is none.
+pub fn estimate(result: &FitResult, name: &str) -> (f64, f64) {
+    let p = result
+        .parameters
+        .iter()
+        .find(|p| p.name == name || p.name.starts_with(&format!("{name}[")))
+        .unwrap_or_else(|| panic!("no parameter {name}"));
+    (p.value, p.std_error.unwrap_or(f64::NAN))
 }
