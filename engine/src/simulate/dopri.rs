@@ -16,7 +16,8 @@
 //! round-off level.
 
 use super::stepper::{
-    current_point_accessors, OdeSystem, StepControl, StepCounts, StepOutcome, StepResult, Stepper,
+    current_point_accessors, IntervalStart, OdeSystem, StepControl, StepCounts, StepOutcome,
+    StepResult, Stepper,
 };
 
 /// Stage times c_i.
@@ -256,21 +257,15 @@ impl Dopri5 {
 impl Stepper for Dopri5 {
     current_point_accessors!(ctrl);
 
-    /// Restarts at state `y` at time `t` towards `t_end` with the step size the last run
-    /// proposed (Hairer's starting step only when there is none yet): for a sequence of
-    /// intervals whose right-hand side jumps between them but keeps its scale (the sample
-    /// intervals of a replayed motion), one evaluation of f instead of two, and a first step
-    /// of the scale the last interval found.
-    fn restart<S: OdeSystem>(
+    /// Starts with the step size the last run proposed (Hairer's starting step only when
+    /// there is none yet): for a sequence of intervals whose right-hand side jumps between
+    /// them but keeps its scale (the sample intervals of a replayed motion), one evaluation
+    /// of f instead of two, and a first step of the scale the last interval found.
+    fn keep_step<S: OdeSystem>(
         &mut self,
         system: &S,
-        t: f64,
-        y: &[f64],
-        t_end: f64,
+        (t, y, t_end): IntervalStart,
     ) -> StepResult<()> {
-        if !self.ctrl.has_step() {
-            return self.reset(system, t, y, t_end);
-        }
         self.start_at(t, y, t_end);
         system.rhs(t, y, &mut self.k[0]);
         self.counts.rhs_evaluations += 1;

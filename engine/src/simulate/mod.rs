@@ -65,7 +65,9 @@ pub use input::Input;
 pub use mechanical::MechanicalEnergy;
 pub use rodas::Rodas4;
 pub use run::{REST_SWING_ATOLS, RODAS_ATOL_SCALE, RODAS_TOL_SCALE};
-pub use stepper::{AffineMotion, OdeSystem, StepCounts, StepOutcome, Stepper, Tolerance};
+pub use stepper::{
+    AffineMotion, IntervalStart, OdeSystem, StepCounts, StepOutcome, Stepper, Tolerance,
+};
 pub use values::{
     Event, EventKind, Initial, Integrator, Rest, RunInputs, SampleGrid, SimOptions, SimStats,
     Trajectory,

@@ -30,7 +30,8 @@
 
 use super::small_lu::SmallLu;
 use super::stepper::{
-    current_point_accessors, OdeSystem, StepControl, StepCounts, StepOutcome, StepResult, Stepper,
+    current_point_accessors, IntervalStart, OdeSystem, StepControl, StepCounts, StepOutcome,
+    StepResult, Stepper,
 };
 
 /// gamma, the diagonal of the method.
@@ -350,12 +351,7 @@ impl Rodas4 {
     /// Starts an interval at state `y` at `t` towards `t_end` with f and J evaluated afresh
     /// and the controller's memory dropped (the step size as it is); `first`: the step is
     /// a starting guess (a reset), not one learnt (a restart).
-    fn start_at<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        (t, y, t_end): (f64, &[f64], f64),
-        first: bool,
-    ) {
+    fn start_at<S: OdeSystem>(&mut self, system: &S, (t, y, t_end): IntervalStart, first: bool) {
         self.ctrl.restart(t, t_end);
         self.y.copy_from_slice(y);
         self.cont[0].copy_from_slice(y);
@@ -381,21 +377,11 @@ impl Rodas4 {
 impl Stepper for Rodas4 {
     current_point_accessors!(ctrl);
 
-    /// Restarts at state `y` at time `t` towards `t_end` with the step size the last run
-    /// proposed (the starting step of [`Stepper::reset`] only when there is none yet), as
-    /// Dopri5's does: f and J are evaluated afresh, the step-size
-    /// controller's memory of the last run is dropped.
-    fn restart<S: OdeSystem>(
-        &mut self,
-        system: &S,
-        t: f64,
-        y: &[f64],
-        t_end: f64,
-    ) -> StepResult<()> {
-        if !self.ctrl.has_step() {
-            return self.reset(system, t, y, t_end);
-        }
-        self.start_at(system, (t, y, t_end), false);
+    /// Starts with the step size the last run proposed (the starting step of
+    /// [`Stepper::reset`] only when there is none yet), as Dopri5's does: f and J are
+    /// evaluated afresh, the step-size controller's memory of the last run is dropped.
+    fn keep_step<S: OdeSystem>(&mut self, system: &S, start: IntervalStart) -> StepResult<()> {
+        self.start_at(system, start, false);
         Ok(())
     }
 

@@ -154,6 +154,9 @@ pub(crate) fn last_step(t: f64, h: f64, t_end: f64) -> Option<f64> {
 /// `counts` for a stepper that keeps its current time in `t`, the previous one in `t_prev`, the
 /// end time in `t_end` (fields of the stepper, or of its field `$clock`, a [`StepControl`]),
 /// the state in `y` and its work counters in `counts`; with a clock, `reached_end` too.
+/// Where an interval starts: the time, the state there and the end time.
+pub type IntervalStart<'a> = (f64, &'a [f64], f64);
+
 macro_rules! current_point_accessors {
     ($($clock:ident)?) => {
         fn time(&self) -> f64 {
@@ -179,6 +182,10 @@ macro_rules! current_point_accessors {
         $(
             fn reached_end(&self) -> bool {
                 self.$clock.reached
+            }
+
+            fn has_step(&self) -> bool {
+                self.$clock.has_step()
             }
         )?
     };
@@ -311,7 +318,8 @@ pub trait Stepper {
 
     /// Restarts at state `y` at time `t` towards `t_end`, keeping what the stepper learnt of
     /// the step size: for a sequence of intervals whose right-hand side jumps between them
-    /// but keeps its scale (the sample intervals of a replayed motion). By default a reset.
+    /// but keeps its scale (the sample intervals of a replayed motion). A reset while the
+    /// stepper has no step size to keep.
     fn restart<S: OdeSystem>(
         &mut self,
         system: &S,
@@ -319,6 +327,23 @@ pub trait Stepper {
         y: &[f64],
         t_end: f64,
     ) -> StepResult<()> {
+        match self.has_step() {
+            true => self.keep_step(system, (t, y, t_end)),
+            false => self.reset(system, t, y, t_end),
+        }
+    }
+
+    /// Whether the stepper has a step size from its last run that a restart can keep. By
+    /// default none: a restart is a reset.
+    fn has_step(&self) -> bool {
+        false
+    }
+
+    /// Starts at (t, y) towards t_end with the step size of the last run; [`restart`]
+    /// (Stepper::restart) calls it only where [`has_step`](Stepper::has_step). By default a
+    /// reset.
+    fn keep_step<S: OdeSystem>(&mut self, system: &S, at: IntervalStart) -> StepResult<()> {
+        let (t, y, t_end) = at;
         self.reset(system, t, y, t_end)
     }
 
