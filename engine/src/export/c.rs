@@ -61,7 +61,8 @@ fn valid_prefix(prefix: &str) -> bool {
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
-/// The constants' macro names: the prefix and the parameter's name in upper case.
+/// The constants' macro names: the prefix and the parameter's name in upper case. Errors:
+/// two names the same in upper case, a value not finite.
 pub fn constant_names(
     desc: &LawDescription,
     upper_prefix: &str,
@@ -79,6 +80,12 @@ pub fn constant_names(
                 "upper case",
             ));
         }
+    }
+    if let Some(p) = desc.params.iter().find(|p| !p.value.is_finite()) {
+        return Err(ExportError::Report {
+            key: format!("model_parameters.{}", p.name),
+            reason: format!("not finite ({})", p.value),
+        });
     }
     Ok(names)
 }
@@ -104,9 +111,7 @@ pub fn emit(desc: &LawDescription, prefix: &str) -> Result<String, ExportError> 
         constants: constant_names(desc, &upper)?,
     };
     let mut out = String::from("/*\n");
-    for l in desc.header("C99 (math.h only, no allocation; link with -lm)") {
-        out.push_str(&format!(" * {l}\n").replace(" * \n", " *\n"));
-    }
+    out.push_str(&desc.commented_header("C99 (math.h only, no allocation; link with -lm)", " *"));
     out.push_str(&format!(
         " *\n * Use:\n *   {p}state s; {p}init(&s);\n *   {p}update(&s, v, n, dt);  (each step)\n *   double f = {p}force(&s, v, n);\n */\n",
         p = prefix
@@ -117,12 +122,6 @@ pub fn emit(desc: &LawDescription, prefix: &str) -> Result<String, ExportError> 
     ));
     out.push_str("/* The fitted parameters: value, [unit], standard error. */\n");
     for (p, name) in desc.params.iter().zip(&syntax.constants) {
-        if !p.value.is_finite() {
-            return Err(ExportError::Report {
-                key: format!("model_parameters.{}", p.name),
-                reason: format!("not finite ({})", p.value),
-            });
-        }
         let value = literal(p.value);
         let value = if p.value < 0.0 {
             format!("({value})")

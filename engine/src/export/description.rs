@@ -287,6 +287,16 @@ impl LawDescription {
         lines
     }
 
+    /// The [`header`](Self::header) for `language` as comment lines led by `lead`.
+    pub fn commented_header(&self, language: &str, lead: &str) -> String {
+        let empty = format!("{lead} \n");
+        let bare = format!("{lead}\n");
+        self.header(language)
+            .iter()
+            .map(|l| format!("{lead} {l}\n").replace(&empty, &bare))
+            .collect()
+    }
+
     /// The comment of parameter `p`: unit, standard error, fitted or fixed, meaning.
     pub fn param_comment(p: &LawParam) -> String {
         let se = p.std_error.map_or("-".to_string(), |s| format!("{s:.3e}"));

@@ -453,6 +453,13 @@ fn gms_element_step(i: usize, k: Expr, w: Expr, two: bool) -> Vec<Stmt> {
         stuck,
         from_zero,
     )];
+    let step = Stmt::If(cmp(Cmp::Gt, local("y0"), num(0.0)), loaded, unloaded);
+    element_block(i, (k, w), z, step)
+}
+
+/// Element `i`'s update: its limit lim = w s_v and, where it is positive, rho = k / lim, the
+/// load y0 = u rho z and the travel's sg = rho travel bound, then `step`.
+fn element_block(i: usize, (k, w): (Expr, Expr), z: Expr, step: Stmt) -> Vec<Stmt> {
     vec![
         Stmt::Comment(format!("element {}", i + 1)),
         let_("lim", mul(w, local("s_v"))),
@@ -462,7 +469,7 @@ fn gms_element_step(i: usize, k: Expr, w: Expr, two: bool) -> Vec<Stmt> {
                 let_("rho", div(k, local("lim"))),
                 let_("y0", mul(mul(local("u"), local("rho")), z)),
                 let_("sg", mul(local("rho"), local("travel"))),
-                Stmt::If(cmp(Cmp::Gt, local("y0"), num(0.0)), loaded, unloaded),
+                step,
             ],
             Vec::new(),
         ),
@@ -553,27 +560,15 @@ fn gms_element_substeps(i: usize, k: Expr, w: Expr, m: Expr) -> Vec<Stmt> {
             ),
         ),
     ];
-    vec![
-        Stmt::Comment(format!("element {}", i + 1)),
-        let_("lim", mul(w, local("s_v"))),
-        Stmt::If(
-            cmp(Cmp::Gt, local("lim"), num(0.0)),
-            vec![
-                let_("rho", div(k, local("lim"))),
-                let_("y0", mul(mul(local("u"), local("rho")), z.clone())),
-                let_("sg", mul(local("rho"), local("travel"))),
-                Stmt::If(
-                    and(
-                        cmp(Cmp::Le, local("y0"), num(0.0)),
-                        cmp(Cmp::Le, add(local("y0"), local("sg")), num(0.0)),
-                    ),
-                    vec![Stmt::SetState(i, add(z, mul(Expr::V, Expr::Dt)))],
-                    loading,
-                ),
-            ],
-            Vec::new(),
+    let step = Stmt::If(
+        and(
+            cmp(Cmp::Le, local("y0"), num(0.0)),
+            cmp(Cmp::Le, add(local("y0"), local("sg")), num(0.0)),
         ),
-    ]
+        vec![Stmt::SetState(i, add(z.clone(), mul(Expr::V, Expr::Dt)))],
+        loading,
+    );
+    element_block(i, (k, w), z, step)
 }
 
 /// A damped element's force k z + sigma dz/dt, its rate v (1 - max(0, sgn(v) rho)^m) bound

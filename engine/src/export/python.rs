@@ -72,12 +72,6 @@ pub fn emit(desc: &LawDescription) -> Result<String, ExportError> {
          Python's math raises where C would give NaN or inf (a domain error in a formula).\n\"\"\"\n\nimport math\n\n",
     );
     for (p, name) in desc.params.iter().zip(&syntax.constants) {
-        if !p.value.is_finite() {
-            return Err(ExportError::Report {
-                key: format!("model_parameters.{}", p.name),
-                reason: format!("not finite ({})", p.value),
-            });
-        }
         out.push_str(&format!(
             "{name} = {}  # {}\n",
             literal(p.value),

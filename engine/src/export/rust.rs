@@ -69,9 +69,10 @@ pub fn emit(desc: &LawDescription) -> Result<String, ExportError> {
         constants: constant_names(desc, "")?,
     };
     let mut out = String::new();
-    for l in desc.header("Rust (no_std; exp, tanh, pow, ... from the `libm` crate)") {
-        out.push_str(&format!("//! {l}\n").replace("//! \n", "//!\n"));
-    }
+    out.push_str(&desc.commented_header(
+        "Rust (no_std; exp, tanh, pow, ... from the `libm` crate)",
+        "//!",
+    ));
     out.push_str(
         "//!\n//! Builds under `#![no_std]`: add `libm = \"0.2\"` to the crate's dependencies and\n\
          //! include this file as a module (`mod law;`).\n\
@@ -79,12 +80,6 @@ pub fn emit(desc: &LawDescription) -> Result<String, ExportError> {
     );
     out.push_str("#![allow(clippy::all)]\n\n");
     for (p, name) in desc.params.iter().zip(&syntax.constants) {
-        if !p.value.is_finite() {
-            return Err(ExportError::Report {
-                key: format!("model_parameters.{}", p.name),
-                reason: format!("not finite ({})", p.value),
-            });
-        }
         out.push_str(&format!(
             "/// {}\npub const {name}: f64 = {};\n",
             LawDescription::param_comment(p),
