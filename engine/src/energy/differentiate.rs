@@ -311,22 +311,8 @@ pub fn savitzky_golay_derivative(
         return Ok(out);
     }
     let uniform_dt = uniform_spacing(&time[..n]);
-    let mut bounds: Vec<usize> = Vec::with_capacity(breaks.len() + 2);
-    bounds.push(0);
-    bounds.extend(breaks.iter().copied().filter(|&b| b > 0 && b < n));
-    bounds.push(n);
-    bounds.sort_unstable();
-    bounds.dedup();
-    for seg in bounds.windows(2) {
-        let (s, e) = (seg[0], seg[1]);
-        // A lone sample between two breaks is fitted with its whole-record neighbourhood.
-        let (s, e) = if e - s < 2 { (0, n) } else { (s, e) };
-        let len = e - s;
-        let (w, p) = if len >= window {
-            (window, order)
-        } else {
-            (len, order.min(len - 1))
-        };
+    for seg in segment_bounds(breaks, n).windows(2) {
+        let (s, e, w, p) = segment_span(seg, n, window, order);
         // Uniform grid: the weights depend only on the sample's place in its window.
         let table = match uniform_dt {
             Some(_) => Some(unit_weights(w, p)?),
@@ -357,6 +343,40 @@ pub fn savitzky_golay_derivative(
     Ok(out)
 }
 
+/// The bounds of the segments between `breaks` in `n` samples: 0, the breaks inside, n.
+fn segment_bounds(breaks: &[usize], n: usize) -> Vec<usize> {
+    let mut bounds: Vec<usize> = Vec::with_capacity(breaks.len() + 2);
+    bounds.push(0);
+    bounds.extend(breaks.iter().copied().filter(|&b| b > 0 && b < n));
+    bounds.push(n);
+    bounds.sort_unstable();
+    bounds.dedup();
+    bounds
+}
+
+/// Where the windows of segment `seg` (of `n` samples) may lie, `(start, end)`, and the
+/// window and order fitted there: `window` and `order`, shortened to a shorter span. A lone
+/// sample between two breaks is fitted with its whole-record neighbourhood.
+fn segment_span(
+    seg: &[usize],
+    n: usize,
+    window: usize,
+    order: usize,
+) -> (usize, usize, usize, usize) {
+    let (s, e) = if seg[1] - seg[0] < 2 {
+        (0, n)
+    } else {
+        (seg[0], seg[1])
+    };
+    let len = e - s;
+    let (w, p) = if len >= window {
+        (window, order)
+    } else {
+        (len, order.min(len - 1))
+    };
+    (s, e, w, p)
+}
+
 /// The noise gain of [`savitzky_golay_derivative`] at each of `n` samples with the same
 /// `window`, `order` and `breaks`: the norm of the sample's weights (unit spacing) over that
 /// of a centred window, so 1 where the window is centred and more where it slides inwards
@@ -375,24 +395,8 @@ pub fn savitzky_golay_noise_gains(
         return Ok(gains);
     }
     let centre = centre_weight_norm(window, order)?;
-    let mut bounds: Vec<usize> = Vec::with_capacity(breaks.len() + 2);
-    bounds.push(0);
-    bounds.extend(breaks.iter().copied().filter(|&b| b > 0 && b < n));
-    bounds.push(n);
-    bounds.sort_unstable();
-    bounds.dedup();
-    for seg in bounds.windows(2) {
-        let (s, e) = if seg[1] - seg[0] < 2 {
-            (0, n)
-        } else {
-            (seg[0], seg[1])
-        };
-        let len = e - s;
-        let (w, p) = if len >= window {
-            (window, order)
-        } else {
-            (len, order.min(len - 1))
-        };
+    for seg in segment_bounds(breaks, n).windows(2) {
+        let (s, e, w, p) = segment_span(seg, n, window, order);
         let table = unit_weights(w, p)?;
         let norm = |row: &[f64]| row.iter().map(|x| x * x).sum::<f64>().sqrt();
         for (i, gain) in gains.iter_mut().enumerate().take(seg[1]).skip(seg[0]) {
