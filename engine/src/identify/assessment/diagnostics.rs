@@ -667,13 +667,9 @@ pub fn starts_at_best(outcomes: &[StartOutcome], best_cost: f64, residual_varian
 mod tests {
     use super::*;
     use crate::exact::coulomb_free_vibration;
+    use crate::identify::assessment::fixtures::{ar1_noise, record_fit_of};
     use crate::identify::values::layout::ParamKind;
     use crate::identify::values::result::EnergySkip;
-    use crate::identify::values::result::FitSeries;
-    use crate::identify::values::result::SampleAxes;
-    use rand::rngs::StdRng;
-    use rand::SeedableRng;
-    use rand_distr::{Distribution, Normal};
 
     const NOISE: f64 = 2e-4;
 
@@ -681,20 +677,6 @@ mod tests {
         coulomb_free_vibration(osc, mu * osc.normal_force, 0.014, time)
             .unwrap()
             .v
-    }
-
-    /// AR(1) noise of stationary standard deviation `sd` and lag-1 correlation `phi`.
-    fn ar1_noise(n: usize, sd: f64, phi: f64, seed: u64) -> Vec<f64> {
-        let mut rng = StdRng::seed_from_u64(seed);
-        let innovation = Normal::new(0.0, sd * (1.0 - phi * phi).sqrt()).unwrap();
-        let mut e = Normal::new(0.0, sd).unwrap().sample(&mut rng);
-        (0..n)
-            .map(|_| {
-                let out = e;
-                e = phi * e + innovation.sample(&mut rng);
-                out
-            })
-            .collect()
     }
 
     /// A record fit whose model is Coulomb with `mu_fit` and whose measurement is the exact
@@ -709,27 +691,7 @@ mod tests {
             .zip(noise)
             .map(|(v, e)| v + e + offset)
             .collect();
-        RecordFit {
-            file: "r".into(),
-            x0: 0.014,
-            release_time: None,
-            samples: time.len(),
-            sliding: None,
-            unreliable_target: None,
-            channel: "velocity".into(),
-            rms_residual: 0.0,
-            channels: Vec::new(),
-            energy_force: None,
-            axes: SampleAxes {
-                time,
-                ..SampleAxes::default()
-            },
-            series: FitSeries {
-                measured,
-                fitted,
-                ..FitSeries::default()
-            },
-        }
+        record_fit_of("velocity", 0.014, time, measured, fitted)
     }
 
     fn structure(fits: &[RecordFit]) -> Finding {

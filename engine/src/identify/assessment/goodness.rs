@@ -211,44 +211,10 @@ pub fn judged_record(fit: &RecordFit, given: Option<f64>) -> JudgedRecord {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::identify::values::result::{FitSeries, SampleAxes};
-    use rand::rngs::StdRng;
-    use rand::SeedableRng;
-    use rand_distr::{Distribution, Normal};
-
-    /// AR(1) noise of stationary standard deviation `sd` and lag-1 correlation `phi`.
-    fn ar1(n: usize, sd: f64, phi: f64, seed: u64) -> Vec<f64> {
-        let mut rng = StdRng::seed_from_u64(seed);
-        let innovation = Normal::new(0.0, sd * (1.0 - phi * phi).sqrt()).unwrap();
-        let mut e = Normal::new(0.0, sd).unwrap().sample(&mut rng);
-        (0..n)
-            .map(|_| {
-                let out = e;
-                e = phi * e + innovation.sample(&mut rng);
-                out
-            })
-            .collect()
-    }
+    use crate::identify::assessment::fixtures::{ar1_noise as ar1, record_fit_of};
 
     fn record(channel: &str, measured: Vec<f64>, fitted: Vec<f64>) -> RecordFit {
-        RecordFit {
-            file: "r".into(),
-            x0: 0.0,
-            release_time: None,
-            samples: measured.len(),
-            sliding: None,
-            channel: channel.into(),
-            rms_residual: 0.0,
-            channels: Vec::new(),
-            energy_force: None,
-            unreliable_target: None,
-            axes: SampleAxes::default(),
-            series: FitSeries {
-                measured,
-                fitted,
-                ..FitSeries::default()
-            },
-        }
+        record_fit_of(channel, 0.0, Vec::new(), measured, fitted)
     }
 
     fn fit_of(signal: &[f64], noise: &[f64], misfit: &[f64]) -> RecordFit {

@@ -7,6 +7,8 @@
 
 pub mod diagnostics;
 pub mod energy_check;
+#[cfg(test)]
+mod fixtures;
 pub mod goodness;
 pub mod identifiability;
 pub mod property_refits;
