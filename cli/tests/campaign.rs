@@ -7,7 +7,7 @@
 
 use frictionid_cli::testing::Says::Contains;
 use frictionid_cli::testing::{
-    assert_bad_inputs, fixtures_dir, scratch_dir, BadInput, FMM_OSCILLATOR,
+    assert_bad_inputs, fixtures_dir, runs_ok, scratch_dir, BadInput, FMM_OSCILLATOR,
 };
 use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::synthetic::add_gaussian_noise;
@@ -209,10 +209,7 @@ fn a_coulomb_campaign_recovers_each_group_and_the_fall_of_mu_with_the_normal_for
     let dir = scratch_dir("campaign", "coulomb");
     let config = coulomb_campaign(&dir);
     let out = dir.join("out");
-    let o = campaign(&config, &out, &["--quiet"]);
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(0), "{stderr}");
-    let report = read_json(&out.join("report.json"));
+    let (report, _) = runs_ok(Ok(campaign(&config, &out, &["--quiet"])), &out);
     let rows = rows_of(&report, "coulomb");
     assert_eq!(rows.len(), 12);
     for row in &rows {
@@ -257,10 +254,7 @@ fn a_dahl_campaign_recovers_each_group_and_the_rise_of_the_stiffness_with_the_no
     let dir = scratch_dir("campaign", "dahl");
     let config = dahl_campaign(&dir);
     let out = dir.join("out");
-    let o = campaign(&config, &out, &["--quiet"]);
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(0), "{stderr}");
-    let report = read_json(&out.join("report.json"));
+    let (report, _) = runs_ok(Ok(campaign(&config, &out, &["--quiet"])), &out);
     let rows = rows_of(&report, "dahl");
     assert_eq!(rows.len(), 12);
     for row in &rows {

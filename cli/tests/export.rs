@@ -260,21 +260,45 @@ fn run(command: &mut Command) -> String {
     String::from_utf8(o.stdout).unwrap()
 }
 
+/// The largest |a - b| over the pairs of `a` and `b`.
+fn worst_difference(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f64, f64::max)
+}
+
 /// The exported replay's forces (one per line) against the engine's.
 fn assert_matches_engine(case: &Case, lang: &str, output: &str) {
     let forces: Vec<f64> = output.lines().map(|l| l.trim().parse().unwrap()).collect();
     assert_eq!(forces.len(), case.engine.len(), "{} {lang}", case.name);
     let level = level(&case.engine);
-    let worst = forces
-        .iter()
-        .zip(&case.engine)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0f64, f64::max);
+    let worst = worst_difference(&forces, &case.engine);
     assert!(
         worst <= 1e-9 * level,
         "{} in {lang}: off by {worst:e} N at a force level of {level} N",
         case.name
     );
+}
+
+/// The tool named by the environment variable `var` (else `default`), where it runs; prints
+/// that `test` is skipped where it does not.
+fn tool(var: &str, default: &str, test: &str) -> Option<String> {
+    let tool = std::env::var(var).unwrap_or_else(|_| default.into());
+    available(&tool, test).then_some(tool)
+}
+
+/// Exports each case's law in `lang` into `<case>/<lang>/law.<ext>`, replays its record with
+/// the program `replay` builds in that folder (its output: one force a line) and checks the
+/// forces against the engine's.
+fn replay_each_case(lang: &str, ext: &str, label: &str, replay: impl Fn(&Case, &Path) -> String) {
+    for case in cases() {
+        let dir = case.dir.join(lang);
+        std::fs::create_dir_all(&dir).unwrap();
+        export(case, lang, &dir.join(format!("law.{ext}")), &[]);
+        let out = replay(case, &dir);
+        assert_matches_engine(case, label, &out);
+    }
 }
 
 /// Whether `tool` runs; prints that the test is skipped when not.
@@ -313,14 +337,10 @@ int main(void) {
 
 #[test]
 fn c_exports_replay_records_as_the_engine_does() {
-    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
-    if !available(&cc, "the C exports") {
+    let Some(cc) = tool("CC", "cc", "the C exports") else {
         return;
-    }
-    for case in cases() {
-        let dir = case.dir.join("c");
-        std::fs::create_dir_all(&dir).unwrap();
-        export(case, "c", &dir.join("law.c"), &[]);
+    };
+    replay_each_case("c", "c", "C", |case, dir| {
         std::fs::write(dir.join("main.c"), C_MAIN).unwrap();
         run(Command::new(&cc)
             .args(["-std=c99", "-Wall", "-Werror", "-O2", "-o"])
@@ -328,18 +348,16 @@ fn c_exports_replay_records_as_the_engine_does() {
             .arg(dir.join("main.c"))
             .arg("-lm"));
         let motion = std::fs::File::open(write_motion(case)).unwrap();
-        let out = run(Command::new(dir.join("replay")).stdin(motion));
-        assert_matches_engine(case, "C", &out);
-    }
+        run(Command::new(dir.join("replay")).stdin(motion))
+    });
 }
 
 /// Two laws in one C program, kept apart by their prefixes.
 #[test]
 fn c_prefixes_keep_several_laws_apart() {
-    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
-    if !available(&cc, "the C prefixes") {
+    let Some(cc) = tool("CC", "cc", "the C prefixes") else {
         return;
-    }
+    };
     let cases = cases();
     let (Some(a), Some(b)) = (cases.first(), cases.last()) else {
         return;
@@ -391,20 +409,16 @@ fn main() {
 
 #[test]
 fn rust_exports_build_without_std_and_replay_records_as_the_engine_does() {
-    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
-    if !available(&rustc, "the Rust exports") {
+    let Some(rustc) = tool("RUSTC", "rustc", "the Rust exports") else {
         return;
-    }
-    for case in cases() {
-        let dir = case.dir.join("rust");
-        std::fs::create_dir_all(&dir).unwrap();
-        export(case, "rust", &dir.join("law.rs"), &[]);
+    };
+    replay_each_case("rust", "rs", "Rust", |case, dir| {
         std::fs::write(dir.join("lib.rs"), "#![no_std]\npub mod law;\n").unwrap();
         std::fs::write(dir.join("libm.rs"), LIBM_SHIM).unwrap();
         std::fs::write(dir.join("main.rs"), RUST_MAIN).unwrap();
         let rustc = || {
             let mut c = Command::new(&rustc);
-            c.args(["--edition", "2021", "-O", "--out-dir"]).arg(&dir);
+            c.args(["--edition", "2021", "-O", "--out-dir"]).arg(dir);
             c
         };
         run(rustc()
@@ -426,12 +440,11 @@ fn rust_exports_build_without_std_and_replay_records_as_the_engine_does() {
             .arg("--extern")
             .arg(format!("law={}", dir.join("liblaw.rlib").display()))
             .arg("-L")
-            .arg(&dir)
+            .arg(dir)
             .arg(dir.join("main.rs")));
         let motion = std::fs::File::open(write_motion(case)).unwrap();
-        let out = run(Command::new(dir.join("main")).stdin(motion));
-        assert_matches_engine(case, "Rust", &out);
-    }
+        run(Command::new(dir.join("main")).stdin(motion))
+    });
 }
 
 const PYTHON_MAIN: &str = r#"import sys
@@ -450,18 +463,14 @@ fn python_exports_replay_records_as_the_engine_does() {
     if !available("python3", "the Python exports") {
         return;
     }
-    for case in cases() {
-        let dir = case.dir.join("python");
-        std::fs::create_dir_all(&dir).unwrap();
-        export(case, "python", &dir.join("law.py"), &[]);
+    replay_each_case("python", "py", "Python", |case, dir| {
         std::fs::write(dir.join("main.py"), PYTHON_MAIN).unwrap();
         let motion = write_motion(case);
-        let out = run(Command::new("python3")
+        run(Command::new("python3")
             .arg(dir.join("main.py"))
-            .arg(&dir)
-            .arg(&motion));
-        assert_matches_engine(case, "Python", &out);
-    }
+            .arg(dir)
+            .arg(&motion))
+    });
 }
 
 /// The compensation table is the law's steady-state curve on a grid symmetric about zero,
@@ -588,11 +597,7 @@ fn gms_at_another_sharpness_follows_the_engines_integration() {
         .arg(write_motion(&case)));
     let forces: Vec<f64> = out.lines().map(|l| l.parse().unwrap()).collect();
     let level = level(&case.engine);
-    let worst = forces
-        .iter()
-        .zip(&case.engine)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0f64, f64::max);
+    let worst = worst_difference(&forces, &case.engine);
     assert!(
         worst <= 1e-6 * level,
         "off by {worst:e} at a level of {level}"

@@ -358,9 +358,7 @@ fn energy_without_a_model_takes_its_reference_from_a_coulomb_fit() {
 #[test]
 fn energy_uses_measured_displacement_and_acceleration_columns() {
     let dir = scratch_dir("fc", "energy-3ch");
-    let osc = frictionid_engine::Oscillator::fmm();
-    let times = frictionid_engine::synthetic::uniform_times(2.0, 1000.0);
-    let ex = frictionid_engine::exact::coulomb_free_vibration(&osc, MU_N, 0.014, &times).unwrap();
+    let ex = exact_release();
     let mut csv = String::from("time,velocity,displacement,acceleration\n");
     for i in 0..ex.time.len() {
         csv += &format!(
@@ -383,6 +381,13 @@ fn energy_uses_measured_displacement_and_acceleration_columns() {
     assert!((mean / MU_N - 1.0).abs() < 1e-6, "mean |F| {mean}");
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(md.contains("measured / measured"), "{md}");
+}
+
+/// The exact Coulomb motion of the FMM oscillator released at 14 mm: 2 s at 1 kHz.
+fn exact_release() -> frictionid_engine::exact::ExactCoulomb {
+    let osc = frictionid_engine::Oscillator::fmm();
+    let times = frictionid_engine::synthetic::uniform_times(2.0, 1000.0);
+    frictionid_engine::exact::coulomb_free_vibration(&osc, MU_N, 0.014, &times).unwrap()
 }
 
 #[test]
@@ -411,9 +416,7 @@ fn expression_sign_law_fits_the_same_mu_as_coulomb() {
 #[test]
 fn a_displacement_only_record_is_fitted_in_displacement() {
     let dir = scratch_dir("fc", "fit-x");
-    let osc = frictionid_engine::Oscillator::fmm();
-    let times = frictionid_engine::synthetic::uniform_times(2.0, 1000.0);
-    let ex = frictionid_engine::exact::coulomb_free_vibration(&osc, MU_N, 0.014, &times).unwrap();
+    let ex = exact_release();
     let mut csv = String::from("time,displacement\n");
     for (t, x) in ex.time.iter().zip(&ex.x) {
         csv += &format!("{t:e},{x:e}\n");
