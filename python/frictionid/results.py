@@ -304,11 +304,11 @@ def _plot_fit_records(ax, records, ylabel, residuals=False):
     """The measured and fitted series of ``records`` on ``ax`` (one legend entry per kind),
     or their residuals; the time axis cut to the motion."""
     shown_t, shown = [], []
-    for i, record in enumerate(records):
+    for record in records:
         t, measured, fitted = record.get("time"), record.get("measured"), record.get("fitted")
         if t is None or measured is None or fitted is None:
             continue
-        hide = "_" if i else ""
+        hide = "_" if shown_t else ""
         if residuals:
             ax.plot(t, measured - fitted, color=MEASURED, lw=0.8, label=f"{hide}measured - fitted")
         else:
@@ -382,8 +382,7 @@ class CompareResult(FitResult):
         """The law whose parameters the result shows: the recommended one, else the best."""
         if self.recommended is not None:
             return self.recommended
-        ranking = self.get("ranking", [])
-        return FitResult(ranking[0]) if ranking else FitResult()
+        return next(iter(self.results.values()), FitResult())
 
     def _param_rows(self):
         return _fit_rows(self._shown().get("parameters", []))

@@ -5,6 +5,7 @@ the notebook view, and `run`, which writes nothing unless asked."""
 import html
 import json
 import os
+import pickle
 import subprocess
 import sys
 from pathlib import Path
@@ -66,6 +67,9 @@ def test_a_fit_is_still_its_dict(fitted):
     # A plain dict of it serializes as report.json does once the arrays are left out.
     plain = {k: v for k, v in fitted.items() if k != "records"}
     assert json.loads(json.dumps(plain)) == plain
+    # It travels to worker processes whole (pickle), text included.
+    copy = pickle.loads(pickle.dumps(fitted))
+    assert copy.report() == fitted.report() and copy["parameters"] == fitted["parameters"]
 
 
 def test_params_is_a_table_of_the_fitted_truth(fitted):
