@@ -208,7 +208,7 @@ fn models_to_compare(
         return spec.models_to_compare(None).map_err(value_error);
     };
     let items = inputs::non_empty_list(
-        &list,
+        list,
         "models: expected a list of names or model dicts",
         "no models to compare",
     )?;
