@@ -460,6 +460,14 @@ def _axis_units(oscillator):
     return "m", "m/s", "N"
 
 
+def _axis_labels(oscillator):
+    """The axis labels of displacement, velocity and friction on the oscillator's axis."""
+    x, v, f = _axis_units(oscillator)
+    if (oscillator or {}).get("axis") == "rotary":
+        return f"angle [{x}]", f"angular velocity [{v}]", f"friction torque [{f}]"
+    return f"x [{x}]", f"v [{v}]", f"friction force [{f}]"
+
+
 class SimulateResult(Result):
     """A simulation: report.json's dict with the trajectory (``t``, ``x``, ``v``, ``a``,
     ``force``, energies, states), ``.params`` (the model's given parameters), ``.report()``
@@ -495,14 +503,10 @@ class SimulateResult(Result):
     def plot(self):
         """A matplotlib Figure: displacement, velocity and friction force against time."""
         plt = _pyplot()
-        x_unit, v_unit, f_unit = _axis_units(self.get("oscillator"))
+        labels = _axis_labels(self.get("oscillator"))
         fig, axes = _figure(plt, 3, height=2.0)
         axes = axes[:, 0]
-        for ax, key, label in [
-            (axes[0], "x", f"x [{x_unit}]"),
-            (axes[1], "v", f"v [{v_unit}]"),
-            (axes[2], "force", f"friction force [{f_unit}]"),
-        ]:
+        for ax, key, label in zip(axes, ("x", "v", "force"), labels):
             ax.plot(self["t"], self[key], color=MEASURED, lw=1.0)
             _cut_to_motion(ax, [self["t"]], [[self["v"]]])
             ax.set_ylabel(label)
@@ -566,7 +570,7 @@ class EnergyResult(Result):
 
         plt = _pyplot()
         records = self.get("records", [])
-        f_unit = _axis_units(self.get("oscillator"))[2]
+        f_label = _axis_labels(self.get("oscillator"))[2]
         fig, axes = _figure(plt, len(records))
         for ax, r in zip(axes[:, 0], records):
             t = r["time"]
@@ -583,7 +587,7 @@ class EnergyResult(Result):
             _cut_to_motion(ax, [t], [series])
             ax.set_title(r.get("file") or "", fontsize=9)
             ax.set_xlabel("time [s]")
-            ax.set_ylabel(f"friction force [{f_unit}]")
+            ax.set_ylabel(f_label)
             ax.grid(alpha=0.3)
         return _finish(fig, "energy-based friction force (Eq. 7)", axes[0, 0])
 

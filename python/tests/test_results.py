@@ -264,3 +264,12 @@ def test_the_core_works_without_pandas_and_matplotlib():
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "ok"
+
+
+def test_a_rotary_result_speaks_in_angles_and_torques():
+    axis = {"axis": "rotary", "inertia": 0.01, "damping": 0.001, "stiffness": 2.0, "normal_force": 10.0}
+    sim = frictionid.simulate(axis, {"type": "viscous_coulomb", "mu": 0.01, "viscous": 0.001}, 0.5,
+                              np.linspace(0.0, 2.0, 201))
+    assert sim.params.loc["viscous", "unit"] == "N m s/rad"
+    labels = [ax.get_ylabel() for ax in sim.plot().axes]
+    assert labels == ["angle [rad]", "angular velocity [rad/s]", "friction torque [N m]"]
