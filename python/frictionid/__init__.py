@@ -2,38 +2,53 @@
 
 The functions take the configuration's tables as dicts (``oscillator``, ``model``, ``fit``,
 ``energy``) and records as dicts of arrays, call the same engine as the ``frictionid``
-command line, and return the same structure as its report.json, with numpy arrays for the
-series. Units are SI (m, s, kg, N). The ``oscillator`` dict may give one standard deviation
-of each property (``mass_std``, ``damping_std``, ``stiffness_std``, ``normal_force_std``):
-every fitted parameter then reports ``std_error_components`` and a total ``std_error``.
+command line, and return result objects: the same structure as its report.json (a dict,
+with numpy arrays for the series), plus a parameter table, the text report, a plot and a
+notebook view. Units are SI (m, s, kg, N). The ``oscillator`` dict may give one standard
+deviation of each property (``mass_std``, ``damping_std``, ``stiffness_std``,
+``normal_force_std``): every fitted parameter then reports ``std_error_components`` and a
+total ``std_error``.
 
 - ``models()``: every registered model (``frictionid models --json``).
-- ``simulate(oscillator, model, x0, t, v0=0.0, options=None)``: one free vibration.
-- ``fit(oscillator, model, records, fit=None)``: a model fitted to records.
-- ``compare(oscillator, models, records, fit=None)``: several models ranked by AIC.
-- ``energy(oscillator, records, model=None, options=None)``: the energy-based force (Eq. 7).
-- ``run(config_path, command="fit", out=None)``: a configuration file, as the CLI runs it.
+- ``simulate(oscillator, model, x0, t, v0=0.0, options=None)``: one free vibration, a
+  ``SimulateResult``.
+- ``fit(oscillator, model, records, fit=None)``: a model fitted to records, a ``FitResult``.
+- ``compare(oscillator, models, records, fit=None)``: several models ranked, with the law to
+  use, a ``CompareResult``.
+- ``energy(oscillator, records, model=None, options=None)``: the energy-based force (Eq. 7),
+  an ``EnergyResult``.
+- ``run(config_path, command="fit", out=None)``: a configuration file, as the CLI runs it;
+  returns what the function of the same name returns. Nothing is written unless ``out``
+  names a folder (then the CLI's report folder is written there too).
 - ``campaign(config, manifest=None, executor=None, out=None)``: every group of a campaign
   (one task per group on any ``concurrent.futures`` executor), campaign.csv as a pandas
   DataFrame (pandas: ``pip install frictionid[campaign]``).
 
-``fit``, ``compare`` and ``run`` (for ``fit`` and ``compare``) return a ``FitResult``: the
-report's dict with ``export(lang="c", prefix="fid_", normal_force=None)``, the fitted law (a
-comparison's recommended one) as C, Rust or Python source text, or ``lang="table"`` for the
-steady-state compensation table (``frictionid export``).
+Every result keeps dict access (``result["parameters"]``) and adds ``.params`` (a pandas
+DataFrame indexed by parameter: ``value``, ``std_error``, ``ci_low``, ``ci_high``, ``unit``,
+``status``), ``.report()`` (the summary the CLI prints; ``report("markdown")``: report.md),
+``.plot()`` (a matplotlib Figure), ``.verdict`` and ``_repr_html_`` for notebooks. pandas
+and matplotlib are needed only for ``.params`` and ``.plot()``: ``pip install
+frictionid[notebook]``. A ``CompareResult`` adds ``.recommended`` (the recommended law's
+``FitResult``), ``.results`` (every law's, by name) and ``.ranking_table``. A ``FitResult``
+(and a comparison) has ``export(lang="c", prefix="fid_", normal_force=None)``, the fitted
+law (a comparison's recommended one) as C, Rust or Python source text, or ``lang="table"``
+for the steady-state compensation table (``frictionid export``).
 
 Bad input raises ``ValueError``; a fit that failed raises ``FitError``. Ctrl-C stops a fit.
 """
 
-import json
-
 from . import _native
-from ._native import FitError, energy, models, simulate
+from ._native import FitError, models
 from .campaign import campaign
+from .results import CompareResult, EnergyResult, FitResult, SimulateResult, result_of
 
 __all__ = [
+    "CompareResult",
+    "EnergyResult",
     "FitError",
     "FitResult",
+    "SimulateResult",
     "campaign",
     "compare",
     "energy",
@@ -43,55 +58,42 @@ __all__ = [
     "simulate",
 ]
 
-# The keys of a fit that an export reads (the series stay behind).
-_FIT_KEYS = ("command", "model", "model_parameters", "parameters", "oscillator", "compared")
-_RECORD_KEYS = ("file", "max_speed")
+_COMMANDS = ("simulate", "fit", "compare", "energy")
 
 
-def _for_export(fit):
-    """The part of a fit's dict an export reads, as plain JSON values."""
-    out = {k: fit[k] for k in _FIT_KEYS if k in fit}
-    out["records"] = [
-        {k: r[k] for k in _RECORD_KEYS if k in r} for r in fit.get("records", [])
-    ]
-    return out
-
-
-class FitResult(dict):
-    """A fit's (or a comparison's) report as a dict, with ``export``."""
-
-    def export(self, lang="c", prefix="fid_", normal_force=None):
-        """The fitted law (a comparison's recommended one) as source text: ``lang`` one of
-        ``"c"``, ``"rust"``, ``"python"`` or ``"table"`` (the steady-state force on a velocity
-        grid, as CSV). ``prefix`` names the C identifiers; ``normal_force`` [N] is the
-        table's (default: the fit's)."""
-        if "ranking" in self:
-            report = {
-                "command": "compare",
-                "verdict": self.get("verdict"),
-                "ranking": [_for_export(f) for f in self["ranking"]],
-            }
-        else:
-            report = _for_export(self)
-        return _native.export(json.dumps(report), lang, prefix, normal_force)
+def simulate(oscillator, model, x0, t, v0=0.0, options=None):
+    """One free vibration released at ``x0`` (and ``v0``), sampled at the times ``t``: a
+    ``SimulateResult`` (report.json's keys, then ``t, x, v, a, force``, the energies, the
+    internal states ``z1..zn`` and ``states``)."""
+    return SimulateResult(*_native.simulate(oscillator, model, x0, t, v0, options))
 
 
 def fit(oscillator, model, records, fit=None):
-    """The model fitted to ``records``: report.json's structure plus the fitted series, as a
-    ``FitResult`` (``result.export("c")`` writes the fitted law as C)."""
-    return FitResult(_native.fit(oscillator, model, records, fit))
+    """The model fitted to ``records``: a ``FitResult`` (report.json's structure plus the
+    fitted series; ``result.params``, ``result.plot()``, ``result.export("c")``)."""
+    return FitResult(*_native.fit(oscillator, model, records, fit))
 
 
 def compare(oscillator, models, records, fit=None):
-    """Several models ranked by AIC, as a ``FitResult`` (its ``export`` writes the
-    recommended law)."""
-    return FitResult(_native.compare(oscillator, models, records, fit))
+    """Several models fitted to the same records and ranked, with the law to use: a
+    ``CompareResult`` (``result.recommended`` is that law's ``FitResult``; ``export`` writes
+    it)."""
+    return CompareResult(*_native.compare(oscillator, models, records, fit))
+
+
+def energy(oscillator, records, model=None, options=None):
+    """The energy-based friction force of every record (Eq. 7) against a reference (the
+    model's force when a model is given, else a fitted Coulomb force): an
+    ``EnergyResult``."""
+    return EnergyResult(*_native.energy(oscillator, records, model, options))
 
 
 def run(config_path, command="fit", out=None):
-    """A configuration file run as ``frictionid <command>`` runs it; its report.json (a
-    ``FitResult`` for ``fit`` and ``compare``)."""
-    report = _native.run(config_path, command, out)
-    if command in ("fit", "compare") and isinstance(report, dict):
-        return FitResult(report)
-    return report
+    """A configuration file run as ``frictionid <command>`` runs it: the result object the
+    function of the same name returns (``models``: the listing). Nothing is written unless
+    ``out`` names a folder; then the CLI's report folder (report.json, .md, .html, plots) is
+    written there as ``frictionid <command> CONFIG --out OUT`` writes it."""
+    native = _native.run(str(config_path), command, None if out is None else str(out))
+    if command in _COMMANDS:
+        return result_of(command, native)
+    return native

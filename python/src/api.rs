@@ -1,4 +1,5 @@
-//! The module's functions: dicts in, the engine's job, a dict out.
+//! The module's functions: dicts in, the engine's job, a dict out with the report's text
+//! forms beside it (`(dict, texts)`, see [`crate::outputs::texts`]).
 //!
 //! Simulations and fits run with the GIL released, on a worker thread, while the calling
 //! thread watches for signals; Ctrl-C stops the fit at its next solver iteration (see
@@ -7,7 +8,7 @@
 use crate::convert::{serialized, to_f64_vec, to_json};
 use crate::errors::{engine_error, job_error, value_error};
 use crate::inputs;
-use crate::outputs::{compare_dict, energy_dict, fit_dict, simulate_dict};
+use crate::outputs::{compare_output, energy_output, fit_output, simulate_output, WithTexts};
 use frictionid_engine::identify::require_oscillator;
 use frictionid_engine::jobs::{compare_job, energy_job, fit_job, simulate_report};
 use frictionid_engine::record::TimeBase;
@@ -18,9 +19,8 @@ use frictionid_engine::{Axis, Spec};
 use frictionid_models::FrictionModel;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::PyString;
 use std::any::Any;
-use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::sync::Arc;
@@ -59,7 +59,7 @@ fn lost_worker(payload: Box<dyn Any + Send>) -> PyErr {
 /// Runs `job` on a worker thread with the GIL released; the calling thread checks for
 /// signals every [`SIGNAL_POLL`]. On Ctrl-C the job is cancelled (it ends at its next solver
 /// iteration) and the signal's exception (`KeyboardInterrupt`) raised at once.
-fn run_job<T: Send + 'static>(
+pub fn run_job<T: Send + 'static>(
     py: Python<'_>,
     job: impl FnOnce(Hooks) -> PyResult<T> + Send + 'static,
 ) -> PyResult<T> {
@@ -138,7 +138,7 @@ pub fn simulate<'py>(
     t: &Bound<'py, PyAny>,
     v0: f64,
     options: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<WithTexts<'py>> {
     let stage = inputs::oscillator(oscillator)?;
     require_oscillator(&stage.unknown, stage.oscillator.axis, "simulate")
         .map_err(|e| value_error(e.to_string()))?;
@@ -163,7 +163,7 @@ pub fn simulate<'py>(
             },
         )
     });
-    simulate_dict(py, &report.map_err(engine_error)?)
+    simulate_output(py, &report.map_err(engine_error)?)
 }
 
 /// The spec of `fit`, `compare` and `energy` from their dicts.
@@ -190,13 +190,13 @@ pub fn fit<'py>(
     model: &Bound<'py, PyAny>,
     records: &Bound<'py, PyAny>,
     fit: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<WithTexts<'py>> {
     let spec = spec_from(oscillator, Some(inputs::model(model)?), fit, None)?;
     let records = inputs::records(records)?;
     let report = run_job(py, move |hooks| {
         fit_job(&spec, &records, &hooks).map_err(job_error)
     })?;
-    fit_dict(py, &report)
+    fit_output(py, &report)
 }
 
 /// The models to compare: names (registered models with their defaults) or model dicts.
@@ -208,7 +208,7 @@ fn models_to_compare(
         return spec.models_to_compare(None).map_err(value_error);
     };
     let items = inputs::non_empty_list(
-        &list,
+        list,
         "models: expected a list of names or model dicts",
         "no models to compare",
     )?;
@@ -236,14 +236,14 @@ pub fn compare<'py>(
     models: Option<&Bound<'py, PyAny>>,
     records: &Bound<'py, PyAny>,
     fit: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<WithTexts<'py>> {
     let spec = spec_from(oscillator, None, fit, None)?;
     let models = models_to_compare(&spec, models)?;
     let records = inputs::records(records)?;
     let report = run_job(py, move |hooks| {
         compare_job(&spec, &models, &records, &hooks).map_err(job_error)
     })?;
-    compare_dict(py, &report)
+    compare_output(py, &report)
 }
 
 /// The energy-based friction force of every record (Eq. 7) against a reference: the model's
@@ -256,7 +256,7 @@ pub fn energy<'py>(
     records: &Bound<'py, PyAny>,
     model: Option<&Bound<'py, PyAny>>,
     options: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<WithTexts<'py>> {
     let model = model
         .filter(|m| !m.is_none())
         .map(inputs::model)
@@ -266,41 +266,5 @@ pub fn energy<'py>(
     let report = run_job(py, move |hooks| {
         energy_job(&spec, &records, &hooks).map_err(job_error)
     })?;
-    energy_dict(py, &report)
-}
-
-/// Runs a configuration file exactly as `frictionid <command> <config_path> --quiet [--out
-/// out]` does (the files are written) and returns its report.json.
-#[pyfunction]
-#[pyo3(signature = (config_path, command = "fit", out = None))]
-pub fn run<'py>(
-    py: Python<'py>,
-    config_path: PathBuf,
-    command: &str,
-    out: Option<PathBuf>,
-) -> PyResult<Bound<'py, PyAny>> {
-    use frictionid_cli::args::OutputArgs;
-    use frictionid_cli::commands;
-    if command == "models" {
-        return models(py, "linear");
-    }
-    let output = OutputArgs {
-        out,
-        quiet: true,
-        json: false,
-    };
-    let dir = output.dir_for(&config_path, command);
-    let ran = py.detach(|| match command {
-        "fit" => commands::fit::run(&config_path, &output),
-        "compare" => commands::compare::run(&config_path, None, &output),
-        "energy" => commands::energy::run(&config_path, &output),
-        "simulate" => commands::simulate::run(&config_path, &output),
-        other => Err(anyhow::anyhow!(
-            "unknown command `{other}`; one of: simulate, fit, compare, energy, models"
-        )),
-    });
-    ran.map_err(|e| value_error(format!("{e:#}")))?;
-    let text = std::fs::read_to_string(dir.join("report.json"))
-        .map_err(|e| value_error(format!("{}: {e}", dir.join("report.json").display())))?;
-    py.import("json")?.call_method1("loads", (text,))
+    energy_output(py, &report)
 }

@@ -45,17 +45,27 @@ pub fn engine_error(e: EngineError) -> PyErr {
     }
 }
 
-/// A job's error: input problems become `ValueError`, failed computations `FitError`.
-pub fn job_error(e: JobError) -> PyErr {
-    let msg = one_line(&e.to_string());
-    let input = match &e {
+/// Whether a job's error is about its input rather than a computation that failed.
+fn is_input_job_error(e: &JobError) -> bool {
+    match e {
         JobError::Spec(_) | JobError::Record { .. } => true,
         JobError::Simulation(inner) | JobError::ReferenceFit(inner) | JobError::Fit(inner) => {
             is_input_error(inner)
         }
         JobError::NothingFitted(_) => false,
-    };
-    if input {
+    }
+}
+
+/// A job's error: input problems become `ValueError`, failed computations `FitError`.
+pub fn job_error(e: JobError) -> PyErr {
+    job_error_as(&e, e.to_string())
+}
+
+/// A job's error, of the class [`job_error`] gives it, with the message `msg` (a config
+/// run's: the file's name first, as the CLI prints it).
+pub fn job_error_as(e: &JobError, msg: String) -> PyErr {
+    let msg = one_line(&msg);
+    if is_input_job_error(e) {
         PyValueError::new_err(msg)
     } else {
         FitError::new_err(msg)

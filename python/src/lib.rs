@@ -10,6 +10,7 @@
 //! - [`outputs`]: report values to dicts with arrays.
 //! - [`errors`]: `ValueError` for bad input, `frictionid.FitError` for a failed fit.
 //! - [`api`]: the module's functions.
+//! - [`run`]: a configuration file run as the CLI runs it.
 //! - [`campaign`]: campaigns, one group a task for any executor.
 //! - [`export`]: a fitted law as C, Rust or Python source, or a compensation table.
 
@@ -25,6 +26,7 @@ pub mod errors;
 pub mod export;
 pub mod inputs;
 pub mod outputs;
+pub mod run;
 
 use pyo3::prelude::*;
 
@@ -37,7 +39,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(api::fit, m)?)?;
     m.add_function(wrap_pyfunction!(api::compare, m)?)?;
     m.add_function(wrap_pyfunction!(api::energy, m)?)?;
-    m.add_function(wrap_pyfunction!(api::run, m)?)?;
+    m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_function(wrap_pyfunction!(export::export, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::campaign_plan, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::campaign_group, m)?)?;

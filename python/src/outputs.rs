@@ -1,10 +1,16 @@
 //! Report values as Python dicts: the report.json structure (through the engine's serde
-//! form) plus numpy arrays for the series report.json leaves out.
+//! form) plus numpy arrays for the series report.json leaves out, and the report's text
+//! forms (the terminal summary the CLI prints, report.md) that the Python result objects
+//! show.
 
 use crate::convert::{serialized, set_array};
+use frictionid_cli::terminal::TerminalWriter;
 use frictionid_engine::identify::{FitResult, FitSeries, ForceBalance};
+use frictionid_engine::report::fit::verdict_line;
+use frictionid_engine::report::format::serialized_name;
+use frictionid_engine::report::markdown::MarkdownWriter;
 use frictionid_engine::report::{
-    CompareReport, EnergyRecord, EnergyReport, FitReport, SimulateReport,
+    CompareReport, EnergyRecord, EnergyReport, FitReport, Render, SimulateReport, Status,
 };
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -160,4 +166,69 @@ pub fn energy_dict<'py>(py: Python<'py>, report: &EnergyReport) -> PyResult<Boun
         dict.set_item("reference_model", name)?;
     }
     Ok(dict)
+}
+
+/// A report's text forms: `text`, the summary `frictionid` prints, and `markdown`, report.md.
+pub fn texts<'py>(py: Python<'py>, report: &dyn Render) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("text", TerminalWriter::render(report))?;
+    d.set_item("markdown", MarkdownWriter::render(report))?;
+    Ok(d)
+}
+
+/// Adds a verdict to a report's texts: `verdict`, its sentence, and `status` (`pass`,
+/// `warn` or `fail`).
+fn set_verdict(d: &Bound<'_, PyDict>, (status, text): (Status, String)) -> PyResult<()> {
+    d.set_item("verdict", text)?;
+    d.set_item("status", serialized_name(&status))
+}
+
+/// A fit's text forms with its verdict.
+fn fit_texts<'py>(py: Python<'py>, report: &FitReport) -> PyResult<Bound<'py, PyDict>> {
+    let d = texts(py, report)?;
+    set_verdict(&d, verdict_line(&report.fit))?;
+    Ok(d)
+}
+
+/// A comparison's text forms with its verdict, plus `laws`: each ranked fit's own, by model
+/// name (a fit report of that law alone).
+pub fn compare_texts<'py>(py: Python<'py>, report: &CompareReport) -> PyResult<Bound<'py, PyDict>> {
+    let d = texts(py, report)?;
+    if let Some(verdict) = report.verdict_line() {
+        set_verdict(&d, verdict)?;
+    }
+    let laws = PyDict::new(py);
+    for fit in &report.comparison.ranking {
+        let alone = FitReport {
+            config: report.config.clone(),
+            fit: fit.clone(),
+            files: Vec::new(),
+        };
+        laws.set_item(&fit.model, fit_texts(py, &alone)?)?;
+    }
+    d.set_item("laws", laws)?;
+    Ok(d)
+}
+
+/// A report's dict and its text forms, as the native functions return them.
+pub type WithTexts<'py> = (Bound<'py, PyDict>, Bound<'py, PyDict>);
+
+/// `fit`'s dict and texts.
+pub fn fit_output<'py>(py: Python<'py>, report: &FitReport) -> PyResult<WithTexts<'py>> {
+    Ok((fit_dict(py, report)?, fit_texts(py, report)?))
+}
+
+/// `compare`'s dict and texts (with every law's).
+pub fn compare_output<'py>(py: Python<'py>, report: &CompareReport) -> PyResult<WithTexts<'py>> {
+    Ok((compare_dict(py, report)?, compare_texts(py, report)?))
+}
+
+/// `energy`'s dict and texts.
+pub fn energy_output<'py>(py: Python<'py>, report: &EnergyReport) -> PyResult<WithTexts<'py>> {
+    Ok((energy_dict(py, report)?, texts(py, report)?))
+}
+
+/// `simulate`'s dict and texts.
+pub fn simulate_output<'py>(py: Python<'py>, report: &SimulateReport) -> PyResult<WithTexts<'py>> {
+    Ok((simulate_dict(py, report)?, texts(py, report)?))
 }
