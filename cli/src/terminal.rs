@@ -1,7 +1,7 @@
 //! The terminal writer: the summary blocks of a report as aligned plain text on stdout.
 
 use crate::report::text_table;
-use frictionid_engine::report::{Render, Role, Sink, Table};
+use frictionid_engine::report::{Render, Role, Sink, Status, Table};
 
 /// Collects the summary of a report (blocks with [`Role::Summary`] or [`Role::Brief`]) as
 /// plain text.
@@ -41,6 +41,13 @@ impl Sink for TerminalWriter {
             self.out.push_str(text);
             self.out.push('\n');
         }
+    }
+
+    fn recommendation(&mut self, _status: Status, text: &str, reasons: &[String]) {
+        self.out
+            .push_str(&format!("recommended: {}\n", text.replace('`', "")));
+        self.list(reasons, Role::Summary);
+        self.out.push('\n');
     }
 
     fn table(&mut self, table: &Table, role: Role) {

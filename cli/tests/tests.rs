@@ -4,6 +4,7 @@
 mod campaign;
 mod channels;
 mod cli;
+mod compare_report;
 mod defects;
 mod export;
 mod fit_compare;

@@ -5,32 +5,79 @@ use crate::error::CliError;
 use frictionid_engine::identify::ForceBalance;
 use frictionid_engine::Axis;
 use frictionid_models::FrictionModel;
+use plotters::style::RGBColor;
 use std::path::Path;
+
+/// How a chart over time is shown: the axis whose units its labels show, and the time window
+/// it is cut to (`None`: the whole record).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct View {
+    /// The axis of the units shown.
+    pub axis: Axis,
+    /// The time window shown.
+    pub window: Option<(f64, f64)>,
+}
+
+impl From<Axis> for View {
+    fn from(axis: Axis) -> Self {
+        Self { axis, window: None }
+    }
+}
+
+/// The measured line (thin, dark and see-through, drawn first) and the fitted line of
+/// `model` over it (wider, in the model's colour), so that the fit is never hidden under a
+/// noisy measurement and the measurement shows wherever the fit leaves it.
+fn fit_and_measured<'a>(
+    panel: Panel<'a>,
+    x: &'a [f64],
+    measured: (&str, &'a [f64]),
+    fitted: &'a [f64],
+    model: &str,
+) -> Panel<'a> {
+    panel
+        .with(
+            Series::solid(measured.0, x, measured.1)
+                .width(1)
+                .alpha(0.65)
+                .color(super::MEASURED),
+        )
+        .with(
+            Series::solid(format!("fitted ({model})"), x, fitted)
+                .width(3)
+                .alpha(0.9)
+                .color(super::model_color(model)),
+        )
+}
 
 /// The measured and fitted response of one record over time, and their difference:
 /// `quantity` is the compared channel and its unit as shown (velocity in m/s, or
-/// displacement in m for interferometer records; a fit's units are on its axis already).
+/// displacement in m for interferometer records; a fit's units are on its axis already);
+/// `window` the time shown.
 pub fn response_fit(
     path: &Path,
     record: &str,
     quantity: (&str, &str),
     time: &[f64],
     series: (&[f64], &[f64]),
-    model: &str,
+    (model, window): (&str, Option<(f64, f64)>),
 ) -> Result<(), CliError> {
     let ((name, unit), (measured, fitted)) = (quantity, series);
     let residual: Vec<f64> = measured.iter().zip(fitted).map(|(m, f)| m - f).collect();
     let color = super::model_color(model);
-    let fit_panel = Panel::new(name, unit)
-        .with(Series::solid("measured", time, measured).color(super::MEASURED))
-        .with(Series::dashed(format!("fitted ({model})"), time, fitted).color(color));
+    let fit_panel = fit_and_measured(
+        Panel::new(name, unit),
+        time,
+        ("measured", measured),
+        fitted,
+        model,
+    );
     let residual_panel = Panel::new("residual measured - fitted", unit)
         .with(Series::solid("", time, &residual).width(1).color(color))
         .with_reference("", 0.0);
     let title = format!("{record}: measured and fitted {name}");
     draw(
         path,
-        &Figure::over_time(title, vec![fit_panel, residual_panel]),
+        &Figure::over_time(title, vec![fit_panel, residual_panel]).window(window),
     )
 }
 
@@ -82,46 +129,55 @@ fn displacement_panel<'a>(time: &'a [f64], x: &'a [f64], scaled: &'a mut Vec<f64
 /// Quantities against time in stacked panels, in the order given: displacement and velocity
 /// (simulations), displacement and the acceleration derived from a measured velocity (the
 /// paper's Figs. 9-10), mechanical energy and its rate of change (Figs. 4-5, 11).
-/// Units are shown on `axis`.
+/// Units are shown on `view`'s axis, over its window.
 pub fn over_time(
     path: &Path,
     title: &str,
     time: &[f64],
     quantities: &[Quantity<'_>],
-    axis: Axis,
+    view: impl Into<View>,
 ) -> Result<(), CliError> {
+    let view = view.into();
     let mut scaled = vec![Vec::new(); quantities.len()];
     let panels = quantities
         .iter()
         .zip(scaled.iter_mut())
         .map(|(q, s)| q.panel(time, s))
         .collect();
-    draw(path, &Figure::over_time(title, panels).on(axis))
+    let fig = Figure::over_time(title, panels)
+        .on(view.axis)
+        .window(view.window);
+    draw(path, &fig)
 }
 
 /// Energy-based friction force against the model's force, with dashed levels at +-reference
-/// (the paper's Figs. 6, 12), in the units of `axis`.
+/// (the paper's Figs. 6, 12), in the units of `view`'s axis: the noisy Eq. 7 trace thin and
+/// see-through, the model's force (label, values, colour) wide and drawn over it.
 pub fn friction_force(
     path: &Path,
     title: &str,
     time: &[f64],
     energy_force: &[f64],
-    model_force: Option<(&str, &[f64])>,
+    model_force: Option<(&str, &[f64], RGBColor)>,
     reference: Option<(&str, f64)>,
-    axis: Axis,
+    view: View,
 ) -> Result<(), CliError> {
-    let mut panel = Panel::new("friction force", "N").with(Series::solid(
-        "energy-based (Eq. 7)",
-        time,
-        energy_force,
-    ));
-    if let Some((name, f)) = model_force {
-        panel = panel.with(Series::dashed(name, time, f));
+    let mut panel = Panel::new("friction force", "N").with(
+        Series::solid("energy-based (Eq. 7)", time, energy_force)
+            .width(1)
+            .alpha(0.55)
+            .color(super::MEASURED),
+    );
+    if let Some((name, f, color)) = model_force {
+        panel = panel.with(Series::solid(name, time, f).width(3).color(color));
     }
     if let Some((label, r)) = reference {
         panel = panel.with_reference(label, r).with_reference("", -r);
     }
-    draw(path, &Figure::over_time(title, vec![panel]).on(axis))
+    let fig = Figure::over_time(title, vec![panel])
+        .on(view.axis)
+        .window(view.window);
+    draw(path, &fig)
 }
 
 /// The force balance of an inverse-dynamics fit over time: in the upper panel the input u
@@ -150,16 +206,13 @@ pub fn force_balance(
         .with(Series::solid("input u", time, &input).color(super::MEASURED))
         .with(Series::solid("inertia J a", time, &inertia).width(1))
         .with(Series::dashed("restoring R(q)", time, &restoring).width(1));
-    let friction = Panel::new("friction force", "N")
-        .with(
-            Series::solid("from the balance", time, &from_balance)
-                .width(1)
-                .color(super::MEASURED),
-        )
-        .with(
-            Series::dashed(format!("fitted ({model})"), time, &fitted)
-                .color(super::model_color(model)),
-        );
+    let friction = fit_and_measured(
+        Panel::new("friction force", "N"),
+        time,
+        ("from the balance", &from_balance),
+        &fitted,
+        model,
+    );
     draw(
         path,
         &Figure::over_time(title, vec![forces, friction]).on(axis),
@@ -206,12 +259,13 @@ pub fn force_against_motion(
     rig: Axis,
 ) -> Result<(), CliError> {
     let x: Vec<f64> = motion.iter().map(|m| m * axis.factor).collect();
-    let panel = Panel::new("friction force", "N")
-        .with(Series::solid(measured.0, &x, measured.1).color(super::MEASURED))
-        .with(
-            Series::dashed(format!("fitted ({model})"), &x, fitted)
-                .color(super::model_color(model)),
-        );
+    let panel = fit_and_measured(
+        Panel::new("friction force", "N"),
+        &x,
+        measured,
+        fitted,
+        model,
+    );
     let fig = Figure {
         title: title.into(),
         x_label: axis.quantity.into(),
@@ -219,6 +273,7 @@ pub fn force_against_motion(
         x_ticks: XTicks::Linear,
         panels: vec![panel],
         axis: rig,
+        x_window: None,
     };
     draw(path, &fig)
 }
@@ -231,13 +286,23 @@ pub const STEADY_STATE_LINEAR_WIDTH: f64 = 1e-4;
 /// v in [-v_max, v_max] on a symmetric-log axis (linear within +-1e-4 m/s, then one decade
 /// per unit), so that Stribeck regions (1e-3 to 1e-2 m/s) are as wide as the sliding range.
 /// Each model keeps its colour ([`super::model_color`]); units are shown on `axis`.
+/// `normal_force` is the N the curves are drawn at, `None` when the fit had none (its levels
+/// are forces, drawn at N = 1 and the title says so).
 pub fn steady_state_curves(
     path: &Path,
     models: &[(&str, &dyn FrictionModel)],
-    normal_force: f64,
+    normal_force: Option<f64>,
     v_max: f64,
     axis: Axis,
 ) -> Result<(), CliError> {
+    let title = match normal_force {
+        Some(n) => format!(
+            "Steady-state friction curves (N = {} N)",
+            crate::report::fmt_num(n)
+        ),
+        None => "Steady-state friction curves (no normal force: the levels are forces)".into(),
+    };
+    let normal_force = normal_force.unwrap_or(1.0);
     let n = 1601;
     let w = STEADY_STATE_LINEAR_WIDTH;
     let v_max = if v_max.is_finite() && v_max > w {
@@ -262,7 +327,7 @@ pub fn steady_state_curves(
     // stay visible.
     let mut panel = Panel::new("steady-state friction force F_ss", "N");
     for (i, ((name, _), f)) in models.iter().zip(&curves).enumerate() {
-        let width = 5u32.saturating_sub(i as u32).max(2);
+        let width = 8u32.saturating_sub(3 * i as u32).max(2);
         let s = if i >= 3 {
             Series::dashed(*name, &u, f)
         } else {
@@ -271,15 +336,13 @@ pub fn steady_state_curves(
         panel = panel.with(s.width(width).color(super::model_color(name)));
     }
     let fig = Figure {
-        title: format!(
-            "Steady-state friction curves (N = {} N)",
-            crate::report::fmt_num(normal_force)
-        ),
+        title,
         x_label: "sliding velocity (symmetric log scale)".into(),
         x_unit: "m/s".into(),
         x_ticks: XTicks::SymLog { linear_width: w },
         panels: vec![panel],
         axis,
+        x_window: None,
     };
     draw(path, &fig)
 }

@@ -12,7 +12,7 @@ mod trends;
 
 pub use charts::{
     force_against_motion, force_balance, friction_force, input_force, over_time, response_fit,
-    steady_state_curves, MotionAxis, Quantity,
+    steady_state_curves, MotionAxis, Quantity, View,
 };
 pub use trends::trend_plots;
 
@@ -23,34 +23,59 @@ use panel::{draw_panel, range};
 use plotters::prelude::*;
 use std::path::Path;
 
-/// The palette of every plot: Okabe and Ito's colour-blind-safe colours with a dark grey and
-/// a brown, and a darkened yellow; cycled by series, or fixed per model by
-/// [`model_color`].
+/// The palette of every plot: Okabe and Ito's colour-blind-safe colours, strongest first,
+/// then a brown, a darkened yellow and a dark grey; cycled by series, or fixed per model by
+/// [`model_color`]. Black is kept for measured data.
 pub const PALETTE: [RGBColor; 10] = [
     RGBColor(0, 114, 178),   // blue
     RGBColor(213, 94, 0),    // vermillion
     RGBColor(0, 158, 115),   // bluish green
-    RGBColor(230, 159, 0),   // orange
     RGBColor(204, 121, 167), // reddish purple
+    RGBColor(230, 159, 0),   // orange
     RGBColor(86, 180, 233),  // sky blue
-    RGBColor(0, 0, 0),       // black
-    RGBColor(102, 102, 102), // dark grey
     RGBColor(140, 86, 75),   // brown
     RGBColor(160, 140, 0),   // dark yellow (Okabe-Ito yellow is faint on white)
+    RGBColor(102, 102, 102), // dark grey
+    RGBColor(0, 0, 0),       // black
 ];
 
-/// The colour of measured data.
+/// The colour of measured data: drawn as a thin dark line under nothing, a fit over it in
+/// its model's colour and wider.
 pub const MEASURED: RGBColor = RGBColor(0, 0, 0);
 
 /// The grey of reference levels (both signs of +-mu N alike).
 pub const REFERENCE_GREY: RGBColor = RGBColor(90, 90, 90);
 
-/// The fixed colour of a registered model: its position among the registered names, so a
-/// model has the same colour on every chart of every report.
+/// The laws that get the strongest colours, in this order; other registered laws follow in
+/// their registry order.
+const COLOUR_ORDER: [&str; 9] = [
+    "coulomb",
+    "viscous_coulomb",
+    "stribeck",
+    "dahl",
+    "lugre",
+    "gms",
+    "makkar",
+    "expression",
+    "none",
+];
+
+/// The fixed colour of a registered model, so a model has the same colour on every chart of
+/// every report: the classical laws first ([`COLOUR_ORDER`]), then the other registered
+/// names; never the measured data's black.
 pub fn model_color(model: &str) -> RGBColor {
     let names = frictionid_models::names();
-    let index = names.iter().position(|n| n == model).unwrap_or(names.len());
-    // Black is kept for measured data.
+    let others = names.iter().filter(|n| !COLOUR_ORDER.contains(&n.as_str()));
+    let index = COLOUR_ORDER
+        .iter()
+        .position(|n| *n == model)
+        .or_else(|| {
+            others
+                .clone()
+                .position(|n| n == model)
+                .map(|i| COLOUR_ORDER.len() + i)
+        })
+        .unwrap_or(COLOUR_ORDER.len() + others.count());
     let colours: Vec<RGBColor> = PALETTE.into_iter().filter(|c| *c != MEASURED).collect();
     colours[index % colours.len()]
 }
@@ -70,6 +95,8 @@ pub struct Series<'a> {
     pub width: u32,
     /// Colour; `None`: the palette colour of the series' position.
     pub color: Option<RGBColor>,
+    /// Opacity, 1 opaque: a noisy trace under a model's line is drawn see-through.
+    pub alpha: f64,
 }
 
 impl<'a> Series<'a> {
@@ -82,6 +109,15 @@ impl<'a> Series<'a> {
             dashed: false,
             width: 2,
             color: None,
+            alpha: 1.0,
+        }
+    }
+
+    /// The same line drawn with opacity `alpha` (0 to 1).
+    pub fn alpha(self, alpha: f64) -> Self {
+        Self {
+            alpha: alpha.clamp(0.0, 1.0),
+            ..self
         }
     }
 
@@ -206,6 +242,8 @@ pub struct Figure<'a> {
     /// The axis whose units the labels show: the figure's units are written for a linear
     /// axis and drawn on this one ([`Axis::unit`]: m/s is rad/s on a rotary axis).
     pub axis: Axis,
+    /// The x range shown (`None`: the lines' whole range); lines are cut at its ends.
+    pub x_window: Option<(f64, f64)>,
 }
 
 impl<'a> Figure<'a> {
@@ -218,6 +256,7 @@ impl<'a> Figure<'a> {
             x_ticks: XTicks::Linear,
             panels,
             axis: Axis::Linear,
+            x_window: None,
         }
     }
 
@@ -225,6 +264,41 @@ impl<'a> Figure<'a> {
     pub fn on(self, axis: Axis) -> Self {
         Self { axis, ..self }
     }
+
+    /// The same figure showing only `window` of its x axis (when given).
+    pub fn window(self, window: Option<(f64, f64)>) -> Self {
+        Self {
+            x_window: window.or(self.x_window),
+            ..self
+        }
+    }
+}
+
+/// The share of a record's peak speed below which its motion counts as at rest.
+pub const REST_SHARE: f64 = 0.03;
+
+/// The time window of a record's motion: from its start to the last sample whose speed
+/// exceeds [`REST_SHARE`] of the peak, plus a margin of a tenth of that span (at least 5 % of
+/// the record); `None` when the motion fills the record (a driven axis, a tribometer), or
+/// when it cannot tell (no finite speed).
+pub fn motion_window(time: &[f64], velocity: &[f64]) -> Option<(f64, f64)> {
+    if time.len() != velocity.len() || time.len() < 2 {
+        return None;
+    }
+    let peak = velocity
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    if peak <= 0.0 {
+        return None;
+    }
+    let last = velocity
+        .iter()
+        .rposition(|v| v.is_finite() && v.abs() > REST_SHARE * peak)?;
+    let (t0, t_end) = (time[0], time[time.len() - 1]);
+    let span = t_end - t0;
+    let end = time[last] + (0.1 * (time[last] - t0)).max(0.05 * span);
+    (end < t_end - 0.05 * span).then_some((t0, end))
 }
 
 /// Renders `fig` as SVG text.
@@ -238,13 +312,15 @@ pub fn render(fig: &Figure<'_>) -> Result<String, String> {
         let root = root
             .titled(&fig.title, ("sans-serif", 22))
             .map_err(|e| e.to_string())?;
-        let x_range = range(
-            fig.panels
-                .iter()
-                .flat_map(|p| p.series.iter())
-                .flat_map(|s| s.x.iter().copied()),
-            false,
-        );
+        let x_range = fig.x_window.unwrap_or_else(|| {
+            range(
+                fig.panels
+                    .iter()
+                    .flat_map(|p| p.series.iter())
+                    .flat_map(|s| s.x.iter().copied()),
+                false,
+            )
+        });
         let areas = root.split_evenly((n, 1));
         for (i, (area, panel)) in areas.iter().zip(&fig.panels).enumerate() {
             draw_panel(area, fig, panel, x_range, i + 1 == fig.panels.len())?;
@@ -366,6 +442,7 @@ mod tests {
             x_unit: "s".into(),
             x_ticks: XTicks::Linear,
             axis: Axis::Linear,
+            x_window: None,
             panels: vec![Panel::new("velocity", "m/s")
                 .with(Series::solid("measured", &t, &y1))
                 .with(Series::dashed("fitted", &t, &y2))

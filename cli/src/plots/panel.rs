@@ -80,11 +80,17 @@ pub(super) fn range(values: impl Iterator<Item = f64>, pad: bool) -> (f64, f64) 
 }
 
 /// Runs of consecutive finite points, each as drawn ([`envelope`]).
+#[cfg(test)]
 pub(super) fn segments(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
+    segments_within(x, y, (f64::NEG_INFINITY, f64::INFINITY))
+}
+
+/// Runs of consecutive finite points whose x lies in `window`, each as drawn.
+pub(super) fn segments_within(x: &[f64], y: &[f64], window: (f64, f64)) -> Vec<Vec<(f64, f64)>> {
     let mut out = Vec::new();
     let mut cur = Vec::new();
     for (&a, &b) in x.iter().zip(y) {
-        if a.is_finite() && b.is_finite() {
+        if a.is_finite() && b.is_finite() && a >= window.0 && a <= window.1 {
             cur.push((a, b));
         } else if !cur.is_empty() {
             out.push(envelope(std::mem::take(&mut cur)));
@@ -150,22 +156,16 @@ fn shows_legend(panel: &Panel<'_>) -> bool {
     legend_entries(panel) > 1 || panel.reference.iter().any(|r| !r.label.is_empty())
 }
 
-/// The y range of the panel's lines and levels, padded; with a legend, extended upwards so
-/// that the legend (upper right corner) covers no data.
-fn y_range(panel: &Panel<'_>) -> (f64, f64) {
-    let mut y_range = range(
-        panel
-            .series
-            .iter()
-            .flat_map(|s| s.y.iter().copied())
-            .chain(panel.reference.iter().map(|r| r.y)),
-        true,
-    );
-    if shows_legend(panel) {
-        let entries = legend_entries(panel) as f64;
-        y_range.1 += (0.04 + 0.075 * entries) * (y_range.1 - y_range.0);
-    }
-    y_range
+/// The y range of the panel's lines (within the x range shown) and levels, padded. The
+/// legend sits above the plotting area, so it needs no room among the data.
+fn y_range(panel: &Panel<'_>, x_range: (f64, f64)) -> (f64, f64) {
+    let shown = panel.series.iter().flat_map(|s| {
+        s.x.iter()
+            .zip(s.y)
+            .filter(move |(x, _)| **x >= x_range.0 && **x <= x_range.1)
+            .map(|(_, y)| *y)
+    });
+    range(shown.chain(panel.reference.iter().map(|r| r.y)), true)
 }
 
 /// Axes, grid, tick labels and axis descriptions (the x description on the last panel only).
@@ -195,40 +195,72 @@ fn draw_mesh(
     mesh.draw().map_err(|e| e.to_string())
 }
 
-/// Where the two strokes of a 24 px legend swatch end and start: a gap for a dashed line,
-/// none for a solid one, so that the swatch is drawn like its line.
+/// Where the two strokes of a dashed legend swatch end and start, so that the swatch is
+/// drawn like its line.
 fn swatch_gap(dashed: bool) -> (i32, i32) {
     if dashed {
-        (9, 14)
+        (11, 17)
     } else {
-        (12, 12)
+        (SWATCH / 2, SWATCH / 2)
     }
 }
 
-/// The panel's lines, broken at non-finite values, each labelled once in the legend.
-fn draw_lines<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, panel: &Panel<'_>) -> PlotResult<()> {
+/// A legend entry: its label and how its line is drawn.
+struct Entry {
+    label: String,
+    style: ShapeStyle,
+    dashed: bool,
+}
+
+/// The panel's legend entries, in drawing order: its labelled lines, then its labelled levels.
+fn entries(panel: &Panel<'_>) -> Vec<Entry> {
+    let lines = panel
+        .series
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| !s.label.is_empty())
+        .map(|(i, s)| Entry {
+            label: s.label.clone(),
+            style: line_style(i, s),
+            dashed: s.dashed,
+        });
+    let levels = panel
+        .reference
+        .iter()
+        .filter(|r| !r.label.is_empty())
+        .map(|r| Entry {
+            label: r.label.clone(),
+            style: REFERENCE_GREY.stroke_width(1),
+            dashed: true,
+        });
+    lines.chain(levels).collect()
+}
+
+/// The stroke of the `i`-th line of a panel: its colour (else the palette's), opacity and
+/// width.
+fn line_style(i: usize, s: &super::Series<'_>) -> ShapeStyle {
+    let color = s.color.unwrap_or(PALETTE[i % PALETTE.len()]);
+    color.mix(s.alpha).stroke_width(s.width)
+}
+
+/// The panel's lines, broken at non-finite values and cut to the x range shown, in order
+/// (a later line is drawn over an earlier one).
+fn draw_lines<'a, 'b: 'a>(
+    chart: &mut Chart<'a, 'b>,
+    panel: &Panel<'_>,
+    x_range: (f64, f64),
+) -> PlotResult<()> {
     for (i, s) in panel.series.iter().enumerate() {
-        let color = s.color.unwrap_or(PALETTE[i % PALETTE.len()]);
-        let style = color.stroke_width(s.width);
-        let (width, dashed) = (s.width, s.dashed);
-        for (k, seg) in segments(s.x, s.y).into_iter().enumerate() {
-            let anno = if s.dashed {
+        let style = line_style(i, s);
+        for seg in segments_within(s.x, s.y, x_range) {
+            if s.dashed {
                 chart
                     .draw_series(DashedLineSeries::new(seg, 8, 5, style))
-                    .map_err(|e| e.to_string())?
+                    .map_err(|e| e.to_string())?;
             } else {
                 chart
                     .draw_series(LineSeries::new(seg, style))
-                    .map_err(|e| e.to_string())?
-            };
-            if k == 0 && !s.label.is_empty() {
-                let (end, start) = swatch_gap(dashed);
-                let st = color.stroke_width(width);
-                anno.label(s.label.clone()).legend(move |(x, y)| {
-                    EmptyElement::at((x, y))
-                        + PathElement::new(vec![(0, 0), (end, 0)], st)
-                        + PathElement::new(vec![(start, 0), (23, 0)], st)
-                });
+                    .map_err(|e| e.to_string())?;
             }
         }
     }
@@ -244,31 +276,82 @@ fn draw_references<'a, 'b: 'a>(
     for r in &panel.reference {
         let style = REFERENCE_GREY.stroke_width(1);
         let line = vec![(x_range.0, r.y), (x_range.1, r.y)];
-        let anno = chart
+        chart
             .draw_series(DashedLineSeries::new(line, 6, 4, style))
             .map_err(|e| e.to_string())?;
-        if !r.label.is_empty() {
-            let (end, start) = swatch_gap(true);
-            anno.label(r.label.clone()).legend(move |(x, y)| {
-                EmptyElement::at((x, y))
-                    + PathElement::new(vec![(0, 0), (end, 0)], style)
-                    + PathElement::new(vec![(start, 0), (23, 0)], style)
-            });
-        }
     }
     Ok(())
 }
 
-/// The legend box in the upper right corner.
-fn draw_legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>) -> PlotResult<()> {
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 14))
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(160, 160, 160))
-        .draw()
-        .map_err(|e| e.to_string())
+/// Height of one row of the legend above a panel [px].
+const LEGEND_ROW: i32 = 22;
+/// Where the legend starts: past the y labels, in line with the plotting area [px].
+const LEGEND_LEFT: i32 = 92;
+/// Width of a legend swatch [px].
+const SWATCH: i32 = 28;
+
+/// The width a legend entry takes at 14 px sans-serif (an estimate: 7.2 px a character).
+fn entry_width(e: &Entry) -> i32 {
+    SWATCH + 8 + (7.2 * e.label.chars().count() as f64) as i32 + 22
+}
+
+/// The legend's rows: entries laid left to right, a new row where one would pass `width`.
+fn legend_rows(entries: &[Entry], width: i32) -> Vec<Vec<(i32, &Entry)>> {
+    let mut rows: Vec<Vec<(i32, &Entry)>> = vec![Vec::new()];
+    let mut x = LEGEND_LEFT;
+    for e in entries {
+        let w = entry_width(e);
+        if x + w > width && x > LEGEND_LEFT {
+            rows.push(Vec::new());
+            x = LEGEND_LEFT;
+        }
+        if let Some(row) = rows.last_mut() {
+            row.push((x, e));
+        }
+        x += w;
+    }
+    rows
+}
+
+/// The legend's height above a panel of `width` pixels (0 without a legend).
+fn legend_height(panel: &Panel<'_>, width: i32) -> i32 {
+    if !shows_legend(panel) {
+        return 0;
+    }
+    let entries = entries(panel);
+    LEGEND_ROW * legend_rows(&entries, width).len() as i32 + 6
+}
+
+/// The legend in a strip above the plotting area, off the data: each entry a swatch drawn
+/// like its line (colour, width, dashes) and its label.
+fn draw_legend(strip: &DrawingArea<SVGBackend<'_>, Shift>, panel: &Panel<'_>) -> PlotResult<()> {
+    let width = strip.dim_in_pixel().0 as i32;
+    let entries = entries(panel);
+    let font = ("sans-serif", 14).into_font().color(&RGBColor(30, 30, 30));
+    for (r, row) in legend_rows(&entries, width).iter().enumerate() {
+        let y = 6 + LEGEND_ROW * r as i32 + LEGEND_ROW / 2;
+        for (x, e) in row {
+            let (end, start) = swatch_gap(e.dashed);
+            let pieces = if e.dashed {
+                vec![(*x, *x + end), (*x + start, *x + SWATCH)]
+            } else {
+                vec![(*x, *x + SWATCH)]
+            };
+            for (a, b) in pieces {
+                strip
+                    .draw(&PathElement::new(vec![(a, y), (b, y)], e.style))
+                    .map_err(|e| e.to_string())?;
+            }
+            strip
+                .draw(&Text::new(
+                    e.label.clone(),
+                    (*x + SWATCH + 8, y - 8),
+                    font.clone(),
+                ))
+                .map_err(|e| e.to_string())?;
+        }
+    }
+    Ok(())
 }
 
 /// Draws one panel of `fig` into `area` over the shared `x_range`.
@@ -279,19 +362,21 @@ pub(super) fn draw_panel(
     x_range: (f64, f64),
     is_last: bool,
 ) -> PlotResult<()> {
-    let y_range = y_range(panel);
+    let y_range = y_range(panel, x_range);
     let spans = (x_range.1 - x_range.0, y_range.1 - y_range.0);
-    let mut chart = ChartBuilder::on(area)
+    let legend = legend_height(panel, area.dim_in_pixel().0 as i32);
+    let (strip, area) = area.split_vertically(legend);
+    if legend > 0 {
+        draw_legend(&strip, panel)?;
+    }
+    let mut chart = ChartBuilder::on(&area)
         .margin(12)
         .x_label_area_size(if is_last { 45 } else { 30 })
         .y_label_area_size(80)
         .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
         .map_err(|e| e.to_string())?;
     draw_mesh(&mut chart, fig, panel, spans, is_last)?;
-    draw_lines(&mut chart, panel)?;
     draw_references(&mut chart, panel, x_range)?;
-    if shows_legend(panel) {
-        draw_legend(&mut chart)?;
-    }
+    draw_lines(&mut chart, panel, x_range)?;
     Ok(())
 }

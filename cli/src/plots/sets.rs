@@ -100,7 +100,10 @@ pub fn simulate_plots(out: &OutputDir, report: &SimulateReport) -> Result<Vec<St
         &format!("{motion}: {title}"),
         &traj.time,
         &[Quantity::Displacement(&traj.x), Quantity::Velocity(&traj.v)],
-        axis,
+        super::View {
+            axis,
+            window: super::motion_window(&traj.time, &traj.v),
+        },
     )?;
     let t = &traj.time;
     draw(
@@ -122,7 +125,8 @@ pub fn simulate_plots(out: &OutputDir, report: &SimulateReport) -> Result<Vec<St
                     &report.energy_rate,
                 )),
             ],
-        ),
+        )
+        .window(super::motion_window(&traj.time, &traj.v)),
     )?;
     let mut files = vec!["displacement_velocity.svg".to_string(), "energy.svg".into()];
     if let Some(input) = &report.input {
@@ -158,12 +162,32 @@ fn fit_force_plot(
         &format!("{}: energy-based and model friction force", r.file),
         &r.axes.time,
         &energy,
-        Some((label.as_str(), shown.as_slice())),
+        Some((
+            label.as_str(),
+            shown.as_slice(),
+            super::model_color(&fit.model),
+        )),
         reference
             .filter(|x| x.is_finite())
             .map(|x| (ref_label.as_str(), x)),
-        axis,
+        super::View {
+            axis,
+            window: record_window(r),
+        },
     )
+}
+
+/// The time window of a fitted record's motion ([`super::motion_window`]): its velocity, or
+/// the compared velocity itself.
+fn record_window(r: &RecordFit) -> Option<(f64, f64)> {
+    let v = if r.axes.velocity.len() == r.axes.time.len() {
+        &r.axes.velocity
+    } else if r.channel == "velocity" {
+        &r.series.measured
+    } else {
+        return None;
+    };
+    super::motion_window(&r.axes.time, v)
 }
 
 /// `fit` and `compare`: the response fit and the friction-force check of every record;
@@ -187,7 +211,7 @@ pub fn fit_record_plots(
             (&r.channel, &fit.residual_unit),
             &r.axes.time,
             (&r.series.measured, &r.series.fitted),
-            &fit.model,
+            (&fit.model, record_window(r)),
         )?;
         files.push(vf);
         if !r.series.energy_based_force.is_empty() {
@@ -238,6 +262,13 @@ fn force_record_plots(
     let measured = break_at_gaps(&r.axes.time, measured);
     let fitted = break_at_gaps(&r.axes.time, fitted);
     let mut files = Vec::new();
+    // mm and mm/s on a linear axis; rad and rad/s (as m and m/s, shown on the axis) on a
+    // rotary one.
+    let (position, speed, factor) = if fit.oscillator.axis.is_linear() {
+        ("mm", "mm/s", 1e3)
+    } else {
+        ("m", "m/s", 1.0)
+    };
     if let Some(balance) = &r.series.balance {
         let file = format!("{stem}_force_balance.svg");
         super::force_balance(
@@ -257,8 +288,8 @@ fn force_record_plots(
             &r.axes.displacement,
             super::MotionAxis {
                 quantity: "displacement",
-                unit: "mm",
-                factor: 1e3,
+                unit: position,
+                factor,
             },
         ),
         (
@@ -267,8 +298,8 @@ fn force_record_plots(
             &r.axes.velocity,
             super::MotionAxis {
                 quantity: "velocity",
-                unit: "mm/s",
-                factor: 1e3,
+                unit: speed,
+                factor,
             },
         ),
     ] {
@@ -316,14 +347,23 @@ pub fn steady_state_plot(
         .iter()
         .map(|f| (f.model.as_str(), f.fitted_model.as_ref()))
         .collect();
+    let normal_force = (!levels_are_forces(first)).then_some(first.oscillator.normal_force);
     super::steady_state_curves(
         &out.path(name),
         &curves,
-        first.oscillator.normal_force,
+        normal_force,
         peak_speed(first),
         first.oscillator.axis,
     )?;
     Ok(vec![name.to_string()])
+}
+
+/// Whether a fit read its friction levels as forces (no normal force given): a level
+/// (`mu`, `mu_*`) carries a force's unit instead of 1.
+pub fn levels_are_forces(fit: &FitResult) -> bool {
+    fit.parameters
+        .iter()
+        .any(|p| (p.name == "mu" || p.name.starts_with("mu_")) && p.unit != "1")
 }
 
 /// `energy`: displacement and acceleration, energy and its rate, and the friction force
@@ -354,7 +394,11 @@ fn energy_record_plots(
     ] {
         let file = format!("{stem}_{kind}.svg");
         let title = format!("{}: {what}", r.file);
-        super::over_time(&out.path(&file), &title, &a.time, &quantities, axis)?;
+        let view = super::View {
+            axis,
+            window: super::motion_window(&a.time, &a.v),
+        };
+        super::over_time(&out.path(&file), &title, &a.time, &quantities, view)?;
         files.push(file);
     }
     let ff = format!("{stem}_friction_force.svg");
@@ -365,14 +409,24 @@ fn energy_record_plots(
     let energy = break_at_reversals(&a.friction, &a.v);
     let model_shown = r.model_force.as_ref().map(|f| where_defined(f, &energy));
     let ref_label = format!("reference ±{} {}", fmt_num(r.reference), axis.unit("N"));
+    let model_color = report
+        .reference_model
+        .as_deref()
+        .map_or(super::PALETTE[0], super::model_color);
     super::friction_force(
         &out.path(&ff),
         &format!("{}: friction force", r.file),
         &a.time,
         &energy,
-        model_label.as_deref().zip(model_shown.as_deref()),
+        model_label
+            .as_deref()
+            .zip(model_shown.as_deref())
+            .map(|(label, f)| (label, f, model_color)),
         Some((ref_label.as_str(), r.reference)).filter(|(_, v)| v.is_finite()),
-        axis,
+        super::View {
+            axis,
+            window: super::motion_window(&a.time, &a.v),
+        },
     )?;
     files.push(ff);
     Ok(files)

@@ -1,8 +1,10 @@
 //! The report of `compare`: several models fitted to the same records, the law to use
-//! first, then the ranking by AIC with each law's held-out score.
+//! first and why ([`super::recommendation`]), then the ranking by AIC with each law's
+//! held-out score, each law's diagnostics and parameters (the recommended law first).
 
-use super::fit::{fit_json, parameter_table, sliding_column, verdict_line};
+use super::fit::{diagnostics_table, fit_json, parameter_table, sliding_column, verdict_line};
 use super::format::{fmt_criterion, fmt_num, fmt_opt};
+use super::recommendation::{recommendation, recommended_fit};
 use super::{render_files, render_opening, Render, Role, Sink, Status, Table};
 use crate::identify::{Check, Comparison, FitResult};
 
@@ -74,24 +76,19 @@ fn ranked_json(c: &Comparison, f: &FitResult) -> Result<serde_json::Value, serde
 }
 
 impl CompareReport {
-    /// The comparison's verdict sentence (the law to use first), with the status of the
-    /// recommended fit, else the best (`None` when no model could be fitted).
+    /// The comparison's verdict sentence (the law to use first, then why), with the status of
+    /// the recommended fit (`None` when no model could be fitted).
     pub fn verdict_line(&self) -> Option<(Status, String)> {
-        let shown = self.recommended().or_else(|| self.best())?;
-        let (status, fit_text) = verdict_line(shown);
-        let ranking = self.comparison.verdict.as_ref().map_or(String::new(), |v| {
-            format!("{}. ", v.message.trim_end_matches('.'))
-        });
+        let r = recommendation(&self.comparison)?;
         Some((
-            status,
-            format!("{ranking}The fit of `{}`: {fit_text}", shown.model),
+            r.status,
+            format!("recommended: {}; {}.", r.headline, r.reasons.join("; ")),
         ))
     }
 
     /// The recommended fit, if the verdict names one.
     pub fn recommended(&self) -> Option<&FitResult> {
-        let name = self.comparison.verdict.as_ref()?.recommended.as_deref()?;
-        self.comparison.ranking.iter().find(|f| f.model == name)
+        recommended_fit(&self.comparison)
     }
 
     /// The best fit (lowest AIC), if any model could be fitted.
@@ -99,7 +96,21 @@ impl CompareReport {
         self.comparison.ranking.first()
     }
 
-    /// The ranking table.
+    /// The fits in the order a report shows them: the recommended first, then the ranking.
+    pub fn shown_order(&self) -> Vec<&FitResult> {
+        let first = self.recommended();
+        first
+            .into_iter()
+            .chain(
+                self.comparison
+                    .ranking
+                    .iter()
+                    .filter(|f| Some(f.model.as_str()) != first.map(|r| r.model.as_str())),
+            )
+            .collect()
+    }
+
+    /// The ranking table: by AIC, with each law's place in the verdict.
     pub fn ranking_table(&self) -> Table {
         let best_aic = self.best().map(|b| b.aic).unwrap_or(f64::NAN);
         let rows = self
@@ -111,6 +122,7 @@ impl CompareReport {
                 vec![
                     (i + 1).to_string(),
                     f.model.clone(),
+                    verdict_cell(&self.comparison, f),
                     fmt_criterion(f.aic),
                     fmt_criterion(f.aic - best_aic),
                     fmt_opt(f.rank.as_ref().map(|r| r.akaike_weight)),
@@ -128,6 +140,7 @@ impl CompareReport {
             &[
                 "rank",
                 "model",
+                "verdict",
                 "AIC",
                 "dAIC",
                 "Akaike weight",
@@ -139,6 +152,20 @@ impl CompareReport {
             ],
             rows,
         )
+    }
+}
+
+/// A law's place in the verdict: `recommended`, `set aside`, or `-`.
+fn verdict_cell(c: &Comparison, f: &FitResult) -> String {
+    let Some(v) = &c.verdict else {
+        return "-".into();
+    };
+    if v.recommended.as_deref() == Some(f.model.as_str()) {
+        "recommended".into()
+    } else if v.set_aside.iter().any(|s| s.model == f.model) {
+        "set aside".into()
+    } else {
+        "-".into()
     }
 }
 
@@ -181,28 +208,18 @@ impl Render for CompareReport {
     fn render(&self, sink: &mut dyn Sink) {
         let c = &self.comparison;
         let summary = format!(
-            "{} model(s) fitted to {} record(s), ranked by AIC (lower is better).",
+            "{} model(s) fitted to {} record(s): the law to use first, then why; the ranking by AIC (lower is better) is information.",
             c.ranking.len(),
             self.records
         );
         render_opening(sink, "compare", &self.config, &summary);
-        if let Some((status, text)) = self.verdict_line() {
-            sink.verdict(status, &text);
+        if let Some(r) = recommendation(c) {
+            sink.recommendation(r.status, &r.headline, &r.reasons);
         }
-        if let Some(verdict) = &c.verdict {
-            let law = verdict.recommended.as_deref().unwrap_or("none");
-            sink.paragraph(&format!("recommended: {law}"), Role::Brief);
-            sink.paragraph(&format!("verdict: {}", verdict.message), Role::Brief);
-        }
+        sink.heading(2, "Ranking", Role::Detail);
         sink.table(&self.ranking_table(), Role::Summary);
         if let Some(table) = self.best().and_then(sliding_table) {
             sink.table(&table, Role::Summary);
-        }
-        if let Some(scheme) = c.validation_scheme {
-            sink.paragraph(
-                &format!("held-out validation: {}", scheme.describe()),
-                Role::Summary,
-            );
         }
         if let Some(verdict) = &c.verdict {
             sink.paragraph(
@@ -218,10 +235,17 @@ impl Render for CompareReport {
             ),
             Role::Brief,
         );
+        let shown = self.shown_order();
         sink.heading(2, "Parameters", Role::Detail);
-        for f in &c.ranking {
+        for f in &shown {
             sink.heading(3, &f.model, Role::Detail);
             sink.table(&parameter_table(f), Role::Detail);
+        }
+        sink.heading(2, "Diagnostics", Role::Detail);
+        for f in &shown {
+            sink.heading(3, &f.model, Role::Detail);
+            sink.paragraph(&verdict_line(f).1, Role::Detail);
+            sink.table(&diagnostics_table(f), Role::Detail);
         }
         if !c.warnings.is_empty() {
             sink.heading(2, "Warnings", Role::Detail);

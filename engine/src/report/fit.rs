@@ -2,7 +2,7 @@
 
 use super::format::{
     column, fmt_criterion, fmt_estimate, fmt_num, fmt_opt, fmt_percent, fmt_std_error,
-    fmt_to_error, serialized_name,
+    fmt_to_error, on_axis, serialized_name,
 };
 use super::{render_files, render_opening, Render, Role, Sink, Status, Table, Verdict};
 use crate::axis::Axis;
@@ -306,38 +306,47 @@ pub fn sliding_column(fit: &FitResult) -> Option<(String, Vec<String>)> {
                 .map_or("-".into(), |s| format!("{} of {}", s.kept, s.of))
         })
         .collect();
+    let unit = on_axis(fit.oscillator.axis, "m/s");
     Some((
-        format!("samples with |v| >= {} m/s", fmt_num(min_speed)),
+        format!("samples with |v| >= {} {unit}", fmt_num(min_speed)),
         cells,
     ))
 }
 
+/// The record, x0 and residual of each record, with the energy check's columns where it ran
+/// on any record (none on a driven axis: no columns of dashes).
 fn energy_record_table(fit: &FitResult) -> Table {
+    let checked = fit.records.iter().any(|r| r.energy_force.is_some());
     let rows = fit
         .records
         .iter()
         .map(|r| {
             let mut row = vec![r.file.clone(), fmt_num(r.x0), fmt_num(r.rms_residual)];
-            row.extend(energy_cells(r.energy_force.as_ref()));
+            if checked {
+                row.extend(energy_cells(r.energy_force.as_ref()));
+            }
             row
         })
         .collect();
     let axis = fit.oscillator.axis;
     let rms = format!("rms residual [{}]", fit.residual_unit);
-    Table::new(
-        &[
-            "record",
-            &column(axis, "x0", "m"),
-            &rms,
-            &column(axis, "mean |F| Eq. 7", "N"),
-            &column(axis, "model mean |F|", "N"),
+    let (x0, mean, model_mean) = (
+        column(axis, "x0", "m"),
+        column(axis, "mean F sgn(v) Eq. 7", "N"),
+        column(axis, "model mean F sgn(v)", "N"),
+    );
+    let mut headers = vec!["record", &x0, &rms];
+    if checked {
+        headers.extend([
+            mean.as_str(),
+            &model_mean,
             "difference [%]",
             "dissipated [J]",
             "model dissipated [J]",
             "difference [%]",
-        ],
-        rows,
-    )
+        ]);
+    }
+    Table::new(&headers, rows)
 }
 
 /// The energy check's cells of a record: Eq. 7's mean against the model's, the dissipated
@@ -429,7 +438,10 @@ pub fn oscillator_table(fit: &FitResult) -> Table {
     if osc.restoring.law().reads_stiffness() {
         rows.push(row(format!("k/{j}"), k / m, std_error("k/m"), "1/s²"));
     }
-    rows.push(row(format!("c/{j}"), c / m, std_error("c/m"), "1/s"));
+    // No damping given nor fitted: c/m = 0 says nothing.
+    if c != 0.0 || std_error("c/m").is_some() {
+        rows.push(row(format!("c/{j}"), c / m, std_error("c/m"), "1/s"));
+    }
     let small = osc.small_motion_stiffness();
     // The stiffness of small motions: k of the linear spring, else R'(0).
     let r0 = if osc.has_linear_spring() {
@@ -525,8 +537,11 @@ impl Render for FitReport {
             );
             sink.table(&budget, Role::Detail);
         }
-        sink.heading(2, "Oscillator", Role::Detail);
-        sink.table(&oscillator_table(f), Role::Detail);
+        let oscillator = oscillator_table(f);
+        if !oscillator.rows.is_empty() {
+            sink.heading(2, "Oscillator", Role::Detail);
+            sink.table(&oscillator, Role::Detail);
+        }
         sink.heading(2, "Records", Role::Detail);
         sink.table(&record_table(f), Role::Summary);
         sink.table(&channel_table(f), Role::Detail);

@@ -111,6 +111,19 @@ impl Sink for HtmlWriter<'_> {
         );
     }
 
+    fn recommendation(&mut self, status: Status, text: &str, reasons: &[String]) {
+        let class = serialized_name(&status);
+        let _ = writeln!(
+            self.body,
+            "<div class=\"verdict recommendation {class}\">\n<p><strong>Recommended:</strong> {}</p>\n<ul>",
+            inline(text)
+        );
+        for reason in reasons {
+            let _ = writeln!(self.body, "<li>{}</li>", inline(reason));
+        }
+        self.body.push_str("</ul>\n</div>\n");
+    }
+
     fn table(&mut self, table: &Table, role: Role) {
         if role != Role::Brief {
             self.body.push_str(&html_table(table));
@@ -221,14 +234,17 @@ code, pre { font-family: ui-monospace, 'SFMono-Regular', Menlo, Consolas, 'DejaV
 pre { background: #f6f6f6; border: 1px solid var(--rule); padding: .75rem; overflow-x: auto;
   white-space: pre-wrap; }
 .verdict { padding: .6rem .9rem; border-left: 6px solid; background: #f7f7f7; font-size: 1.05rem; }
-.verdict.pass { border-color: var(--ok); }
+.verdict.pass { border-color: var(--ok); background: #eef6f0; }
+.recommendation p { margin: 0 0 .3rem; font-size: 1.15rem; }
+.recommendation ul { margin: 0; padding-left: 1.2rem; font-size: .95rem; }
+.recommendation li { margin: .15rem 0; }
 .verdict.warn { border-color: var(--warn); background: #fdf3e9; }
 .verdict.fail { border-color: var(--fail); background: #fbeeee; }
 .scroll { overflow-x: auto; }
 table { border-collapse: collapse; margin: .5rem 0 1rem; font-variant-numeric: tabular-nums; }
-th, td { padding: .25rem .7rem; border-bottom: 1px solid var(--rule); text-align: left;
+th, td { padding: .25rem .55rem; border-bottom: 1px solid var(--rule); text-align: left;
   vertical-align: top; }
-th { border-bottom: 2px solid var(--ink); white-space: nowrap; }
+th { border-bottom: 2px solid var(--ink); }
 td.status { font-weight: 600; text-transform: uppercase; font-size: .85em; }
 td.status.pass { color: var(--ok); }
 td.status.warn { color: var(--warn); }

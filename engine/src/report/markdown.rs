@@ -1,6 +1,7 @@
 //! The Markdown writer (report.md).
 
-use super::{Render, Role, Sink, Table};
+use super::format::serialized_name;
+use super::{Render, Role, Sink, Status, Table};
 
 /// Collects a report as Markdown text.
 #[derive(Debug, Clone, Default)]
@@ -58,6 +59,14 @@ impl Sink for MarkdownWriter {
             return;
         }
         self.out.push_str(&format!("{text}\n\n"));
+    }
+
+    fn recommendation(&mut self, status: Status, text: &str, reasons: &[String]) {
+        self.out.push_str(&format!(
+            "**Recommended: {text}** ({})\n\n",
+            serialized_name(&status)
+        ));
+        self.list(reasons, Role::Summary);
     }
 
     fn table(&mut self, table: &Table, role: Role) {

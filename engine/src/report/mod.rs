@@ -20,6 +20,7 @@ pub mod html;
 pub mod json;
 pub mod markdown;
 pub mod models;
+pub mod recommendation;
 pub mod simulate;
 
 pub use campaign::{CampaignReport, GroupReport};
@@ -85,6 +86,15 @@ pub trait Sink {
     fn verdict(&mut self, status: Status, text: &str) {
         let _ = status;
         self.paragraph(&format!("Verdict: {text}"), Role::Detail);
+    }
+    /// A recommendation (compare's verdict), shown first everywhere: `text` names what to use
+    /// (written after "Recommended:"), `status` is its own result's, and `reasons` are the
+    /// grounds it rests on, one per item. Writers without their own way of showing it write
+    /// a paragraph, then the reasons as a list.
+    fn recommendation(&mut self, status: Status, text: &str, reasons: &[String]) {
+        let _ = status;
+        self.paragraph(&format!("Recommended: {text}"), Role::Summary);
+        self.list(reasons, Role::Summary);
     }
     /// A table.
     fn table(&mut self, table: &Table, role: Role);
