@@ -4,6 +4,7 @@
 //! other test running beside it, and `test_laws.rs`, whose modules register friction laws of
 //! their own that would join this binary's "every registered model" tests.
 
+mod asymmetric_levels;
 mod calibration;
 mod channels;
 mod compare_verdict;
@@ -17,6 +18,7 @@ mod identify;
 mod inverse_dynamics;
 mod levels_as_forces;
 mod pendulum;
+mod polynomial_spring;
 mod records;
 mod replay;
 mod robot_joint;

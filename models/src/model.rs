@@ -233,6 +233,14 @@ pub trait SwitchedLaw: FrictionModel {
         None
     }
 
+    /// The centre of the stick band for a law whose breakaway forces differ by direction:
+    /// the mass sticks while the force it must hold, less this offset, lies within
+    /// +-`static_limit` (levels F+ and F-: offset (F+ - F-)/2, limit (F+ + F-)/2). Default 0:
+    /// the band is symmetric.
+    fn static_offset(&self, _normal: f64) -> f64 {
+        0.0
+    }
+
     /// The force while slipping in `direction` (+1 or -1). `v` may be zero or of the wrong
     /// sign by round-off at a mode boundary: the direction of the set-valued part must come
     /// from `direction`, never from sgn(v). Default: the force at `v`.

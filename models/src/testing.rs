@@ -690,10 +690,11 @@ pub fn check_slip_direction(model: &Model) -> Outcome {
         };
         for d in [1.0, -1.0] {
             let f0 = law.slip_force(0.0, d, normal);
+            let offset = law.static_offset(normal);
             ensure(
                 model,
                 Check::SlipDirection,
-                (f0 - d * limit).abs() <= 1e-12 * (1.0 + limit),
+                (f0 - offset - d * limit).abs() <= 1e-12 * (1.0 + limit + offset.abs()),
                 || {
                     format!("slip force {f0} at v = 0 in direction {d}, breakaway {limit}, N = {normal}")
                 },

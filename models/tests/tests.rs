@@ -1,6 +1,7 @@
 //! The model crate's integration tests, one module per subject, built into one binary (one
 //! link instead of one per file).
 
+mod asymmetric;
 mod harness;
 mod jacobian;
 mod makkar_gms_expression;

@@ -12,12 +12,14 @@ mod cubic_spring;
 mod linear_spring;
 mod no_restoring;
 mod pendulum;
+mod polynomial;
 mod units;
 
 pub use cubic_spring::CubicSpring;
 pub use linear_spring::LinearSpring;
 pub use no_restoring::NoRestoring;
 pub use pendulum::Pendulum;
+pub use polynomial::Polynomial;
 pub use units::Axis;
 
 use serde::de::Error as _;
@@ -54,6 +56,8 @@ pub trait BuildRestoring: RestoringLaw + Sized {
     const NAME: &'static str;
     /// Its parameter keys, in the order of [`BuildRestoring::from_values`].
     const KEYS: &'static [&'static str];
+    /// The keys a table may leave out: 0 when absent.
+    const OPTIONAL: &'static [&'static str] = &[];
     /// The law from one value per key.
     fn from_values(values: &[f64]) -> Self;
     /// One value per key.
@@ -151,6 +155,7 @@ fn build_law<L: BuildRestoring>(table: &BTreeMap<String, RawValue>) -> Result<L,
                     key: key.to_string(),
                 })
             }
+            None if L::OPTIONAL.contains(key) => values.push(0.0),
             None => {
                 return Err(RestoringError::MissingKey {
                     law,
@@ -256,6 +261,7 @@ restoring_laws! {
     None(NoRestoring),
     Pendulum(Pendulum),
     CubicSpring(CubicSpring),
+    Polynomial(Polynomial),
 }
 
 impl Default for Restoring {
@@ -316,6 +322,69 @@ impl<'de> Deserialize<'de> for Restoring {
     }
 }
 
+/// `restoring = { ... }` as `[oscillator]` holds it: the law, and the stiffness k that a law
+/// reading the oscillator's `stiffness` may carry in its own table (`restoring = { type =
+/// "polynomial", stiffness = k1, quadratic_stiffness = k2 }`), which is the oscillator's
+/// `stiffness`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WrittenRestoring {
+    /// The law.
+    pub law: Restoring,
+    /// The stiffness written in the law's table.
+    pub stiffness: Option<f64>,
+}
+
+impl From<Restoring> for WrittenRestoring {
+    fn from(law: Restoring) -> Self {
+        Self {
+            law,
+            stiffness: None,
+        }
+    }
+}
+
+impl WrittenRestoring {
+    /// From a table: `stiffness` kept aside for a law that reads it, an unknown key of the
+    /// others.
+    fn from_table(mut table: BTreeMap<String, RawValue>) -> Result<Self, RestoringError> {
+        let stiffness = table.remove("stiffness");
+        let kept = stiffness.clone();
+        let law = Restoring::from_table(table.clone())?;
+        let stiffness = match stiffness {
+            None => None,
+            Some(RawValue::Number(k)) if law.law().reads_stiffness() => Some(k),
+            Some(RawValue::Text(_)) if law.law().reads_stiffness() => {
+                return Err(RestoringError::NotANumber {
+                    law: law.name().into(),
+                    key: "stiffness".into(),
+                })
+            }
+            Some(_) => {
+                table.extend(kept.map(|v| ("stiffness".to_string(), v)));
+                return Restoring::from_table(table).map(Self::from);
+            }
+        };
+        Ok(Self { law, stiffness })
+    }
+}
+
+impl Serialize for WrittenRestoring {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut table = self.law.table();
+        if let Some(k) = self.stiffness {
+            table.insert("stiffness".into(), RawValue::Number(k));
+        }
+        table.serialize(serializer)
+    }
+}
+
+impl<'de> Deserialize<'de> for WrittenRestoring {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let table = BTreeMap::<String, RawValue>::deserialize(deserializer)?;
+        Self::from_table(table).map_err(D::Error::custom)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -331,6 +400,7 @@ mod tests {
             serde_json::json!({"type": "none"}),
             serde_json::json!({"type": "pendulum", "gravity_moment": 120.0}),
             serde_json::json!({"type": "cubic_spring", "cubic_stiffness": 5e6}),
+            serde_json::json!({"type": "polynomial", "quadratic_stiffness": -2.0, "cubic_stiffness": 5e6}),
         ] {
             let law = parse(json.clone()).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(serde_json::to_value(law).ok(), Some(json));
@@ -360,6 +430,10 @@ mod tests {
             Restoring::CubicSpring(CubicSpring {
                 cubic_stiffness: 4e5,
             }),
+            Restoring::Polynomial(Polynomial {
+                quadratic_stiffness: -700.0,
+                cubic_stiffness: 4e5,
+            }),
         ];
         let k = 1982.0;
         for law in laws {
@@ -379,6 +453,50 @@ mod tests {
             }
             assert_eq!(l.potential(0.0, k), 0.0);
         }
+    }
+
+    /// The polynomial spring's absent terms are 0, and with k2 = 0 it is the cubic spring.
+    #[test]
+    fn the_polynomial_spring_without_k2_is_the_cubic_spring() {
+        let p = parse(serde_json::json!({"type": "polynomial", "cubic_stiffness": 3.0}));
+        let p = p.unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(p.parameter("quadratic_stiffness"), Some(0.0));
+        let cubic = CubicSpring {
+            cubic_stiffness: 3.0,
+        };
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-14 * (1.0 + b.abs());
+        for q in [-0.7, -0.1, 0.0, 0.2, 1.3] {
+            assert!(close(p.law().force(q, 2.0), cubic.force(q, 2.0)), "{q}");
+            assert!(close(p.law().stiffness(q, 2.0), cubic.stiffness(q, 2.0)));
+            assert!(close(p.law().potential(q, 2.0), cubic.potential(q, 2.0)));
+        }
+        // k1 q + k2 q^2 at q = +-0.5 with k1 = 2, k2 = 4: 1 + 1 and -1 + 1.
+        let quadratic = Polynomial {
+            quadratic_stiffness: 4.0,
+            cubic_stiffness: 0.0,
+        };
+        assert_eq!(quadratic.force(0.5, 2.0), 2.0);
+        assert_eq!(quadratic.force(-0.5, 2.0), 0.0);
+        // V = k1 q^2 / 2 + k2 q^3 / 3 = 0.25 + 1/6 at q = 0.5.
+        assert!((quadratic.potential(0.5, 2.0) - (0.25 + 1.0 / 6.0)).abs() < 1e-15);
+        let e = parse(serde_json::json!({"type": "polynomial", "quadratic_stiffness": f64::NAN}));
+        assert!(e.is_err());
+    }
+
+    /// A law that reads the oscillator's stiffness may carry it in its table; the others may
+    /// not.
+    #[test]
+    fn the_stiffness_may_be_written_in_a_spring_table() {
+        let written: Result<WrittenRestoring, _> = serde_json::from_value(
+            serde_json::json!({"type": "polynomial", "stiffness": 0.5, "quadratic_stiffness": 0.2}),
+        );
+        let written = written.unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(written.stiffness, Some(0.5));
+        assert_eq!(written.law.parameter("quadratic_stiffness"), Some(0.2));
+        let refused: Result<WrittenRestoring, _> = serde_json::from_value(
+            serde_json::json!({"type": "pendulum", "stiffness": 0.5, "gravity_moment": 1.0}),
+        );
+        assert!(refused.is_err_and(|e| e.to_string().contains("unknown key `stiffness`")));
     }
 
     #[test]

@@ -4,7 +4,7 @@
 //! property is one variant and its facts below.
 
 use super::Oscillator;
-use crate::axis::Axis;
+use crate::axis::{Axis, Restoring};
 use serde::{Deserialize, Serialize};
 
 /// An oscillator property: one a fit may vary ([`OscillatorProperty::FITTED`]), or the normal
@@ -23,6 +23,11 @@ pub enum OscillatorProperty {
     GravityMoment,
     /// The input's offset F_0 [N] (see [`Oscillator::input_offset`]).
     InputOffset,
+    /// The quadratic stiffness k2 [N/m^2] of the polynomial spring
+    /// (`restoring = { type = "polynomial" }`).
+    QuadraticStiffness,
+    /// The cubic stiffness k3 [N/m^3] of the polynomial or the cubic spring.
+    CubicStiffness,
     /// The normal force N [N] on the friction contact: known or not, never fitted (and
     /// refused as a fitted property by `[fit.options] oscillator`).
     #[serde(skip_deserializing)]
@@ -42,21 +47,25 @@ pub enum PropertyDomain {
 
 impl OscillatorProperty {
     /// The properties a fit may vary, in the order of their keys.
-    pub const FITTED: [Self; 5] = [
+    pub const FITTED: [Self; 7] = [
         Self::Mass,
         Self::Damping,
         Self::Stiffness,
         Self::GravityMoment,
         Self::InputOffset,
+        Self::QuadraticStiffness,
+        Self::CubicStiffness,
     ];
 
     /// Every property: the fitted ones, then the normal force.
-    pub const ALL: [Self; 6] = [
+    pub const ALL: [Self; 8] = [
         Self::Mass,
         Self::Damping,
         Self::Stiffness,
         Self::GravityMoment,
         Self::InputOffset,
+        Self::QuadraticStiffness,
+        Self::CubicStiffness,
         Self::NormalForce,
     ];
 
@@ -68,6 +77,8 @@ impl OscillatorProperty {
             Self::Stiffness => "stiffness",
             Self::GravityMoment => "gravity_moment",
             Self::InputOffset => "input_offset",
+            Self::QuadraticStiffness => "quadratic_stiffness",
+            Self::CubicStiffness => "cubic_stiffness",
             Self::NormalForce => "normal_force",
         }
     }
@@ -80,6 +91,8 @@ impl OscillatorProperty {
             Self::Stiffness => &["stiffness"],
             Self::GravityMoment => &["gravity_moment"],
             Self::InputOffset => &["input_offset"],
+            Self::QuadraticStiffness => &["quadratic_stiffness"],
+            Self::CubicStiffness => &["cubic_stiffness"],
             Self::NormalForce => &["normal_force"],
         }
     }
@@ -99,6 +112,8 @@ impl OscillatorProperty {
             Self::Mass => "kg",
             Self::Damping => "N s/m",
             Self::Stiffness => "N/m",
+            Self::QuadraticStiffness => "N/m^2",
+            Self::CubicStiffness => "N/m^3",
             Self::GravityMoment | Self::InputOffset | Self::NormalForce => "N",
         }
     }
@@ -130,7 +145,9 @@ impl OscillatorProperty {
         match self {
             Self::Mass | Self::Stiffness | Self::GravityMoment => PropertyDomain::Positive,
             Self::Damping | Self::NormalForce => PropertyDomain::NonNegative,
-            Self::InputOffset => PropertyDomain::Any,
+            Self::InputOffset | Self::QuadraticStiffness | Self::CubicStiffness => {
+                PropertyDomain::Any
+            }
         }
     }
 
@@ -159,7 +176,10 @@ impl OscillatorProperty {
 
     /// Whether it is a parameter of the restoring force R(q).
     pub fn is_restoring(self) -> bool {
-        matches!(self, Self::Stiffness | Self::GravityMoment)
+        matches!(
+            self,
+            Self::Stiffness | Self::GravityMoment | Self::QuadraticStiffness | Self::CubicStiffness
+        )
     }
 
     /// Where it is a parameter of a restoring law other than the spring: the
@@ -167,6 +187,10 @@ impl OscillatorProperty {
     pub fn restoring_table(self) -> Option<&'static str> {
         match self {
             Self::GravityMoment => Some(r#"{ type = "pendulum", gravity_moment = ... }"#),
+            Self::QuadraticStiffness => {
+                Some(r#"{ type = "polynomial", quadratic_stiffness = ... }"#)
+            }
+            Self::CubicStiffness => Some(r#"{ type = "polynomial", cubic_stiffness = ... }"#),
             _ => None,
         }
     }
@@ -177,7 +201,9 @@ impl OscillatorProperty {
             Self::Mass => Some(osc.mass),
             Self::Damping => Some(osc.damping),
             Self::Stiffness => Some(osc.stiffness),
-            Self::GravityMoment => osc.restoring.parameter(self.key()),
+            Self::GravityMoment | Self::QuadraticStiffness | Self::CubicStiffness => {
+                osc.restoring.parameter(self.key())
+            }
             Self::InputOffset => Some(osc.input_offset),
             Self::NormalForce => Some(osc.normal_force),
         }
@@ -189,7 +215,7 @@ impl OscillatorProperty {
             Self::Mass => osc.mass = value,
             Self::Damping => osc.damping = value,
             Self::Stiffness => osc.stiffness = value,
-            Self::GravityMoment => {
+            Self::GravityMoment | Self::QuadraticStiffness | Self::CubicStiffness => {
                 osc.restoring.set_parameter(self.key(), value);
             }
             Self::InputOffset => osc.input_offset = value,
@@ -208,7 +234,8 @@ impl OscillatorProperty {
 
     /// Its column in the balance J a + c v + R(q) + F_0 of an axis at acceleration `a`,
     /// velocity `v` and coordinate `q`, on the law it belongs to (the stiffness on the
-    /// linear spring k q, the gravity moment on the pendulum M_g sin q): the balance's
+    /// linear spring k q, the gravity moment on the pendulum M_g sin q, k2 q^2 and k3 q^3 on
+    /// the polynomial spring): the balance's
     /// derivative with respect to it (0 for the normal force, which is not in it).
     pub fn balance_column(self, a: f64, v: f64, q: f64) -> f64 {
         match self {
@@ -217,27 +244,40 @@ impl OscillatorProperty {
             Self::Stiffness => q,
             Self::GravityMoment => q.sin(),
             Self::InputOffset => 1.0,
+            Self::QuadraticStiffness => q * q,
+            Self::CubicStiffness => q * q * q,
             Self::NormalForce => 0.0,
         }
     }
 
     /// Whether [`Self::balance_column`] is the balance's exact derivative on `osc`'s
-    /// restoring law (the stiffness only on the linear spring; not the gravity moment,
+    /// restoring law (the stiffness only on the linear and polynomial springs, the polynomial
+    /// terms where the law has them; not the gravity moment,
     /// whose column a fit takes by differences).
     pub fn balance_column_exact(self, osc: &Oscillator) -> bool {
         match self {
             Self::Mass | Self::Damping | Self::InputOffset => true,
-            Self::Stiffness => osc.restoring.is_linear_spring(),
+            Self::Stiffness => {
+                osc.restoring.is_linear_spring()
+                    || matches!(osc.restoring, Restoring::Polynomial(_))
+            }
+            Self::QuadraticStiffness | Self::CubicStiffness => {
+                osc.restoring.parameter(self.key()).is_some()
+            }
             Self::GravityMoment | Self::NormalForce => false,
         }
     }
 
-    /// The scale of its linear coordinate when its value is 0: an offset's a newton, any
+    /// The scale of its linear coordinate when its value is 0: an offset's a newton, a
+    /// polynomial term's the small-motion stiffness (at least 1) per unit of q^n, any
     /// other's 2e-3 of the critical damping of `osc`'s small motions (of a kilogram-second
     /// without a restoring force).
     pub fn typical(self, osc: &Oscillator) -> f64 {
         match self {
             Self::InputOffset => 1.0,
+            Self::QuadraticStiffness | Self::CubicStiffness => {
+                osc.small_motion_stiffness().abs().max(1.0)
+            }
             _ if osc.small_motion_stiffness() > 0.0 => {
                 2e-3 * (osc.mass * osc.small_motion_stiffness()).sqrt()
             }
@@ -294,7 +334,16 @@ mod tests {
             .collect();
         assert_eq!(
             rotary,
-            ["kg m^2", "N m s/rad", "N m/rad", "N m", "N m", "N m"]
+            [
+                "kg m^2",
+                "N m s/rad",
+                "N m/rad",
+                "N m",
+                "N m",
+                "N m/rad^2",
+                "N m/rad^3",
+                "N m"
+            ]
         );
     }
 
@@ -304,7 +353,7 @@ mod tests {
         let mut osc = Oscillator::fmm();
         for (i, p) in OscillatorProperty::ALL.into_iter().enumerate() {
             p.set(&mut osc, 1.5 + i as f64);
-            let expected = (p != OscillatorProperty::GravityMoment).then_some(1.5 + i as f64);
+            let expected = p.restoring_table().is_none().then_some(1.5 + i as f64);
             assert_eq!(p.value(&osc), expected, "{p:?}");
         }
     }

@@ -360,18 +360,18 @@ impl<R: Recorder> Driver<'_, R> {
     /// and when the stick lasts to the end.
     fn breakaway(&self, t: f64, x: f64, t_end: f64) -> Option<(f64, f64)> {
         let input = self.dynamics.input?;
-        let Law::Switched { limit } = self.dynamics.law else {
+        let Law::Switched { limit, offset } = self.dynamics.law else {
             return None;
         };
-        // The input itself must leave the band about R(x) + F_0.
-        let centre = self.dynamics.restoring_force(x) + self.dynamics.osc.input_offset;
+        // The input itself must leave the band about R(x) + F_0 (+ the law's offset).
+        let centre = self.dynamics.restoring_force(x) + self.dynamics.osc.input_offset + offset;
         let t_b = input.first_exceedance(t, t_end, centre, limit)?;
         // A stick that the input leaves at once is a stick the slip force cannot end
         // (a law whose slip force at rest exceeds its static limit): it lasts.
         if t_b <= t {
             return None;
         }
-        Some((t_b, sgn(self.dynamics.held_force(t_b, x))))
+        Some((t_b, sgn(self.dynamics.held_force(t_b, x) - offset)))
     }
 }
 

@@ -9,8 +9,10 @@ use frictionid_models::{sgn, Derivatives, FrictionModel, InternalStates, Switche
 /// How the friction law is treated.
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Law<'a> {
-    /// Static law with a set-valued force at v = 0: switched system (slip+, slip-, stick).
-    Switched { limit: f64 },
+    /// Static law with a set-valued force at v = 0: switched system (slip+, slip-, stick);
+    /// it sticks while the held force less `offset` is within +-`limit` (an offset for
+    /// levels that differ by direction).
+    Switched { limit: f64, offset: f64 },
     /// Smooth static law: no mode switch, restart at turning points.
     Smooth,
     /// Dynamic model with internal states integrated alongside x and v: its states' law
@@ -174,12 +176,12 @@ impl Dynamics<'_> {
             return Start::Slip(sgn(v));
         }
         match self.law {
-            Law::Switched { limit } => {
+            Law::Switched { limit, offset } => {
                 let held = self.held_force(t, x);
-                if held.abs() <= limit {
+                if (held - offset).abs() <= limit {
                     return Start::Rest;
                 }
-                let dir = sgn(held);
+                let dir = sgn(held - offset);
                 let a = self.accel(t, x, 0.0, self.slip_force(0.0, dir));
                 if dir * a > 0.0 {
                     Start::Slip(dir)
@@ -208,8 +210,13 @@ fn classify_law(model: &dyn FrictionModel, normal: f64) -> Result<Law<'_>, Engin
             derivatives,
         });
     }
+    let offset = model
+        .switching()
+        .map_or(0.0, |law| law.static_offset(normal));
     match model.switching().and_then(|law| law.static_limit(normal)) {
-        Some(limit) if limit.is_finite() && limit >= 0.0 => Ok(Law::Switched { limit }),
+        Some(limit) if limit.is_finite() && limit >= 0.0 && offset.abs() <= limit => {
+            Ok(Law::Switched { limit, offset })
+        }
         Some(limit) => Err(EngineError::InvalidInput(format!(
             "model `{}` reports a static limit of {limit} N",
             model.name()

@@ -2,7 +2,7 @@
 //! deviations and the keys not given.
 
 use super::error::SpecError;
-use crate::axis::{Axis, Restoring};
+use crate::axis::{Axis, Restoring, WrittenRestoring};
 use crate::identify::PropertyUncertainty;
 use crate::oscillator::{Oscillator, OscillatorProperty, PartialOscillator};
 use serde::{Deserialize, Serialize};
@@ -36,9 +36,10 @@ pub struct OscillatorTable {
     /// The rotary name of `mass` [kg m^2].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     inertia: Option<f64>,
-    /// The restoring law (default: the linear spring of `stiffness`).
+    /// The restoring law (default: the linear spring of `stiffness`); a law that reads the
+    /// stiffness may carry it in its table.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    restoring: Option<Restoring>,
+    restoring: Option<WrittenRestoring>,
     /// The input's offset: a constant force (torque) in the balance [N or N m] (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     input_offset: Option<f64>,
@@ -67,7 +68,7 @@ impl TryFrom<OscillatorTable> for OscillatorSpec {
         let (mut oscillator, mut unknown) = PartialOscillator {
             mass: o.mass.or(o.inertia),
             damping: o.damping,
-            stiffness: o.stiffness,
+            stiffness: stiffness_of(&o)?,
             normal_force: o.normal_force,
         }
         .resolve();
@@ -92,11 +93,23 @@ impl TryFrom<OscillatorTable> for OscillatorSpec {
     }
 }
 
+/// The stiffness k, given in `[oscillator]` or in the restoring law's table (not both).
+fn stiffness_of(o: &OscillatorTable) -> Result<Option<f64>, SpecError> {
+    match (o.stiffness, o.restoring.and_then(|r| r.stiffness)) {
+        (Some(_), Some(_)) => Err(SpecError::Oscillator(
+            "`stiffness` is given twice, in [oscillator] and in its `restoring` table: \
+             keep one"
+                .into(),
+        )),
+        (given, in_table) => Ok(given.or(in_table)),
+    }
+}
+
 /// The axis and the restoring law of `[oscillator]`: the pendulum turns (a rotary axis
 /// unless the axis is given, an error on a linear one); `inertia` belongs to a rotary
 /// axis and names the same property as `mass`.
 fn axis_of(o: &OscillatorTable) -> Result<(Axis, Restoring), SpecError> {
-    let restoring = o.restoring.unwrap_or_default();
+    let restoring = o.restoring.map(|r| r.law).unwrap_or_default();
     let turns = matches!(restoring, Restoring::Pendulum(_));
     let axis = match (o.axis, turns) {
         (Some(Axis::Linear), true) => {
@@ -133,7 +146,7 @@ impl From<OscillatorSpec> for OscillatorTable {
         Self {
             axis: rotary.then_some(p.axis),
             inertia: given(OscillatorProperty::Mass, p.mass).filter(|_| rotary),
-            restoring: (!p.restoring.is_linear_spring()).then_some(p.restoring),
+            restoring: (!p.restoring.is_linear_spring()).then_some(p.restoring.into()),
             input_offset: (p.input_offset != 0.0).then_some(p.input_offset),
             mass: given(OscillatorProperty::Mass, p.mass).filter(|_| !rotary),
             damping: given(OscillatorProperty::Damping, p.damping),
@@ -166,5 +179,38 @@ impl OscillatorSpec {
             .validate()
             .and_then(|()| self.uncertainty.validate())
             .map_err(|e| SpecError::Oscillator(e.to_string()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(json: serde_json::Value) -> Result<OscillatorSpec, String> {
+        serde_json::from_value(json).map_err(|e| e.to_string())
+    }
+
+    /// The polynomial spring's k1 is the oscillator's stiffness, written in its table or in
+    /// `[oscillator]`, not in both; it round-trips through `[oscillator]`.
+    #[test]
+    fn the_polynomial_spring_takes_its_stiffness_from_either_place() {
+        let in_table = parse(serde_json::json!({
+            "mass": 0.01, "damping": 0.002, "normal_force": 1.0, "axis": "rotary",
+            "restoring": {"type": "polynomial", "stiffness": 0.5, "quadratic_stiffness": 0.4},
+        }))
+        .unwrap_or_else(|e| panic!("{e}"));
+        let osc = in_table.oscillator;
+        assert_eq!(osc.stiffness, 0.5);
+        assert!(in_table.unknown.is_empty());
+        // R(0.2) = 0.5 * 0.2 + 0.4 * 0.04.
+        assert!((osc.restoring_force(0.2) - 0.116).abs() < 1e-15);
+        let written = serde_json::to_value(&in_table).unwrap_or_default();
+        assert_eq!(parse(written).ok(), Some(in_table));
+
+        let twice = parse(serde_json::json!({
+            "mass": 1.0, "stiffness": 2.0, "normal_force": 1.0,
+            "restoring": {"type": "polynomial", "stiffness": 0.5},
+        }));
+        assert!(twice.is_err_and(|e| e.contains("`stiffness` is given twice")));
     }
 }

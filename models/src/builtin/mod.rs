@@ -1,6 +1,7 @@
 //! The built-in friction models, one per file.
 
 mod coulomb;
+mod coulomb_asymmetric;
 mod dahl;
 mod expression;
 mod gms;
@@ -10,8 +11,10 @@ mod makkar;
 mod none;
 mod stribeck;
 mod viscous_coulomb;
+mod viscous_coulomb_asymmetric;
 
 pub use coulomb::Coulomb;
+pub use coulomb_asymmetric::CoulombAsymmetric;
 pub use dahl::Dahl;
 pub use expression::{Expression, ExpressionConfig};
 pub use gms::{Gms, GmsConfig, GmsElement, PerElement, MAX_ELEMENTS};
@@ -20,3 +23,4 @@ pub use makkar::Makkar;
 pub use none::NoFriction;
 pub use stribeck::{mu_s_warning, Stribeck};
 pub use viscous_coulomb::ViscousCoulomb;
+pub use viscous_coulomb_asymmetric::ViscousCoulombAsymmetric;
