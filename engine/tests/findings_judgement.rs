@@ -44,3 +44,101 @@ fn a_wrong_law_on_a_noise_free_record_is_still_flagged() {
         r.diagnostics
     );
 }
+
+/// A measured friction force along a stroke of speed 10 +- 5 mm/s under 10 N: one way only
+/// (sgn(v) = 1 throughout) or back and forth.
+fn stroke(one_way: bool) -> frictionid_engine::Record {
+    use frictionid_engine::record::{Channel, TimeBase};
+    use frictionid_engine::synthetic::add_gaussian_noise;
+    let n = 2000;
+    let time: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
+    let v: Vec<f64> = time
+        .iter()
+        .map(|&t| {
+            let swing = (2.0 * std::f64::consts::PI * t).sin();
+            if one_way {
+                0.01 + 0.005 * swing
+            } else {
+                0.01 * swing
+            }
+        })
+        .collect();
+    let mut x = vec![0.0; n];
+    for i in 1..n {
+        x[i] = x[i - 1] + 0.5 * (v[i] + v[i - 1]) * 1e-3;
+    }
+    // viscous_coulomb: mu = 0.3 under 10 N, 5 N s/m, and a load cell's 0.4 N offset.
+    let mut force: Vec<f64> = v
+        .iter()
+        .map(|&v| 3.0 * v.signum() + 5.0 * v + 0.4)
+        .collect();
+    add_gaussian_noise(&mut force, 0.01, 5);
+    frictionid_engine::Record::from_time_base("stroke", TimeBase::new(time).unwrap())
+        .with_channel(Channel::Displacement, x)
+        .with_channel(Channel::Velocity, v)
+        .with_channel(Channel::NormalForce, vec![10.0; n])
+        .with_channel(Channel::Force, force)
+}
+
+fn stroke_fit(one_way: bool) -> FitResult {
+    use frictionid_engine::identify::{FitDomain, TargetOptions};
+    use frictionid_engine::oscillator::OscillatorProperty;
+    let opts = FitOptions {
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            force_offset: true,
+            unknown_oscillator: vec![
+                OscillatorProperty::Mass,
+                OscillatorProperty::Damping,
+                OscillatorProperty::Stiffness,
+            ],
+            ..TargetOptions::default()
+        },
+        ..FitOptions::default()
+    };
+    let model = frictionid_models::ViscousCoulomb::default();
+    fit(&Oscillator::fmm(), &model, &[stroke(one_way)], &opts).unwrap()
+}
+
+/// On a one-way stroke the Coulomb level's column sgn(v) is the offset's column: the records
+/// fix their sum only, so both are flagged and neither carries a standard error; back and
+/// forth, both are determined and recovered.
+#[test]
+fn a_level_and_an_offset_sharing_a_column_are_both_flagged() {
+    use frictionid_engine::identify::Identifiability;
+    let one_way = stroke_fit(true);
+    for name in ["mu", "force_offset[stroke]"] {
+        let p = one_way.param(name).unwrap();
+        assert_ne!(
+            p.identifiability,
+            Some(Identifiability::Determined),
+            "{name}: {p:?}"
+        );
+        assert!(p.std_error.is_none(), "{name}: {p:?}");
+    }
+    let flagged: Vec<&str> = one_way
+        .diagnostics
+        .iter()
+        .filter(|d| d.check == Check::Identifiability && d.status == Status::Warn)
+        .map(|d| d.message.as_str())
+        .collect();
+    assert!(
+        flagged.iter().any(|m| m.contains("force_offset[stroke]")),
+        "{flagged:?}"
+    );
+    let both_ways = stroke_fit(false);
+    for (name, truth) in [("mu", 0.3), ("force_offset[stroke]", 0.4)] {
+        let p = both_ways.param(name).unwrap();
+        assert!(
+            p.identifiability
+                .is_none_or(|c| c == Identifiability::Determined),
+            "{name}: {p:?}"
+        );
+        let se = p.std_error.unwrap();
+        assert!(
+            (p.value - truth).abs() < 4.0 * se,
+            "{name}: {} +- {se}",
+            p.value
+        );
+    }
+}

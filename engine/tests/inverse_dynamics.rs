@@ -18,14 +18,14 @@ use frictionid_models::ViscousCoulomb;
 use std::f64::consts::PI;
 
 /// The axis's truth.
-struct Axis {
-    mass: f64,
-    viscous: f64,
-    coulomb: f64,
-    offset: f64,
+pub(crate) struct Axis {
+    pub(crate) mass: f64,
+    pub(crate) viscous: f64,
+    pub(crate) coulomb: f64,
+    pub(crate) offset: f64,
 }
 
-const TRUTH: Axis = Axis {
+pub(crate) const TRUTH: Axis = Axis {
     mass: 5.0,
     viscous: 20.0,
     coulomb: 3.0,
@@ -135,7 +135,7 @@ impl Axis {
     }
 
     /// `n` samples at 1 kHz from rest at x = 0: time, position, velocity and input.
-    fn record(&self, n: usize) -> Record {
+    pub(crate) fn record(&self, n: usize) -> Record {
         let dt = 1e-3;
         let mut state = State {
             t: 0.0,
@@ -174,7 +174,7 @@ fn options() -> (frictionid_engine::Oscillator, FitOptions) {
     (osc, serial(opts))
 }
 
-fn inverse_dynamics(record: &Record) -> FitResult {
+pub(crate) fn inverse_dynamics(record: &Record) -> FitResult {
     let (osc, opts) = options();
     fit(
         &osc,
@@ -185,7 +185,7 @@ fn inverse_dynamics(record: &Record) -> FitResult {
     .unwrap()
 }
 
-fn truths() -> [(&'static str, f64); 4] {
+pub(crate) fn truths() -> [(&'static str, f64); 4] {
     [
         ("mass", TRUTH.mass),
         ("viscous", TRUTH.viscous),

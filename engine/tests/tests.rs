@@ -25,5 +25,6 @@ mod robot_joint;
 mod robust_targets;
 mod simulate;
 mod slow_runs;
+mod standard_errors;
 mod units;
 mod util;

@@ -56,6 +56,11 @@ struct Statistics {
     widening: Option<Finding>,
     /// Names the free parameters that change no residual.
     without_effect: Option<Finding>,
+    /// What the records say about each free parameter, with the parameters that share an
+    /// undetermined one's column not identifiable too.
+    standings: Vec<Standing>,
+    /// The parameters that share an undetermined one's column.
+    shared: Vec<identifiability::SharedColumn>,
 }
 
 fn statistics<R: Residuals>(
@@ -69,7 +74,13 @@ fn statistics<R: Residuals>(
     let (jac, r) = reference.take_jacobian_physical(&p_best)?;
     let ssr = r.norm_squared();
     let without_effect = diagnostics::parameters_without_effect(&reference.layout, &p_best, &jac);
-    let mut cov = covariance_of_determined(&jac, ssr, standings);
+    // Model parameters are profiled; the others take the verdict of a column they share.
+    let unprofiled: Vec<bool> = (0..reference.layout.len())
+        .map(|j| !matches!(reference.layout[j].kind, ParamKind::Model(_)))
+        .collect();
+    let shared = identifiability::shared_columns(&jac, standings, &unprofiled);
+    let standings = identifiability::with_shared(standings, &shared);
+    let mut cov = covariance_of_determined(&jac, ssr, &standings);
     let segments: Vec<usize> = reference
         .records
         .iter()
@@ -87,21 +98,27 @@ fn statistics<R: Residuals>(
         t_quantile,
         widening,
         without_effect,
+        standings,
+        shared,
     })
 }
 
-/// Noise lag-1 correlation above which standard errors are checked for widening (white
-/// noise gives about 1/sqrt(n), far below).
-pub const AUTOCORRELATION_THRESHOLD: f64 = 0.1;
+/// The smallest widening of a standard error that is applied and reported: below, the
+/// HAC estimate's own scatter on white noise (a few per cent) would move the errors of
+/// every well-fitted record.
+pub const MIN_WIDENING: f64 = 1.1;
 
 pub use super::diagnostics::SMOOTH_RESIDUALS;
 
-/// Widens the covariance when the residuals are autocorrelated noise: each standard error
-/// becomes the larger of the classical and the Newey-West one, after AR(1) prewhitening with
-/// the noise's lag-1 correlation and with Bartlett lags by Andrews' plug-in rule on what the
-/// prewhitening leaves (bounded: [`stats::andrews_lags`], at most a quarter of the shortest
-/// record), keeping the correlations. Residuals smooth enough to correlate near 1 at lag 1
-/// are not noise: a warning says so and nothing is widened. Returns the finding.
+/// Widens the covariance for autocorrelated residuals: each standard error becomes the
+/// larger of the classical and the HAC one ([`stats::hac_covariance`]: Newey-West on each
+/// parameter's scores prewhitened by their own AR(2) filter, Bartlett lags by Andrews'
+/// plug-in rule, at most a quarter of the shortest record), keeping the correlations, when
+/// some error grows by [`MIN_WIDENING`] or more. Nothing here hangs on a noise estimate
+/// that a ringing can turn negative: the filters' gains at zero frequency are positive by
+/// construction. Residuals smoother than measurement noise at the sample scale (a ringing,
+/// low-pass filtered data, or a misfit the law cannot follow) are widened alike and warned
+/// about. Returns the finding.
 fn widen_for_autocorrelation(
     cov: &mut Covariance,
     jac: &DMatrix<f64>,
@@ -110,47 +127,67 @@ fn widen_for_autocorrelation(
 ) -> Option<Finding> {
     let parts = split(r, segments);
     let smoothness = diagnostics::residual_smoothness(&parts);
-    if smoothness >= SMOOTH_RESIDUALS {
-        return Some(smooth_residuals_finding(smoothness));
+    let smooth = smoothness >= SMOOTH_RESIDUALS;
+    let usable = !cov.singular && cov.residual_variance.is_finite() && cov.residual_variance > 0.0;
+    if !usable {
+        return smooth.then(|| smooth_residuals_finding(smoothness, None));
     }
-    let phi = diagnostics::noise_correlation(&parts);
-    if phi <= AUTOCORRELATION_THRESHOLD
-        || cov.singular
-        || cov.residual_variance.is_nan()
-        || cov.residual_variance <= 0.0
-    {
-        return None;
-    }
-    let phi = phi.min(stats::MAX_PLUG_IN_CORRELATION);
-    let filtered: Vec<Vec<f64>> = parts
-        .iter()
-        .map(|p| p.windows(2).map(|w| w[1] - phi * w[0]).collect())
-        .collect();
-    let rho = diagnostics::lag_one_correlation(&filtered);
     let shortest = segments.iter().copied().min().unwrap_or(0);
-    let lags = stats::andrews_lags(rho, r.len(), shortest / 4 + 1);
-    let bread = &cov.matrix / cov.residual_variance;
-    let hac = stats::newey_west_prewhitened(jac, r, segments, lags, &bread, phi);
+    // Undetermined parameters' rows are NaN: they take no part in the sandwich.
+    let bread = (&cov.matrix / cov.residual_variance).map(|b| if b.is_finite() { b } else { 0.0 });
+    let hac = stats::hac_covariance(jac, r, segments, &bread, shortest / 4 + 1);
     let p = cov.std_errors.len();
     let factors: Vec<f64> = (0..p)
-        .map(|i| (hac[(i, i)] / cov.matrix[(i, i)]).sqrt())
+        .map(|i| (hac.matrix[(i, i)] / cov.matrix[(i, i)]).sqrt())
         .map(|f| if f.is_finite() { f.max(1.0) } else { 1.0 })
         .collect();
-    for a in 0..p {
-        for b in 0..p {
-            cov.matrix[(a, b)] *= factors[a] * factors[b];
-        }
-        cov.std_errors[a] *= factors[a];
-    }
     let widest = factors.iter().copied().fold(1.0, f64::max);
-    Some(Finding::new(
-        Check::NoiseCorrelation,
-        Status::Pass,
-        Some(widest),
+    let widening = (widest >= MIN_WIDENING).then(|| {
+        for a in 0..p {
+            for b in 0..p {
+                cov.matrix[(a, b)] *= factors[a] * factors[b];
+            }
+            cov.std_errors[a] *= factors[a];
+        }
+        Widening {
+            widest,
+            lags: hac.lags,
+            rho: diagnostics::lag_one_correlation(&parts),
+        }
+    });
+    if smooth {
+        return Some(smooth_residuals_finding(smoothness, widening));
+    }
+    widening.map(|w| {
+        Finding::new(
+            Check::NoiseCorrelation,
+            Status::Pass,
+            Some(w.widest),
+            format!(
+                "residuals are autocorrelated (lag-1 correlation {:.2}): standard errors widened by up to {:.2}x ({})",
+                w.rho,
+                w.widest,
+                w.method()
+            ),
+        )
+    })
+}
+
+/// How far the standard errors were widened, and how.
+#[derive(Debug, Clone, Copy)]
+struct Widening {
+    widest: f64,
+    lags: usize,
+    rho: f64,
+}
+
+impl Widening {
+    fn method(&self) -> String {
         format!(
-            "residuals are autocorrelated (noise lag-1 correlation {phi:.2}): standard errors widened by up to {widest:.2}x (Newey-West after AR(1) prewhitening, {lags} Bartlett lags by Andrews' plug-in rule)"
-        ),
-    ))
+            "Newey-West on scores prewhitened by an AR(2) filter each, {} Bartlett lags by Andrews' plug-in rule",
+            self.lags
+        )
+    }
 }
 
 /// `r` cut into its records' parts.
@@ -166,13 +203,22 @@ fn split(r: &[f64], segments: &[usize]) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// The warning for residuals smoother than any measurement noise.
-fn smooth_residuals_finding(smoothness: f64) -> Finding {
+/// The warning for residuals smoother than measurement noise at the sample scale, saying
+/// how far the standard errors were widened (`widening`).
+fn smooth_residuals_finding(smoothness: f64, widening: Option<Widening>) -> Finding {
+    let errors = match widening {
+        Some(w) => format!(
+            "the standard errors are widened by up to {:.2}x as for coloured noise ({}), which understates the uncertainty of a misfit",
+            w.widest,
+            w.method()
+        ),
+        None => "the standard errors are not widened and may understate the uncertainty".into(),
+    };
     Finding::warn(
         Check::NoiseCorrelation,
         Some(smoothness),
         format!(
-            "the residuals correlate {:.3} at lag 1 (from their differences): smoother than measurement noise, so a misfit the law cannot follow (or low-pass filtered data), not noise to correct for; the standard errors are not widened and understate the uncertainty (look at the residual plot, try another model)",
+            "the residuals correlate {:.3} at lag 1 (from their differences): smoother than measurement noise at the sample scale, so a ringing, low-pass filtered data or a misfit the law cannot follow; {errors} (look at the residual plot, try another model)",
             smoothness.min(1.0)
         ),
     )
@@ -190,7 +236,7 @@ pub fn summarise<R: Residuals>(
     let fits = record_fits(ctx.reference, &stats.world, ctx.energy)?;
     simulations += ctx.reference.records.len() as u64;
     let levels = ctx.reference.residuals.friction_levels();
-    let parameters = parameter_entries(&stats, params, ctx.standings, levels);
+    let parameters = parameter_entries(&stats, params, &stats.standings, levels);
     let axis = stats.world.oscillator.axis;
     let findings = diagnose(ctx, &runs, &stats, &parameters, &fits);
     let n_free = params.len();
@@ -301,6 +347,8 @@ fn diagnose<R: Residuals>(
         .map(|f| (f.name.clone(), f.unit.clone()))
         .collect();
     findings.extend(identifiability::findings(&names, ctx.standings));
+    let slot_names: Vec<String> = names.iter().map(|(n, _)| n.clone()).collect();
+    findings.extend(identifiability::shared_findings(&slot_names, &stats.shared));
     findings.extend(identifiability::consistency_findings(
         stats.world.model.as_ref(),
         ctx.reference.residuals.friction_levels(),
@@ -550,7 +598,7 @@ mod tests {
     /// Smooth residuals warn, unless every record's residuals are at the numerical floor.
     #[test]
     fn smooth_residuals_at_the_numerical_floor_do_not_warn() {
-        let warning = smooth_residuals_finding(0.999);
+        let warning = smooth_residuals_finding(0.999, None);
         let floor = [judged(goodness::RecordGoodness::Numerical(3e-11))];
         let f = at_numerical_floor(warning.clone(), &floor);
         assert_eq!(f.status, Status::Pass, "{}", f.message);

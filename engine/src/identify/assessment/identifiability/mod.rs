@@ -19,8 +19,9 @@
 //! The rooms: which parameters to profile (`flat.rs`), the profiles themselves
 //! (`profiles.rs`), the rigid-contact limit's likelihood-ratio test (`rigid_limit.rs`), refits
 //! with some parameters pinned (`pinned.rs`), the settling of a best run (`settle.rs`, the
-//! entry [`settle`]), the covariance of the determined parameters (`covariance.rs`) and the
-//! findings (`findings.rs`).
+//! entry [`settle`]), the covariance of the determined parameters (`covariance.rs`), the
+//! parameters that share an undetermined one's column (`shared.rs`) and the findings
+//! (`findings.rs`).
 
 mod covariance;
 mod findings;
@@ -29,6 +30,7 @@ mod pinned;
 mod profiles;
 mod rigid_limit;
 mod settle;
+mod shared;
 
 pub use covariance::covariance_of_determined;
 pub use findings::{consistency_findings, findings};
@@ -39,6 +41,7 @@ pub use profiles::{
 };
 pub use rigid_limit::LIMIT_APPROACH_DECADES;
 pub use settle::{settle, PROFILE_RESTARTS};
+pub use shared::{shared_columns, shared_findings, with_shared, SharedColumn, SHARED_CORRELATION};
 
 use crate::identify::values::result::Identifiability;
 
