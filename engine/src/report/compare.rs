@@ -235,6 +235,14 @@ impl Render for CompareReport {
             ),
             Role::Brief,
         );
+        // The recommended law's plots before the details of every law.
+        let plots: Vec<String> = self
+            .files
+            .iter()
+            .filter(|f| f.starts_with("best_") || f.as_str() == "steady_state_curves.svg")
+            .cloned()
+            .collect();
+        sink.figures(&plots);
         let shown = self.shown_order();
         sink.heading(2, "Parameters", Role::Detail);
         for f in &shown {

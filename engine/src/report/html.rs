@@ -23,6 +23,8 @@ pub struct HtmlWriter<'a> {
     page: &'a Page<'a>,
     title: String,
     body: String,
+    /// The plots shown already (by [`Sink::figures`]), not shown again with the files.
+    shown: Vec<String>,
 }
 
 impl<'a> HtmlWriter<'a> {
@@ -32,6 +34,7 @@ impl<'a> HtmlWriter<'a> {
             page,
             title: String::new(),
             body: String::new(),
+            shown: Vec::new(),
         };
         report.render(&mut w);
         w.finish()
@@ -65,8 +68,14 @@ impl<'a> HtmlWriter<'a> {
     }
 
     fn push_figures(&mut self, names: &[&String]) {
-        self.body.push_str("<h2>Plots</h2>\n");
+        let heading = if self.shown.is_empty() {
+            "Plots"
+        } else {
+            "Other plots"
+        };
+        let _ = writeln!(self.body, "<h2>{heading}</h2>");
         for name in names {
+            self.shown.push(name.to_string());
             let Some(text) = (self.page.plot)(name) else {
                 continue;
             };
@@ -141,11 +150,23 @@ impl Sink for HtmlWriter<'_> {
         self.body.push_str("</ul>\n");
     }
 
+    fn figures(&mut self, plots: &[String]) {
+        let plots: Vec<&String> = plots.iter().filter(|p| p.ends_with(".svg")).collect();
+        if !plots.is_empty() {
+            self.push_figures(&plots);
+        }
+    }
+
     fn files(&mut self, files: &[String]) {
         let (plots, others): (Vec<&String>, Vec<&String>) =
             files.iter().partition(|f| f.ends_with(".svg"));
-        if !plots.is_empty() {
-            self.push_figures(&plots);
+        let rest: Vec<&String> = plots
+            .iter()
+            .copied()
+            .filter(|p| !self.shown.contains(p))
+            .collect();
+        if !rest.is_empty() {
+            self.push_figures(&rest);
         }
         self.body.push_str("<h2>Files</h2>\n<ul class=\"files\">\n");
         for f in plots.iter().chain(&others) {
@@ -225,7 +246,7 @@ const STYLE: &str = "
   --ok: #1b7837; --warn: #b35806; --fail: #b2182b; }
 body { margin: 0; color: var(--ink); background: #fff;
   font: 15px/1.5 system-ui, -apple-system, 'Segoe UI', Roboto, 'Helvetica Neue', Arial, sans-serif; }
-main { max-width: 1000px; margin: 0 auto; padding: 1.5rem 1.25rem 3rem; }
+main { max-width: 1100px; margin: 0 auto; padding: 1.5rem 1.25rem 3rem; }
 h1 { font-size: 1.6rem; margin: 0 0 .5rem; }
 h2 { font-size: 1.25rem; margin: 2rem 0 .5rem; border-bottom: 1px solid var(--rule); }
 h3 { font-size: 1.05rem; margin: 1.25rem 0 .4rem; }
@@ -245,6 +266,8 @@ table { border-collapse: collapse; margin: .5rem 0 1rem; font-variant-numeric: t
 th, td { padding: .25rem .55rem; border-bottom: 1px solid var(--rule); text-align: left;
   vertical-align: top; }
 th { border-bottom: 2px solid var(--ink); }
+td { white-space: nowrap; }
+td:last-child { white-space: normal; }
 td.status { font-weight: 600; text-transform: uppercase; font-size: .85em; }
 td.status.pass { color: var(--ok); }
 td.status.warn { color: var(--warn); }
@@ -305,6 +328,33 @@ mod tests {
         assert!(html.contains("<li><code>missing.svg</code></li>"));
         assert!(html.contains("<pre>[model]\ntype = &quot;a&lt;b&quot;</pre>"));
         assert!(html.trim_end().ends_with("</html>"));
+    }
+
+    /// Plots shown early by `figures` are not shown again with the files, which still list
+    /// them; the others follow under their own heading.
+    #[test]
+    fn figures_shown_early_are_shown_once() {
+        struct Early;
+        impl Render for Early {
+            fn render(&self, sink: &mut dyn Sink) {
+                sink.title("t");
+                sink.figures(&["a.svg".into()]);
+                sink.heading(2, "Parameters", Role::Detail);
+                sink.files(&["a.svg".into(), "b.svg".into(), "report.json".into()]);
+            }
+        }
+        let f = |_: &str| Some("<svg viewBox=\"0 0 1 1\"></svg>".to_string());
+        let page = Page {
+            plot: &f,
+            config: None,
+        };
+        let html = HtmlWriter::render(&Early, &page);
+        assert_eq!(html.matches("<figure>").count(), 2);
+        let plots = html.find("<h2>Plots</h2>").unwrap();
+        let parameters = html.find("<h2>Parameters</h2>").unwrap();
+        let other = html.find("<h2>Other plots</h2>").unwrap();
+        assert!(plots < parameters && parameters < other);
+        assert!(html.contains("<li><code>a.svg</code></li>"));
     }
 
     #[test]

@@ -102,6 +102,11 @@ pub trait Sink {
     fn list(&mut self, items: &[String], role: Role);
     /// The files written with the report (plots, data), by name in the output directory.
     fn files(&mut self, files: &[String]);
+    /// Plots to show here, ahead of the files (a writer that shows plots shows these here
+    /// and the rest with the files; others list them with the files only).
+    fn figures(&mut self, plots: &[String]) {
+        let _ = plots;
+    }
 }
 
 /// A report that can write itself into any [`Sink`].
