@@ -3,6 +3,7 @@
 //! otherwise run these laws too.
 
 mod energy;
+mod gms_replay_paths;
 mod simulate_custom;
 mod starts;
 mod util;
