@@ -22,7 +22,7 @@ use crate::identify::values::outcome::{Check, Finding, StartOutcome, Status, Ter
 use crate::identify::values::result::EnergyForce;
 use crate::identify::values::result::{FittedParam, RecordFit};
 use crate::oscillator::Oscillator;
-use crate::record::noise::quantisation_step;
+use crate::record::noise::{difference_noise, quantisation_step, RESPONSE_ORDER};
 
 /// An energy-balance difference above this many percent warns.
 pub const ENERGY_WARN_PERCENT: f64 = 5.0;
@@ -188,8 +188,27 @@ fn demeaned(mut v: Vec<f64>) -> Vec<f64> {
     v
 }
 
+/// Noise levels of the velocity read above which a sample counts as moving.
+pub const MOVING_NOISE_LEVELS: f64 = 5.0;
+
+/// The speed above which a record's velocity `v` counts as moving: the `configured`
+/// threshold, raised to [`MOVING_NOISE_LEVELS`] noise levels of `v` (from its third
+/// differences, blind to the motion: a noisy velocity's rest is not motion); on a record
+/// that never moves faster than that (a slow tribometer stroke) the noise levels alone, at
+/// least 1e-3 of its top speed.
+fn moving_threshold(v: &[f64], configured: f64) -> f64 {
+    let noise = MOVING_NOISE_LEVELS * difference_noise(v, RESPONSE_ORDER);
+    let top = v.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let raised = configured.max(noise);
+    if top > raised {
+        raised
+    } else {
+        noise.max(1e-3 * top)
+    }
+}
+
 /// The moving part of a record fit: from its first sample to the last one whose fitted speed
-/// exceeds `threshold`.
+/// exceeds `threshold` ([`moving_threshold`]).
 struct Moving {
     residual: Vec<f64>,
     sign: Vec<f64>,
@@ -199,6 +218,7 @@ struct Moving {
 
 fn moving_part(r: &RecordFit, osc: &Oscillator, threshold: f64) -> Result<Moving, String> {
     let (v, x) = motion_of(r)?;
+    let threshold = moving_threshold(&v, threshold);
     let Some(last) = v.iter().rposition(|v| v.abs() > threshold) else {
         return Err(format!(
             "record `{}` never moves faster than {threshold:e}",
@@ -769,6 +789,34 @@ mod tests {
             "{}",
             f.message
         );
+    }
+
+    /// A force record along a slow stroke (peak 0.2 mm/s, below the configured 1 mm/s) is
+    /// judged with a threshold that follows its velocity's noise: the right law passes, a
+    /// wrong level is caught; before, both were skipped for never moving.
+    #[test]
+    fn a_slow_force_record_is_judged_with_a_threshold_from_its_noise() {
+        let noise = ar1_noise(2000, NOISE, 0.0, 9);
+        let slow = |mu_fit: f64| {
+            let mut force = record_fit(0.24, mu_fit, &noise, 0.0);
+            let truth = exact_v(&Oscillator::fmm(), 0.24, &force.axes.time);
+            force.axes.velocity = truth.iter().map(|v| 3e-3 * v).collect();
+            force.channel = "force".into();
+            force
+        };
+        let right = structure(&[slow(0.24)]);
+        assert_eq!(right.status, Status::Pass, "{}", right.message);
+        assert!(right.value.is_some(), "{}", right.message);
+        let wrong = structure(&[slow(0.20)]);
+        assert!(
+            matches!(wrong.status, Status::Warn | Status::Fail),
+            "{}",
+            wrong.message
+        );
+        // A noisy velocity at rest is not motion: the threshold rises to its noise.
+        let jitter: Vec<f64> = ar1_noise(2000, 1e-3, 0.0, 4);
+        assert!(moving_threshold(&jitter, 1e-3) > 3e-3);
+        assert_eq!(moving_threshold(&[0.0, 0.5, 0.1, -0.4], 1e-3), 1e-3);
     }
 
     fn energy_force(eq7: f64, energies: f64) -> EnergyForce {
