@@ -104,3 +104,56 @@ fn the_quadratic_spring_is_recovered_and_the_linear_spring_is_rejected() {
     );
     assert!(s.rms_residual > 2.0 * r.rms_residual);
 }
+
+/// An asymmetric spring with direction-dependent friction, released from either side: the
+/// total energy (kinetic plus the polynomial's potential) never rises, and the mass comes to
+/// rest where the force the friction holds, -R(q), lies within its stick band
+/// [-mu_neg N, mu_pos N].
+#[test]
+fn an_asymmetric_spring_with_asymmetric_friction_loses_energy_and_sticks_in_its_band() {
+    use frictionid_engine::simulate::{simulate, Initial, SimOptions};
+    use frictionid_engine::synthetic::uniform_times;
+    use frictionid_models::ViscousCoulombAsymmetric;
+
+    let osc = Oscillator {
+        restoring: Restoring::Polynomial(Polynomial {
+            quadratic_stiffness: 5e4,
+            cubic_stiffness: -2e5,
+        }),
+        ..Oscillator::fmm()
+    };
+    let law = ViscousCoulombAsymmetric {
+        mu_pos: 0.25,
+        mu_neg: 0.1,
+        viscous: 0.5,
+    };
+    let n = osc.normal_force;
+    let times = uniform_times(4.0, 1000.0);
+    for x0 in [0.014, -0.014] {
+        let sim = simulate(
+            &osc,
+            &law,
+            &Initial::at_rest(x0),
+            4.0,
+            &times,
+            &SimOptions::default(),
+        )
+        .expect("a simulation");
+        let energy = sim.total_energy();
+        let tolerance = 1e-9 * energy[0];
+        let rise = energy
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .fold(f64::MIN, f64::max);
+        assert!(rise <= tolerance, "from {x0}: energy rises by {rise}");
+        assert!(energy[0] > 0.1, "{}", energy[0]);
+        let rest = sim.rest.expect("the mass comes to rest").displacement;
+        // The friction must hold -R(q) at rest: -mu_neg N <= -R(q) <= mu_pos N.
+        let held = -osc.restoring_force(rest);
+        eprintln!("from {x0}: rest at {rest} m, held force {held} N");
+        assert!(
+            -law.mu_neg * n - 1e-9 <= held && held <= law.mu_pos * n + 1e-9,
+            "from {x0}: {held}"
+        );
+    }
+}

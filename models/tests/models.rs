@@ -23,6 +23,7 @@ fn registry_lists_the_built_in_models() {
         names(),
         vec![
             "coulomb",
+            "coulomb_asymmetric",
             "dahl",
             "expression",
             "gms",
@@ -30,7 +31,8 @@ fn registry_lists_the_built_in_models() {
             "makkar",
             "none",
             "stribeck",
-            "viscous_coulomb"
+            "viscous_coulomb",
+            "viscous_coulomb_asymmetric"
         ]
     );
     for l in listings() {
