@@ -216,3 +216,47 @@ fn the_velocity_route_recovers_both_levels() {
 fn the_inverse_dynamics_route_recovers_both_levels() {
     check("inverse dynamics", FitDomain::Force);
 }
+
+/// `compare` on free releases of the FMM stage: a direction-dependent truth recommends the
+/// direction-dependent law, which ends at least as low as the symmetric laws it holds (none
+/// is set aside for a failed search); a symmetric truth recommends the symmetric law, not
+/// the one with a level more.
+#[test]
+fn compare_recommends_direction_dependent_levels_only_where_the_records_have_them() {
+    use crate::util::{records, NOISE};
+    use frictionid_engine::identify::compare;
+    use frictionid_models::{default_model, FrictionModel};
+
+    let osc = Oscillator::fmm();
+    let names = ["coulomb", "viscous_coulomb", "viscous_coulomb_asymmetric"];
+    let models: Vec<Box<dyn FrictionModel>> =
+        names.iter().map(|n| default_model(n).unwrap()).collect();
+    let asymmetric = ViscousCoulombAsymmetric {
+        mu_pos: 0.26,
+        mu_neg: 0.18,
+        viscous: 0.5,
+    };
+    let symmetric = ViscousCoulomb {
+        mu: 0.22,
+        viscous: 0.5,
+    };
+    for (truth, expected) in [
+        (
+            &asymmetric as &dyn FrictionModel,
+            "viscous_coulomb_asymmetric",
+        ),
+        (&symmetric, "viscous_coulomb"),
+    ] {
+        let recs = records(&osc, truth, NOISE, 11);
+        let c = compare(&osc, &models, &recs, &FitOptions::default()).expect("a comparison");
+        let verdict = c.verdict.as_ref().expect("a verdict");
+        eprintln!("{} truth: {}", truth.name(), verdict.message);
+        assert!(c.failed.is_empty(), "{:?}", c.failed);
+        assert_eq!(
+            verdict.recommended.as_deref(),
+            Some(expected),
+            "{}",
+            verdict.message
+        );
+    }
+}
