@@ -63,7 +63,6 @@ pub fn response_fit(
 ) -> Result<(), CliError> {
     let ((name, unit), (measured, fitted)) = (quantity, series);
     let residual: Vec<f64> = measured.iter().zip(fitted).map(|(m, f)| m - f).collect();
-    let color = super::model_color(model);
     let fit_panel = fit_and_measured(
         Panel::new(name, unit),
         time,
@@ -72,7 +71,11 @@ pub fn response_fit(
         model,
     );
     let residual_panel = Panel::new("residual measured - fitted", unit)
-        .with(Series::solid("", time, &residual).width(1).color(color))
+        .with(
+            Series::solid("", time, &residual)
+                .width(1)
+                .color(super::REFERENCE_GREY),
+        )
         .with_reference("", 0.0);
     let title = format!("{record}: measured and fitted {name}");
     draw(
