@@ -15,11 +15,11 @@
 //! fits a configuration listing them. [`table`] turns each group's fits into rows of the
 //! results table, [`trends`] fits each parameter against each numeric condition.
 
-pub mod cell;
-pub mod groups;
-pub mod manifest;
-pub mod table;
-pub mod trends;
+pub(crate) mod cell;
+pub(crate) mod groups;
+pub(crate) mod manifest;
+pub(crate) mod table;
+pub(crate) mod trends;
 
 pub use cell::CellValue;
 pub use groups::{plan_groups, GroupTask};

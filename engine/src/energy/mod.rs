@@ -66,9 +66,9 @@
 //! default takes the middle window: 30 ms is 1/15 of the FMM period, short enough for stages
 //! a few times stiffer, and the quartic keeps the fit error at 4e-6 of the acceleration.
 
-pub mod differentiate;
-pub mod halfcycle;
-pub mod model_force;
+pub(crate) mod differentiate;
+pub(crate) mod halfcycle;
+pub(crate) mod model_force;
 mod numerical_replay;
 
 pub use crate::simulate::MechanicalEnergy;

@@ -22,14 +22,14 @@
 //! called with n = 1 (the engine's convention, `identify::values::levels`), which its header
 //! says. [`table`] writes the steady-state force on a velocity grid. Values in, text out.
 
-pub mod c;
-pub mod code;
+pub(crate) mod c;
+pub(crate) mod code;
 mod description;
-pub mod laws;
+pub(crate) mod laws;
 mod print;
-pub mod python;
-pub mod rust;
-pub mod table;
+pub(crate) mod python;
+pub(crate) mod rust;
+pub(crate) mod table;
 
 pub use description::{LawDescription, LawParam};
 

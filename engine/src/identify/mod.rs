@@ -18,8 +18,8 @@
 //! refits are computed below and run here), and [`compare`] fits several models.
 
 pub mod assessment;
-pub mod compare;
-pub mod fit;
+pub(crate) mod compare;
+pub(crate) mod fit;
 pub mod problem;
 pub mod search;
 pub mod values;

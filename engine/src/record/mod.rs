@@ -7,12 +7,12 @@
 //! - [`release`]: the release instant, given or found in the pre-trigger rest.
 //! - [`sanity`]: units checked against the oscillator (mm/s, milliseconds, x0 in mm).
 
-pub mod channel;
-pub mod checked;
-pub mod noise;
-pub mod release;
-pub mod sanity;
-pub mod time;
+pub(crate) mod channel;
+pub(crate) mod checked;
+pub(crate) mod noise;
+pub(crate) mod release;
+pub(crate) mod sanity;
+pub(crate) mod time;
 
 pub use channel::{Channel, NormalForce};
 pub use release::{detect_release, Release};

@@ -11,17 +11,17 @@
 //! Inline code in text is written between backticks (`` `x14mm.csv` ``); writers render it
 //! in their own syntax.
 
-pub mod campaign;
-pub mod compare;
-pub mod energy;
+pub(crate) mod campaign;
+pub(crate) mod compare;
+pub(crate) mod energy;
 pub mod fit;
-pub mod format;
+pub(crate) mod format;
 pub mod html;
 pub mod json;
 pub mod markdown;
-pub mod models;
-pub mod recommendation;
-pub mod simulate;
+pub(crate) mod models;
+pub(crate) mod recommendation;
+pub(crate) mod simulate;
 
 pub use campaign::{CampaignReport, GroupReport};
 pub use compare::CompareReport;

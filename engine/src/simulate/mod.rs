@@ -46,7 +46,7 @@ mod entry;
 mod euler;
 mod input;
 mod jacobian;
-pub mod mechanical;
+pub(crate) mod mechanical;
 mod recorders;
 mod rodas;
 mod root;

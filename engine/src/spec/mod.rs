@@ -14,13 +14,13 @@
 //! The measured records are not part of this value yet: front ends read them and hand them
 //! to the jobs in [`crate::jobs`].
 
-pub mod energy;
-pub mod error;
-pub mod fit;
-pub mod model;
-pub mod oscillator;
-pub mod resolve;
-pub mod simulation;
+pub(crate) mod energy;
+pub(crate) mod error;
+pub(crate) mod fit;
+pub(crate) mod model;
+pub(crate) mod oscillator;
+pub(crate) mod resolve;
+pub(crate) mod simulation;
 
 pub use self::energy::{DifferentiatorMethod, EnergySpec};
 pub use self::error::SpecError;

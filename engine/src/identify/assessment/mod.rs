@@ -5,15 +5,15 @@
 //! ([`record_fits`]), the sum-up into a `FitResult` ([`summary`]) and the refits under the
 //! oscillator's property uncertainties ([`property_refits`], handed the refit by the fit).
 
-pub mod diagnostics;
-pub mod energy_check;
+pub(crate) mod diagnostics;
+pub(crate) mod energy_check;
 #[cfg(test)]
 mod fixtures;
-pub mod goodness;
+pub(crate) mod goodness;
 pub mod identifiability;
-pub mod property_refits;
-pub mod record_fits;
+pub(crate) mod property_refits;
+pub(crate) mod record_fits;
 pub mod stats;
-pub mod summary;
+pub(crate) mod summary;
 
 pub use energy_check::{energy_force_check, ForceReference};

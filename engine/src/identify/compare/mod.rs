@@ -3,8 +3,8 @@
 //! ([`nesting`]) and naming the law to use ([`verdict`]).
 
 mod nesting;
-pub mod validation;
-pub mod verdict;
+pub(crate) mod validation;
+pub(crate) mod verdict;
 
 pub use validation::{LawValidation, ValidationScheme};
 pub use verdict::SetAside;

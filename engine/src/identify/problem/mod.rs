@@ -4,16 +4,16 @@
 //! problem over the free parameters ([`FitProblem`], argmin's `Operator` and `Jacobian`).
 //! Imports the values only; knows nothing of solvers, starts or findings.
 
-pub mod analysis_cache;
-pub mod force_along_motion;
-pub mod guess;
+pub(crate) mod analysis_cache;
+pub(crate) mod force_along_motion;
+pub(crate) mod guess;
 pub mod inverse_dynamics;
-pub mod least_squares;
-pub mod motion_check;
-pub mod residuals;
-pub mod simulated_response;
-pub mod state_cache;
-pub mod step_allowance;
+pub(crate) mod least_squares;
+pub(crate) mod motion_check;
+pub(crate) mod residuals;
+pub(crate) mod simulated_response;
+pub(crate) mod state_cache;
+pub(crate) mod step_allowance;
 pub mod unit_check;
 
 pub use analysis_cache::AnalysisRequest;

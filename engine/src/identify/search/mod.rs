@@ -4,11 +4,11 @@
 //! laws, global) and the force-domain prefit's options and finding ([`prefit`]).
 //! Imports the values and the problem; knows nothing of statistics or findings of a fit.
 
-pub mod free_params;
+pub(crate) mod free_params;
 pub mod lm;
-pub mod prefit;
+pub(crate) mod prefit;
 pub mod starts;
-pub mod strategy;
+pub(crate) mod strategy;
 
 pub use free_params::{build_layout, Layout};
 pub use lm::LevenbergMarquardt;

@@ -5,18 +5,18 @@
 //! returns ([`FitResult`], its typed outcomes and findings). Nothing here imports from the
 //! floors above (problem, search, assessment).
 
-pub mod fit_options;
-pub mod layout;
-pub mod levels;
-pub mod nuisance;
-pub mod option_keys;
-pub mod options;
-pub mod outcome;
-pub mod param_options;
-pub mod result;
+pub(crate) mod fit_options;
+pub(crate) mod layout;
+pub(crate) mod levels;
+pub(crate) mod nuisance;
+pub(crate) mod option_keys;
+pub(crate) mod options;
+pub(crate) mod outcome;
+pub(crate) mod param_options;
+pub(crate) mod result;
 pub mod search;
-pub mod target_options;
-pub mod uncertainty;
+pub(crate) mod target_options;
+pub(crate) mod uncertainty;
 
 pub use fit_options::{fit_sim_options, FitOptions, Hooks};
 pub use layout::{BoundSide, FreeParam, ParamKind};
