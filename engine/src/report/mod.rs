@@ -27,7 +27,7 @@ pub use campaign::{CampaignReport, GroupReport};
 pub use compare::CompareReport;
 pub use energy::{EnergyRecord, EnergyReport};
 pub use fit::FitReport;
-pub use format::fmt_num;
+pub use format::{fmt_num, serialized_name};
 pub use models::ModelsReport;
 pub use simulate::{InputSeries, SimulateReport};
 
