@@ -171,7 +171,7 @@ struct State {
 }
 
 /// The inverse-dynamics options: the mass and an offset fitted, no normal force, no spring.
-fn options() -> (frictionid_engine::Oscillator, FitOptions) {
+pub(crate) fn options() -> (frictionid_engine::Oscillator, FitOptions) {
     let (osc, unknown) = PartialOscillator::default().resolve();
     let opts = FitOptions {
         target: TargetOptions {
