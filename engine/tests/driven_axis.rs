@@ -114,7 +114,7 @@ fn reference(t_s: &[f64], u: &[f64]) -> Vec<f64> {
     out
 }
 
-fn record(name: &str, phase: f64, noise: f64, seed: u64) -> Record {
+pub(crate) fn record(name: &str, phase: f64, noise: f64, seed: u64) -> Record {
     let (t, u) = multisine(phase);
     let mut v = reference(&t, &u);
     if noise > 0.0 {
@@ -126,6 +126,18 @@ fn record(name: &str, phase: f64, noise: f64, seed: u64) -> Record {
 }
 
 fn identify(records: &[Record]) -> FitResult {
+    let model = ViscousCoulomb {
+        mu: 4.0,
+        viscous: 15.0,
+    };
+    identify_with(&model, records)
+}
+
+/// The velocity route's fit of `model` (its start) with the mass and the input offset.
+pub(crate) fn identify_with(
+    model: &(dyn frictionid_models::FrictionModel + 'static),
+    records: &[Record],
+) -> FitResult {
     let start = driven_slide(1.5, 0.0);
     let opts = FitOptions {
         params: ParamOptions {
@@ -135,11 +147,7 @@ fn identify(records: &[Record]) -> FitResult {
         },
         ..FitOptions::default()
     };
-    let model = ViscousCoulomb {
-        mu: 4.0,
-        viscous: 15.0,
-    };
-    fit(&start, &model, records, &opts).expect("a fit")
+    fit(&start, model, records, &opts).expect("a fit")
 }
 
 const TRUTH: [(&str, f64); 4] = [

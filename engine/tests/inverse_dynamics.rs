@@ -169,7 +169,7 @@ struct State {
 
 /// The inverse-dynamics options on one thread: the mass and an offset fitted, no normal
 /// force, no spring.
-fn options() -> (frictionid_engine::Oscillator, FitOptions) {
+pub(crate) fn options() -> (frictionid_engine::Oscillator, FitOptions) {
     let (osc, opts) = inverse_dynamics_options();
     (osc, serial(opts))
 }

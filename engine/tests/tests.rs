@@ -11,6 +11,7 @@ mod compare_verdict;
 mod driven_axis;
 mod dynamic;
 mod false_alarms;
+mod false_alarms_driven;
 mod findings_judgement;
 mod force_domain;
 mod force_jacobian;

@@ -42,6 +42,55 @@ pub const MAX_QUANTISATION_SHARE: f64 = 0.025;
 /// judged with: E|F + e| exceeds F by under 0.1 % while sd(e) <= F / 3.
 pub const MAX_NOISE_SHARE: f64 = 1.0 / 3.0;
 
+/// The largest share of the friction's part (the Eq. 7 mean, the dissipated energy) that the
+/// standard error of a fitted damping alone may move for the part to be judged: half the
+/// warning threshold, as for the quantisation.
+pub const MAX_CONDITION_SHARE: f64 = 0.025;
+
+/// A fitted damping: its value and standard error \[N s/m\].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FittedDamping {
+    /// The value.
+    pub value: f64,
+    /// Its standard error.
+    pub std_error: f64,
+}
+
+/// Skips each part of `ef` (made from `analysis`) that rests on an ill-conditioned remainder:
+/// the friction's part is what the energy balance leaves after the viscous part c v of a
+/// fitted `damping`, and the damping's standard error alone moves the Eq. 7 mean by
+/// sigma_c mean|v| and the dissipated energy by sigma_c int v^2 dt; above
+/// [`MAX_CONDITION_SHARE`] of the part, the part cannot judge the law (a damping fitted as
+/// an oscillator property that trades with the friction).
+pub fn skip_ill_conditioned(
+    ef: &mut EnergyForce,
+    analysis: &EnergyAnalysis,
+    damping: FittedDamping,
+) {
+    let se = damping.std_error;
+    if !(se.is_finite() && se > 0.0) {
+        return;
+    }
+    let skip = |share: f64| {
+        (share > MAX_CONDITION_SHARE || share.is_nan()).then(|| EnergySkip::IllConditioned {
+            property: "damping".into(),
+            share,
+        })
+    };
+    if ef.eq7_skipped.is_none() {
+        let speed = mean_against_motion(&analysis.v, &analysis.friction, &analysis.v);
+        ef.eq7_skipped = skip(se * speed / ef.reference.abs());
+    }
+    if ef.dissipation_skipped.is_none() && !analysis.half_cycles.is_empty() {
+        let squares: f64 = analysis
+            .half_cycles
+            .iter()
+            .map(|c| work_over(analysis, &analysis.v, c))
+            .sum();
+        ef.dissipation_skipped = skip(se * squares / ef.dissipated.abs());
+    }
+}
+
 /// What the energy-based force is compared with.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ForceReference<'a> {
@@ -458,6 +507,60 @@ mod tests {
         ])
         .collect();
         assert_eq!(runs, [0..3, 7..11]);
+    }
+
+    /// A damping known to 1 % of a small value leaves the check judging; one whose standard
+    /// error moves the friction's part by more than 2.5 % skips both parts with the reason.
+    #[test]
+    fn a_remainder_an_uncertain_damping_dominates_is_skipped() {
+        let osc = Oscillator::fmm();
+        let a = exact_analysis(&osc, 0.24);
+        let model: Vec<f64> =
+            a.v.iter()
+                .map(|v| 0.24 * osc.normal_force * v.signum())
+                .collect();
+        let check = || energy_force_check(&a, ForceReference::ModelForce(&model)).unwrap();
+        let mut known = check();
+        let small = FittedDamping {
+            value: 0.275,
+            std_error: 0.003,
+        };
+        skip_ill_conditioned(&mut known, &a, small);
+        assert!(known.eq7_skipped.is_none() && known.dissipation_skipped.is_none());
+        let mut traded = check();
+        let large = FittedDamping {
+            value: 0.275,
+            std_error: 20.0,
+        };
+        skip_ill_conditioned(&mut traded, &a, large);
+        for part in [&traded.eq7_skipped, &traded.dissipation_skipped] {
+            let Some(EnergySkip::IllConditioned { share, .. }) = part else {
+                panic!("{part:?}");
+            };
+            assert!(*share > MAX_CONDITION_SHARE, "{share}");
+        }
+        // By hand: sigma_c mean|v| over the samples where Eq. 7 is defined, over mu N.
+        let (sum, n) =
+            a.v.iter()
+                .zip(&a.friction)
+                .filter(|(_, f)| f.is_finite())
+                .fold((0.0, 0), |(s, n), (v, _)| (s + v.abs(), n + 1));
+        let want = 20.0 * sum / n as f64 / (0.24 * osc.normal_force);
+        let Some(EnergySkip::IllConditioned { share, .. }) = traded.eq7_skipped else {
+            unreachable!()
+        };
+        assert!((share / want - 1.0).abs() < 1e-9, "{share} vs {want}");
+        let finding = crate::identify::assessment::diagnostics::energy_balance(
+            "r",
+            &traded,
+            crate::axis::Axis::Linear,
+        );
+        assert_eq!(finding.status, crate::identify::values::Status::Skipped);
+        assert!(
+            finding.message.contains("ill-conditioned"),
+            "{}",
+            finding.message
+        );
     }
 
     #[test]

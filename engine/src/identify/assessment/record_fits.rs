@@ -2,7 +2,9 @@
 //! and fitted series and the energy-based force check along it.
 
 use super::diagnostics;
-use super::energy_check::{energy_force_check, ForceReference};
+use super::energy_check::{
+    energy_force_check, skip_ill_conditioned, FittedDamping, ForceReference,
+};
 use crate::axis::Axis;
 use crate::energy::{
     analyze_record, forces_from_states, states_along, EnergyOptions, MeasuredMotion,
@@ -36,6 +38,7 @@ pub fn record_fits<R: Residuals>(
     problem: &FitProblem<R>,
     world: &Realised,
     energy: &EnergyOptions,
+    damping: Option<FittedDamping>,
 ) -> Result<RecordFits, EngineError> {
     let mut out = RecordFits {
         records: Vec::new(),
@@ -44,7 +47,7 @@ pub fn record_fits<R: Residuals>(
         findings: Vec::new(),
     };
     for (ri, rec) in problem.records.iter().enumerate() {
-        let (record, sum_sq, finding) = record_fit(problem, world, energy, ri, rec)?;
+        let (record, sum_sq, finding) = record_fit(problem, world, (energy, damping), ri, rec)?;
         out.sum_sq += sum_sq;
         out.n_total += record.series.measured.len();
         out.findings.extend(finding);
@@ -64,7 +67,7 @@ pub fn record_fits<R: Residuals>(
 fn record_fit<R: Residuals>(
     problem: &FitProblem<R>,
     world: &Realised,
-    energy: &EnergyOptions,
+    energy: (&EnergyOptions, Option<FittedDamping>),
     ri: usize,
     rec: &Record,
 ) -> Result<(RecordFit, f64, Option<Finding>), EngineError> {
@@ -128,7 +131,7 @@ struct CheckedRecord {
 fn record_energy_check<R: Residuals>(
     problem: &FitProblem<R>,
     world: &Realised,
-    energy: &EnergyOptions,
+    (energy, damping): (&EnergyOptions, Option<FittedDamping>),
     ri: usize,
     rec: &Record,
 ) -> CheckedRecord {
@@ -143,7 +146,14 @@ fn record_energy_check<R: Residuals>(
         };
     }
     let nuisance = &world.nuisance[ri];
-    match energy_check(problem.residuals.as_ref(), ri, rec, nuisance, world, energy) {
+    match energy_check(
+        problem.residuals.as_ref(),
+        ri,
+        rec,
+        nuisance,
+        world,
+        (energy, damping),
+    ) {
         Ok((ef, ebf, mf)) => CheckedRecord {
             finding: Some(diagnostics::energy_balance(
                 &rec.name,
@@ -226,7 +236,7 @@ fn energy_check<R: Residuals + ?Sized>(
     rec: &Record,
     nuisance: &NuisanceValues,
     world: &Realised,
-    energy: &EnergyOptions,
+    (energy, damping): (&EnergyOptions, Option<FittedDamping>),
 ) -> Result<(EnergyForce, Vec<f64>, Vec<f64>), EngineError> {
     // The energy analysis sees the measured velocity corrected by the fitted offset, from the
     // fitted release displacement.
@@ -258,7 +268,10 @@ fn energy_check<R: Residuals + ?Sized>(
     };
     let states = states_along(model, motion)?;
     let model_force = forces_from_states(model, &analysis.v, &normal, &states);
-    let ef = energy_force_check(&analysis, ForceReference::ModelForce(&model_force))?;
+    let mut ef = energy_force_check(&analysis, ForceReference::ModelForce(&model_force))?;
+    if let Some(damping) = damping {
+        skip_ill_conditioned(&mut ef, &analysis, damping);
+    }
     drop(states);
     // The analysis is the check's own unless a cache still shares it: its force is moved out.
     let friction = match Arc::try_unwrap(analysis) {

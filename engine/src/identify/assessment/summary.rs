@@ -3,6 +3,7 @@
 //! parameter's entry, the per-record fits and the findings, in report order.
 
 use super::diagnostics::{self, starts_at_best};
+use super::energy_check::FittedDamping;
 use super::goodness;
 use super::identifiability::{self, covariance_of_determined, Standing};
 use super::record_fits::{record_fits, RecordFits};
@@ -17,7 +18,7 @@ use crate::identify::values::{
     Check, Derived, Finding, FitResult, FittedParam, FreeParam, FrictionLevels, OscillatorParam,
     ParamKind, Search, StartOutcome, Status,
 };
-use crate::oscillator::Oscillator;
+use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::Channel;
 use nalgebra::DMatrix;
 use std::time::Instant;
@@ -233,7 +234,12 @@ pub fn summarise<R: Residuals>(
     let params = &ctx.layout.params;
     let stats = statistics(ctx.reference, &runs.best, ctx.standings)?;
     let mut simulations = runs.simulations + ctx.reference.simulations();
-    let fits = record_fits(ctx.reference, &stats.world, ctx.energy)?;
+    let fits = record_fits(
+        ctx.reference,
+        &stats.world,
+        ctx.energy,
+        fitted_damping(params, &stats),
+    )?;
     simulations += ctx.reference.records.len() as u64;
     let levels = ctx.reference.residuals.friction_levels();
     let parameters = parameter_entries(&stats, params, &stats.standings, levels);
@@ -294,6 +300,17 @@ pub fn summarise<R: Residuals>(
         rank: None,
         fitted_model: stats.world.model,
         oscillator: stats.world.oscillator,
+    })
+}
+
+/// The damping and its standard error when it is fitted as an oscillator property.
+fn fitted_damping(params: &[FreeParam], stats: &Statistics) -> Option<FittedDamping> {
+    let slot = params
+        .iter()
+        .position(|f| f.kind == ParamKind::Property(OscillatorProperty::Damping))?;
+    Some(FittedDamping {
+        value: stats.p_best[slot],
+        std_error: stats.cov.std_errors[slot],
     })
 }
 

@@ -317,6 +317,14 @@ pub enum EnergySkip {
         /// The friction level [N].
         level: f64,
     },
+    /// The friction's part is a remainder after the viscous part of a fitted damping, whose
+    /// standard error alone moves it by this share (an ill-conditioned remainder).
+    IllConditioned {
+        /// The fitted property.
+        property: String,
+        /// The share of the friction's part its standard error moves.
+        share: f64,
+    },
 }
 
 impl std::fmt::Display for EnergySkip {
@@ -342,6 +350,11 @@ impl std::fmt::Display for EnergySkip {
             Self::NoisyDerivative { force_noise, level } => write!(
                 f,
                 "the noise of the Eq. 7 force ({force_noise:.3} N) is more than a third of the friction level ({level:.3} N)"
+            ),
+            Self::IllConditioned { property, share } => write!(
+                f,
+                "the friction's part is what remains after the viscous part of the fitted {property}, whose standard error alone moves it by {:.1} %: an ill-conditioned remainder the check cannot judge",
+                100.0 * share
             ),
         }
     }
