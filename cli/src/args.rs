@@ -4,13 +4,20 @@ use clap::{Args, Parser, Subcommand};
 use frictionid_engine::Axis;
 use std::path::{Path, PathBuf};
 
-/// Identify friction models from the measured free vibration of an oscillator.
+/// Identify friction laws from measured motion: the free vibration of an oscillator, a driven
+/// axis under a measured input, or a tribometer's force along its motion.
 #[derive(Debug, Parser)]
 #[command(
     name = "frictionid",
     version,
-    about,
-    after_help = "Example:\n  frictionid compare fixtures/fmm-compare.toml --out results/\n\n\
+    about = "Identify friction laws from measured motion (a free vibration, a driven axis, a \
+             tribometer): write a config from a data file, simulate, fit, compare laws and check \
+             each fit against the energy balance",
+    disable_help_subcommand = true,
+    after_help = "Start from a data file:\n  frictionid init run.csv --mass 10.4 --stiffness 1982   (writes run.toml, commented)\n  \
+                  frictionid compare run.toml\n\n\
+                  The configuration's keys: `frictionid help config` (docs/config.md).\n\n\
+                  Example:\n  frictionid compare fixtures/fmm-compare.toml --out results/\n\n\
                   Exit codes: 0 success (warnings allowed), 1 error (one line on stderr, no report),\n\
                   2 a fit (or compare's best model) did not converge, 3 a fit converged but one of\n\
                   its diagnostics failed; with 2 and 3 the report is written and says why."
@@ -60,6 +67,52 @@ impl OutputArgs {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Read a data file (delimiter, decimal mark, preamble, header units, sample rate, a
+    /// pre-trigger rest) and write a commented configuration for it.
+    #[command(
+        after_help = "Examples:\n  frictionid init run.txt --mass 10.391 --stiffness 1982 --normal-force 14.5\n  \
+                      frictionid init drive.csv --mass 2.0 --out drive.toml\n\n\
+                      Prints what it found and writes CONFIG (default: DATAFILE with .toml); the lines\n\
+                      marked \"<- SET\" need the rig's values that were not given here.\n\
+                      The configuration's keys: `frictionid help config`."
+    )]
+    Init {
+        /// The data file (delimited text).
+        datafile: PathBuf,
+        /// The configuration file to write [default: DATAFILE with the extension .toml].
+        #[arg(long, value_name = "CONFIG")]
+        out: Option<PathBuf>,
+        /// The moving mass [kg] (the moment of inertia [kg m^2] on a rotary axis).
+        #[arg(long, value_name = "KG")]
+        mass: Option<f64>,
+        /// Viscous damping [N s/m] (0 when not given).
+        #[arg(long, value_name = "C")]
+        damping: Option<f64>,
+        /// The spring's stiffness [N/m]; 0 for none (a driven axis, a free mass).
+        #[arg(long, value_name = "K")]
+        stiffness: Option<f64>,
+        /// The contact's normal force [N] (without it the friction levels are forces).
+        #[arg(long, value_name = "N")]
+        normal_force: Option<f64>,
+        /// The release displacement [m] (default: estimated from the velocity and fitted).
+        #[arg(long, value_name = "M", allow_negative_numbers = true)]
+        x0: Option<f64>,
+        /// `linear` or `rotary` [default: from the columns' units, else linear].
+        #[arg(long, value_parser = parse_axis)]
+        axis: Option<Axis>,
+        /// Replace CONFIG if it exists.
+        #[arg(long)]
+        force: bool,
+        /// Print nothing but errors.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Print help: `frictionid help config` prints the configuration reference
+    /// (docs/config.md); `frictionid help COMMAND` a command's help.
+    Help {
+        /// `config`, or a command's name.
+        topic: Option<String>,
+    },
     /// List every registered friction model with its parameters and equation.
     #[command(
         after_help = "Examples:\n  frictionid models\n  frictionid models --json\n  frictionid models --axis rotary"
@@ -78,7 +131,8 @@ pub enum Command {
     },
     /// Simulate a free vibration from the config's oscillator, model and simulation tables.
     #[command(
-        after_help = "Example:\n  frictionid simulate fixtures/paper-140mm.toml --out sim-140mm/\n\nWrites trajectory.csv, report.json, report.md, report.html and SVG plots; with `noise` in\n[simulation] also record.csv, a noisy velocity record usable in [[records]]."
+        after_help = "Example:\n  frictionid simulate fixtures/paper-140mm.toml --out sim-140mm/\n\nWrites trajectory.csv, report.json, report.md, report.html and SVG plots; with `noise` in\n[simulation] also record.csv, a noisy velocity record usable in [[records]].\n\n\
+                      The configuration's keys: `frictionid help config`; a config from a data file: `frictionid init DATAFILE`."
     )]
     Simulate {
         /// The TOML configuration file.
@@ -90,7 +144,8 @@ pub enum Command {
     #[command(
         after_help = "Example:\n  frictionid fit fixtures/fmm-fit.toml --out fit/\n\n\
                       Exit codes: 0 converged (warnings allowed), 1 error, 2 not converged,\n\
-                      3 a diagnostic failed (the report says which)."
+                      3 a diagnostic failed (the report says which).\n\n\
+                      The configuration's keys: `frictionid help config`; a config from a data file: `frictionid init DATAFILE`."
     )]
     Fit {
         /// The TOML configuration file.
@@ -100,7 +155,8 @@ pub enum Command {
     },
     /// Fit several models to the same records and rank them by AIC.
     #[command(
-        after_help = "Examples:\n  frictionid compare fixtures/fmm-compare.toml\n  frictionid compare fixtures/fmm-compare.toml --models coulomb,stribeck,lugre"
+        after_help = "Examples:\n  frictionid compare fixtures/fmm-compare.toml\n  frictionid compare fixtures/fmm-compare.toml --models coulomb,stribeck,lugre\n\n\
+                      The configuration's keys: `frictionid help config`; a config from a data file: `frictionid init DATAFILE`."
     )]
     Compare {
         /// The TOML configuration file.
@@ -119,7 +175,8 @@ pub enum Command {
                       Writes campaign.csv (one row per group and model), report.json, report.md,\n\
                       report.html with trend plots, and each group's reports under groups/<id>/.\n\
                       Exit codes: 0 every group fitted cleanly, 1 error before any fit, 2 a group\n\
-                      could not be fitted or did not converge, 3 a group's fit failed a diagnostic."
+                      could not be fitted or did not converge, 3 a group's fit failed a diagnostic.\n\n\
+                      The configuration's keys: `frictionid help config`."
     )]
     Campaign {
         /// The TOML configuration file, with a [campaign] table.
@@ -135,7 +192,10 @@ pub enum Command {
         output: OutputArgs,
     },
     /// Energy-based friction force of each record (the paper's Eq. 7) against the reference.
-    #[command(after_help = "Example:\n  frictionid energy fixtures/fmm-energy.toml --out energy/")]
+    #[command(
+        after_help = "Example:\n  frictionid energy fixtures/fmm-energy.toml --out energy/\n\n\
+                      The configuration's keys: `frictionid help config`; a config from a data file: `frictionid init DATAFILE`."
+    )]
     Energy {
         /// The TOML configuration file.
         config: PathBuf,

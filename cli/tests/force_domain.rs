@@ -160,14 +160,14 @@ fn bad_force_domain_configurations_are_named() {
         )
         .says(Contains("c.toml: record `r.csv`: [fit.options] force_target = \"measured\" but the record has no force channel (it has: velocity")),
         case("no-mck-velocity", "fit", config("normal_force = 14.5", "", ""))
-            .says(Contains("c.toml: invalid input: [oscillator]: a velocity-domain fit needs mass, damping and stiffness; `mass`, `damping`, `stiffness` not given")),
+            .says(Contains("c.toml: invalid input: [oscillator]: a velocity-domain fit needs mass, damping and stiffness; `mass`, `stiffness` not given")),
         // Force domain without a force channel falls back to Eq. 7, which needs them too.
         case(
             "no-mck-energy",
             "compare",
             config("normal_force = 14.5\nmass = 10.0", "domain = \"force\"", ""),
         )
-        .says(Contains("the energy-based force (Eq. 7) needs mass, damping and stiffness; `damping`, `stiffness` not given")),
+        .says(Contains("the energy-based force (Eq. 7) needs mass, damping and stiffness; `stiffness` not given")),
         case(
             "no-column",
             "fit",

@@ -194,13 +194,21 @@ fn driving_input(record: &Record) -> Result<Driving, JobError> {
 /// their given values.
 pub fn fit_job(spec: &Spec, records: &[Record], hooks: &Hooks) -> Result<FitReport, JobError> {
     let model = spec.require_model("fit")?;
-    let opts = spec.fit_options(&model.given, hooks);
+    let mut opts = spec.fit_options(&model.given, hooks);
+    opts.params.time_shift |= release_found(records);
     let fit = fit(&spec.oscillator, model.model.as_ref(), records, &opts).map_err(JobError::Fit)?;
     Ok(FitReport {
         config: String::new(),
         fit,
         files: Vec::new(),
     })
+}
+
+/// Whether a record's release was found in its samples (`release = "auto"`): the fit then
+/// fits the release instant (`time_shift`), which the whole motion sets far better than the
+/// few samples of the rise.
+fn release_found(records: &[Record]) -> bool {
+    records.iter().any(|r| r.release_found)
 }
 
 /// `compare`: every model of `models` (see [`Spec::models_to_compare`]) fitted to `records`
@@ -213,7 +221,8 @@ pub fn compare_job(
 ) -> Result<CompareReport, JobError> {
     // Options common to every model; per-model free lists and bounds are filtered by the
     // identifier to the parameters each model has.
-    let opts = spec.fit_options(&[], hooks);
+    let mut opts = spec.fit_options(&[], hooks);
+    opts.params.time_shift |= release_found(records);
     let comparison = compare(&spec.oscillator, models, records, &opts).map_err(JobError::Fit)?;
     if comparison.ranking.is_empty() {
         let why = comparison

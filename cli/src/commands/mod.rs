@@ -6,6 +6,8 @@ pub mod compare;
 pub mod energy;
 pub mod export;
 pub mod fit;
+pub mod help;
+pub mod init;
 pub mod models;
 pub mod simulate;
 
@@ -85,6 +87,9 @@ pub struct Inputs {
 /// Loads `config` and prints the model's warnings to stderr.
 pub fn load_config(config: &std::path::Path) -> anyhow::Result<crate::config::Config> {
     let cfg = crate::config::Config::load(config)?;
+    for assumed in cfg.spec.assumptions() {
+        warn(&format!("{}: {assumed}", config.display()));
+    }
     if let Some(m) = &cfg.spec.model {
         for w in &m.warnings {
             warn(&format!("{}: [model]: {w}", config.display()));

@@ -1,76 +1,43 @@
-//! Delimited text records: CSV (comma, semicolon or tab) or whitespace-separated columns with a
-//! header row. Blank lines and lines starting with `#` are skipped anywhere in the file.
+//! Delimited text records: columns separated by a comma, semicolon, tab or whitespace, with
+//! a header row, after any preamble (comment lines starting with `#`, or lines of text before
+//! the header); numbers with a decimal point or comma. The layout is sniffed from the file
+//! ([`super::layout`]) where the `delimiter` and `decimal` keys do not give it. Blank lines
+//! and lines starting with `#` are skipped anywhere in the file. A unit in a column's name
+//! (`Velocity [mm/s]`) scales a column found by its name without the unit, unless a scale is
+//! given ([`super::units`]).
 
+use super::layout::{parse_number, sniff_layout, DecimalMark, Separator, SNIFF_LINES};
+use super::units::{split_unit, unit_of, Quantity};
 use super::{
-    finish, quoted, too_many_samples, Channel, DataError, DataFormat, RawSamples, ReadOptions,
-    MAX_SAMPLES,
+    finish, quoted, too_many_samples, Channel, ColumnSpec, DataError, DataFormat, RawSamples,
+    ReadOptions, MAX_SAMPLES,
 };
 use crate::record::Record;
 use std::path::Path;
 
-/// How the fields of a line are separated.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Separator {
-    Char(char),
-    Whitespace,
-}
-
-impl Separator {
-    /// Chooses the separator from the header row.
-    fn detect(header: &str, format: DataFormat) -> Self {
-        let by_char = [',', ';', '\t']
-            .into_iter()
-            .find(|c| header.contains(*c))
-            .map(Separator::Char);
-        match format {
-            DataFormat::Whitespace => Separator::Whitespace,
-            DataFormat::Csv => by_char.unwrap_or(Separator::Char(',')),
-            _ => match by_char {
-                // Tabs separate names that hold spaces (`Time [s]`); otherwise any whitespace.
-                Some(Separator::Char('\t')) if tab_fields_hold_spaces(header) => {
-                    Separator::Char('\t')
-                }
-                Some(Separator::Char('\t')) | None => Separator::Whitespace,
-                Some(sep) => sep,
-            },
-        }
-    }
-
-    fn split<'a>(&self, line: &'a str) -> Vec<&'a str> {
-        match self {
-            Separator::Char(c) => line.split(*c).map(clean_field).collect(),
-            Separator::Whitespace => line.split_whitespace().map(clean_field).collect(),
-        }
-    }
-}
-
-/// Whether a tab-separated header has a column name with a space inside.
-fn tab_fields_hold_spaces(header: &str) -> bool {
-    header
-        .split('\t')
-        .any(|f| f.trim().contains(char::is_whitespace))
-}
-
-fn clean_field(field: &str) -> &str {
-    let f = field.trim();
-    f.strip_prefix('"')
-        .and_then(|g| g.strip_suffix('"'))
-        .unwrap_or(f)
-        .trim()
-}
-
-/// Position of `name` in the header: exact match first, then ignoring case.
-fn find_column(header: &[&str], name: &str) -> Option<usize> {
+/// Position of `name` in the header: exact match first, then ignoring case, then the
+/// header's names without their units (`velocity` finds `Velocity [mm/s]`). The flag says
+/// whether the name was found without its unit (so the unit is the reader's to apply).
+fn find_column(header: &[&str], name: &str) -> Option<(usize, bool)> {
     header
         .iter()
         .position(|h| *h == name)
         .or_else(|| header.iter().position(|h| h.eq_ignore_ascii_case(name)))
+        .map(|i| (i, false))
+        .or_else(|| {
+            header
+                .iter()
+                .position(|h| split_unit(h).0.eq_ignore_ascii_case(name.trim()))
+                .map(|i| (i, true))
+        })
 }
 
-/// The header row: its line, the separator it implies and its column names.
+/// The header row: its line, the separator and decimal mark of the file and its column
+/// names.
 struct Header<'a> {
     line: usize,
     sep: Separator,
+    decimal: DecimalMark,
     names: Vec<&'a str>,
 }
 
@@ -88,25 +55,33 @@ pub fn read_delimited(
     format: DataFormat,
     opts: &ReadOptions,
 ) -> Result<Record, DataError> {
-    let mut lines = text
-        .lines()
+    let mut lines = content_lines(text);
+    let head: Vec<(usize, &str)> = lines.by_ref().take(SNIFF_LINES).collect();
+    let layout = sniff_layout(&head, format, opts.delimiter, opts.decimal);
+    let header = read_header(path, head.get(layout.header).copied(), layout, opts)?;
+    let columns = locate_columns(path, &header, opts)?;
+    let rows = head.iter().skip(layout.header + 1).copied().chain(lines);
+    let raw = read_rows(path, &header, &columns, rows)?;
+    finish(path, raw, opts)
+}
+
+/// The lines of `text` that are not blank or comments, with their 1-based line numbers.
+fn content_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.lines()
         .enumerate()
         .map(|(i, l)| (i + 1, l.trim_end_matches('\r')))
         .filter(|(_, l)| {
             let t = l.trim_start();
             !t.is_empty() && !t.starts_with('#')
-        });
-    let header = read_header(path, lines.next(), format, opts)?;
-    let columns = locate_columns(path, &header, opts)?;
-    let raw = read_rows(path, &header, &columns, lines)?;
-    finish(path, raw, opts)
+        })
 }
 
-/// The header row (the first line that is not blank or a comment).
+/// The header row (the line before the data block, or the first line that is not blank or
+/// a comment when no data block is found).
 fn read_header<'a>(
     path: &Path,
     first: Option<(usize, &'a str)>,
-    format: DataFormat,
+    layout: super::layout::Layout,
     opts: &ReadOptions,
 ) -> Result<Header<'a>, DataError> {
     let Some((line, text)) = first else {
@@ -115,9 +90,12 @@ fn read_header<'a>(
             reason: "the file has no header row and no data".into(),
         });
     };
-    let sep = Separator::detect(text, format);
+    let sep = layout.separator;
     let names = sep.split(text);
-    if names.iter().all(|h| h.parse::<f64>().is_ok()) {
+    if names
+        .iter()
+        .all(|h| parse_number(h, layout.decimal).is_some())
+    {
         let first_channel = opts
             .channels
             .values()
@@ -131,11 +109,17 @@ fn read_header<'a>(
             ),
         });
     }
-    Ok(Header { line, sep, names })
+    Ok(Header {
+        line,
+        sep,
+        decimal: layout.decimal,
+        names,
+    })
 }
 
-/// The positions of the time column and of every channel found: a required column that is
-/// missing is an error, and so is a header without any channel column.
+/// The positions of the time column and of every channel found, with their scales: a
+/// required column that is missing is an error, and so is a header without any channel
+/// column.
 fn locate_columns(path: &Path, header: &Header, opts: &ReadOptions) -> Result<Columns, DataError> {
     let missing = |name: &str| DataError::MissingColumn {
         file: path.to_path_buf(),
@@ -144,12 +128,26 @@ fn locate_columns(path: &Path, header: &Header, opts: &ReadOptions) -> Result<Co
         hint: suggestion(header, name),
         available: quoted(&header.names.join(", ")),
     };
-    let time =
+    let (time, bare) =
         find_column(&header.names, &opts.time.column).ok_or_else(|| missing(&opts.time.column))?;
+    let time_scale = column_scale(
+        path,
+        header,
+        time,
+        bare,
+        &opts.time,
+        "time",
+        &[Quantity::Time],
+    )?;
     let mut channels = Vec::new();
     for (&channel, spec) in &opts.channels {
         match find_column(&header.names, &spec.column) {
-            Some(idx) => channels.push((channel, idx, spec.scale)),
+            Some((idx, bare)) => {
+                let quantities = channel_quantities(channel);
+                let scale =
+                    column_scale(path, header, idx, bare, spec, channel.name(), quantities)?;
+                channels.push((channel, idx, scale));
+            }
             None if spec.required => return Err(missing(&spec.column)),
             None => {}
         }
@@ -159,9 +157,48 @@ fn locate_columns(path: &Path, header: &Header, opts: &ReadOptions) -> Result<Co
     }
     Ok(Columns {
         time,
-        time_scale: opts.time.scale,
+        time_scale,
         channels,
     })
+}
+
+/// The quantities a channel's unit may measure (on a linear or a rotary axis).
+fn channel_quantities(channel: Channel) -> &'static [Quantity] {
+    match channel {
+        Channel::Velocity => &[Quantity::Velocity, Quantity::AngularVelocity],
+        Channel::Displacement => &[Quantity::Length, Quantity::Angle],
+        Channel::Acceleration => &[Quantity::Acceleration, Quantity::AngularAcceleration],
+        Channel::Force | Channel::NormalForce => &[Quantity::Force],
+        Channel::InputForce => &[Quantity::Force, Quantity::Torque],
+    }
+}
+
+/// The scale of the column at `idx`: the one given, else the factor of the unit in its name
+/// when the column was found by its name without the unit (`bare`), else 1. A unit that does
+/// not measure the column's quantity is an error naming the key that overrides it.
+fn column_scale(
+    path: &Path,
+    header: &Header,
+    idx: usize,
+    bare: bool,
+    spec: &ColumnSpec,
+    key: &str,
+    quantities: &[Quantity],
+) -> Result<f64, DataError> {
+    if spec.scale_given || !bare {
+        return Ok(spec.scale);
+    }
+    let name = header.names.get(idx).copied().unwrap_or_default();
+    match unit_of(name) {
+        Some(unit) if quantities.contains(&unit.quantity) => Ok(spec.scale * unit.factor),
+        Some(_) => Err(DataError::UnitMismatch {
+            file: path.to_path_buf(),
+            line: header.line,
+            column: quoted(name),
+            key: key.to_string(),
+        }),
+        None => Ok(spec.scale),
+    }
 }
 
 /// The error for a header without any channel column: a near miss of one column name is
@@ -249,7 +286,7 @@ fn field_number(
 ) -> Result<f64, DataError> {
     let name = header.names.get(idx).copied().unwrap_or_default();
     let raw = fields.get(idx).copied().unwrap_or_default();
-    let value = raw.parse::<f64>().map_err(|_| DataError::BadNumber {
+    let value = parse_number(raw, header.decimal).ok_or_else(|| DataError::BadNumber {
         file: path.to_path_buf(),
         line,
         column: quoted(name),
@@ -409,6 +446,62 @@ mod tests {
         assert_eq!(r.velocity(), vec![3.0, 6.0, 9.0]);
         assert_eq!(r.channel(Channel::NormalForce), Some(&[4.0, 8.0, 12.0][..]));
         assert_eq!(r.channel(Channel::Acceleration), None);
+    }
+
+    /// A vibrometer's ASCII export: `#` lines holding commas, a line of plain text, a
+    /// header with units, semicolons and decimal commas; the units scale the columns found
+    /// by their names without them.
+    #[test]
+    fn an_instrument_export_after_its_preamble_with_decimal_commas_and_units() {
+        let rows: String = (0..5)
+            .map(|i| format!("{:.6};{:.3}\n", i as f64 * 2e-4, 1.5 * i as f64).replace('.', ","))
+            .collect();
+        let text = format!(
+            "# Vibrometer export, channel 1, velocity\n# Sample rate: 5000,0 Hz\n\
+             # Range: 100 mm/s, filter off\nMeasured on the rig, run 3\n\
+             Time [s];Velocity [mm/s]\n{rows}"
+        );
+        let r = read(&text).unwrap();
+        assert_eq!(r.time(), vec![0.0, 2e-4, 4e-4, 6e-4, 8e-4]);
+        let expected = [0.0, 1.5e-3, 3e-3, 4.5e-3, 6e-3];
+        for (v, e) in r.velocity().iter().zip(expected) {
+            assert!((v - e).abs() < 1e-15, "{v} {e}");
+        }
+        // A scale given replaces the unit; a column named with its unit is read as written.
+        let opts = ReadOptions {
+            min_samples: 3,
+            ..ReadOptions::default()
+        };
+        let given = opts.clone().with_scale(Channel::Velocity, 1.0);
+        let r = read_delimited(Path::new("v.txt"), &text, DataFormat::Auto, &given).unwrap();
+        assert_eq!(r.velocity()[1], 1.5);
+        let named = opts
+            .clone()
+            .with_column(Channel::Velocity, "Velocity [mm/s]");
+        let r = read_delimited(Path::new("v.txt"), &text, DataFormat::Auto, &named).unwrap();
+        assert_eq!(r.velocity()[1], 1.5);
+        // The keys decide what sniffing cannot: here a point read as the decimal mark.
+        let point = ReadOptions {
+            decimal: crate::data::DecimalMark::Point,
+            ..opts
+        };
+        let e = read_delimited(Path::new("v.txt"), &text, DataFormat::Auto, &point).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "v.txt: line 6: column `Time [s]`: `0,000000` is not a number"
+        );
+    }
+
+    #[test]
+    fn a_unit_of_another_quantity_names_the_key_that_overrides_it() {
+        let e = read("time,velocity [mm]\n0,1\n1,2\n2,3\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "r.csv: line 1: column `velocity [mm]`: its unit is not one of a velocity column; \
+             give `velocity_scale` (the factor to SI) or fix the name"
+        );
+        let r = read("time (ms)\tvelocity\n0\t1\n1\t2\n2\t3\n").unwrap();
+        assert_eq!(r.time(), vec![0.0, 1e-3, 2e-3]);
     }
 
     #[test]

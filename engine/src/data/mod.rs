@@ -8,11 +8,15 @@
 //! message is one line naming the file and, where there is one, the line and the reason.
 
 mod delimited;
+pub mod layout;
 mod mat5;
+pub mod sniff;
 pub mod source;
 mod uff58;
+pub mod units;
 
 pub use delimited::read_delimited;
+pub use layout::{DecimalMark, Delimiter};
 pub use mat5::read_mat;
 pub use source::{RecordSource, RecordSourceError, RecordUse, ResolvedSource};
 pub use uff58::read_uff58;
@@ -77,6 +81,10 @@ pub struct ColumnSpec {
     /// otherwise the channel is read when its column is found.
     #[serde(default)]
     pub required: bool,
+    /// Whether `scale` was given: a scale given replaces the unit in the column's name
+    /// (`Velocity [mm/s]`), which otherwise scales a column found by its name without it.
+    #[serde(default)]
+    pub scale_given: bool,
 }
 
 impl ColumnSpec {
@@ -86,6 +94,7 @@ impl ColumnSpec {
             column: column.into(),
             scale: 1.0,
             required: true,
+            scale_given: false,
         }
     }
 
@@ -104,6 +113,10 @@ impl ColumnSpec {
 pub struct ReadOptions {
     /// File format.
     pub format: DataFormat,
+    /// How the fields of a delimited text file are separated (default: sniffed).
+    pub delimiter: Delimiter,
+    /// The decimal mark of a delimited text file's numbers (default: sniffed).
+    pub decimal: DecimalMark,
     /// The time column \[s after scaling\].
     pub time: ColumnSpec,
     /// The channels looked for, each in its column: a required column must be present, an
@@ -122,6 +135,8 @@ impl Default for ReadOptions {
     fn default() -> Self {
         Self {
             format: DataFormat::Auto,
+            delimiter: Delimiter::Auto,
+            decimal: DecimalMark::Auto,
             time: ColumnSpec::named("time"),
             // The input is read where its column or scale is named: a column of that name
             // alone is not a record of the motion.
@@ -156,12 +171,15 @@ impl ReadOptions {
     /// These options with the time stamps multiplied by `scale` (1e-3 for milliseconds).
     pub fn with_time_scale(mut self, scale: f64) -> Self {
         self.time.scale = scale;
+        self.time.scale_given = true;
         self
     }
 
     /// These options with `channel` scaled by `scale`.
     pub fn with_scale(mut self, channel: Channel, scale: f64) -> Self {
-        self.channel_mut(channel).scale = scale;
+        let spec = self.channel_mut(channel);
+        spec.scale = scale;
+        spec.scale_given = true;
         self
     }
 
@@ -244,6 +262,14 @@ pub enum DataError {
         line: usize,
         column: String,
         text: String,
+    },
+    /// The unit in a column's name does not measure the column's quantity.
+    #[error("{file}: line {line}: column `{column}`: its unit is not one of a {key} column; give `{key}_scale` (the factor to SI) or fix the name")]
+    UnitMismatch {
+        file: PathBuf,
+        line: usize,
+        column: String,
+        key: String,
     },
     /// A value is NaN or infinite.
     #[error("{file}: line {line}: column `{column}` is {value} (values must be finite)")]

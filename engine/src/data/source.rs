@@ -12,6 +12,8 @@
 //! weight = 1.0                # optional, in a joint fit
 //! format = "auto"             # auto | csv | whitespace | uff58 | mat (a MAT-file: each
 //!                             # *_column names a variable)
+//! delimiter = "auto"          # or ";", ",", "tab", "whitespace" (default: sniffed)
+//! decimal = "auto"            # or "point", "comma" (default: sniffed)
 //! time_column = "time"        # and time_scale (1e-3 for milliseconds)
 //! velocity_column = "velocity"
 //! velocity_scale = 1e-3       # the file's velocity unit in m/s (here mm/s)
@@ -35,7 +37,7 @@
 //! ([`ResolvedSource::load`]), and [`crate::record::Record::require_x0`] refuses a record
 //! whose x0 is unknown wherever else one is needed.
 
-use super::{read_record, DataError, DataFormat, ReadOptions};
+use super::{read_record, DataError, DataFormat, DecimalMark, Delimiter, ReadOptions};
 use crate::oscillator::Oscillator;
 use crate::record::{
     check_scales, detect_release, Channel, NormalForce, Record, Release, X0Source,
@@ -64,6 +66,10 @@ pub struct RecordSource {
     pub weight: Option<f64>,
     /// File format (default: from the extension).
     pub format: Option<DataFormat>,
+    /// How a text file's fields are separated (default: sniffed from the file).
+    pub delimiter: Option<Delimiter>,
+    /// The decimal mark of a text file's numbers (default: sniffed from the file).
+    pub decimal: Option<DecimalMark>,
     /// Header name of the time column (default `time`).
     pub time_column: Option<String>,
     /// Factor from the file's time unit to s (default 1; 1e-3 for milliseconds).
@@ -166,6 +172,9 @@ pub enum RecordUse {
     /// Replayed as measured (a force-domain fit): x0 only where the energy analysis or Eq. 7
     /// integrates a velocity ([`crate::record::Record::require_x0`]).
     Replayed,
+    /// Simulated on an axis without a restoring law (a driven axis, a free mass): the
+    /// position enters no equation, so x0 is not needed (0 stands in).
+    Unpositioned,
 }
 
 /// Every key of [`RecordSource`], for the merge with `[record_defaults]`.
@@ -177,6 +186,8 @@ macro_rules! record_keys {
             v0,
             weight,
             format,
+            delimiter,
+            decimal,
             time_column,
             time_scale,
             velocity_column,
@@ -249,6 +260,9 @@ impl ResolvedSource {
         }
         let mut record = self.start_at_release(record)?;
         record.set_release_displacement(self.x0);
+        if record.x0_source == X0Source::Unknown && self.used == RecordUse::Unpositioned {
+            record.x0_source = X0Source::Unused;
+        }
         if record.x0_source == X0Source::Unknown && self.used == RecordUse::Simulated {
             return Err(RecordSourceError::MissingX0 {
                 index: self.entry,
@@ -273,17 +287,19 @@ impl ResolvedSource {
             file: self.file.clone(),
             reason,
         };
-        let release = match self.release {
+        let (release, found) = match self.release {
             None => return Ok(record),
-            Some(Release::At(t)) => t,
+            Some(Release::At(t)) => (t, false),
             Some(Release::Auto) => {
                 if record.channel(Channel::Velocity).is_none() {
                     return Err(options(
                         "release = \"auto\" needs a velocity channel".into(),
                     ));
                 }
-                detect_release(record.time(), record.velocity())
-                    .unwrap_or_else(|| record.time().first().copied().unwrap_or(0.0))
+                match detect_release(record.time(), record.velocity()) {
+                    Some(t) => (t, true),
+                    None => (record.time().first().copied().unwrap_or(0.0), false),
+                }
             }
         };
         let last = record.time().last().copied().unwrap_or(f64::NAN);
@@ -298,6 +314,7 @@ impl ResolvedSource {
             .saturating_sub(1);
         let mut started = record.starting_at(first);
         started.release_time = Some(release);
+        started.release_found = found;
         let needed = self.read.min_samples.max(2);
         if started.len() < needed {
             return Err(DataError::TooFewSamples {
@@ -489,11 +506,17 @@ impl RecordSource {
         if let Some(format) = self.format {
             read.format = format;
         }
+        if let Some(delimiter) = self.delimiter {
+            read.delimiter = delimiter;
+        }
+        if let Some(decimal) = self.decimal {
+            read.decimal = decimal;
+        }
         if let Some(column) = &self.time_column {
             read.time.column = column.clone();
         }
         if let Some(scale) = self.time_scale {
-            read.time.scale = scale;
+            read = read.with_time_scale(scale);
         }
         for (channel, column, scale) in self.channel_keys() {
             if let Some(column) = column {

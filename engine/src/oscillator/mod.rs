@@ -202,6 +202,12 @@ impl Oscillator {
         self.restoring_stiffness(0.0)
     }
 
+    /// Whether the axis has a restoring law (without one the position enters no equation,
+    /// and a release displacement means nothing).
+    pub fn has_restoring_force(&self) -> bool {
+        !matches!(self.restoring, Restoring::None(_))
+    }
+
     /// Whether R(q) is exactly k q (the closed-form propagator applies).
     pub fn has_linear_spring(&self) -> bool {
         self.restoring.law().is_linear_spring()

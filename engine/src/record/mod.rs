@@ -55,6 +55,11 @@ pub struct Record {
     /// before it. `None`: the record starts at release.
     #[serde(default)]
     pub release_time: Option<f64>,
+    /// Whether `release_time` was found in the samples (`release = "auto"`), not given: a
+    /// fit then fits the release instant too (`time_shift`), since the samples' noise sets
+    /// the instant found only to a part of a sample.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub release_found: bool,
     /// What was worked out from the samples (noise levels, checks), kept until they change.
     #[serde(skip)]
     derived: SampleFacts,
@@ -72,6 +77,9 @@ pub enum X0Source {
     /// Neither given nor measured: `x0` is 0 in its place, and what needs it refuses the
     /// record ([`Record::require_x0`]).
     Unknown,
+    /// Not needed: the axis has no restoring law, so the position enters no equation (0
+    /// stands in).
+    Unused,
 }
 
 impl X0Source {
@@ -128,6 +136,7 @@ impl Record {
             v0: 0.0,
             weight: 1.0,
             release_time: None,
+            release_found: false,
             derived: SampleFacts::default(),
         }
     }
@@ -293,6 +302,7 @@ impl Record {
             v0: self.v0,
             weight: self.weight,
             release_time: self.release_time,
+            release_found: self.release_found,
             derived: SampleFacts::default(),
         }
     }

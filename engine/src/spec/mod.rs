@@ -57,6 +57,8 @@ pub struct Spec {
     /// `[oscillator]` keys not given (their values in `oscillator` are placeholders): a
     /// force-domain fit on a measured force needs only the normal force.
     pub unknown_oscillator: Vec<OscillatorProperty>,
+    /// `[oscillator]` keys not given whose values were assumed (damping: 0).
+    pub assumed_oscillator: Vec<OscillatorProperty>,
 }
 
 impl Spec {
@@ -83,6 +85,7 @@ impl Spec {
             simulation,
             energy,
             unknown_oscillator: oscillator.unknown,
+            assumed_oscillator: oscillator.assumed,
         })
     }
 
@@ -90,9 +93,35 @@ impl Spec {
     /// (force domain), which decides whether a `[[records]]` entry needs `x0`.
     pub fn record_use(&self) -> RecordUse {
         match self.fit.target.domain {
-            FitDomain::Velocity => RecordUse::Simulated,
+            FitDomain::Velocity if self.oscillator.has_restoring_force() => RecordUse::Simulated,
+            FitDomain::Velocity => RecordUse::Unpositioned,
             FitDomain::Force => RecordUse::Replayed,
         }
+    }
+
+    /// What was assumed for the `[oscillator]` keys not given, one sentence each (for the
+    /// reports and the terminal), where the run's equation reads them: a simulation, a
+    /// velocity fit, the energy analysis (a force-domain fit reads damping only through Eq. 7
+    /// or inverse dynamics), once the keys those need are given.
+    pub fn assumptions(&self) -> Vec<String> {
+        let incomplete = [OscillatorProperty::Mass, OscillatorProperty::Stiffness]
+            .iter()
+            .any(|p| self.unknown_oscillator.contains(p));
+        if self.fit.target.domain == FitDomain::Force || incomplete {
+            // Nothing to say yet: the run is refused, naming the keys it needs first.
+            return Vec::new();
+        }
+        self.assumed_oscillator
+            .iter()
+            .map(|p| {
+                format!(
+                    "[oscillator]: `{}` not given: assumed 0 (no viscous damping); give it, or \
+                     fit it with `[fit.options] oscillator = [\"{}\"]`",
+                    p.name_on(self.oscillator.axis),
+                    p.name_on(self.oscillator.axis)
+                )
+            })
+            .collect()
     }
 
     /// Checks the units of a read record against the oscillator: the speed, period and angle

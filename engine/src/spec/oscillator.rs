@@ -2,7 +2,7 @@
 //! deviations and the keys not given.
 
 use super::error::SpecError;
-use crate::axis::{Axis, Restoring, WrittenRestoring};
+use crate::axis::{Axis, NoRestoring, Restoring, WrittenRestoring};
 use crate::identify::PropertyUncertainty;
 use crate::oscillator::{Oscillator, OscillatorProperty, PartialOscillator};
 use serde::{Deserialize, Serialize};
@@ -22,6 +22,9 @@ pub struct OscillatorSpec {
     /// normal force; the analyses that need the others name them
     /// ([`crate::identify::require_mechanics`]).
     pub unknown: Vec<OscillatorProperty>,
+    /// The properties not given whose value was assumed (damping: 0, no viscous damping),
+    /// for the report to say so.
+    pub assumed: Vec<OscillatorProperty>,
 }
 
 /// `[oscillator]` as written; [`OscillatorSpec`] is built from it.
@@ -65,9 +68,20 @@ impl TryFrom<OscillatorTable> for OscillatorSpec {
 
     fn try_from(o: OscillatorTable) -> Result<Self, SpecError> {
         let (axis, restoring) = axis_of(&o)?;
+        // A linear spring of stiffness 0 is no spring at all: a free mass.
+        let restoring = match (restoring, o.stiffness) {
+            (r, Some(k)) if r.is_linear_spring() && k == 0.0 => Restoring::None(NoRestoring),
+            (r, _) => r,
+        };
+        // No damping given: none (c = 0), said in the report.
+        let assumed = if o.damping.is_none() {
+            vec![OscillatorProperty::Damping]
+        } else {
+            Vec::new()
+        };
         let (mut oscillator, mut unknown) = PartialOscillator {
             mass: o.mass.or(o.inertia),
-            damping: o.damping,
+            damping: o.damping.or(Some(0.0)),
             stiffness: stiffness_of(&o)?,
             normal_force: o.normal_force,
         }
@@ -87,6 +101,7 @@ impl TryFrom<OscillatorTable> for OscillatorSpec {
                 normal_force: o.normal_force_std,
             },
             unknown,
+            assumed,
         };
         spec.validate()?;
         Ok(spec)
@@ -168,6 +183,7 @@ impl From<Oscillator> for OscillatorSpec {
             oscillator,
             uncertainty: PropertyUncertainty::default(),
             unknown: Vec::new(),
+            assumed: Vec::new(),
         }
     }
 }
@@ -212,5 +228,28 @@ mod tests {
             "restoring": {"type": "polynomial", "stiffness": 0.5},
         }));
         assert!(twice.is_err_and(|e| e.contains("`stiffness` is given twice")));
+    }
+
+    fn spec(json: serde_json::Value) -> Result<OscillatorSpec, serde_json::Error> {
+        serde_json::from_value(json)
+    }
+
+    /// Only the keys the equation uses: a spring of stiffness 0 is none, and damping not
+    /// given is 0, said as an assumption; a negative stiffness is still refused.
+    #[test]
+    fn a_free_mass_and_an_assumed_damping() {
+        let free = spec(serde_json::json!({"mass": 2.0, "stiffness": 0.0})).unwrap();
+        assert!(!free.oscillator.has_restoring_force());
+        assert_eq!(free.oscillator.damping, 0.0);
+        assert_eq!(free.assumed, vec![OscillatorProperty::Damping]);
+        assert_eq!(free.unknown, vec![OscillatorProperty::NormalForce]);
+        let none = spec(serde_json::json!({"mass": 2.0, "restoring": {"type": "none"}})).unwrap();
+        assert!(!none.oscillator.has_restoring_force());
+        assert!(!none.unknown.contains(&OscillatorProperty::Stiffness));
+        let given =
+            spec(serde_json::json!({"mass": 2.0, "damping": 0.5, "stiffness": 10.0})).unwrap();
+        assert!(given.assumed.is_empty() && given.oscillator.has_restoring_force());
+        let e = spec(serde_json::json!({"mass": 2.0, "stiffness": -1.0})).unwrap_err();
+        assert!(e.to_string().contains("`stiffness` must be > 0"), "{e}");
     }
 }

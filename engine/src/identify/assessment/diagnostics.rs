@@ -454,7 +454,7 @@ fn structure_finding(stats: &[Statistic]) -> Finding {
         "residuals show no structure locked to the motion".to_string()
     } else {
         format!(
-            "residuals are locked to the motion: they follow {}; a wrong friction law, an unmodelled offset or a missed release leaves such a pattern",
+            "residuals are locked to the motion: they follow {}; a wrong friction law (compare others), an unmodelled offset (`[fit.options] velocity_offset = true`) or a missed release (`[fit.options] time_shift = true`) leaves such a pattern",
             flagged.join(", ")
         )
     };

@@ -247,6 +247,10 @@ fn held_out(
         eval.params.time_shift = false;
         for (r, n) in test.iter_mut().zip(&trained.world.nuisance) {
             r.x0 = n.x0_of(r);
+            if n.shift != 0.0 {
+                let t0 = r.time().first().copied().unwrap_or(0.0);
+                r.release_time = Some(r.release_time.unwrap_or(t0) + n.shift);
+            }
         }
     }
     let world = &trained.world;
