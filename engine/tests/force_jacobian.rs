@@ -239,8 +239,6 @@ fn the_law_and_offset_columns_of_force_records_are_the_residuals_derivatives() {
         force_records(),
         Oscillator::fmm(),
         &force_options(&gms),
-        // At its lower bound (1) the sharpness's internal coordinate has no two-sided
-        // difference to hold the column against.
         &["sharpness"],
     );
     let stribeck = ["mu_c", "mu_s", "v_s", "delta", "viscous"];
@@ -280,9 +278,8 @@ fn the_balance_columns_of_inverse_dynamics_are_the_residuals_derivatives() {
     );
 }
 
-/// The columns the producer gives directly are all the law's (GMS's sharpness included: its
-/// sensitivity is integrated with the states) and the offsets, not a restoring law's own
-/// parameters.
+/// The columns the producer gives directly are all but GMS's sharpness (which has no closed-form
+/// sensitivity) and a restoring law's own parameters.
 #[test]
 fn the_producer_gives_every_column_it_has_in_closed_form() {
     let gms = ["k_1", "w_1", "mu_c", "sharpness"];
@@ -313,14 +310,7 @@ fn the_producer_gives_every_column_it_has_in_closed_form() {
             .collect();
         assert_eq!(
             given,
-            [
-                "k_1",
-                "w_1",
-                "mu_c",
-                "sharpness",
-                "force_offset[a]",
-                "force_offset[b]"
-            ],
+            ["k_1", "w_1", "mu_c", "force_offset[a]", "force_offset[b]"],
             "record {index}"
         );
     }

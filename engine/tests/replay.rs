@@ -150,30 +150,11 @@ fn force_at(model: &(dyn FrictionModel + 'static), m: &Motion, j: usize, value: 
     model_force_with_normal(moved.as_ref(), &m.time, &m.v, &m.normal).expect("a replay")
 }
 
-/// dF/dp_j at every sample by central differences with steps h and h/2, extrapolated; at a
-/// parameter's lower bound (GMS's sharpness 1), by the one-sided second-order difference
-/// (3 F(p) - 4 F(p + h) + F(p + 2 h)) / (-2 h) at the same steps, extrapolated alike.
+/// dF/dp_j at every sample by central differences with steps h and h/2, extrapolated.
 fn differenced(model: &(dyn FrictionModel + 'static), m: &Motion, j: usize) -> Vec<f64> {
     let p = model.params()[j];
     let h = 1e-6 * if p == 0.0 { 1.0 } else { p.abs() };
-    let at_bound = !model.param_info()[j].admits(p - h);
-    let centre = if at_bound {
-        force_at(model, m, j, p)
-    } else {
-        Vec::new()
-    };
     let central = |h: f64| -> Vec<f64> {
-        if at_bound {
-            let (a, b) = (
-                force_at(model, m, j, p + h),
-                force_at(model, m, j, p + 2.0 * h),
-            );
-            return centre
-                .iter()
-                .zip(a.iter().zip(&b))
-                .map(|(c, (a, b))| (4.0 * a - b - 3.0 * c) / (2.0 * h))
-                .collect();
-        }
         let (a, b) = (force_at(model, m, j, p + h), force_at(model, m, j, p - h));
         a.iter().zip(&b).map(|(a, b)| (a - b) / (2.0 * h)).collect()
     };
@@ -192,7 +173,12 @@ fn replayed_force_derivatives_match_central_differences() {
         let names: Vec<String> = model.param_info().into_iter().map(|p| p.name).collect();
         for (j, name) in names.iter().enumerate() {
             if !d.given[j] {
-                panic!("{} gives no sensitivity of {name}", model.name());
+                assert_eq!(
+                    (model.name(), name.as_str()),
+                    ("gms", "sharpness"),
+                    "only GMS's sharpness has no closed-form sensitivity"
+                );
+                continue;
             }
             let expected = differenced(model.as_ref(), &m, j);
             let largest = expected.iter().fold(0.0f64, |a, x| a.max(x.abs()));

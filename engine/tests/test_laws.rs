@@ -3,7 +3,6 @@
 //! otherwise run these laws too.
 
 mod energy;
-mod gms_replay_paths;
 mod simulate_custom;
 mod starts;
 mod util;

@@ -269,7 +269,7 @@ pub trait SwitchedLaw: FrictionModel {
 /// integration, `testing::check_exact_steps`).
 pub trait Propagator: InternalStates {
     /// Whether [`propagate`](Self::propagate) is exact at the current parameter values (GMS:
-    /// for sharpness >= 1); where it is not, the engine integrates the states
+    /// only for sharpness 1 and 2); where it is not, the engine integrates the states
     /// numerically. Default: `true`.
     fn propagates_exactly(&self) -> bool {
         true

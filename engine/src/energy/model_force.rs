@@ -16,8 +16,7 @@
 //! # Exact steps
 //! At constant v and N a law's states often have a closed form over the interval (LuGre's
 //! bristle relaxes exponentially in the distance travelled; Dahl's force, and each GMS element
-//! follow separable laws in the travel, in closed form for sharpness 1 and 2 and by a
-//! smooth integration in ln|1 - load| for any other): a law with a
+//! for sharpness 1 and 2, follow separable laws in the travel): a law with a
 //! [`Propagator`](frictionid_models::Propagator) exact at its parameters is stepped by it, one
 //! call per sample whatever its stiffness, and the same pass carries the states' sensitivities
 //! to the parameters ([`force_derivatives_along`]): with the force's parameter gradient
@@ -25,7 +24,7 @@
 //! derivatives of the force along the motion, dF/dp + dF/dz dz/dp, from one replay.
 //!
 //! # Numerical replay
-//! A law without an exact step (a plugin law) has each interval
+//! A law without an exact step (a plugin, GMS at another sharpness) has each interval
 //! integrated on its own (the right-hand side jumps at the samples, where v̄ and N̄ change;
 //! each interval starts with the step size the last ended on), under error control
 //! (rtol 1e-8, atol 1e-12 per state): by the Dormand-Prince 5(4) pair where the interval is
