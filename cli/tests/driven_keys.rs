@@ -94,5 +94,21 @@ fn a_driven_axis_fits_with_its_mass_and_no_spring_alone() {
             stderr.contains("`damping` not given: assumed 0"),
             "{tag}: {stderr}"
         );
+        assert!(
+            states_assumed_damping(&r),
+            "{tag}: no assumption finding in report.json"
+        );
     }
+}
+
+/// Whether the report's findings state the assumed damping, as every writer prints them.
+fn states_assumed_damping(r: &serde_json::Value) -> bool {
+    r["diagnostics"].as_array().is_some_and(|d| {
+        d.iter().any(|f| {
+            f["check"] == "assumption"
+                && f["message"]
+                    .as_str()
+                    .is_some_and(|m| m.contains("`damping` not given: assumed 0"))
+        })
+    })
 }

@@ -12,7 +12,8 @@ use crate::energy::{
 };
 use crate::error::EngineError;
 use crate::identify::{
-    compare, fit, require_mechanics, require_oscillator, FitResult, PropertyUncertainty,
+    compare, fit, require_mechanics, require_oscillator, Check, Finding, FitResult,
+    PropertyUncertainty, Status,
 };
 use crate::oscillator::Oscillator;
 use crate::record::{channel_list, Channel, Record};
@@ -196,12 +197,24 @@ pub fn fit_job(spec: &Spec, records: &[Record], hooks: &Hooks) -> Result<FitRepo
     let model = spec.require_model("fit")?;
     let mut opts = spec.fit_options(&model.given, hooks);
     opts.params.time_shift |= release_found(records);
-    let fit = fit(&spec.oscillator, model.model.as_ref(), records, &opts).map_err(JobError::Fit)?;
+    let mut fit =
+        fit(&spec.oscillator, model.model.as_ref(), records, &opts).map_err(JobError::Fit)?;
+    state_assumptions(spec, &mut fit);
     Ok(FitReport {
         config: String::new(),
         fit,
         files: Vec::new(),
     })
+}
+
+/// Adds what the spec assumed for keys it was not given (damping 0) to the fit's findings,
+/// so every writer says what its numbers rest on.
+fn state_assumptions(spec: &Spec, fit: &mut FitResult) {
+    fit.diagnostics.extend(
+        spec.assumptions()
+            .into_iter()
+            .map(|text| Finding::new(Check::Assumption, Status::Pass, None, text)),
+    );
 }
 
 /// Whether a record's release was found in its samples (`release = "auto"`): the fit then
@@ -223,7 +236,12 @@ pub fn compare_job(
     // identifier to the parameters each model has.
     let mut opts = spec.fit_options(&[], hooks);
     opts.params.time_shift |= release_found(records);
-    let comparison = compare(&spec.oscillator, models, records, &opts).map_err(JobError::Fit)?;
+    let mut comparison =
+        compare(&spec.oscillator, models, records, &opts).map_err(JobError::Fit)?;
+    comparison
+        .ranking
+        .iter_mut()
+        .for_each(|fit| state_assumptions(spec, fit));
     if comparison.ranking.is_empty() {
         let why = comparison
             .failed

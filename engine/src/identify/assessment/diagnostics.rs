@@ -64,7 +64,7 @@ pub fn energy_balance(record: &str, ef: &EnergyForce, axis: Axis) -> Finding {
         .filter(|(d, judged)| *judged && !d.is_nan())
         .map(|(d, _)| *d)
         .fold(f64::NAN, f64::max);
-    let skipped = energy_skips(ef);
+    let skipped = energy_skips(ef, axis);
     if worst.is_nan() {
         let why = if skipped.is_empty() {
             "neither comparison is defined".to_string()
@@ -101,14 +101,18 @@ pub fn energy_balance(record: &str, ef: &EnergyForce, axis: Axis) -> Finding {
     Finding::new(Check::EnergyBalance, status, Some(worst), message)
 }
 
-/// The parts of an energy check that could not judge, each with its reason.
-fn energy_skips(ef: &EnergyForce) -> Vec<String> {
+/// The parts of an energy check that could not judge, each with its reason in the units of
+/// `axis`.
+fn energy_skips(ef: &EnergyForce, axis: Axis) -> Vec<String> {
     [
         ("Eq. 7", &ef.eq7_skipped),
         ("dissipated energy", &ef.dissipation_skipped),
     ]
     .into_iter()
-    .filter_map(|(part, skip)| skip.as_ref().map(|s| format!("{part}: {s}")))
+    .filter_map(|(part, skip)| {
+        skip.as_ref()
+            .map(|s| format!("{part}: {}", s.describe(axis)))
+    })
     .collect()
 }
 
@@ -874,6 +878,21 @@ mod tests {
             "{}",
             f.message
         );
+    }
+
+    /// On a rotary axis the reason a part cannot judge speaks of torques: N m, never N.
+    #[test]
+    fn a_skipped_part_on_a_rotary_axis_gives_its_noise_in_newton_metres() {
+        let mut ef = energy_force(150.0, 1.0);
+        ef.eq7_skipped = Some(EnergySkip::NoisyReplay {
+            force_noise: 0.02,
+            level: 0.03,
+        });
+        let rotary = energy_balance("r", &ef, Axis::Rotary).message;
+        assert!(rotary.contains("0.020 N m of its noise"), "{rotary}");
+        assert!(rotary.contains("(0.030 N m)"), "{rotary}");
+        let linear = energy_balance("r", &ef, Axis::Linear).message;
+        assert!(linear.contains("0.020 N of its noise"), "{linear}");
     }
 
     #[test]

@@ -73,9 +73,12 @@ fn inconsistency(fit: &FitResult) -> Option<String> {
     }
     let resolution = velocity_resolution(fit);
     match value("v_s") {
-        Some(v_s) if v_s.abs() < resolution => Some(format!(
-            "its Stribeck velocity v_s = {v_s:.3e} m/s is below the records' velocity resolution {resolution:.3e} m/s"
-        )),
+        Some(v_s) if v_s.abs() < resolution => {
+            let unit = fit.oscillator.axis.unit("m/s");
+            Some(format!(
+                "its Stribeck velocity v_s = {v_s:.3e} {unit} is below the records' velocity resolution {resolution:.3e} {unit}"
+            ))
+        }
         _ => None,
     }
 }

@@ -221,6 +221,9 @@ pub enum Check {
     /// The residual RMS against the records' noise floor: a law that follows the records
     /// leaves only their noise.
     GoodnessOfFit,
+    /// A value the configuration left out and the run assumed (no damping given: c = 0),
+    /// stated so the reader knows what the numbers rest on.
+    Assumption,
 }
 
 /// One diagnostic of a fit: a check, its status, the value it judged and a plain message.

@@ -5,6 +5,7 @@ use super::uncertainty::StdErrorComponents;
 use super::outcome::{as_display, worst_status, Finding, StartOutcome, Status, TerminationReason};
 
 use super::search::Search;
+use crate::axis::Axis;
 use crate::oscillator::Oscillator;
 use frictionid_models::FrictionModel;
 use serde::Serialize;
@@ -327,36 +328,41 @@ pub enum EnergySkip {
     },
 }
 
-impl std::fmt::Display for EnergySkip {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+impl EnergySkip {
+    /// The reason in words, its forces and lengths in the units of `axis` (N m and rad on a
+    /// rotary axis).
+    pub fn describe(&self, axis: Axis) -> String {
+        let n = axis.force_unit();
+        let m = axis.displacement_unit();
         match self {
-            Self::NoHalfCycle => write!(f, "no complete half-cycle"),
+            Self::NoHalfCycle => "no complete half-cycle".to_string(),
             Self::FewSamples {
                 per_half_cycle,
                 needed,
-            } => write!(
-                f,
-                "{per_half_cycle} samples per half-cycle, at least {needed} needed"
-            ),
-            Self::Quantised { step, share } => write!(
-                f,
-                "the displacement's quantisation step {step:.3e} m makes the energies at the turning points uncertain by {:.1} % of the energy dissipated",
+            } => format!("{per_half_cycle} samples per half-cycle, at least {needed} needed"),
+            Self::Quantised { step, share } => format!(
+                "the {}'s quantisation step {step:.3e} {m} makes the energies at the turning points uncertain by {:.1} % of the energy dissipated",
+                axis.coordinate_name(),
                 100.0 * share
             ),
-            Self::NoisyReplay { force_noise, level } => write!(
-                f,
-                "the model's force replayed along the measured velocity carries {force_noise:.3} N of its noise, more than a third of the friction level ({level:.3} N)"
+            Self::NoisyReplay { force_noise, level } => format!(
+                "the model's force replayed along the measured velocity carries {force_noise:.3} {n} of its noise, more than a third of the friction level ({level:.3} {n})"
             ),
-            Self::NoisyDerivative { force_noise, level } => write!(
-                f,
-                "the noise of the Eq. 7 force ({force_noise:.3} N) is more than a third of the friction level ({level:.3} N)"
+            Self::NoisyDerivative { force_noise, level } => format!(
+                "the noise of the Eq. 7 force ({force_noise:.3} {n}) is more than a third of the friction level ({level:.3} {n})"
             ),
-            Self::IllConditioned { property, share } => write!(
-                f,
+            Self::IllConditioned { property, share } => format!(
                 "the friction's part is what remains after the viscous part of the fitted {property}, whose standard error alone moves it by {:.1} %: an ill-conditioned remainder the check cannot judge",
                 100.0 * share
             ),
         }
+    }
+}
+
+impl std::fmt::Display for EnergySkip {
+    /// The reason on a linear axis; [`EnergySkip::describe`] gives it on any axis.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.describe(Axis::Linear))
     }
 }
 

@@ -79,17 +79,19 @@ impl ForceTrack {
         let (used, target, sliding) = keep_sliding(used, target, &motion.v, opts.target.min_speed);
         if sliding.is_some_and(|s| s.kept < 2) {
             return Err(err(format!(
-                "{} samples slide with |v| >= [fit.options] min_speed = {} m/s; lower it",
+                "{} samples slide with |v| >= [fit.options] min_speed = {} {}; lower it",
                 target.len(),
-                opts.target.min_speed.unwrap_or_default()
+                opts.target.min_speed.unwrap_or_default(),
+                osc.axis.unit("m/s")
             )));
         }
         if target.len() < 2 {
             return Err(err(format!(
                 "{} samples to compare the model force with (Eq. 7 and the inverse-dynamics \
-                 force are masked where |v| <= [energy] velocity_threshold = {} m/s)",
+                 force are masked where |v| <= [energy] velocity_threshold = {} {})",
                 target.len(),
-                opts.energy.velocity_threshold
+                opts.energy.velocity_threshold,
+                osc.axis.unit("m/s")
             )));
         }
         let noise_channel = match source {
