@@ -11,6 +11,7 @@ mod fixtures;
 mod force_domain;
 mod html_report;
 mod outputs;
+mod plan;
 mod rotary;
 mod simulate_input;
 mod units;

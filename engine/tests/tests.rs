@@ -17,6 +17,7 @@ mod identify;
 mod inverse_dynamics;
 mod levels_as_forces;
 mod pendulum;
+mod plan;
 mod records;
 mod replay;
 mod robot_joint;

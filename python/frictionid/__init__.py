@@ -12,6 +12,8 @@ every fitted parameter then reports ``std_error_components`` and a total ``std_e
 - ``fit(oscillator, model, records, fit=None)``: a model fitted to records.
 - ``compare(oscillator, models, records, fit=None)``: several models ranked by AIC.
 - ``energy(oscillator, records, model=None, options=None)``: the energy-based force (Eq. 7).
+- ``plan(oscillator, model, plan, records=None, fit=None)``: which records to take next
+  (``frictionid plan``; ``plan`` is the ``[plan]`` table).
 - ``run(config_path, command="fit", out=None)``: a configuration file, as the CLI runs it.
 - ``campaign(config, manifest=None, executor=None, out=None)``: every group of a campaign
   (one task per group on any ``concurrent.futures`` executor), campaign.csv as a pandas
@@ -28,7 +30,7 @@ Bad input raises ``ValueError``; a fit that failed raises ``FitError``. Ctrl-C s
 import json
 
 from . import _native
-from ._native import FitError, energy, models, simulate
+from ._native import FitError, energy, models, plan, simulate
 from .campaign import campaign
 
 __all__ = [
@@ -39,6 +41,7 @@ __all__ = [
     "energy",
     "fit",
     "models",
+    "plan",
     "run",
     "simulate",
 ]

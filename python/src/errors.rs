@@ -49,7 +49,7 @@ pub fn engine_error(e: EngineError) -> PyErr {
 pub fn job_error(e: JobError) -> PyErr {
     let msg = one_line(&e.to_string());
     let input = match &e {
-        JobError::Spec(_) | JobError::Record { .. } => true,
+        JobError::Spec(_) | JobError::Record { .. } | JobError::Plan(_) => true,
         JobError::Simulation(inner) | JobError::ReferenceFit(inner) | JobError::Fit(inner) => {
             is_input_error(inner)
         }

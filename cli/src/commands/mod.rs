@@ -7,6 +7,7 @@ pub mod energy;
 pub mod export;
 pub mod fit;
 pub mod models;
+pub mod plan;
 pub mod simulate;
 
 use crate::args::OutputArgs;

@@ -20,6 +20,7 @@ pub mod html;
 pub mod json;
 pub mod markdown;
 pub mod models;
+pub mod plan;
 pub mod simulate;
 
 pub use campaign::{CampaignReport, GroupReport};
@@ -28,6 +29,7 @@ pub use energy::{EnergyRecord, EnergyReport};
 pub use fit::FitReport;
 pub use format::fmt_num;
 pub use models::ModelsReport;
+pub use plan::PlanReport;
 pub use simulate::{InputSeries, SimulateReport};
 
 /// Where a block belongs: in the short summary a terminal shows, or only in the full report.

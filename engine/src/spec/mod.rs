@@ -19,6 +19,7 @@ pub mod error;
 pub mod fit;
 pub mod model;
 pub mod oscillator;
+pub mod plan;
 pub mod resolve;
 pub mod simulation;
 
@@ -27,6 +28,7 @@ pub use self::error::SpecError;
 pub use self::fit::{FitSpec, RunChoices};
 pub use self::model::ModelSpec;
 pub use self::oscillator::{OscillatorSpec, OscillatorTable};
+pub use self::plan::{CandidateSpec, PlanSpec};
 pub use self::simulation::{
     IntegratorMethod, IntegratorSpec, SimulationInput, SimulationSpec, DEFAULT_SAMPLE_RATE,
     EULER_STEPS_PER_PERIOD,
