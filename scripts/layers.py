@@ -37,7 +37,7 @@ LAYERS = [
     ["exact", "synthetic"],
     ["testing"],
     ["identify"],
-    ["campaign"],
+    ["campaign", "plan"],
     ["spec", "report"],
     ["jobs", "export"],
 ]

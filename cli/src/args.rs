@@ -191,6 +191,19 @@ pub enum Command {
         #[command(flatten)]
         output: OutputArgs,
     },
+    /// Which records to take next: each candidate experiment's predicted standard errors
+    /// from the Fisher information at the assumed law, the recommended set, and the
+    /// parameters out of reach with the smallest change that would reach them.
+    #[command(
+        after_help = "Example:\n  frictionid plan fixtures/plan-stribeck.toml --out plan/\n\n\
+                      Writes report.json, report.md, report.html and predicted_std.svg."
+    )]
+    Plan {
+        /// The TOML configuration file, with a [plan] table.
+        config: PathBuf,
+        #[command(flatten)]
+        output: OutputArgs,
+    },
     /// Energy-based friction force of each record (the paper's Eq. 7) against the reference.
     #[command(
         after_help = "Example:\n  frictionid energy fixtures/fmm-energy.toml --out energy/\n\n\

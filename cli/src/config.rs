@@ -46,7 +46,7 @@ use crate::error::CliError;
 use frictionid_engine::campaign::CampaignSpec;
 use frictionid_engine::data::{DataError, RecordSource, RecordUse};
 use frictionid_engine::spec::{
-    EnergySpec, FitSpec, ModelSpec, OscillatorSpec, SimulationSpec, Spec, SpecError,
+    EnergySpec, FitSpec, ModelSpec, OscillatorSpec, PlanSpec, SimulationSpec, Spec, SpecError,
 };
 use frictionid_engine::Record;
 use frictionid_models::build_toml;
@@ -75,6 +75,8 @@ pub struct Config {
     pub record_defaults: RecordSource,
     /// The `[campaign]` table, if given.
     pub campaign: Option<CampaignSpec>,
+    /// The `[plan]` table, if given.
+    pub plan: Option<PlanSpec>,
 }
 
 /// One `[[records]]` entry, checked and resolved (the engine's shared record source).
@@ -95,6 +97,7 @@ struct RawConfig {
     #[serde(default)]
     records: Vec<RecordSource>,
     campaign: Option<CampaignSpec>,
+    plan: Option<PlanSpec>,
 }
 
 use frictionid_models::suggest::did_you_mean as hint;
@@ -292,6 +295,7 @@ impl Config {
             records,
             record_defaults,
             campaign: raw.campaign,
+            plan: raw.plan,
         })
     }
 

@@ -78,6 +78,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         }
         Command::Simulate { config, output } => commands::simulate::run(&config, &output),
         Command::Energy { config, output } => commands::energy::run(&config, &output),
+        Command::Plan { config, output } => commands::plan::run(&config, &output),
         Command::Fit { config, output } => commands::fit::run(&config, &output),
         Command::Compare {
             config,

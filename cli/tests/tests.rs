@@ -14,6 +14,7 @@ mod force_domain;
 mod html_report;
 mod init;
 mod outputs;
+mod plan;
 mod rotary;
 mod simulate_input;
 mod units;

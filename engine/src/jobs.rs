@@ -50,6 +50,9 @@ pub enum JobError {
     /// The identifier could not run.
     #[error(transparent)]
     Fit(EngineError),
+    /// The plan cannot be made.
+    #[error(transparent)]
+    Plan(#[from] crate::plan::PlanError),
     /// Every model of a comparison failed; the reasons, one per model.
     #[error("no model could be fitted ({})", .0.join("; "))]
     NothingFitted(Vec<String>),
@@ -521,4 +524,72 @@ mod tests {
         assert_eq!(record_reference(None, Some(&model), &friction), 3.0);
         assert!(record_reference(None, None, &friction).is_nan());
     }
+}
+
+/// What `plan` reads besides the spec: the records already taken, each candidate's input
+/// record (`None` where it names no file), the record whose noise level the candidates take,
+/// and a previous fit's law with the report's name (instead of `[model]`).
+#[derive(Default)]
+pub struct PlanInputs<'a> {
+    /// The `[[records]]` already taken.
+    pub taken: &'a [Record],
+    /// Each candidate's input record.
+    pub candidate_inputs: &'a [Option<Record>],
+    /// `[plan] noise_record`, read.
+    pub noise_record: Option<&'a Record>,
+    /// `[plan] prior`: the fitted law and where it comes from.
+    pub prior: Option<(Box<dyn FrictionModel>, String)>,
+}
+
+/// `plan`: the records to take next ([`crate::plan::plan`]) from `[plan]`, the oscillator,
+/// the assumed law (`[model]` or the prior) and what `[fit]` frees.
+pub fn plan_job(
+    spec: &Spec,
+    plan_spec: &crate::spec::PlanSpec,
+    inputs: PlanInputs<'_>,
+) -> Result<crate::report::PlanReport, JobError> {
+    use crate::plan::{plan, Assumed, Noise, PlanRequest};
+    let (model, from) = match inputs.prior {
+        Some((law, source)) => (law, format!("the prior `{source}`")),
+        None => (
+            spec.require_model("plan")?.model.clone(),
+            "[model]".to_string(),
+        ),
+    };
+    let estimated = inputs
+        .noise_record
+        .and_then(|r| r.noise_level(Channel::Velocity));
+    if inputs.noise_record.is_some() && estimated.is_none() {
+        return Err(SpecError::Plan(
+            "noise_record: no velocity noise level can be estimated".into(),
+        )
+        .into());
+    }
+    let options = spec.fit_options(&[], &Hooks::default());
+    let request = PlanRequest {
+        assumed: Assumed {
+            oscillator: spec.oscillator,
+            model: model.as_ref(),
+            params: options.params,
+            sim: options.sim,
+        },
+        candidates: plan_spec.experiments(inputs.candidate_inputs)?,
+        taken: inputs.taken.to_vec(),
+        targets: Some(plan_spec.parameters.clone()),
+        choose: plan_spec.choose,
+        criterion: plan_spec.criterion,
+        noise: Noise {
+            velocity: plan_spec.velocity_noise.or(estimated),
+            correlation: plan_spec.noise_correlation,
+        },
+        reach: plan_spec.reach,
+        suggest: plan_spec.suggest,
+    };
+    let made = plan(&request)?;
+    Ok(crate::report::PlanReport::new(
+        made,
+        model.name(),
+        &from,
+        plan_spec.choose,
+    ))
 }

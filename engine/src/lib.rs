@@ -48,6 +48,7 @@ pub mod export;
 pub mod identify;
 pub mod jobs;
 pub mod oscillator;
+pub mod plan;
 pub mod record;
 pub mod report;
 pub mod simulate;

@@ -19,6 +19,7 @@ mod identify;
 mod inverse_dynamics;
 mod levels_as_forces;
 mod pendulum;
+mod plan;
 mod polynomial_spring;
 mod records;
 mod replay;

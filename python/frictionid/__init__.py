@@ -17,6 +17,8 @@ total ``std_error``.
   use, a ``CompareResult``.
 - ``energy(oscillator, records, model=None, options=None)``: the energy-based force (Eq. 7),
   an ``EnergyResult``.
+- ``plan(oscillator, model, plan, records=None, fit=None)``: which records to take next
+  (``frictionid plan``; ``plan`` is the ``[plan]`` table), report.json's dict.
 - ``run(config_path, command="fit", out=None)``: a configuration file, as the CLI runs it;
   returns what the function of the same name returns. Nothing is written unless ``out``
   names a folder (then the CLI's report folder is written there too).
@@ -39,7 +41,7 @@ Bad input raises ``ValueError``; a fit that failed raises ``FitError``. Ctrl-C s
 """
 
 from . import _native
-from ._native import FitError, models
+from ._native import FitError, models, plan
 from .campaign import campaign
 from .results import CompareResult, EnergyResult, FitResult, SimulateResult, result_of
 
@@ -54,6 +56,7 @@ __all__ = [
     "energy",
     "fit",
     "models",
+    "plan",
     "run",
     "simulate",
 ]
@@ -91,9 +94,11 @@ def energy(oscillator, records, model=None, options=None):
 def run(config_path, command="fit", out=None):
     """A configuration file run as ``frictionid <command>`` runs it: the result object the
     function of the same name returns (``models``: the listing). Nothing is written unless
-    ``out`` names a folder; then the CLI's report folder (report.json, .md, .html, plots) is
+    ``out`` names a folder (``plan``: report.json's dict); then the CLI's report folder (report.json, .md, .html, plots) is
     written there as ``frictionid <command> CONFIG --out OUT`` writes it."""
     native = _native.run(str(config_path), command, None if out is None else str(out))
     if command in _COMMANDS:
         return result_of(command, native)
+    if command == "plan":
+        return native[0]
     return native

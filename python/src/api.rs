@@ -268,3 +268,45 @@ pub fn energy<'py>(
     })?;
     energy_output(py, &report)
 }
+
+/// Which records to take next, as `frictionid plan` says: `plan` is the `[plan]` table as a
+/// dict (candidates released or driven by a multisine; input files, `noise_record` and
+/// `prior` are read by `run(config, "plan")`), `records` the records already taken, `fit`
+/// what a fit would free. Returns report.json's structure.
+#[pyfunction]
+#[pyo3(signature = (oscillator, model, plan, records = None, fit = None))]
+pub fn plan<'py>(
+    py: Python<'py>,
+    oscillator: &Bound<'py, PyAny>,
+    model: &Bound<'py, PyAny>,
+    plan: &Bound<'py, PyAny>,
+    records: Option<&Bound<'py, PyAny>>,
+    fit: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    use frictionid_engine::jobs::{plan_job, PlanInputs};
+    use frictionid_engine::spec::PlanSpec;
+    let spec = spec_from(oscillator, Some(inputs::model(model)?), fit, None)?;
+    let plan_spec: PlanSpec = serde_json::from_value(to_json(plan, "plan")?)
+        .map_err(|e| value_error(format!("plan: {e}")))?;
+    let files = plan_spec.candidates.iter().any(|c| c.input.is_some())
+        || plan_spec.noise_record.is_some()
+        || plan_spec.prior.is_some();
+    if files {
+        return Err(value_error(
+            "plan: input files, noise_record and prior are read by run(config, \"plan\"); \
+             give multisines, velocity_noise and the model here",
+        ));
+    }
+    let taken = match records.filter(|r| !r.is_none()) {
+        Some(r) => inputs::records(r)?,
+        None => Vec::new(),
+    };
+    let report = run_job(py, move |_hooks| {
+        let given = PlanInputs {
+            taken: &taken,
+            ..PlanInputs::default()
+        };
+        plan_job(&spec, &plan_spec, given).map_err(job_error)
+    })?;
+    serialized(py, &report)
+}

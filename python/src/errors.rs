@@ -48,7 +48,7 @@ pub fn engine_error(e: EngineError) -> PyErr {
 /// Whether a job's error is about its input rather than a computation that failed.
 fn is_input_job_error(e: &JobError) -> bool {
     match e {
-        JobError::Spec(_) | JobError::Record { .. } => true,
+        JobError::Spec(_) | JobError::Record { .. } | JobError::Plan(_) => true,
         JobError::Simulation(inner) | JobError::ReferenceFit(inner) | JobError::Fit(inner) => {
             is_input_error(inner)
         }

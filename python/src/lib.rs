@@ -39,6 +39,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(api::fit, m)?)?;
     m.add_function(wrap_pyfunction!(api::compare, m)?)?;
     m.add_function(wrap_pyfunction!(api::energy, m)?)?;
+    m.add_function(wrap_pyfunction!(api::plan, m)?)?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_function(wrap_pyfunction!(export::export, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::campaign_plan, m)?)?;

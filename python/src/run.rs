@@ -3,6 +3,7 @@
 //! forms). The CLI's report folder is written only when `out` names one.
 
 use crate::api::{models, run_job};
+use crate::convert::serialized;
 use crate::errors::{job_error_as, value_error};
 use crate::outputs::{compare_output, energy_output, fit_output, simulate_output};
 use frictionid_cli::args::OutputArgs;
@@ -12,11 +13,11 @@ use frictionid_engine::jobs::{compare_job, energy_job, fit_job, simulate_job, Jo
 use frictionid_engine::report::{CompareReport, EnergyReport, FitReport, SimulateReport};
 use frictionid_engine::spec::Hooks;
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
+use pyo3::types::{PyDict, PyTuple};
 use std::path::{Path, PathBuf};
 
 /// The commands [`run`] knows besides `models`.
-const COMMANDS: [&str; 4] = ["simulate", "fit", "compare", "energy"];
+const COMMANDS: [&str; 5] = ["simulate", "fit", "compare", "energy", "plan"];
 
 /// A configuration problem (the file, its records) as a `ValueError` with the CLI's text.
 fn config_error(e: impl Into<anyhow::Error>) -> PyErr {
@@ -76,6 +77,12 @@ fn simulate_report(config: &Path) -> PyResult<SimulateReport> {
 
 /// The report of `command` on `config` as `(dict, texts)`.
 fn computed<'py>(py: Python<'py>, config: PathBuf, command: &str) -> PyResult<Bound<'py, PyTuple>> {
+    if command == "plan" {
+        let report = py
+            .detach(|| commands::plan::report(&config))
+            .map_err(config_error)?;
+        return PyTuple::new(py, [serialized(py, &report)?, PyDict::new(py).into_any()]);
+    }
     let (dict, texts) = match command {
         "fit" => fit_output(py, &run_job(py, move |h| fit_report(&config, &h))?)?,
         "compare" => compare_output(py, &run_job(py, move |h| compare_report(&config, &h))?)?,
@@ -97,12 +104,13 @@ fn write_folder(py: Python<'_>, config: &Path, command: &str, out: PathBuf) -> P
         "fit" => commands::fit::run(config, &output),
         "compare" => commands::compare::run(config, None, &output),
         "energy" => commands::energy::run(config, &output),
+        "plan" => commands::plan::run(config, &output),
         _ => commands::simulate::run(config, &output),
     });
     ran.map(|_| ()).map_err(config_error)
 }
 
-/// Runs `command` (`fit`, `compare`, `energy`, `simulate` or `models`) on a configuration
+/// Runs `command` (`fit`, `compare`, `energy`, `simulate`, `plan` or `models`) on a configuration
 /// file as the CLI does; returns `(dict, texts)` as the module's functions do (`models`: the
 /// listing). With `out`, the CLI's report folder is written there too (the job runs again,
 /// in the CLI's own code, so the folder is exactly the CLI's); without it nothing is written.
@@ -119,7 +127,7 @@ pub fn run<'py>(
     }
     if !COMMANDS.contains(&command) {
         return Err(value_error(format!(
-            "unknown command `{command}`; one of: simulate, fit, compare, energy, models"
+            "unknown command `{command}`; one of: simulate, fit, compare, energy, plan, models"
         )));
     }
     let result = computed(py, config_path.clone(), command)?;

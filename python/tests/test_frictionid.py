@@ -320,3 +320,25 @@ def test_a_fit_exports_its_law_as_source():
     assert "pub struct Law" in result.export("rust")
     with pytest.raises(ValueError, match="fortran"):
         result.export("fortran")
+
+
+def test_plan_adds_the_information_of_the_recommended_records():
+    """A Coulomb coefficient's information adds over records: the recommended pair's
+    standard error is (sum 1/s_i^2)^-1/2 of its two candidates'."""
+    plan = {
+        "choose": 2,
+        "velocity_noise": 2e-4,
+        "candidates": [
+            {"x0": 0.004, "duration": 1.0},
+            {"x0": 0.010, "duration": 1.0},
+            {"x0": 0.022, "duration": 1.0, "velocity_noise": 1e-3},
+        ],
+    }
+    report = frictionid.plan(FMM, {"type": "coulomb", "mu": 0.2}, plan)
+    stds = [c["predicted_std"]["mu"] for c in report["candidates"]]
+    chosen = report["recommended"]
+    assert len(chosen) == 2
+    combined = sum(stds[i] ** -2 for i in chosen) ** -0.5
+    assert math.isclose(report["predicted_std"]["mu"], combined, rel_tol=1e-9)
+    with pytest.raises(ValueError, match="choose = 4"):
+        frictionid.plan(FMM, {"type": "coulomb", "mu": 0.2}, {**plan, "choose": 4})

@@ -9,6 +9,7 @@ pub mod fit;
 pub mod help;
 pub mod init;
 pub mod models;
+pub mod plan;
 pub mod simulate;
 
 use crate::args::OutputArgs;

@@ -7,6 +7,7 @@
 
 mod charts;
 mod panel;
+mod plan;
 pub mod sets;
 mod trends;
 
@@ -14,6 +15,7 @@ pub use charts::{
     force_against_motion, force_balance, friction_force, input_force, over_time, response_fit,
     steady_state_curves, MotionAxis, Quantity, View,
 };
+pub use plan::{plan_plots, PLAN_PLOT};
 pub use trends::trend_plots;
 
 use crate::error::CliError;

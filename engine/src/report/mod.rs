@@ -20,6 +20,7 @@ pub mod html;
 pub mod json;
 pub mod markdown;
 pub(crate) mod models;
+pub mod plan;
 pub(crate) mod recommendation;
 pub(crate) mod simulate;
 
@@ -29,6 +30,7 @@ pub use energy::{EnergyRecord, EnergyReport};
 pub use fit::FitReport;
 pub use format::{fmt_num, serialized_name};
 pub use models::ModelsReport;
+pub use plan::PlanReport;
 pub use simulate::{InputSeries, SimulateReport};
 
 /// Where a block belongs: in the short summary a terminal shows, or only in the full report.

@@ -78,6 +78,9 @@ pub enum SpecError {
         /// Where: at rest, or a record's velocity and time.
         place: String,
     },
+    /// A value out of range or a key missing in `[plan]`.
+    #[error("[plan]: {0}")]
+    Plan(String),
     /// A model error.
     #[error(transparent)]
     Model(#[from] ModelError),

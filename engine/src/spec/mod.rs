@@ -19,6 +19,7 @@ pub(crate) mod error;
 pub(crate) mod fit;
 pub(crate) mod model;
 pub(crate) mod oscillator;
+pub(crate) mod plan;
 pub(crate) mod resolve;
 pub(crate) mod simulation;
 
@@ -27,6 +28,7 @@ pub use self::error::SpecError;
 pub use self::fit::{FitSpec, RunChoices};
 pub use self::model::ModelSpec;
 pub use self::oscillator::{OscillatorSpec, OscillatorTable};
+pub use self::plan::{prior_model, CandidateSpec, PlanSpec};
 pub use self::simulation::{
     IntegratorMethod, IntegratorSpec, SimulationInput, SimulationSpec, DEFAULT_SAMPLE_RATE,
     EULER_STEPS_PER_PERIOD,
