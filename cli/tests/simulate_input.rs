@@ -13,12 +13,13 @@ const PUSH: f64 = 10.0;
 const COULOMB: f64 = 2.0;
 
 /// The slide (no restoring force; the Coulomb level is a force over N = 1) and a one-second
-/// simulation at 1 kHz driven by `drive.csv`.
+/// simulation at 1 kHz driven by `drive.csv`, from rest at 0 (no `x0`: a driven axis starts
+/// where it is).
 fn config(input: &str) -> String {
     format!(
         "[oscillator]\nmass = {MASS}\ndamping = {DAMPING}\nnormal_force = 1.0\n\
          restoring = {{ type = \"none\" }}\n[model]\ntype = \"coulomb\"\nmu = {COULOMB}\n\
-         [simulation]\nx0 = 0.0\nduration = 1.0\n{input}"
+         [simulation]\nduration = 1.0\n{input}"
     )
 }
 

@@ -95,7 +95,7 @@ pub const DEFAULT_SAMPLE_RATE: f64 = 1000.0;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "SimulationInput")]
 pub struct SimulationSpec {
-    /// Release displacement \[m\].
+    /// Release displacement \[m\] (an axis driven by `input`: the start, 0 by default).
     pub x0: f64,
     /// Release velocity \[m/s\].
     pub v0: f64,
@@ -160,11 +160,21 @@ fn required(what: &str, meaning: &str, value: Option<f64>) -> Result<f64, SpecEr
     value.ok_or_else(|| SpecError::Simulation(format!("missing `{what}` ({meaning})")))
 }
 
+/// The displacement the simulation starts from: a free vibration needs its release `x0`; an
+/// axis driven by a measured input starts at rest where it is, at 0 unless `x0` is given.
+fn start_displacement(x0: Option<f64>, driven: bool) -> Result<f64, SpecError> {
+    match x0 {
+        Some(x0) => Ok(x0),
+        None if driven => Ok(0.0),
+        None => required("x0", "the release displacement, m", None),
+    }
+}
+
 impl TryFrom<SimulationInput> for SimulationSpec {
     type Error = SpecError;
 
     fn try_from(s: SimulationInput) -> Result<Self, SpecError> {
-        let x0 = required("x0", "the release displacement, m", s.x0)?;
+        let x0 = start_displacement(s.x0, s.input.is_some())?;
         let duration = required("duration", "the simulated time, s", s.duration)?;
         if let Some(n) = s.noise.filter(|n| !(n.is_finite() && *n >= 0.0)) {
             return Err(SpecError::Simulation(format!(
@@ -204,6 +214,25 @@ impl SimulationSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A free vibration needs its release; a driven axis starts at 0 unless told otherwise.
+    #[test]
+    fn only_a_free_vibration_needs_its_release_displacement() {
+        let free: Result<SimulationSpec, _> =
+            serde_json::from_value(serde_json::json!({"duration": 1.0}));
+        let e = free.unwrap_err().to_string();
+        assert!(e.contains("missing `x0`"), "{e}");
+        let input = serde_json::json!({"file": "drive.csv", "input_force_column": "u"});
+        let driven: SimulationSpec =
+            serde_json::from_value(serde_json::json!({"duration": 1.0, "input": input}))
+                .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(driven.x0, 0.0);
+        let placed: SimulationSpec = serde_json::from_value(
+            serde_json::json!({"duration": 1.0, "x0": 0.02, "input": input}),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(placed.x0, 0.02);
+    }
 
     #[test]
     fn integrator_spec_maps_onto_engine_options() {
