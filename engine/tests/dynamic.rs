@@ -2,16 +2,12 @@
 //! noise, the oracle): the
 //! default configuration names only the model; the truths are independent of the fit.
 
-use crate::util::{lugre_truth, records, stiff_lugre_truth, NOISE};
+use crate::util::{lugre_truth, records, rel, stiff_lugre_truth, NOISE};
 use frictionid_engine::identify::{
     fit, FitOptions, FitResult, Identifiability, Search, SearchOptions,
 };
 use frictionid_engine::Oscillator;
 use frictionid_models::{Coulomb, Dahl, FrictionModel, Gms, LuGre};
-
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
-}
 
 /// Every free parameter of `truth` is within 3 standard errors of its true value, or the
 /// fit flags it as not determined; returns (and prints) the table of errors.

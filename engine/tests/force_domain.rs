@@ -3,7 +3,9 @@
 //! classical Runge-Kutta scheme (not the engine's stepper); and the energy-based route
 //! (Eq. 7, no force sensor) on the exact Coulomb free vibration and on Stribeck records.
 
-use crate::util::{force_route_options, measured_force_options, records, stribeck_truth, NOISE};
+use crate::util::{
+    force_route_options, measured_force_options, records, rel, stribeck_truth, NOISE,
+};
 use frictionid_engine::exact::coulomb_free_vibration;
 use frictionid_engine::identify::{fit, FitOptions, ForceTarget, TargetOptions};
 use frictionid_engine::record::{Channel, TimeBase};
@@ -11,10 +13,6 @@ use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{Coulomb, FrictionModel, LuGre, Stribeck};
 use std::f64::consts::PI;
-
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
-}
 
 /// The prescribed motion: x = A sin(w t), 5 mm at 2 Hz.
 const AMPLITUDE: f64 = 5e-3;

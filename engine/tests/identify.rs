@@ -1,14 +1,10 @@
 //! The identifier against known truths: synthetic FMM records made by the engine from a known
 //! model, with Gaussian noise of 2e-4 m/s and fixed seeds.
 
-use crate::util::{lugre_truth, records, stribeck_truth, NOISE};
+use crate::util::{lugre_truth, records, rel, stribeck_truth, NOISE};
 use frictionid_engine::identify::{compare, fit, FitOptions, OscillatorParam, ParamOptions};
 use frictionid_engine::{Integrator, Oscillator, SimOptions};
 use frictionid_models::{default_model, Coulomb, FrictionModel, LuGre, NoFriction, Stribeck};
-
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
-}
 
 #[test]
 fn coulomb_mu_is_recovered_from_any_start() {

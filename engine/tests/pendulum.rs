@@ -5,11 +5,11 @@
 //! (angle in degrees, quantised to 0.09 deg, 1 kHz) and read back with
 //! `displacement_scale = pi / 180`.
 
+use crate::util::{fit_coulomb_and_properties, rel};
 use frictionid_engine::axis::{Axis, Pendulum, Restoring};
 use frictionid_engine::data::RecordSource;
-use frictionid_engine::identify::{fit, FitOptions, FitResult, OscillatorParam, ParamOptions};
+use frictionid_engine::identify::{FitResult, OscillatorParam};
 use frictionid_engine::{Oscillator, Record};
-use frictionid_models::Coulomb;
 use std::f64::consts::PI;
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -122,18 +122,7 @@ fn pendulum(gravity_moment: f64, damping: f64) -> Oscillator {
 }
 
 fn fit_with(start: &Oscillator, free: Vec<OscillatorParam>, records: &[Record]) -> FitResult {
-    let opts = FitOptions {
-        params: ParamOptions {
-            oscillator: free,
-            ..ParamOptions::default()
-        },
-        ..FitOptions::default()
-    };
-    fit(start, &Coulomb { mu: 0.02 }, records, &opts).expect("a fit")
-}
-
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
+    fit_coulomb_and_properties(start, 0.02, free, records)
 }
 
 #[test]

@@ -4,8 +4,9 @@
 //! damping and the Coulomb torque recovers them; the linear spring fitted to the same record
 //! leaves a residual at least twice as large.
 
+use crate::util::{fit_coulomb_and_properties, rel};
 use frictionid_engine::axis::{Axis, Polynomial, Restoring};
-use frictionid_engine::identify::{fit, FitOptions, FitResult, OscillatorParam, ParamOptions};
+use frictionid_engine::identify::{FitResult, OscillatorParam};
 use frictionid_engine::synthetic::release_records;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::Coulomb;
@@ -54,18 +55,7 @@ fn records() -> Vec<Record> {
 }
 
 fn fit_with(start: &Oscillator, free: Vec<OscillatorParam>, records: &[Record]) -> FitResult {
-    let opts = FitOptions {
-        params: ParamOptions {
-            oscillator: free,
-            ..ParamOptions::default()
-        },
-        ..FitOptions::default()
-    };
-    fit(start, &Coulomb { mu: 0.002 }, records, &opts).expect("a fit")
-}
-
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
+    fit_coulomb_and_properties(start, 0.002, free, records)
 }
 
 #[test]

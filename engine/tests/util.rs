@@ -4,13 +4,37 @@
 
 use frictionid_engine::axis::{NoRestoring, Restoring};
 use frictionid_engine::identify::{
-    FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam, TargetOptions,
+    fit, FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam, ParamOptions,
+    TargetOptions,
 };
 use frictionid_engine::oscillator::{OscillatorProperty, PartialOscillator};
 use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid, Trajectory};
 use frictionid_engine::synthetic::release_records;
 use frictionid_engine::{Initial, Oscillator, Record, SimOptions};
-use frictionid_models::{FrictionModel, LuGre, Stribeck};
+use frictionid_models::{Coulomb, FrictionModel, LuGre, Stribeck};
+
+/// |a - b| / |b|: the relative error of `a` against the truth `b`.
+pub fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+/// Coulomb friction of start level `mu` fitted to `records` from `start`, with the
+/// oscillator properties `free` fitted alongside (the rest of the options the defaults).
+pub fn fit_coulomb_and_properties(
+    start: &Oscillator,
+    mu: f64,
+    free: Vec<OscillatorParam>,
+    records: &[Record],
+) -> FitResult {
+    let opts = FitOptions {
+        params: ParamOptions {
+            oscillator: free,
+            ..ParamOptions::default()
+        },
+        ..FitOptions::default()
+    };
+    fit(start, &Coulomb { mu }, records, &opts).expect("a fit")
+}
 
 /// The releases of the paper: 10, 14 and 22 mm.
 pub const RELEASES: [f64; 3] = [0.010, 0.014, 0.022];

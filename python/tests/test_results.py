@@ -151,7 +151,7 @@ def test_compare_recommends_the_simpler_true_law(compared):
     table = compared.ranking_table
     assert list(table.index) == [f["model"] for f in compared["ranking"]]
     assert table["recommended"].tolist() == [m == "coulomb" for m in table.index]
-    assert "use `coulomb`" in compared.verdict
+    assert compared.verdict.startswith("recommended: `coulomb`")
     assert "coulomb" in compared.report() and "viscous_coulomb" in compared.report()
     # Each law's own report is a fit report of that law.
     assert "| viscous |" in compared.results["viscous_coulomb"].report("markdown")
