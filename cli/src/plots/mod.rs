@@ -465,7 +465,8 @@ mod tests {
             assert!(svg.contains(text), "missing {text}");
         }
     }
-    /// A figure drawn on a rotary axis labels its velocity in rad/s and its force in N m.
+    /// A figure drawn on a rotary axis labels its velocity in rad/s, its friction as a torque
+    /// in N m and its displacement as an angle in rad.
     #[test]
     fn rotary_figures_label_angles_and_torques() {
         let t = [0.0, 0.5, 1.0];
@@ -475,12 +476,15 @@ mod tests {
             vec![
                 Panel::new("velocity", "m/s").with(Series::solid("v", &t, &y)),
                 Panel::new("friction force", "N").with(Series::solid("F", &t, &y)),
+                Panel::new("displacement", "m").with(Series::solid("x", &t, &y)),
             ],
         )
         .on(Axis::Rotary);
         let svg = render(&fig).unwrap();
         assert!(svg.contains("velocity [rad/s]"));
-        assert!(svg.contains("friction force [N m]"));
+        assert!(svg.contains("friction torque [N m]"));
+        assert!(svg.contains("angle [rad]"));
+        assert!(!svg.contains("displacement"));
         assert!(!svg.contains("[m/s]"));
     }
 }

@@ -5,14 +5,33 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-/// An axis's description `label [unit]`, the unit (written for a linear axis) shown on the
-/// figure's axis: the one place a plot's units pass through [`frictionid_engine::Axis::unit`].
+/// An axis's description `label [unit]`, the label and unit (written for a linear axis) shown
+/// on the figure's axis: the one place a plot's units pass through
+/// [`frictionid_engine::Axis::unit`] and its quantities through [`quantity_on`].
 fn axis_text(fig: &Figure<'_>, label: &str, unit: &str) -> String {
+    let label = quantity_on(fig.axis, label);
     if unit.is_empty() {
-        label.to_string()
+        label
     } else {
         format!("{label} [{}]", fig.axis.unit(unit))
     }
+}
+
+/// `label`, written for a linear axis, on `axis`: on a rotary one a displacement is an angle
+/// and a force a torque ("friction force" -> "friction torque").
+fn quantity_on(axis: frictionid_engine::Axis, label: &str) -> String {
+    if axis.is_linear() {
+        return label.to_string();
+    }
+    label
+        .split(' ')
+        .map(|word| match word {
+            "displacement" => "angle",
+            "force" => "torque",
+            other => other,
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// Tick label for `v` on an axis spanning `span`: round-off next to zero shows as 0, and the
