@@ -60,8 +60,8 @@ pub fn run(
     Ok(())
 }
 
-/// The data file as the config names it: its name when both sit in one directory, else its
-/// absolute path.
+/// The data file as the config names it: relative to the config's directory when it lies in
+/// it or below it (its name when both sit in one directory), else its absolute path.
 fn record_path(datafile: &Path, config: &Path) -> String {
     let dir = |p: &Path| {
         p.parent()
@@ -74,9 +74,13 @@ fn record_path(datafile: &Path, config: &Path) -> String {
             })
             .and_then(|d| d.canonicalize().ok())
     };
-    match (dir(datafile), dir(config), datafile.file_name()) {
-        (Some(a), Some(b), Some(name)) if a == b => name.to_string_lossy().into_owned(),
-        _ => datafile
+    let below = match (dir(datafile), dir(config), datafile.file_name()) {
+        (Some(a), Some(b), Some(name)) => a.strip_prefix(&b).ok().map(|rel| rel.join(name)),
+        _ => None,
+    };
+    match below {
+        Some(relative) => relative.display().to_string(),
+        None => datafile
             .canonicalize()
             .unwrap_or_else(|_| PathBuf::from(datafile))
             .display()
@@ -382,6 +386,23 @@ fn summary(found: &Survey, plan: &Plan, config: &Path) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A config beside or above its data file names it relatively, so the two travel
+    /// together; elsewhere it names it absolutely.
+    #[test]
+    fn the_record_path_is_relative_to_the_config_where_it_can_be() {
+        let root =
+            std::env::temp_dir().join(format!("frictionid-init-path-{}", std::process::id()));
+        let data_dir = root.join("data").join("run1");
+        std::fs::create_dir_all(&data_dir).unwrap();
+        let data = data_dir.join("v.csv");
+        std::fs::write(&data, "time,velocity\n0,0\n").unwrap();
+        assert_eq!(record_path(&data, &data_dir.join("c.toml")), "v.csv");
+        assert_eq!(record_path(&data, &root.join("c.toml")), "data/run1/v.csv");
+        let elsewhere = record_path(&data, &data_dir.join("..").join("other").join("c.toml"));
+        assert!(Path::new(&elsewhere).is_absolute(), "{elsewhere}");
+        let _ = std::fs::remove_dir_all(&root);
+    }
 
     #[test]
     fn significant_digits() {
