@@ -5,7 +5,7 @@
 //! free vibration measured by its velocity, an estimate of the release displacement. What
 //! the file cannot decide is listed with the key that decides it, never guessed.
 
-use super::layout::{sniff_layout, DecimalMark, Delimiter, SNIFF_LINES};
+use super::layout::{sniff_layout, DecimalMark, Delimiter, Layout, SNIFF_LINES};
 use super::units::{split_unit, unit_of, Quantity, Unit};
 use super::{
     into_text, read_bytes, read_delimited, resolve_format, Channel, DataError, DataFormat,
@@ -121,34 +121,9 @@ impl Survey {
 /// Errors: the file cannot be read, is not delimited text, has no header row over rows of
 /// numbers, no time column, or its rows do not read.
 pub fn survey(path: &Path) -> Result<Survey, DataError> {
-    let refused = |reason: String| DataError::Empty {
-        file: path.to_path_buf(),
-        reason,
-    };
-    if matches!(
-        resolve_format(path, DataFormat::Auto),
-        DataFormat::Mat | DataFormat::Uff58
-    ) {
-        return Err(refused(
-            "init reads delimited text; write the [[records]] entry of a MAT-file or UFF file \
-             by hand (docs/config.md)"
-                .into(),
-        ));
-    }
+    refuse_binary(path)?;
     let text = into_text(read_bytes(path)?);
-    let all: Vec<(usize, &str)> = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim_end_matches('\r')))
-        .filter(|(_, l)| !l.trim().is_empty())
-        .take(4 * SNIFF_LINES)
-        .collect();
-    let content: Vec<(usize, &str)> = all
-        .iter()
-        .copied()
-        .filter(|(_, l)| !l.trim_start().starts_with('#'))
-        .take(SNIFF_LINES)
-        .collect();
+    let (all, content) = first_lines(&text);
     let layout = sniff_layout(
         &content,
         DataFormat::Auto,
@@ -157,49 +132,18 @@ pub fn survey(path: &Path) -> Result<Survey, DataError> {
     );
     let header = content.get(layout.header).filter(|_| layout.found);
     let Some(&(header_line, header_text)) = header else {
-        return Err(refused(format!(
-            "no header row of column names above rows of numbers in the first {SNIFF_LINES} \
-             lines; give `delimiter` and `decimal` in a [[records]] entry"
-        )));
+        return Err(refused(
+            path,
+            format!(
+                "no header row of column names above rows of numbers in the first \
+                 {SNIFF_LINES} lines; give `delimiter` and `decimal` in a [[records]] entry"
+            ),
+        ));
     };
     let names = layout.separator.split(header_text);
     let mut undecided = Vec::new();
     let columns = assign_roles(&names, &mut undecided);
-    let time = columns
-        .iter()
-        .find(|c| c.role == Some(Role::Time))
-        .ok_or_else(|| {
-            refused(format!(
-                "line {header_line}: no time column among {}; name it with `time_column`",
-                names.join(", ")
-            ))
-        })?;
-    if !columns
-        .iter()
-        .any(|c| matches!(c.role, Some(Role::Channel(_))))
-    {
-        return Err(refused(format!(
-            "line {header_line}: no column's name or unit says velocity, displacement, \
-             acceleration or force among {}; name it with `velocity_column` (or another \
-             channel's `*_column`)",
-            names.join(", ")
-        )));
-    }
-    let mut opts = ReadOptions {
-        delimiter: layout.separator.delimiter(),
-        decimal: layout.decimal,
-        channels: BTreeMap::new(),
-        ..ReadOptions::default()
-    };
-    opts.time.column = time.name.clone();
-    opts = opts.with_time_scale(time.scale.unwrap_or(1.0));
-    for c in &columns {
-        if let Some(Role::Channel(channel)) = c.role {
-            opts = opts
-                .with_column(channel, c.name.clone())
-                .with_scale(channel, c.scale.unwrap_or(1.0));
-        }
-    }
+    let opts = read_options(path, &layout, &columns, header_line, &names)?;
     let record = read_delimited(path, &text, DataFormat::Auto, &opts)?;
     let axis = axis_of(&columns, &mut undecided);
     let preamble_lines = all.iter().take_while(|(l, _)| *l < header_line).count();
@@ -221,6 +165,105 @@ pub fn survey(path: &Path) -> Result<Survey, DataError> {
         },
         &record,
     ))
+}
+
+/// The survey's refusal of `path` for `reason`.
+fn refused(path: &Path, reason: String) -> DataError {
+    DataError::Empty {
+        file: path.to_path_buf(),
+        reason,
+    }
+}
+
+/// MAT-files and UFF files are not surveyed: their variables are named by hand.
+fn refuse_binary(path: &Path) -> Result<(), DataError> {
+    if matches!(
+        resolve_format(path, DataFormat::Auto),
+        DataFormat::Mat | DataFormat::Uff58
+    ) {
+        return Err(refused(
+            path,
+            "init reads delimited text; write the [[records]] entry of a MAT-file or UFF file \
+             by hand (docs/config.md)"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Lines with their numbers in the file, counted from 1.
+type NumberedLines<'a> = Vec<(usize, &'a str)>;
+
+/// The file's first non-blank lines, numbered from 1 (comments included, to count the
+/// preamble), and the first [`SNIFF_LINES`] of them that are not `#` comments (to sniff).
+fn first_lines(text: &str) -> (NumberedLines<'_>, NumberedLines<'_>) {
+    let all: NumberedLines<'_> = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim_end_matches('\r')))
+        .filter(|(_, l)| !l.trim().is_empty())
+        .take(4 * SNIFF_LINES)
+        .collect();
+    let content = all
+        .iter()
+        .copied()
+        .filter(|(_, l)| !l.trim_start().starts_with('#'))
+        .take(SNIFF_LINES)
+        .collect();
+    (all, content)
+}
+
+/// How to read the file: its layout, the time column and each channel's column and scale;
+/// an error naming the header line when there is no time column or no channel.
+fn read_options(
+    path: &Path,
+    layout: &Layout,
+    columns: &[SurveyColumn],
+    header_line: usize,
+    names: &[&str],
+) -> Result<ReadOptions, DataError> {
+    let time = columns
+        .iter()
+        .find(|c| c.role == Some(Role::Time))
+        .ok_or_else(|| {
+            refused(
+                path,
+                format!(
+                    "line {header_line}: no time column among {}; name it with `time_column`",
+                    names.join(", ")
+                ),
+            )
+        })?;
+    if !columns
+        .iter()
+        .any(|c| matches!(c.role, Some(Role::Channel(_))))
+    {
+        return Err(refused(
+            path,
+            format!(
+                "line {header_line}: no column's name or unit says velocity, displacement, \
+                 acceleration or force among {}; name it with `velocity_column` (or another \
+                 channel's `*_column`)",
+                names.join(", ")
+            ),
+        ));
+    }
+    let mut opts = ReadOptions {
+        delimiter: layout.separator.delimiter(),
+        decimal: layout.decimal,
+        channels: BTreeMap::new(),
+        ..ReadOptions::default()
+    };
+    opts.time.column = time.name.clone();
+    opts = opts.with_time_scale(time.scale.unwrap_or(1.0));
+    for c in columns {
+        if let Some(Role::Channel(channel)) = c.role {
+            opts = opts
+                .with_column(channel, c.name.clone())
+                .with_scale(channel, c.scale.unwrap_or(1.0));
+        }
+    }
+    Ok(opts)
 }
 
 /// The survey with the record's sample rate, span, pre-trigger rest and x0 estimate.
