@@ -5,9 +5,9 @@
 //! a driven rotary axis without a normal force shows rad/s and N m, no N = 1 N and no empty
 //! energy columns.
 
+use crate::rotary::driven_pendulum_csv;
 use frictionid_cli::testing::{read_report, run_ok, scratch_dir};
 use html5gum::{Token, Tokenizer};
-use std::fmt::Write as _;
 use std::path::Path;
 use std::process::Command;
 
@@ -16,7 +16,6 @@ use std::process::Command;
 /// torque from the balance u = J a + c v + M_g sin q + T_c sgn v with 1e-3 N m of
 /// deterministic pseudo-random noise.
 fn driven_csv() -> String {
-    let mut csv = String::from("time,angle,velocity,acceleration,torque\n");
     let mut state: u64 = 12345;
     let mut uniform = move || {
         state = state
@@ -24,18 +23,8 @@ fn driven_csv() -> String {
             .wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
     };
-    for i in 0..1500 {
-        let t = i as f64 * 2e-3;
-        let (w1, w2) = (2.1, 5.3);
-        let q = 0.6 * (w1 * t).sin() + 0.3 * (w2 * t).sin();
-        let v = 0.6 * w1 * (w1 * t).cos() + 0.3 * w2 * (w2 * t).cos();
-        let a = -0.6 * w1 * w1 * (w1 * t).sin() - 0.3 * w2 * w2 * (w2 * t).sin();
-        // Twelve uniforms of variance 1/12 each: unit variance.
-        let noise: f64 = (0..12).map(|_| uniform()).sum();
-        let u = 0.02 * a + 0.002 * v + 0.5 * q.sin() + 0.012 * v.signum() + 1e-3 * noise;
-        let _ = writeln!(csv, "{t:.4},{q:.9},{v:.9},{a:.9},{u:.9}");
-    }
-    csv
+    // Twelve uniforms of variance 1/12 each: unit variance.
+    driven_pendulum_csv(move || 1e-3 * (0..12).map(|_| uniform()).sum::<f64>())
 }
 
 const DRIVEN_CONFIG: &str = "[oscillator]\naxis = \"rotary\"\ninertia = 0.02\ndamping = 0.002\n\

@@ -14,6 +14,20 @@ use frictionid_models::Stribeck;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+/// `frictionid COMMAND CONFIG --out OUT --quiet`, checked to succeed: report.json and stderr.
+fn run_into(command: &str, config: &Path, out: &Path) -> (serde_json::Value, String) {
+    runs_ok(
+        frictionid()
+            .arg(command)
+            .arg(config)
+            .arg("--out")
+            .arg(out)
+            .arg("--quiet")
+            .output(),
+        out,
+    )
+}
+
 fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
 }
@@ -110,16 +124,7 @@ fn init_then_compare_recommends_the_truth_from_a_vibrometer_export() {
     let text = std::fs::read_to_string(&config).unwrap();
     assert!(text.contains("frictionid help config"), "{text}");
     let out = dir.join("compare");
-    let (r, stderr) = runs_ok(
-        frictionid()
-            .arg("compare")
-            .arg(&config)
-            .arg("--out")
-            .arg(&out)
-            .arg("--quiet")
-            .output(),
-        &out,
-    );
+    let (r, stderr) = run_into("compare", &config, &out);
     assert_eq!(r["verdict"]["recommended"], "stribeck", "{stderr}");
     let ranking = r["ranking"].as_array().unwrap();
     let stribeck = ranking.iter().find(|f| f["model"] == "stribeck").unwrap();
@@ -139,16 +144,7 @@ fn the_export_named_in_a_hand_written_config_fits() {
     )
     .unwrap();
     let out = dir.join("fit");
-    let (r, stderr) = runs_ok(
-        frictionid()
-            .arg("fit")
-            .arg(&config)
-            .arg("--out")
-            .arg(&out)
-            .arg("--quiet")
-            .output(),
-        &out,
-    );
+    let (r, stderr) = run_into("fit", &config, &out);
     assert_levels(&r);
     // The release found in the samples, then fitted: the instant to a twentieth of a sample.
     let found = r["records"][0]["release_time"].as_f64().unwrap();

@@ -105,6 +105,12 @@ fn a_pendulum_fit_reports_rotary_units() {
 /// closed form, the input torque from the balance u = J a + c v + M_g sin q + T_c sgn v
 /// (the oracle: the equation itself, J = 0.02, c = 0.002, M_g = 0.5, T_c = 0.012).
 fn driven_csv() -> String {
+    driven_pendulum_csv(|| 0.0)
+}
+
+/// The driven pendulum of [`driven_csv`] over 3 s at 500 Hz, `noise()` added to each sample
+/// of the input torque.
+pub(crate) fn driven_pendulum_csv(mut noise: impl FnMut() -> f64) -> String {
     let mut csv = String::from("time,angle,velocity,acceleration,torque\n");
     for i in 0..1500 {
         let t = i as f64 * 2e-3;
@@ -112,7 +118,7 @@ fn driven_csv() -> String {
         let q = 0.6 * (w1 * t).sin() + 0.3 * (w2 * t).sin();
         let v = 0.6 * w1 * (w1 * t).cos() + 0.3 * w2 * (w2 * t).cos();
         let a = -0.6 * w1 * w1 * (w1 * t).sin() - 0.3 * w2 * w2 * (w2 * t).sin();
-        let u = 0.02 * a + 0.002 * v + 0.5 * q.sin() + 0.012 * v.signum();
+        let u = 0.02 * a + 0.002 * v + 0.5 * q.sin() + 0.012 * v.signum() + noise();
         let _ = writeln!(csv, "{t:.4},{q:.9},{v:.9},{a:.9},{u:.9}");
     }
     csv

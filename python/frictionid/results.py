@@ -468,12 +468,9 @@ def _axis_labels(oscillator):
     return f"x [{x}]", f"v [{v}]", f"friction force [{f}]"
 
 
-class SimulateResult(Result):
-    """A simulation: report.json's dict with the trajectory (``t``, ``x``, ``v``, ``a``,
-    ``force``, energies, states), ``.params`` (the model's given parameters), ``.report()``
-    and ``.plot()`` (displacement, velocity and friction force against time)."""
-
-    command = "simulate"
+class _GivenModelResult(Result):
+    """A result of a model given, not fitted (a simulation, the energy analysis): its
+    parameters are the given ones, on the oscillator's axis."""
 
     def _axis(self):
         return (self.get("oscillator") or {}).get("axis", "linear")
@@ -483,6 +480,14 @@ class SimulateResult(Result):
         if isinstance(model, dict):
             return _given_rows(model, self._axis())
         return []
+
+
+class SimulateResult(_GivenModelResult):
+    """A simulation: report.json's dict with the trajectory (``t``, ``x``, ``v``, ``a``,
+    ``force``, energies, states), ``.params`` (the model's given parameters), ``.report()``
+    and ``.plot()`` (displacement, velocity and friction force against time)."""
+
+    command = "simulate"
 
     def _title(self):
         model = self.get("model") or {}
@@ -515,7 +520,7 @@ class SimulateResult(Result):
         return _finish(fig, self._title())
 
 
-class EnergyResult(Result):
+class EnergyResult(_GivenModelResult):
     """The energy-based friction force (Eq. 7): report.json's dict with every record's
     series (``time``, ``friction``, ``model_force``, ...), ``.params`` (the reference
     model's parameters when one was given), ``.record_table`` (each record's mean force
@@ -523,15 +528,6 @@ class EnergyResult(Result):
     one panel per record)."""
 
     command = "energy"
-
-    def _axis(self):
-        return (self.get("oscillator") or {}).get("axis", "linear")
-
-    def _param_rows(self):
-        model = self.get("model")
-        if isinstance(model, dict):
-            return _given_rows(model, self._axis())
-        return []
 
     def _record_rows(self):
         return [
