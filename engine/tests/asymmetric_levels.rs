@@ -9,6 +9,7 @@
 //! inverse-dynamics route (the balance u - M a against the law) recover both levels within
 //! 1 %; the symmetric law is worse.
 
+use crate::util::{multisine, sample_times, Tone};
 use frictionid_engine::axis::{NoRestoring, Restoring};
 use frictionid_engine::identify::{
     fit, FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam, ParamOptions,
@@ -17,7 +18,6 @@ use frictionid_engine::identify::{
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{ViscousCoulomb, ViscousCoulombAsymmetric};
-use std::f64::consts::PI;
 
 const MASS: f64 = 2.0;
 const VISCOUS: f64 = 20.0;
@@ -28,15 +28,13 @@ const DURATION: f64 = 4.0;
 
 /// The input [N] at the sample times: four sines.
 fn input(t: f64) -> f64 {
-    [
+    const TONES: [Tone; 4] = [
         (12.0, 0.7, 0.0),
         (8.0, 1.9, 1.0),
         (5.0, 3.3, 2.0),
         (3.0, 5.1, 0.5),
-    ]
-    .iter()
-    .map(|&(a, f, p)| a * (2.0 * PI * f * t + p).sin())
-    .sum()
+    ];
+    multisine(&TONES, t)
 }
 
 /// The samples' input, linear between them (as the engine reads it).
@@ -82,8 +80,8 @@ fn rk4(u: &[f64], t: f64, (x, v): (f64, f64), d: f64, h: f64) -> (f64, f64) {
 /// The reference record from rest at x = 0: time, displacement, velocity and input.
 fn record(name: &str) -> Record {
     const H: f64 = 1e-5;
-    let n = (DURATION * RATE) as usize + 1;
-    let time: Vec<f64> = (0..n).map(|i| i as f64 / RATE).collect();
+    let time = sample_times(DURATION, RATE);
+    let n = time.len();
     let u: Vec<f64> = time.iter().map(|&t| input(t)).collect();
     let (mut t, mut x, mut v, mut d) = (0.0, 0.0, 0.0, breakaway(u[0]));
     let (mut xs, mut vs) = (Vec::with_capacity(n), Vec::with_capacity(n));

@@ -5,7 +5,7 @@
 //! bisection on the piecewise-linear input. The velocity route (simulate the axis under the
 //! measured input, compare velocities) recovers M, Fv, Fc and the offset F0.
 
-use crate::util::driven_slide;
+use crate::util::{driven_slide, sample_times, Tone};
 use frictionid_engine::identify::{fit, FitOptions, FitResult, OscillatorParam, ParamOptions};
 use frictionid_engine::record::Channel;
 use frictionid_engine::Record;
@@ -13,7 +13,6 @@ use frictionid_models::ViscousCoulomb;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use std::f64::consts::PI;
 
 const MASS: f64 = 2.0;
 const VISCOUS: f64 = 20.0;
@@ -24,22 +23,16 @@ const DURATION: f64 = 4.0;
 
 /// The input: four sines [N] sampled at `RATE`.
 fn multisine(phase: f64) -> (Vec<f64>, Vec<f64>) {
-    let n = (DURATION * RATE) as usize + 1;
-    let t: Vec<f64> = (0..n).map(|i| i as f64 / RATE).collect();
-    let parts = [
-        (12.0, 0.7, 0.0),
-        (8.0, 1.9, 1.0),
-        (5.0, 3.3, 2.0),
-        (3.0, 5.1, 0.5),
+    let t = sample_times(DURATION, RATE);
+    let parts: [Tone; 4] = [
+        (12.0, 0.7, phase),
+        (8.0, 1.9, 1.0 + phase),
+        (5.0, 3.3, 2.0 + phase),
+        (3.0, 5.1, 0.5 + phase),
     ];
     let u = t
         .iter()
-        .map(|&t| {
-            parts
-                .iter()
-                .map(|&(a, f, p)| a * (2.0 * PI * f * t + p + phase).sin())
-                .sum()
-        })
+        .map(|&t| crate::util::multisine(&parts, t))
         .collect();
     (t, u)
 }

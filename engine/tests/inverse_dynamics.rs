@@ -9,13 +9,12 @@
 //! within 0.5 % noise-free, and within three standard errors with noise on u. Also the
 //! errors a user meets: no input channel, no motion channel, no mass.
 
-use crate::util::{estimate, inverse_dynamics_options, serial};
+use crate::util::{estimate, inverse_dynamics_options, multisine, serial, Tone};
 use frictionid_engine::identify::{fit, FitOptions, FitResult, ParamOptions};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::Record;
 use frictionid_models::ViscousCoulomb;
-use std::f64::consts::PI;
 
 /// The axis's truth.
 pub(crate) struct Axis {
@@ -34,17 +33,14 @@ pub(crate) const TRUTH: Axis = Axis {
 
 /// The multisine input u(t) \[N\]: five tones from 0.3 to 3.4 Hz.
 fn input(t: f64) -> f64 {
-    const TONES: [(f64, f64, f64); 5] = [
+    const TONES: [Tone; 5] = [
         (12.0, 0.3, 0.0),
         (8.0, 0.7, 1.1),
         (6.0, 1.3, 2.3),
         (4.0, 2.1, 0.4),
         (3.0, 3.4, 4.0),
     ];
-    TONES
-        .iter()
-        .map(|(a, f, phase)| a * (2.0 * PI * f * t + phase).sin())
-        .sum()
+    multisine(&TONES, t)
 }
 
 impl Axis {

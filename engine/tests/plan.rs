@@ -296,14 +296,7 @@ fn stribeck_pair_prediction_matches_monte_carlo() {
 fn lugre_sigma0_reach_agrees_with_the_fits_findings() {
     use frictionid_engine::identify::Identifiability;
     let osc = Oscillator::fmm();
-    let law = frictionid_models::LuGre {
-        sigma0: 1e7,
-        sigma1: 4000.0,
-        sigma2: 2.0,
-        mu_c: 0.18,
-        mu_s: 0.26,
-        v_s: 0.005,
-    };
+    let law = crate::util::stiff_lugre_truth();
     let free = ["sigma0", "sigma1", "mu_c", "mu_s", "v_s"];
     for rate in [1000.0, 20_000.0] {
         let candidates: Vec<Experiment> = [0.010, 0.014, 0.022]

@@ -4,14 +4,16 @@
 //! input. The inverse-dynamics target differentiates the quantised position twice: across a
 //! reversal a few samples' accelerations are wrong by tens of m/s^2.
 
-use crate::util::{driven_from_rest, driven_slide, estimate, inverse_dynamics_options, serial};
+use crate::util::{
+    driven_from_rest, driven_slide, estimate, inverse_dynamics_options, multisine, sample_times,
+    serial, Tone,
+};
 use frictionid_engine::identify::values::search::Loss;
 use frictionid_engine::identify::{compare, fit, Check, FitOptions, FitResult, Status};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{default_model, FrictionModel, ViscousCoulomb};
-use std::f64::consts::PI;
 
 const MASS: f64 = 12.0;
 const VISCOUS: f64 = 30.0;
@@ -23,17 +25,14 @@ const FORCE_NOISE: f64 = 0.2;
 
 /// The multisine input u(t) \[N\]: five tones from 0.3 to 3.4 Hz.
 fn input(t: f64) -> f64 {
-    const TONES: [(f64, f64, f64); 5] = [
+    const TONES: [Tone; 5] = [
         (30.0, 0.3, 0.0),
         (20.0, 0.7, 1.1),
         (15.0, 1.3, 2.3),
         (10.0, 2.1, 0.4),
         (7.5, 3.4, 4.0),
     ];
-    TONES
-        .iter()
-        .map(|(a, f, phase)| a * (2.0 * PI * f * t + phase).sin())
-        .sum()
+    multisine(&TONES, t)
 }
 
 /// `seconds` of the drive at [`RATE`]: time, position quantised to [`QUANTUM`] and written
@@ -60,8 +59,7 @@ fn drive_record_exact(seconds: f64) -> Record {
 
 /// `seconds` of the drive at [`RATE`] from rest: time, position and input.
 fn simulated(seconds: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let n = (seconds * RATE) as usize + 1;
-    let t: Vec<f64> = (0..n).map(|i| i as f64 / RATE).collect();
+    let t = sample_times(seconds, RATE);
     let u: Vec<f64> = t.iter().map(|&t| input(t)).collect();
     let model = ViscousCoulomb {
         mu: COULOMB,

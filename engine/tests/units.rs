@@ -5,6 +5,7 @@
 //! motion in millimetres, micrometres, mm/s or degrees is named with the scale to set, and a
 //! pendulum's angle in degrees is named whether its properties are known or not.
 
+use crate::util::{multisine, sample_times, Tone};
 use frictionid_engine::axis::{NoRestoring, Pendulum};
 use frictionid_engine::identify::problem::unit_check::{
     balance_scale, check_driven_balance, check_swing, implied_inertia, MassReference,
@@ -38,24 +39,14 @@ fn slide(mass: f64, axis: Axis) -> Oscillator {
 /// The simulated motion of `osc` under a multisine scaled with its mass: (t, x, v, a, u).
 fn drive(osc: &Oscillator) -> [Vec<f64>; 5] {
     let scale = osc.mass / 12.0;
-    let n = (DURATION * RATE) as usize + 1;
-    let t: Vec<f64> = (0..n).map(|i| i as f64 / RATE).collect();
-    let tones = [
+    let t = sample_times(DURATION, RATE);
+    let tones: [Tone; 4] = [
         (40.0, 0.7, 0.0),
         (25.0, 1.9, 1.0),
         (15.0, 3.3, 2.0),
         (10.0, 5.1, 0.5),
     ];
-    let u: Vec<f64> = t
-        .iter()
-        .map(|&t| {
-            scale
-                * tones
-                    .iter()
-                    .map(|&(a, f, p)| a * (2.0 * PI * f * t + p).sin())
-                    .sum::<f64>()
-        })
-        .collect();
+    let u: Vec<f64> = t.iter().map(|&t| scale * multisine(&tones, t)).collect();
     let law = ViscousCoulomb {
         mu: 8.0,
         viscous: 30.0 * scale,

@@ -12,6 +12,24 @@ use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid,
 use frictionid_engine::synthetic::release_records;
 use frictionid_engine::{Initial, Oscillator, Record, SimOptions};
 use frictionid_models::{Coulomb, FrictionModel, LuGre, Stribeck};
+use std::f64::consts::PI;
+
+/// A tone of a multisine: amplitude, frequency [Hz] and phase [rad].
+pub type Tone = (f64, f64, f64);
+
+/// The multisine of `tones` at time `t`: the sum of a sin(2 pi f t + phase).
+pub fn multisine(tones: &[Tone], t: f64) -> f64 {
+    tones
+        .iter()
+        .map(|&(a, f, phase)| a * (2.0 * PI * f * t + phase).sin())
+        .sum()
+}
+
+/// The sample times of `duration` seconds at `rate` Hz from 0, both ends included.
+pub fn sample_times(duration: f64, rate: f64) -> Vec<f64> {
+    let n = (duration * rate) as usize + 1;
+    (0..n).map(|i| i as f64 / rate).collect()
+}
 
 /// |a - b| / |b|: the relative error of `a` against the truth `b`.
 pub fn rel(a: f64, b: f64) -> f64 {
