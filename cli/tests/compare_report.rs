@@ -5,9 +5,9 @@
 //! a driven rotary axis without a normal force shows rad/s and N m, no N = 1 N and no empty
 //! energy columns.
 
+use crate::html::{tokens, Html};
 use crate::rotary::driven_pendulum_csv;
 use frictionid_cli::testing::{read_report, run_ok, scratch_dir};
-use html5gum::{Token, Tokenizer};
 use std::path::Path;
 use std::process::Command;
 
@@ -94,17 +94,17 @@ fn read_page(html: &str) -> Page {
     let mut section = String::new();
     let mut text = String::new();
     let mut row: Vec<String> = Vec::new();
-    for token in Tokenizer::new(html) {
-        let Ok(token) = token;
+    for token in tokens(html) {
         match token {
-            Token::Error(e) => panic!("HTML parse error: {e:?}"),
-            Token::StartTag(tag) => {
-                let name = String::from_utf8_lossy(&tag.name).to_string();
-                let class = tag
-                    .attributes
-                    .iter()
-                    .find(|(k, _)| k.as_slice() == b"class")
-                    .map(|(_, v)| String::from_utf8_lossy(v).to_string())
+            Html::Start {
+                name,
+                attributes,
+                self_closing,
+            } => {
+                let class = attributes
+                    .into_iter()
+                    .find(|(k, _)| k == "class")
+                    .map(|(_, v)| v)
                     .unwrap_or_default();
                 if verdict_depth.is_none()
                     && page.verdict_class.is_empty()
@@ -119,12 +119,11 @@ fn read_page(html: &str) -> Page {
                 if name == "tr" {
                     row.clear();
                 }
-                if !tag.self_closing && !matches!(name.as_str(), "meta" | "br") {
+                if !self_closing && !matches!(name.as_str(), "meta" | "br") {
                     open.push(name);
                 }
             }
-            Token::EndTag(tag) => {
-                let name = String::from_utf8_lossy(&tag.name).to_string();
+            Html::End(name) => {
                 open.pop();
                 if verdict_depth == Some(open.len()) {
                     verdict_depth = None;
@@ -147,14 +146,12 @@ fn read_page(html: &str) -> Page {
                     _ => {}
                 }
             }
-            Token::String(s) => {
-                let s = String::from_utf8_lossy(&s).to_string();
+            Html::Text(s) => {
                 if verdict_depth.is_some() {
                     page.verdict_text.push_str(&s);
                 }
                 text.push_str(&s);
             }
-            _ => {}
         }
     }
     page

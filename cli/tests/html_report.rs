@@ -2,8 +2,8 @@
 //! with html5gum, a WHATWG-conformant tokenizer) that shows the report's content and its
 //! plots inline and loads nothing from outside the file.
 
+use crate::html::{tokens, Html};
 use frictionid_cli::testing::{fixtures_dir, run_ok, scratch_dir};
-use html5gum::{Token, Tokenizer};
 use std::process::Command;
 
 /// Runs `frictionid <command> <config> --out <fresh dir> --quiet` and returns report.html.
@@ -33,43 +33,42 @@ const FORBIDDEN: [&str; 7] = [
 fn check_document(html: &str) -> Vec<String> {
     let mut open: Vec<String> = Vec::new();
     let mut seen = Vec::new();
-    for token in Tokenizer::new(html) {
-        let Ok(token) = token;
+    for token in tokens(html) {
         match token {
-            Token::Error(e) => panic!("HTML parse error: {e:?}"),
-            Token::StartTag(tag) => {
-                let name = String::from_utf8_lossy(&tag.name).to_string();
+            Html::Start {
+                name,
+                attributes,
+                self_closing,
+            } => {
                 assert!(!FORBIDDEN.contains(&name.as_str()), "<{name}> in the page");
-                for (key, value) in &tag.attributes {
-                    let key = String::from_utf8_lossy(key).to_lowercase();
-                    let value = String::from_utf8_lossy(value).to_lowercase();
+                for (key, value) in &attributes {
+                    let key = key.to_lowercase();
+                    let value = value.to_lowercase();
                     assert!(
                         !matches!(key.as_str(), "src" | "href" | "xlink:href" | "srcset"),
                         "<{name} {key}=\"{value}\"> refers to another resource"
                     );
                     assert!(!value.contains("url("), "<{name} {key}> loads {value}");
                 }
-                if !tag.self_closing && !VOID.contains(&name.as_str()) {
+                if !self_closing && !VOID.contains(&name.as_str()) {
                     open.push(name.clone());
                 }
                 seen.push(name);
             }
-            Token::EndTag(tag) => {
-                let name = String::from_utf8_lossy(&tag.name).to_string();
+            Html::End(name) => {
                 assert_eq!(
                     open.pop().as_deref(),
                     Some(name.as_str()),
                     "unbalanced </{name}>"
                 );
             }
-            Token::String(text) => {
-                let text = String::from_utf8_lossy(&text).to_lowercase();
+            Html::Text(text) => {
+                let text = text.to_lowercase();
                 assert!(
                     !text.contains("@import") && !text.contains("url("),
                     "styles load something from elsewhere"
                 );
             }
-            _ => {}
         }
     }
     assert!(open.is_empty(), "elements left open: {open:?}");

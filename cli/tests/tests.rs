@@ -11,6 +11,7 @@ mod export;
 mod fit_compare;
 mod fixtures;
 mod force_domain;
+mod html;
 mod html_report;
 mod init;
 mod outputs;

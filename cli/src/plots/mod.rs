@@ -22,6 +22,7 @@ use crate::error::CliError;
 use crate::report::write_atomic;
 use frictionid_engine::Axis;
 use panel::{draw_panel, range};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -47,6 +48,21 @@ pub const PALETTE: [RGBColor; 12] = [
 /// The colour of measured data: drawn as a thin dark line under nothing, a fit over it in
 /// its model's colour and wider.
 pub const MEASURED: RGBColor = RGBColor(0, 0, 0);
+
+/// Draws `chart`'s legend (a nearly opaque white box with a black border), then writes out
+/// `root`, the area the chart is drawn on.
+fn finish_with_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    root: &DrawingArea<DB, Shift>,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| e.to_string())?;
+    root.present().map_err(|e| e.to_string())
+}
 
 /// The grey of reference levels (both signs of +-mu N alike).
 pub const REFERENCE_GREY: RGBColor = RGBColor(90, 90, 90);

@@ -110,13 +110,7 @@ fn render(report: &PlanReport) -> Result<Option<String>, String> {
                 .draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))
                 .map_err(|e| e.to_string())?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())?;
+        super::finish_with_legend(&mut chart, &root)?;
     }
     Ok(Some(buf))
 }

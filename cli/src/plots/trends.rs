@@ -124,13 +124,7 @@ fn render(t: &Trend, series: &[(String, Vec<Point>)]) -> Result<String, String> 
                 draw_fit(&mut chart, f, label, x_range)?;
             }
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())?;
+        super::finish_with_legend(&mut chart, &root)?;
     }
     Ok(buf)
 }
