@@ -82,24 +82,9 @@ pub enum Command {
         /// The configuration file to write [default: DATAFILE with the extension .toml].
         #[arg(long, value_name = "CONFIG")]
         out: Option<PathBuf>,
-        /// The moving mass [kg] (the moment of inertia [kg m^2] on a rotary axis).
-        #[arg(long, value_name = "KG")]
-        mass: Option<f64>,
-        /// Viscous damping [N s/m] (0 when not given).
-        #[arg(long, value_name = "C")]
-        damping: Option<f64>,
-        /// The spring's stiffness [N/m]; 0 for none (a driven axis, a free mass).
-        #[arg(long, value_name = "K")]
-        stiffness: Option<f64>,
-        /// The contact's normal force [N] (without it the friction levels are forces).
-        #[arg(long, value_name = "N")]
-        normal_force: Option<f64>,
-        /// The release displacement [m] (default: estimated from the velocity and fitted).
-        #[arg(long, value_name = "M", allow_negative_numbers = true)]
-        x0: Option<f64>,
-        /// `linear` or `rotary` [default: from the columns' units, else linear].
-        #[arg(long, value_parser = parse_axis)]
-        axis: Option<Axis>,
+        /// The rig's values.
+        #[command(flatten)]
+        rig: RigValues,
         /// Replace CONFIG if it exists.
         #[arg(long)]
         force: bool,
@@ -236,6 +221,29 @@ pub enum Command {
         #[arg(long, value_name = "N")]
         normal_force: Option<f64>,
     },
+}
+
+/// The rig's values given on the command line (SI units; N m and kg m^2 on a rotary axis).
+#[derive(Debug, Clone, Default, Args)]
+pub struct RigValues {
+    /// The moving mass [kg] (the moment of inertia [kg m^2] on a rotary axis).
+    #[arg(long, value_name = "KG")]
+    pub mass: Option<f64>,
+    /// Viscous damping [N s/m] (0 when not given).
+    #[arg(long, value_name = "C")]
+    pub damping: Option<f64>,
+    /// The spring's stiffness [N/m]; 0 for none (a driven axis, a free mass).
+    #[arg(long, value_name = "K")]
+    pub stiffness: Option<f64>,
+    /// The contact's normal force [N] (without it the friction levels are forces).
+    #[arg(long, value_name = "N")]
+    pub normal_force: Option<f64>,
+    /// The release displacement [m] (default: estimated from the velocity and fitted).
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    pub x0: Option<f64>,
+    /// `linear` or `rotary` [default: from the columns' units, else linear].
+    #[arg(long, value_parser = parse_axis)]
+    pub axis: Option<Axis>,
 }
 
 /// An axis as `[oscillator] axis` spells it: `linear` or `rotary`.

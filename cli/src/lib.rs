@@ -52,26 +52,11 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Init {
             datafile,
             out,
-            mass,
-            damping,
-            stiffness,
-            normal_force,
-            x0,
-            axis,
+            rig,
             force,
             quiet,
-        } => {
-            let rig = commands::init::RigValues {
-                mass,
-                damping,
-                stiffness,
-                normal_force,
-                x0,
-                axis,
-            };
-            commands::init::run(&datafile, out.as_deref(), &rig, force, quiet)
-                .map(|_| Outcome::Done)
-        }
+        } => commands::init::run(&datafile, out.as_deref(), &rig, force, quiet)
+            .map(|_| Outcome::Done),
         Command::Help { topic } => commands::help::run(topic.as_deref()).map(|_| Outcome::Done),
         Command::Models { json, quiet, axis } => {
             commands::models::run(json, quiet, axis).map(|_| Outcome::Done)

@@ -2,29 +2,13 @@
 //! [`survey`]), prints what it found and writes a commented configuration that runs once the
 //! rig's values are given (here, or on the lines marked `<- SET`).
 
+pub use crate::args::RigValues;
 use crate::error::CliError;
 use frictionid_engine::data::sniff::{survey, Survey};
 use frictionid_engine::record::Channel;
 use frictionid_engine::Axis;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// The rig's values given on the command line (SI units; N m and kg m^2 on a rotary axis).
-#[derive(Debug, Clone, Default)]
-pub struct RigValues {
-    /// Mass (inertia).
-    pub mass: Option<f64>,
-    /// Viscous damping.
-    pub damping: Option<f64>,
-    /// Stiffness of the spring (0: none).
-    pub stiffness: Option<f64>,
-    /// Normal force.
-    pub normal_force: Option<f64>,
-    /// Release displacement.
-    pub x0: Option<f64>,
-    /// The axis, when the units do not say.
-    pub axis: Option<Axis>,
-}
 
 /// The marker of a line that needs the rig's value.
 const SET: &str = "<- SET";
