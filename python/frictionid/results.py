@@ -14,6 +14,7 @@ pandas and matplotlib are imported only when ``.params`` or ``.plot()`` is used
 """
 
 import html
+import importlib
 import json
 import math
 import re
@@ -41,24 +42,22 @@ _FIT_KEYS = ("command", "model", "model_parameters", "parameters", "oscillator",
 _RECORD_KEYS = ("file", "max_speed")
 
 
-def _pandas():
+def _optional(module, needed_by, package):
+    """Imports `module`, or says which extra provides it when it is missing."""
     try:
-        import pandas
+        return importlib.import_module(module)
     except ImportError as e:  # pragma: no cover - the message is the point
         raise ImportError(
-            "frictionid: .params needs pandas (pip install 'frictionid[notebook]')"
+            f"frictionid: {needed_by} needs {package} (pip install 'frictionid[notebook]')"
         ) from e
-    return pandas
+
+
+def _pandas():
+    return _optional("pandas", ".params", "pandas")
 
 
 def _pyplot():
-    try:
-        import matplotlib.pyplot as plt
-    except ImportError as e:  # pragma: no cover - the message is the point
-        raise ImportError(
-            "frictionid: .plot() needs matplotlib (pip install 'frictionid[notebook]')"
-        ) from e
-    return plt
+    return _optional("matplotlib.pyplot", ".plot()", "matplotlib")
 
 
 def _rows_frame(rows):

@@ -58,16 +58,15 @@ impl OscillatorProperty {
     ];
 
     /// Every property: the fitted ones, then the normal force.
-    pub const ALL: [Self; 8] = [
-        Self::Mass,
-        Self::Damping,
-        Self::Stiffness,
-        Self::GravityMoment,
-        Self::InputOffset,
-        Self::QuadraticStiffness,
-        Self::CubicStiffness,
-        Self::NormalForce,
-    ];
+    pub const ALL: [Self; 8] = {
+        let mut all = [Self::NormalForce; 8];
+        let mut i = 0;
+        while i < Self::FITTED.len() {
+            all[i] = Self::FITTED[i];
+            i += 1;
+        }
+        all
+    };
 
     /// Its `[oscillator]` key (the linear axis's name).
     pub fn key(self) -> &'static str {
