@@ -3,24 +3,26 @@
 
 Usage: python3 scripts/shared-crates.py   (from the repository root)
 
-python/ is a workspace of its own (its crate links against Python), so its Cargo.lock and
-its feature resolution are its own. `.ci/run` builds it into the workspace's target/ with the
-workspace's test-profile settings; cargo reuses a crate compiled by `cargo test --workspace`
-only where the version and the features are the same in both graphs. Every crate the two
-graphs share at a different version or with other features is printed as
+python/ is a workspace member built apart: `.ci/run` tests the workspace without it
+(`--exclude frictionid-python`, as it links against Python), then maturin builds it into the
+same target/ with the test profile. The lock file is one, so the versions agree; cargo
+reuses a crate compiled by the test build only where its features are the same in both
+graphs too. Every crate the two graphs share with other features is printed as
 `name version: workspace [...] / python [...]` and the exit code is 1 when there is one
-(pin the version in python/Cargo.lock, or turn the feature on in the graph that lacks it:
-the root's dev-dependencies, python/Cargo.toml's dependencies); "shared crates aligned" and
-0 otherwise.
+(turn the feature on in the graph that lacks it: the root's dev-dependencies, python/
+Cargo.toml's dependencies); "shared crates aligned" and 0 otherwise.
 """
 
 import subprocess
 import sys
 
 FORMAT = ["-f", "{p}|{f}", "--prefix", "none"]
-WORKSPACE = ["cargo", "tree", "--workspace", "-e", "normal,build,dev", *FORMAT]
+WORKSPACE = [
+    "cargo", "tree", "--workspace", "--exclude", "frictionid-python", "-e", "normal,build,dev",
+    *FORMAT,
+]
 PYTHON = [
-    "cargo", "tree", "--manifest-path", "python/Cargo.toml", "-e", "normal,build",
+    "cargo", "tree", "-p", "frictionid-python", "-e", "normal,build",
     "--features", "pyo3/extension-module", *FORMAT,
 ]
 

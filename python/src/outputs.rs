@@ -7,8 +7,8 @@ use crate::convert::{serialized, set_array};
 use frictionid_cli::terminal::TerminalWriter;
 use frictionid_engine::identify::{FitResult, FitSeries, ForceBalance};
 use frictionid_engine::report::fit::verdict_line;
-use frictionid_engine::report::serialized_name;
 use frictionid_engine::report::markdown::MarkdownWriter;
+use frictionid_engine::report::serialized_name;
 use frictionid_engine::report::{
     CompareReport, EnergyRecord, EnergyReport, FitReport, Render, SimulateReport, Status,
 };
