@@ -96,12 +96,10 @@ fn read_page(html: &str) -> Page {
     let mut row: Vec<String> = Vec::new();
     for token in tokens(html) {
         match token {
-            Html::Start {
-                name,
-                attributes,
-                self_closing,
-            } => {
-                let class = attributes
+            Html::Start(tag) => {
+                let name = tag.name;
+                let class = tag
+                    .attributes
                     .into_iter()
                     .find(|(k, _)| k == "class")
                     .map(|(_, v)| v)
@@ -119,7 +117,7 @@ fn read_page(html: &str) -> Page {
                 if name == "tr" {
                     row.clear();
                 }
-                if !self_closing && !matches!(name.as_str(), "meta" | "br") {
+                if !tag.self_closing && !matches!(name.as_str(), "meta" | "br") {
                     open.push(name);
                 }
             }

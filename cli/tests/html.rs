@@ -3,14 +3,20 @@
 
 use html5gum::{Token, Tokenizer};
 
+/// A start tag.
+pub struct Tag {
+    /// The element's name.
+    pub name: String,
+    /// Its attributes (name, value), in order.
+    pub attributes: Vec<(String, String)>,
+    /// Whether it closes itself (`<br/>`).
+    pub self_closing: bool,
+}
+
 /// One token of a page.
 pub enum Html {
-    /// A start tag: its name, its attributes (name, value) and whether it closes itself.
-    Start {
-        name: String,
-        attributes: Vec<(String, String)>,
-        self_closing: bool,
-    },
+    /// A start tag.
+    Start(Tag),
     /// An end tag's name.
     End(String),
     /// Text between tags.
@@ -29,7 +35,7 @@ pub fn tokens(html: &str) -> Vec<Html> {
         let Ok(token) = token;
         match token {
             Token::Error(e) => panic!("HTML parse error: {e:?}"),
-            Token::StartTag(tag) => out.push(Html::Start {
+            Token::StartTag(tag) => out.push(Html::Start(Tag {
                 name: text(&tag.name),
                 attributes: tag
                     .attributes
@@ -37,7 +43,7 @@ pub fn tokens(html: &str) -> Vec<Html> {
                     .map(|(k, v)| (text(k), text(v)))
                     .collect(),
                 self_closing: tag.self_closing,
-            }),
+            })),
             Token::EndTag(tag) => out.push(Html::End(text(&tag.name))),
             Token::String(s) => out.push(Html::Text(text(&s))),
             _ => {}

@@ -35,13 +35,10 @@ fn check_document(html: &str) -> Vec<String> {
     let mut seen = Vec::new();
     for token in tokens(html) {
         match token {
-            Html::Start {
-                name,
-                attributes,
-                self_closing,
-            } => {
+            Html::Start(tag) => {
+                let name = tag.name;
                 assert!(!FORBIDDEN.contains(&name.as_str()), "<{name}> in the page");
-                for (key, value) in &attributes {
+                for (key, value) in &tag.attributes {
                     let key = key.to_lowercase();
                     let value = value.to_lowercase();
                     assert!(
@@ -50,7 +47,7 @@ fn check_document(html: &str) -> Vec<String> {
                     );
                     assert!(!value.contains("url("), "<{name} {key}> loads {value}");
                 }
-                if !self_closing && !VOID.contains(&name.as_str()) {
+                if !tag.self_closing && !VOID.contains(&name.as_str()) {
                     open.push(name.clone());
                 }
                 seen.push(name);
