@@ -3,18 +3,22 @@
 //!
 //! - [`time`]: the [`TimeBase`] and the one check of time stamps used everywhere.
 //! - [`channel`]: the [`Channel`] names and the [`NormalForce`].
+//! - [`conditions`]: the values a law's conditions (x, a, u, named channels) take along a
+//!   record.
 //! - [`noise`]: a channel's white-noise level estimated from its samples.
 //! - [`release`]: the release instant, given or found in the pre-trigger rest.
 //! - [`sanity`]: units checked against the oscillator (mm/s, milliseconds, x0 in mm).
 
 pub(crate) mod channel;
 pub(crate) mod checked;
+pub mod conditions;
 pub(crate) mod noise;
 pub(crate) mod release;
 pub(crate) mod sanity;
 pub(crate) mod time;
 
 pub use channel::{Channel, NormalForce};
+pub use conditions::{ConditionColumns, ConditionSource};
 pub use release::{detect_release, Release};
 pub use sanity::{check_scales, ScaleError};
 pub use time::{check_sorted, check_time, TimeBase, TimeError};
