@@ -91,3 +91,130 @@ fn laws_without_conditions_keep_their_force() {
     law.force_param_gradient_in(0.1, &[], 5.0, &[4.0], &mut with);
     assert_eq!(plain, with);
 }
+
+/// dF/dp of `law` at (v, N, conditions `at`) by central differences of `force_in`.
+fn numerical_gradient(law: &dyn FrictionModel, v: f64, normal: f64, at: &[f64]) -> Vec<f64> {
+    let p0 = law.params();
+    let mut probe = dyn_clone::clone_box(law);
+    (0..p0.len())
+        .map(|j| {
+            let h = 1e-6 * p0[j].abs().max(1e-3);
+            let mut p = p0.clone();
+            p[j] = p0[j] + h;
+            probe.set_params(&p).unwrap();
+            let plus = probe.force_in(v, &[], normal, at);
+            p[j] = p0[j] - h;
+            probe.set_params(&p).unwrap();
+            let minus = probe.force_in(v, &[], normal, at);
+            (plus - minus) / (2.0 * h)
+        })
+        .collect()
+}
+
+fn assert_gradient_matches(law: &dyn FrictionModel, v: f64, normal: f64, at: &[f64]) {
+    let mut exact = vec![0.0; law.params().len()];
+    law.param_gradients()
+        .unwrap()
+        .force_param_gradient_in(v, &[], normal, at, &mut exact);
+    for (j, (e, n)) in exact
+        .iter()
+        .zip(numerical_gradient(law, v, normal, at))
+        .enumerate()
+    {
+        assert!(
+            (e - n).abs() <= 1e-6 * (1.0 + n.abs()),
+            "{} parameter {j}: {e} against {n}",
+            law.name()
+        );
+    }
+}
+
+/// The load law against its equation by hand, its exact gradient against differences, and
+/// its load-free limit: `viscous_coulomb`, from which it starts exactly.
+#[test]
+fn coulomb_load_reads_the_load_channel() {
+    let law = CoulombLoad {
+        mu: 0.3,
+        mu_load: 0.02,
+        viscous: 1.5,
+    };
+    assert_eq!(law.conditions(), vec![Condition::Channel("load".into())]);
+    for (v, load) in [(0.1, 40.0), (-0.2, -25.0), (0.05, -3.0), (0.0, 10.0)] {
+        let s = if v > 0.0 {
+            1.0
+        } else if v < 0.0 {
+            -1.0
+        } else {
+            0.0
+        };
+        let by_hand = (0.3 * 2.0 + 0.02 * f64::abs(load)) * s + 1.5 * v;
+        assert!((law.force_in(v, &[], 2.0, &[load]) - by_hand).abs() < 1e-12);
+        if v != 0.0 {
+            assert_gradient_matches(&law, v, 2.0, &[load]);
+        }
+    }
+    let plain = ViscousCoulomb {
+        mu: 0.25,
+        viscous: 3.0,
+    };
+    let mut started = CoulombLoad::default();
+    let ctx = StartContext::new(2.0, 1.0);
+    assert!(started.staging().unwrap().start_from(&plain, &ctx));
+    assert_eq!(started.params(), vec![0.25, 0.0, 3.0]);
+    for v in [-0.3, 0.01, 0.7] {
+        assert_eq!(
+            started.force_in(v, &[], 2.0, &[55.0]),
+            plain.force(v, &[], 2.0)
+        );
+    }
+}
+
+/// The ripple law against its equation by hand, its exact gradient against differences (the
+/// period's included, away from x = 0), and its ripple-free limit.
+#[test]
+fn position_ripple_reads_the_displacement() {
+    let law = PositionRipple {
+        mu: 0.2,
+        ripple: 0.05,
+        period: 0.01,
+        phase: 0.7,
+        viscous: 2.0,
+    };
+    assert_eq!(law.conditions(), vec![Condition::Displacement]);
+    for (v, x) in [(0.1, 0.0123), (-0.05, -0.031), (0.3, 0.5)] {
+        let s = if v > 0.0 { 1.0 } else { -1.0 };
+        let theta = 2.0 * std::f64::consts::PI * x / 0.01 + 0.7;
+        let by_hand = (0.2 + 0.05 * f64::sin(theta)) * 3.0 * s + 2.0 * v;
+        assert!((law.force_in(v, &[], 3.0, &[x]) - by_hand).abs() < 1e-12);
+        assert_gradient_matches(&law, v, 3.0, &[x]);
+    }
+    let mut started = law.clone();
+    let plain = Coulomb { mu: 0.3 };
+    assert!(started
+        .staging()
+        .unwrap()
+        .start_from(&plain, &StartContext::new(3.0, 1.0)));
+    assert_eq!(
+        started.force_in(0.2, &[], 3.0, &[0.004]),
+        plain.force(0.2, &[], 3.0)
+    );
+}
+
+#[test]
+fn documentation_tables_match_the_declarations() {
+    for (name, source) in [
+        (
+            "coulomb_load",
+            include_str!("../src/builtin/coulomb_load.rs"),
+        ),
+        (
+            "position_ripple",
+            include_str!("../src/builtin/position_ripple.rs"),
+        ),
+    ] {
+        let info = default_model(name).unwrap().param_info();
+        if let Some(table) = testing::doc_table_mismatch(source, &info) {
+            panic!("the documentation of `{name}` should contain\n{table}");
+        }
+    }
+}
