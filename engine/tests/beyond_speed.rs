@@ -1,6 +1,10 @@
 //! Laws that read more than the sliding speed, fitted along a measured motion against
 //! records whose friction force is written here in closed form (not through the law):
 //!
+//! - a guide whose level ripples along its travel, F = (Fc + Fr sin(2 pi x / p + phase))
+//!   sgn(v) + b v (`position_ripple`, reading the displacement);
+//! - a gearbox joint whose Coulomb torque grows with its measured load torque,
+//!   F = (Tc + mu_l |load|) sgn(v) + b v (`coulomb_load`, reading the `load` channel);
 //! - a drive warming from 25 to 60 degC, F = Fc (1 + kt (T - 25)) sgn(v) + b v, as a formula
 //!   reading the record's `temperature` channel.
 //!
@@ -13,7 +17,7 @@ use frictionid_engine::identify::{compare, fit, FitOptions};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
 use frictionid_engine::{Oscillator, Record};
-use frictionid_models::{build_json, FrictionModel, ViscousCoulomb};
+use frictionid_models::{build_json, CoulombLoad, FrictionModel, PositionRipple, ViscousCoulomb};
 use std::f64::consts::PI;
 
 /// Sample rate of the records [Hz].
@@ -180,5 +184,73 @@ fn a_formula_reading_the_temperature_recovers_its_drift() {
         &[relative("Fc", fc), relative("kt", kt), relative("b", b)],
         record(None),
         record(Some((0.05, 7))),
+    );
+}
+
+/// A guide that rubs harder every 10 mm of its travel, along a slow back-and-forth stroke:
+/// F = (Fc + Fr sin(2 pi x / p + phase)) sgn(v) + b v, fitted by `position_ripple` from a
+/// period 2 % off.
+#[test]
+fn position_ripple_recovers_the_ripple_of_a_stroke() {
+    let (fc, fr, p, phase, b) = (3.0, 0.4, 0.01, 1.0, 10.0);
+    let truth =
+        |_t: f64, x: f64, v: f64| (fc + fr * (2.0 * PI * x / p + phase).sin()) * sgn(v) + b * v;
+    let record = |noise| stroke("guide.csv", 0.05, 4.0, truth, &[], noise);
+    let start = PositionRipple {
+        mu: 2.5,
+        ripple: 0.2,
+        period: 0.0102,
+        phase: 0.7,
+        viscous: 8.0,
+    };
+    accept(
+        "ripple",
+        &start,
+        &[
+            relative("mu", fc),
+            relative("ripple", fr),
+            relative("period", p),
+            Truth {
+                name: "phase",
+                value: phase,
+                absolute: Some(0.02),
+            },
+            relative("viscous", b),
+        ],
+        record(None),
+        record(Some((0.05, 11))),
+    );
+}
+
+/// A strain-wave gearbox whose Coulomb torque grows with the load torque it transmits,
+/// measured beside the motion: F = (Tc + mu_l |load|) sgn(v) + b v, fitted by
+/// `coulomb_load` reading the record's `load` channel.
+#[test]
+fn coulomb_load_recovers_a_gearbox_s_load_dependence() {
+    let (tc, mu_l, b) = (2.0, 0.03, 5.0);
+    let load =
+        |t: f64| 30.0 * (2.0 * PI * 0.13 * t).sin() + 10.0 * (2.0 * PI * 0.41 * t + 1.0).sin();
+    let truth = |t: f64, _x: f64, v: f64| (tc + mu_l * load(t).abs()) * sgn(v) + b * v;
+    let channel: Vec<f64> = uniform_times(DURATION, RATE)
+        .iter()
+        .map(|&t| load(t))
+        .collect();
+    let named = [("load", channel)];
+    let record = |noise| stroke("joint.csv", 0.5, 3.0, truth, &named, noise);
+    let start = CoulombLoad {
+        mu: 1.5,
+        mu_load: 0.01,
+        viscous: 3.0,
+    };
+    accept(
+        "gearbox",
+        &start,
+        &[
+            relative("mu", tc),
+            relative("mu_load", mu_l),
+            relative("viscous", b),
+        ],
+        record(None),
+        record(Some((0.05, 13))),
     );
 }
