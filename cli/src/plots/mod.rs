@@ -12,8 +12,8 @@ pub mod sets;
 mod trends;
 
 pub use charts::{
-    force_against_motion, force_balance, friction_force, input_force, over_time, response_fit,
-    steady_state_curves, MotionAxis, Quantity, View,
+    force_against_motion, force_balance, friction_force, input_force, named_channels, over_time,
+    response_fit, steady_state_curves, MotionAxis, Quantity, View,
 };
 pub use plan::{plan_plots, PLAN_PLOT};
 pub use trends::trend_plots;
