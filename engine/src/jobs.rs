@@ -566,6 +566,7 @@ pub fn plan_job(
         )
         .into());
     }
+    require_no_conditions(model.as_ref()).map_err(JobError::Fit)?;
     let options = spec.fit_options(&[], &Hooks::default());
     let request = PlanRequest {
         assumed: Assumed {
