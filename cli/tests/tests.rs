@@ -1,6 +1,7 @@
 //! The command line's end-to-end tests, one module per subject, built into one binary (one
 //! link instead of one per file).
 
+mod beyond_speed;
 mod campaign;
 mod channels;
 mod cli;

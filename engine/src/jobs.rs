@@ -12,8 +12,8 @@ use crate::energy::{
 };
 use crate::error::EngineError;
 use crate::identify::{
-    compare, fit, require_mechanics, require_oscillator, Check, Finding, FitResult,
-    PropertyUncertainty, Status,
+    compare, fit, require_mechanics, require_no_conditions, require_oscillator, Check, Finding,
+    FitResult, PropertyUncertainty, Status,
 };
 use crate::oscillator::Oscillator;
 use crate::record::{channel_list, Channel, Record};
@@ -121,6 +121,7 @@ pub fn simulate_job(spec: &Spec, input: Option<&Record>) -> Result<SimulateRepor
     let model = &spec.require_model("simulate")?.model;
     require_oscillator(&spec.unknown_oscillator, spec.oscillator.axis, "simulate")
         .map_err(JobError::Fit)?;
+    require_no_conditions(model.as_ref()).map_err(JobError::Fit)?;
     let sim: &SimulationSpec = spec.require_simulation("simulate")?;
     let times = uniform_times(sim.duration, sim.sample_rate);
     let init = Initial {
@@ -565,6 +566,7 @@ pub fn plan_job(
         )
         .into());
     }
+    require_no_conditions(model.as_ref()).map_err(JobError::Fit)?;
     let options = spec.fit_options(&[], &Hooks::default());
     let request = PlanRequest {
         assumed: Assumed {

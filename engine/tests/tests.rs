@@ -5,6 +5,7 @@
 //! their own that would join this binary's "every registered model" tests.
 
 mod asymmetric_levels;
+mod beyond_speed;
 mod calibration;
 mod channels;
 mod compare_verdict;

@@ -6,6 +6,7 @@
 //! module parses and compiles the formulas of the `expression` model.
 
 pub mod builtin;
+pub mod conditions;
 pub mod error;
 pub mod formula;
 pub mod hints;
@@ -20,6 +21,7 @@ pub mod suggest;
 pub mod testing;
 
 pub use builtin::*;
+pub use conditions::{condition_value, Condition};
 pub use error::ModelError;
 pub use hints::{GuessHint, StartContext};
 pub use interval::Interval;

@@ -13,6 +13,7 @@
 //! A law implements the group's trait for itself and names the group in
 //! [`law_groups!`](crate::law_groups), which writes the accessor (`Some(self)`).
 
+use crate::conditions::Condition;
 use crate::error::ModelError;
 use crate::hints::{GuessHint, StartContext};
 use crate::interval::Interval;
@@ -59,6 +60,21 @@ pub trait FrictionModel: dyn_clone::DynClone + Send + Sync + std::fmt::Debug {
     /// steady sliding reaches).
     fn steady_state(&self, v: f64, normal: f64) -> f64 {
         self.force(v, &[], normal)
+    }
+
+    /// What the law reads at each instant besides v, N and its states (the displacement, the
+    /// acceleration, the input force, named record channels), in the order
+    /// [`force_in`](Self::force_in) receives their values. Default: nothing.
+    fn conditions(&self) -> Vec<Condition> {
+        Vec::new()
+    }
+
+    /// The friction force with the values `at` of the law's [`conditions`](Self::conditions)
+    /// (one per condition, in that order). The default, [`force`](Self::force), is right for
+    /// a law that reads none; a law that reads some writes this, and its `force` is this at
+    /// every condition 0 (a load law's force without load).
+    fn force_in(&self, v: f64, z: &[f64], normal: f64, _at: &[f64]) -> f64 {
+        self.force(v, z, normal)
     }
 
     /// The internal states and their law, for a dynamic model (`Some(self)`); `None` (the
@@ -299,6 +315,20 @@ pub trait ParamGradients: FrictionModel {
     /// dF/dp_j at velocity `v`, states `z` and normal force `normal`, into `out` (one entry
     /// per parameter, in [`FrictionModel::params`] order).
     fn force_param_gradient(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]);
+
+    /// [`force_param_gradient`](Self::force_param_gradient) with the values `at` of the law's
+    /// [`conditions`](FrictionModel::conditions). Default: the gradient without them (right
+    /// for a law that reads none).
+    fn force_param_gradient_in(
+        &self,
+        v: f64,
+        z: &[f64],
+        normal: f64,
+        _at: &[f64],
+        out: &mut [f64],
+    ) {
+        self.force_param_gradient(v, z, normal, out);
+    }
 }
 
 /// How a model starts a fit: from the data, or from a fitted simpler model.

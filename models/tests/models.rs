@@ -24,12 +24,14 @@ fn registry_lists_the_built_in_models() {
         vec![
             "coulomb",
             "coulomb_asymmetric",
+            "coulomb_load",
             "dahl",
             "expression",
             "gms",
             "lugre",
             "makkar",
             "none",
+            "position_ripple",
             "stribeck",
             "viscous_coulomb",
             "viscous_coulomb_asymmetric"

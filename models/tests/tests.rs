@@ -2,6 +2,7 @@
 //! link instead of one per file).
 
 mod asymmetric;
+mod conditions;
 mod harness;
 mod jacobian;
 mod makkar_gms_expression;

@@ -66,7 +66,16 @@ pub fn spec(
 }
 
 /// The keys a record dict may have besides its channels.
-const RECORD_KEYS: [&str; 7] = ["name", "t", "time", "x0", "v0", "weight", "release_time"];
+const RECORD_KEYS: [&str; 8] = [
+    "name",
+    "t",
+    "time",
+    "x0",
+    "v0",
+    "weight",
+    "release_time",
+    "channels",
+];
 
 /// The channel a record dict's key names (`v`, `x`, `a` as short names).
 fn channel_of(key: &str) -> Option<Channel> {
@@ -124,8 +133,30 @@ fn add_channel(
     Ok(record.with_channel(channel, values))
 }
 
+/// The named channels of a record dict (`channels = {"load": [...], "temperature": [...]}`):
+/// the conditions a law beyond speed reads, each an array of one value per sample.
+fn named_channels(dict: &Bound<'_, PyDict>, mut record: Record, what: &str) -> PyResult<Record> {
+    let Some(channels) = dict.get_item("channels")? else {
+        return Ok(record);
+    };
+    if channels.is_none() {
+        return Ok(record);
+    }
+    let channels = channels.cast::<PyDict>().map_err(|_| {
+        value_error(format!(
+            "{what}: `channels` must be a dict of named arrays (e.g. {{\"load\": [...]}})"
+        ))
+    })?;
+    for (name, values) in channels.iter() {
+        let name: String = name.extract()?;
+        let values = to_f64_vec(&values, &format!("{what}: channels.{name}"))?;
+        record = record.with_named_channel(name, values);
+    }
+    Ok(record)
+}
+
 /// One record from a dict: `t` and channels as arrays, optional `x0`, `name`, `v0`, `weight`,
-/// `release_time` and `<channel>_noise` levels. `x0` follows the configuration's rule
+/// `release_time`, `<channel>_noise` levels and named `channels` (a dict of arrays). `x0` follows the configuration's rule
 /// ([`Record::set_release_displacement`]): given, else the first displacement sample, else
 /// unknown, which whatever simulates the record from rest refuses with a message naming it.
 pub fn record(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<Record> {
@@ -155,6 +186,7 @@ pub fn record(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<Record> {
             None => add_channel(record, &key, &value, &name)?,
         };
     }
+    let mut record = named_channels(dict, record, &name)?;
     record.set_release_displacement(x0);
     Ok(record)
 }

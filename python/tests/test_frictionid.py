@@ -277,6 +277,26 @@ def test_force_domain_fit_from_arrays_recovers_a_coulomb_law():
     assert abs(param["value"] / mu - 1.0) < 1e-6
 
 
+def test_a_named_channel_of_a_record_dict_feeds_a_law_beyond_speed():
+    """A gearbox's load torque given as a named channel: coulomb_load recovers its level and
+    load coefficient exactly from F = (2 + 0.03 |load|) sgn(v) + 5 v, its results' parameter
+    table carries mu_load, and a record without the channel is refused naming both."""
+    t = np.arange(0.0, 10.0, 5e-3)
+    v = 0.5 * np.sin(2.0 * np.pi * t / 3.0 + 0.1)
+    load = 30.0 * np.sin(2.0 * np.pi * 0.13 * t) + 10.0 * np.sin(2.0 * np.pi * 0.41 * t + 1.0)
+    force = (2.0 + 0.03 * np.abs(load)) * np.sign(v) + 5.0 * v
+    record = {"name": "joint", "t": t, "v": v, "force": force, "channels": {"load": load}}
+    model = {"type": "coulomb_load", "mu": 1.5, "mu_load": 0.01, "viscous": 3.0}
+    options = {"options": {"domain": "force"}}
+    out = frictionid.fit({}, model, [record], options)
+    values = {p["name"]: p["value"] for p in out["parameters"]}
+    assert abs(values["mu_load"] / 0.03 - 1.0) < 1e-6
+    assert abs(values["mu"] / 2.0 - 1.0) < 1e-6
+    del record["channels"]
+    with pytest.raises(ValueError, match=r"record `joint`: the law reads channel `load`"):
+        frictionid.fit({}, model, [record], options)
+
+
 def test_channel_noise_keys_weight_a_vibrometer_accelerometer_fit():
     """A vibrometer + accelerometer record with the sensors' noise levels given as
     `velocity_noise` and `acceleration_noise`: the fit compares both channels and reports

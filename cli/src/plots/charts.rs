@@ -237,6 +237,24 @@ pub fn input_force(
     draw(path, &Figure::over_time(title, vec![panel]).on(axis))
 }
 
+/// The named channels of one record (a load, a temperature) against time, one panel each,
+/// in the SI unit their scales gave them.
+pub fn named_channels(
+    path: &Path,
+    record: &str,
+    time: &[f64],
+    channels: &[(&str, &[f64])],
+) -> Result<(), CliError> {
+    let panels = channels
+        .iter()
+        .map(|&(name, values)| {
+            Panel::new(name, "").with(Series::solid(name, time, values).color(super::MEASURED))
+        })
+        .collect();
+    let title = format!("{record}: named channels");
+    draw(path, &Figure::over_time(title, panels))
+}
+
 /// The motion axis of a force-against-motion chart: quantity, unit and the factor from SI.
 #[derive(Debug, Clone, Copy)]
 pub struct MotionAxis {

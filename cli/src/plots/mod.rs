@@ -12,8 +12,8 @@ pub mod sets;
 mod trends;
 
 pub use charts::{
-    force_against_motion, force_balance, friction_force, input_force, over_time, response_fit,
-    steady_state_curves, MotionAxis, Quantity, View,
+    force_against_motion, force_balance, friction_force, input_force, named_channels, over_time,
+    response_fit, steady_state_curves, MotionAxis, Quantity, View,
 };
 pub use plan::{plan_plots, PLAN_PLOT};
 pub use trends::trend_plots;
@@ -27,10 +27,10 @@ use plotters::prelude::*;
 use std::path::Path;
 
 /// The palette of every plot: Okabe and Ito's colour-blind-safe colours, strongest first,
-/// then a brown, a darkened yellow, two of Paul Tol's muted colours and a dark grey (one
+/// then a brown, a darkened yellow, four of Paul Tol's muted colours and a dark grey (one
 /// colour for each registered law); cycled by series, or fixed per model by
 /// [`model_color`]. Black is kept for measured data.
-pub const PALETTE: [RGBColor; 12] = [
+pub const PALETTE: [RGBColor; 14] = [
     RGBColor(0, 114, 178),   // blue
     RGBColor(213, 94, 0),    // vermillion
     RGBColor(0, 158, 115),   // bluish green
@@ -41,6 +41,8 @@ pub const PALETTE: [RGBColor; 12] = [
     RGBColor(160, 140, 0),   // dark yellow (Okabe-Ito yellow is faint on white)
     RGBColor(136, 34, 85),   // wine (Paul Tol's muted scheme: a colour per registered law)
     RGBColor(51, 34, 136),   // indigo (Tol's muted)
+    RGBColor(68, 170, 153),  // teal (Tol's muted)
+    RGBColor(204, 102, 119), // rose (Tol's muted)
     RGBColor(102, 102, 102), // dark grey
     RGBColor(0, 0, 0),       // black
 ];

@@ -433,7 +433,9 @@ fn energy_record_plots(
 }
 
 /// The measured input of every record that has an `input_force` channel, against time:
-/// `<stem>_input.svg`, with the stems the records' other plots have ([`unique_stems`]).
+/// `<stem>_input.svg`, and the named channels of every record that has some (a load, a
+/// temperature: what a law beyond speed reads), `<stem>_channels.svg`, with the stems the
+/// records' other plots have ([`unique_stems`]).
 pub fn input_plots(
     out: &OutputDir,
     records: &[Record],
@@ -442,6 +444,16 @@ pub fn input_plots(
     let names: Vec<&str> = records.iter().map(|r| r.name.as_str()).collect();
     let mut files = Vec::new();
     for (record, stem) in records.iter().zip(unique_stems(&names)) {
+        let named: Vec<(&str, &[f64])> = record
+            .named_channels()
+            .into_iter()
+            .filter_map(|n| Some((n, record.named_channel(n)?)))
+            .collect();
+        if !named.is_empty() {
+            let file = format!("{stem}_channels.svg");
+            super::named_channels(&out.path(&file), &record.name, record.time(), &named)?;
+            files.push(file);
+        }
         let Some(input) = record.channel(Channel::InputForce) else {
             continue;
         };

@@ -46,6 +46,7 @@ struct Columns {
     time: usize,
     time_scale: f64,
     channels: Vec<(Channel, usize, f64)>,
+    named: Vec<(String, usize, f64)>,
 }
 
 /// Parses delimited text (already read from `path`) into a record.
@@ -155,12 +156,34 @@ fn locate_columns(path: &Path, header: &Header, opts: &ReadOptions) -> Result<Co
     if channels.is_empty() {
         return Err(no_channel(path, header, opts, missing));
     }
+    let mut named = Vec::with_capacity(opts.named.len());
+    for (name, spec) in &opts.named {
+        let (idx, bare) =
+            find_column(&header.names, &spec.column).ok_or_else(|| missing(&spec.column))?;
+        let scale = column_scale(path, header, idx, bare, spec, name, ANY_QUANTITY)?;
+        named.push((name.clone(), idx, scale));
+    }
     Ok(Columns {
         time,
         time_scale,
         channels,
+        named,
     })
 }
+
+/// Every quantity: a named channel's unit may measure any (a load torque, a length), and a
+/// unit not recognised (`degC`) leaves its values as they are.
+const ANY_QUANTITY: &[Quantity] = &[
+    Quantity::Time,
+    Quantity::Length,
+    Quantity::Velocity,
+    Quantity::Acceleration,
+    Quantity::Force,
+    Quantity::Angle,
+    Quantity::AngularVelocity,
+    Quantity::AngularAcceleration,
+    Quantity::Torque,
+];
 
 /// The quantities a channel's unit may measure (on a linear or a rotary axis).
 fn channel_quantities(channel: Channel) -> &'static [Quantity] {
@@ -245,6 +268,11 @@ fn read_rows<'a>(
             .iter()
             .map(|&(c, _, _)| (c, Vec::new()))
             .collect(),
+        named: columns
+            .named
+            .iter()
+            .map(|(n, _, _)| (n.clone(), Vec::new()))
+            .collect(),
         lines: Vec::new(),
     };
     for (line, text) in lines {
@@ -263,6 +291,9 @@ fn read_rows<'a>(
         let number = |idx: usize| field_number(path, line, header, &fields, idx);
         raw.time.push(number(columns.time)? * columns.time_scale);
         for ((_, idx, scale), (_, values)) in columns.channels.iter().zip(&mut raw.channels) {
+            values.push(number(*idx)? * scale);
+        }
+        for ((_, idx, scale), (_, values)) in columns.named.iter().zip(&mut raw.named) {
             values.push(number(*idx)? * scale);
         }
         raw.lines.push(line);

@@ -499,6 +499,7 @@ pub fn read_mat(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Record,
     let endian = file_endian(bytes).map_err(error)?;
     let names: Vec<&str> = std::iter::once(opts.time.column.as_str())
         .chain(opts.channels.values().map(|c| c.column.as_str()))
+        .chain(opts.named.values().map(|c| c.column.as_str()))
         .collect();
     let wanted = |name: &str| names.iter().any(|n| n.eq_ignore_ascii_case(name));
     let variables = scan(bytes, endian, &wanted).map_err(error)?;
@@ -536,11 +537,38 @@ fn collect(file: &MatVariables<'_>, opts: &ReadOptions) -> Result<RawSamples, Da
     if channels.is_empty() {
         return Err(no_channel(file, opts));
     }
+    let named = named_channels(file, opts, time.len())?;
     Ok(RawSamples {
         lines: (1..=time.len()).collect(),
         time,
         channels,
+        named,
     })
+}
+
+/// Every named channel's variable, scaled; each must be present and as long as the time.
+fn named_channels(
+    file: &MatVariables<'_>,
+    opts: &ReadOptions,
+    len: usize,
+) -> Result<Vec<(String, Vec<f64>)>, DataError> {
+    let mut named = Vec::with_capacity(opts.named.len());
+    for (name, spec) in &opts.named {
+        let key = format!("channels.{name}");
+        let index = find_variable(&file.variables, &spec.column)
+            .ok_or_else(|| file.missing(&key, &spec.column))?;
+        let values = file.samples(index, &key, spec.scale)?;
+        if values.len() != len {
+            return Err(file.error(format!(
+                "{key}: variable `{}` has {} samples, the time `{}` has {len}",
+                quoted(&spec.column),
+                values.len(),
+                quoted(&opts.time.column),
+            )));
+        }
+        named.push((name.clone(), values));
+    }
+    Ok(named)
 }
 
 /// The error for a file without any channel variable: a near miss of one name is named as
@@ -683,6 +711,27 @@ mod tests {
             assert_eq!(r.time(), t);
             assert_eq!(r.channel(Channel::Velocity), Some(&v[..]), "{endian:?}");
         }
+    }
+
+    /// A named channel is read from its variable with its scale; a missing one names the
+    /// channel's key.
+    #[test]
+    fn named_channels_are_read_from_their_variables() {
+        let t = [0.0, 0.5, 1.0];
+        let v = [1.0, -2.0, 3.5];
+        let load = [4.0, 5.0, 6.0];
+        let bytes = file(
+            Endian::Little,
+            &[("time", &t), ("velocity", &v), ("tau_l", &load)],
+        );
+        let with = opts().with_named("load", "tau_l", Some(0.5));
+        let r = read_mat(Path::new("r.mat"), &bytes, &with).unwrap();
+        assert_eq!(r.named_channel("load"), Some(&[2.0, 2.5, 3.0][..]));
+        let wrong = opts().with_named("load", "torque", None);
+        let e = read_mat(Path::new("r.mat"), &bytes, &wrong)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("channels.load") && e.contains("torque"), "{e}");
     }
 
     /// Every prefix and every single-byte corruption of a valid file is read or refused with

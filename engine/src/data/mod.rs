@@ -122,6 +122,10 @@ pub struct ReadOptions {
     /// The channels looked for, each in its column: a required column must be present, an
     /// optional one is read when present; at least one channel must be found.
     pub channels: BTreeMap<Channel, ColumnSpec>,
+    /// Named channels besides those (a load torque, a temperature), each in its column,
+    /// which must be present: conditions a law may read.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub named: BTreeMap<String, ColumnSpec>,
     /// Fewest samples accepted.
     pub min_samples: usize,
     /// Largest accepted deviation of one time step from the median step, relative to the
@@ -145,6 +149,7 @@ impl Default for ReadOptions {
                 .filter(|&c| c != Channel::InputForce)
                 .map(|c| (c, ColumnSpec::default_for(c)))
                 .collect(),
+            named: BTreeMap::new(),
             min_samples: 10,
             sampling_tolerance: 0.01,
         }
@@ -165,6 +170,23 @@ impl ReadOptions {
         let spec = self.channel_mut(channel);
         spec.column = column.into();
         spec.required = true;
+        self
+    }
+
+    /// These options with the named channel `name` read from `column` (which must be
+    /// present), scaled by `scale` when one is given.
+    pub fn with_named(
+        mut self,
+        name: impl Into<String>,
+        column: impl Into<String>,
+        scale: Option<f64>,
+    ) -> Self {
+        let mut spec = ColumnSpec::named(column);
+        if let Some(scale) = scale {
+            spec.scale = scale;
+            spec.scale_given = true;
+        }
+        self.named.insert(name.into(), spec);
         self
     }
 
@@ -203,7 +225,12 @@ impl ReadOptions {
                 self.time.scale
             ));
         }
-        for (channel, spec) in &self.channels {
+        let scales = self
+            .channels
+            .iter()
+            .map(|(c, spec)| (c.name(), spec))
+            .chain(self.named.iter().map(|(n, spec)| (n.as_str(), spec)));
+        for (channel, spec) in scales {
             if !(spec.scale.is_finite() && spec.scale != 0.0) {
                 return Err(format!(
                     "{channel}_scale must be finite and non-zero, got {}",
@@ -429,6 +456,8 @@ fn record_name(path: &Path) -> String {
 pub(crate) struct RawSamples {
     pub time: Vec<f64>,
     pub channels: Vec<(Channel, Vec<f64>)>,
+    /// The named channels read, by name.
+    pub named: Vec<(String, Vec<f64>)>,
     pub lines: Vec<usize>,
 }
 
@@ -448,7 +477,8 @@ fn finish(path: &Path, raw: RawSamples, opts: &ReadOptions) -> Result<Record, Da
     // Values parse as finite, but scaling or an evenly spaced UFF abscissa can overflow.
     for i in 0..raw.time.len() {
         let columns = std::iter::once(("time", &raw.time))
-            .chain(raw.channels.iter().map(|(c, v)| (c.name(), v)));
+            .chain(raw.channels.iter().map(|(c, v)| (c.name(), v)))
+            .chain(raw.named.iter().map(|(n, v)| (n.as_str(), v)));
         for (column, values) in columns {
             let value = values.get(i).copied().unwrap_or(f64::NAN);
             if !value.is_finite() {
@@ -486,12 +516,15 @@ fn finish(path: &Path, raw: RawSamples, opts: &ReadOptions) -> Result<Record, Da
     })?;
     check_even_sampling(path, time.as_slice(), &raw.lines, opts.sampling_tolerance)?;
     let record = Record::from_time_base(record_name(path), time);
-    Ok(raw
+    let record = raw
         .channels
         .into_iter()
         .fold(record, |r, (channel, values)| {
             r.with_channel(channel, values)
-        }))
+        });
+    Ok(raw.named.into_iter().fold(record, |r, (name, values)| {
+        r.with_named_channel(name, values)
+    }))
 }
 
 /// Checks that no time step deviates from the median step by more than `tolerance` of it.

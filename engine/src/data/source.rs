@@ -24,6 +24,10 @@
 //! velocity_noise = 2e-4       # m/s, the channel's noise level (default: estimated from it);
 //! # displacement_, acceleration_, force_ and input_force_noise alike, in the channel's SI unit
 //! normal_force = 14.5         # N, this record's constant normal force (else the oscillator's)
+//! channels = { temperature = "T [degC]", load = "Load torque [N m]", load_scale = -1.0 }
+//!                             # named channels a law or a formula reads by name, each from
+//!                             # its column (a unit in a column found by a name without it
+//!                             # scales it, as above); `<name>_scale` the factor to SI
 //! release = "auto"            # or a time in s: drop the pre-trigger rest (default: none)
 //! min_samples = 10
 //! sampling_tolerance = 0.01
@@ -43,6 +47,7 @@ use crate::record::{
     check_scales, detect_release, Channel, NormalForce, Record, Release, X0Source,
 };
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -112,12 +117,24 @@ pub struct RecordSource {
     pub force_noise: Option<f64>,
     /// Noise level of the input-force channel \[N\] (default: estimated).
     pub input_force_noise: Option<f64>,
+    /// Named channels: each name's column, and `<name>_scale` its factor to SI (default 1).
+    pub channels: Option<BTreeMap<String, NamedEntry>>,
     /// Where the free vibration starts (default: at the first sample).
     pub release: Option<Release>,
     /// Fewest samples accepted (default 10).
     pub min_samples: Option<usize>,
     /// Largest relative deviation of a time step from the median step (default 0.01).
     pub sampling_tolerance: Option<f64>,
+}
+
+/// One value of a `channels` table: a column name, or the `<name>_scale` of one.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum NamedEntry {
+    /// The channel's column (delimited text) or variable (MAT-file).
+    Column(String),
+    /// A `<name>_scale`: the factor from the file's unit to SI.
+    Scale(f64),
 }
 
 /// Why a `[[records]]` entry cannot be used. `index` is the entry's 1-based position.
@@ -158,6 +175,13 @@ pub enum RecordSourceError {
         index: usize,
         file: String,
         value: f64,
+    },
+    /// A `channels` table that names a channel wrongly.
+    #[error("[[records]] entry {index} (`{file}`): `channels`: {reason}")]
+    BadChannels {
+        index: usize,
+        file: String,
+        reason: String,
     },
     /// Both a constant normal force and a normal-force column.
     #[error("[[records]] entry {index} (`{file}`): give either `normal_force` (a constant) or `normal_force_column`, not both")]
@@ -208,6 +232,7 @@ macro_rules! record_keys {
             acceleration_noise,
             force_noise,
             input_force_noise,
+            channels,
             release,
             min_samples,
             sampling_tolerance
@@ -390,6 +415,12 @@ impl RecordSource {
         }
         let normal_force = self.normal_force(index, &file)?;
         let noise = self.noise(index, &file)?;
+        self.named_channels()
+            .map_err(|reason| RecordSourceError::BadChannels {
+                index,
+                file: file.clone(),
+                reason,
+            })?;
         let path = Path::new(&file);
         Ok(ResolvedSource {
             file: if path.is_absolute() {
@@ -466,6 +497,43 @@ impl RecordSource {
             .collect()
     }
 
+    /// The named channels: name, column and the scale given, checked: each name a valid
+    /// formula name that is none of the record's own channels nor `v`, `N`, `x`, `a`, `u`,
+    /// each `<name>_scale` a number for a channel named here; the message is the reason.
+    pub fn named_channels(&self) -> Result<Vec<(String, String, Option<f64>)>, String> {
+        let Some(table) = &self.channels else {
+            return Ok(Vec::new());
+        };
+        let mut named = Vec::new();
+        for (name, entry) in table {
+            let NamedEntry::Column(column) = entry else {
+                continue;
+            };
+            check_channel_name(name)?;
+            let scale = match table.get(&format!("{name}_scale")) {
+                Some(NamedEntry::Scale(s)) => Some(*s),
+                Some(NamedEntry::Column(text)) => {
+                    return Err(format!("`{name}_scale` must be a number, got \"{text}\""))
+                }
+                None => None,
+            };
+            named.push((name.clone(), column.clone(), scale));
+        }
+        for (key, entry) in table {
+            let NamedEntry::Scale(_) = entry else {
+                continue;
+            };
+            let base = key.strip_suffix("_scale").unwrap_or(key);
+            if !named.iter().any(|(n, _, _)| n == base) {
+                return Err(format!(
+                    "`{key}` = a number names no channel (give `{base} = \"<column>\"`, or a \
+                     column name as a channel's value)"
+                ));
+            }
+        }
+        Ok(named)
+    }
+
     /// The column and scale keys of each channel.
     fn channel_keys(&self) -> [(Channel, Option<&String>, Option<f64>); 6] {
         [
@@ -529,6 +597,9 @@ impl RecordSource {
         if self.normal_force.is_some() {
             read.channels.remove(&Channel::NormalForce);
         }
+        for (name, column, scale) in self.named_channels().unwrap_or_default() {
+            read = read.with_named(name, column, scale);
+        }
         if let Some(n) = self.min_samples {
             read.min_samples = n;
         }
@@ -548,6 +619,26 @@ impl RecordSource {
     pub fn load_checked(&self, base_dir: &Path, osc: &Oscillator) -> Result<Record, DataError> {
         self.resolve(1, base_dir)?.load_checked(osc)
     }
+}
+
+/// A named channel's name is one a formula can read and no other key's.
+fn check_channel_name(name: &str) -> Result<(), String> {
+    if !frictionid_models::formula::is_identifier(name) {
+        return Err(format!(
+            "`{name}` is not a valid name (a letter or `_`, then letters, digits or `_`)"
+        ));
+    }
+    if Channel::from_name(name).is_some() || name == "time" {
+        return Err(format!(
+            "`{name}` is a channel of its own: name its column with `{name}_column`"
+        ));
+    }
+    if ["v", "N", "x", "a", "u"].contains(&name) || frictionid_models::formula::is_reserved(name) {
+        return Err(format!(
+            "`{name}` is reserved (v, N, x, a, u and function names cannot name a channel)"
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -662,6 +753,65 @@ mod tests {
             "record `r.csv`: missing `x0` (the release displacement, m): a test needs it for a \
              record without a displacement channel"
         );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// Named channels are read from their columns with their scales (a unit in a column
+    /// found by its bare name scales it, one in a column named in full does not), cut at the
+    /// release with the motion; a wrong table is one line naming the entry and the name.
+    #[test]
+    fn named_channels_are_read_scaled_and_cut_at_the_release() {
+        let dir = std::env::temp_dir().join(format!("frictionid-named-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let rows: String = (0..14)
+            .map(|i| format!("{},{},{},{}\n", i as f64 * 1e-3, i, 20 + i, 2 * i))
+            .collect();
+        std::fs::write(
+            dir.join("r.csv"),
+            format!("time,velocity,T [degC],Load torque [mN m]\n{rows}"),
+        )
+        .unwrap();
+        let s = source(
+            "file = \"r.csv\"\nx0 = 0.0\nrelease = 0.0035\nchannels = { \"temperature\": \"T [degC]\", \"load\": \"Load torque\", \"temperature_scale\": 2.0 }",
+        )
+        .unwrap();
+        let r = s.load(&dir).unwrap();
+        assert_eq!(r.named_channels(), vec!["load", "temperature"]);
+        assert_eq!(r.len(), 11);
+        assert_eq!(r.named_channel("temperature").unwrap()[0], 2.0 * 23.0);
+        let load = r.named_channel("load").unwrap();
+        assert!((load[1] - 8e-3).abs() < 1e-15, "{load:?}");
+        for (channels, says) in [
+            (
+                "{ \"velocity\": \"v\" }",
+                "`velocity` is a channel of its own",
+            ),
+            ("{ \"x\": \"X\" }", "`x` is reserved"),
+            (
+                "{ \"load\": \"L\", \"lod_scale\": 2.0 }",
+                "`lod_scale` = a number names no channel",
+            ),
+            (
+                "{ \"load\": \"L\", \"load_scale\": \"2\" }",
+                "`load_scale` must be a number",
+            ),
+        ] {
+            let e = source(&format!("file = \"r.csv\"\nchannels = {channels}"))
+                .unwrap()
+                .resolve(3, &dir)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.starts_with("[[records]] entry 3 (`r.csv`): `channels`: ") && e.contains(says),
+                "{e}"
+            );
+        }
+        let missing = source("file = \"r.csv\"\nx0 = 0.0\nchannels = { \"load\": \"Torque\" }")
+            .unwrap()
+            .load(&dir)
+            .unwrap_err()
+            .to_string();
+        assert!(missing.contains("no column `Torque`"), "{missing}");
         std::fs::remove_dir_all(&dir).ok();
     }
 

@@ -108,6 +108,15 @@ pub fn read_uff58(path: &Path, text: &str, opts: &ReadOptions) -> Result<Record,
         line,
         reason,
     };
+    if let Some(name) = opts.named.keys().next() {
+        return Err(DataError::Options {
+            file: path.to_path_buf(),
+            reason: format!(
+                "channel `{name}`: a UFF dataset 58 holds one function, so named channels \
+                 cannot be read from it; export them with the motion as CSV or a MAT-file"
+            ),
+        });
+    }
     let mut i = 0;
     while let Some(&(_, line)) = lines.get(i) {
         if !is_delimiter(line) {
@@ -428,6 +437,7 @@ fn samples(
     RawSamples {
         time,
         channels: vec![(header.channel, ordinate)],
+        named: Vec::new(),
         lines,
     }
 }

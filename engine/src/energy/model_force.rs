@@ -51,7 +51,7 @@ use super::numerical_replay::numerical_replay;
 use super::EnergyAnalysis;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
-use crate::record::NormalForce;
+use crate::record::{ConditionColumns, NormalForce};
 use frictionid_models::{Derivatives, FrictionModel, Interval, ParamGradients, Propagator};
 use serde::Serialize;
 
@@ -236,14 +236,21 @@ pub fn force_derivatives_along(
             motion.len()
         )));
     }
-    Ok(force_derivatives_checked(model, motion, samples))
+    Ok(force_derivatives_checked(
+        model,
+        motion,
+        samples,
+        &ConditionColumns::none(),
+    ))
 }
 
-/// [`force_derivatives_along`] of a checked motion and samples within it.
+/// [`force_derivatives_along`] of a checked motion and samples within it, the law reading
+/// its conditions from `conditions` (bound to its [`FrictionModel::conditions`]).
 pub(crate) fn force_derivatives_checked(
     model: &dyn FrictionModel,
     motion: CheckedMotion<'_>,
     samples: &[usize],
+    conditions: &ConditionColumns<'_>,
 ) -> Option<ForceDerivatives> {
     let gradients = model.param_gradients()?;
     let np = model.params().len();
@@ -252,11 +259,14 @@ pub(crate) fn force_derivatives_checked(
         gradient: vec![0.0; samples.len() * np],
         given: vec![true; np],
     };
+    let mut at = vec![0.0; conditions.len()];
     let Some(law) = model.states() else {
         for (k, &i) in samples.iter().enumerate() {
             let (v, normal) = (motion.v[i], motion.normal.at(i));
-            out.force.push(model.force(v, &[], normal));
-            gradients.force_param_gradient(v, &[], normal, &mut out.gradient[k * np..(k + 1) * np]);
+            conditions.fill(i, &mut at);
+            out.force.push(model.force_in(v, &[], normal, &at));
+            let row = &mut out.gradient[k * np..(k + 1) * np];
+            gradients.force_param_gradient_in(v, &[], normal, &at, row);
         }
         return Some(out);
     };
@@ -277,8 +287,9 @@ pub(crate) fn force_derivatives_checked(
         }
         while let Some((k, _)) = next.next_if(|(_, &s)| s == i) {
             let row = &mut out.gradient[k * np..(k + 1) * np];
+            conditions.fill(i, &mut at);
             out.force
-                .push(replay.derivatives_at(motion.v[i], motion.normal.at(i), row));
+                .push(replay.derivatives_at(motion.v[i], motion.normal.at(i), &at, row));
         }
     }
     for (j, given) in out.given.iter().enumerate() {
@@ -318,10 +329,11 @@ impl<'a> SensitivityReplay<'a> {
         }
     }
 
-    /// The force at velocity `v` and normal force `normal` with the current states, its
-    /// total derivatives dF/dp + dF/dz dz/dp written into `row`.
-    fn derivatives_at(&mut self, v: f64, normal: f64, row: &mut [f64]) -> f64 {
-        self.gradients.force_param_gradient(v, &self.z, normal, row);
+    /// The force at velocity `v`, normal force `normal` and conditions `at` with the current
+    /// states, its total derivatives dF/dp + dF/dz dz/dp written into `row`.
+    fn derivatives_at(&mut self, v: f64, normal: f64, at: &[f64], row: &mut [f64]) -> f64 {
+        self.gradients
+            .force_param_gradient_in(v, &self.z, normal, at, row);
         self.derivatives
             .force_gradient(v, &self.z, normal, &mut self.df_dz);
         let np = row.len();
@@ -330,7 +342,7 @@ impl<'a> SensitivityReplay<'a> {
                 *r += d * dz;
             }
         }
-        self.model.force(v, &self.z, normal)
+        self.model.force_in(v, &self.z, normal, at)
     }
 }
 
@@ -353,9 +365,26 @@ pub fn forces_at(
     states: &[f64],
     indices: impl Iterator<Item = usize>,
 ) -> Vec<f64> {
+    forces_in(model, v, normal, states, indices, &ConditionColumns::none())
+}
+
+/// [`forces_at`] with the law reading its conditions from `conditions` (bound to its
+/// [`FrictionModel::conditions`]): `force_in` at each sample.
+pub fn forces_in(
+    model: &dyn FrictionModel,
+    v: &[f64],
+    normal: &NormalForce,
+    states: &[f64],
+    indices: impl Iterator<Item = usize>,
+    conditions: &ConditionColumns<'_>,
+) -> Vec<f64> {
     let ns = model.n_states();
+    let mut at = vec![0.0; conditions.len()];
     indices
-        .map(|i| model.force(v[i], &states[i * ns..(i + 1) * ns], normal.at(i)))
+        .map(|i| {
+            conditions.fill(i, &mut at);
+            model.force_in(v[i], &states[i * ns..(i + 1) * ns], normal.at(i), &at)
+        })
         .collect()
 }
 

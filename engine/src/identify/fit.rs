@@ -15,7 +15,9 @@
 use super::assessment::identifiability;
 use super::assessment::property_refits::add_property_uncertainty;
 use super::assessment::summary::{summarise, FinishContext};
-use super::problem::{check_force_domain, check_moves, require_mechanics, ForceAlongMotion};
+use super::problem::{
+    check_force_domain, check_moves, require_mechanics, require_no_conditions, ForceAlongMotion,
+};
 use super::problem::{
     simulated_levels, FitProblem, ProblemParts, Realised, Residuals, SimulatedResponse,
 };
@@ -55,6 +57,7 @@ pub fn fit(
     if target.domain == FitDomain::Force {
         return fit_force(osc, model, records, opts);
     }
+    require_no_conditions(model)?;
     let clock = Instant::now();
     let (residuals, simulated) = simulated_response(osc, records, opts)?;
     let seed = prefit_options(model, opts)
@@ -107,6 +110,7 @@ pub fn fit_force(
 ) -> Result<FitResult, EngineError> {
     check_force_domain(opts)?;
     let producer = ForceAlongMotion::new(records, osc, opts)?;
+    producer.check_conditions(model)?;
     let mean_normal = producer.mean_normal_force();
     // Inverse dynamics starts its oscillator properties at the linear estimate.
     let start = producer.starting_oscillator(osc, &opts.params.oscillator);
@@ -209,9 +213,11 @@ pub(crate) fn lean_fit(
     if opts.target.domain == FitDomain::Force {
         check_force_domain(opts)?;
         let producer = ForceAlongMotion::new(records, osc, opts)?;
+        producer.check_conditions(model)?;
         let start = producer.starting_oscillator(osc, &opts.params.oscillator);
         return lean_with(Arc::new(producer), &start, model, records, opts);
     }
+    require_no_conditions(model)?;
     let (residuals, simulated) = simulated_response(osc, records, opts)?;
     lean_with(residuals, &simulated, model, records, opts)
 }

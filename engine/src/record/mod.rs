@@ -3,18 +3,22 @@
 //!
 //! - [`time`]: the [`TimeBase`] and the one check of time stamps used everywhere.
 //! - [`channel`]: the [`Channel`] names and the [`NormalForce`].
+//! - [`conditions`]: the values a law's conditions (x, a, u, named channels) take along a
+//!   record.
 //! - [`noise`]: a channel's white-noise level estimated from its samples.
 //! - [`release`]: the release instant, given or found in the pre-trigger rest.
 //! - [`sanity`]: units checked against the oscillator (mm/s, milliseconds, x0 in mm).
 
 pub(crate) mod channel;
 pub(crate) mod checked;
+pub mod conditions;
 pub(crate) mod noise;
 pub(crate) mod release;
 pub(crate) mod sanity;
 pub(crate) mod time;
 
 pub use channel::{Channel, NormalForce};
+pub use conditions::{ConditionColumns, ConditionSource};
 pub use release::{detect_release, Release};
 pub use sanity::{check_scales, ScaleError};
 pub use time::{check_sorted, check_time, TimeBase, TimeError};
@@ -36,6 +40,11 @@ pub struct Record {
     /// by the record's clones (a fit, each model of a comparison and each stage of a search
     /// clones its records) until one of them changes its samples.
     channels: BTreeMap<Channel, Arc<Vec<f64>>>,
+    /// Named channels besides those (`[[records]] channels = { load = "..." }`): conditions a
+    /// law may read (a load torque, a temperature), each as long as the time base, in the SI
+    /// unit its scale gave it.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    named: BTreeMap<String, Arc<Vec<f64>>>,
     /// The contact's normal force; `None`: the oscillator's.
     normal_force: Option<NormalForce>,
     /// Noise levels given for channels (`<channel>_noise`), in the channel's unit.
@@ -129,6 +138,7 @@ impl Record {
             name: name.into(),
             time,
             channels: BTreeMap::new(),
+            named: BTreeMap::new(),
             normal_force: None,
             noise: BTreeMap::new(),
             x0: 0.0,
@@ -152,6 +162,28 @@ impl Record {
             }
         }
         self
+    }
+
+    /// The record with `values` as its named channel `name` (replacing one already there).
+    pub fn with_named_channel(mut self, name: impl Into<String>, values: Vec<f64>) -> Self {
+        self.samples_changed();
+        self.named.insert(name.into(), Arc::new(values));
+        self
+    }
+
+    /// The samples of the named channel `name`, if the record has it.
+    pub fn named_channel(&self, name: &str) -> Option<&[f64]> {
+        self.named.get(name).map(|v| v.as_slice())
+    }
+
+    /// The named channel `name`, shared (no copy), if the record has it.
+    pub fn named_channel_shared(&self, name: &str) -> Option<Arc<Vec<f64>>> {
+        self.named.get(name).cloned()
+    }
+
+    /// The names of the record's named channels, in alphabetical order.
+    pub fn named_channels(&self) -> Vec<&str> {
+        self.named.keys().map(String::as_str).collect()
     }
 
     fn with_x0(mut self, x0: f64) -> Self {
@@ -292,6 +324,11 @@ impl Record {
                 .iter()
                 .map(|(&c, v)| (c, Arc::new(tail(v))))
                 .collect(),
+            named: self
+                .named
+                .iter()
+                .map(|(c, v)| (c.clone(), Arc::new(tail(v))))
+                .collect(),
             normal_force: self.normal_force.as_ref().map(|n| match n {
                 NormalForce::Sampled(v) => NormalForce::Sampled(tail(v)),
                 constant => constant.clone(),
@@ -316,6 +353,11 @@ impl Record {
                 .channels
                 .iter()
                 .map(|(&c, v)| (c, Arc::new(head(v))))
+                .collect(),
+            named: self
+                .named
+                .iter()
+                .map(|(c, v)| (c.clone(), Arc::new(head(v))))
                 .collect(),
             normal_force: self.normal_force.as_ref().map(|n| match n {
                 NormalForce::Sampled(v) => NormalForce::Sampled(head(v)),
@@ -432,6 +474,14 @@ impl Record {
                 return Err(format!("{n} time stamps but {len} {what}"));
             }
         }
+        for (name, values) in &self.named {
+            if values.len() != n {
+                return Err(format!(
+                    "{n} time stamps but {} samples of channel `{name}`",
+                    values.len()
+                ));
+            }
+        }
         Ok(())
     }
 
@@ -455,6 +505,14 @@ impl Record {
             if let Some(i) = values.iter().position(|x| !x.is_finite()) {
                 return Err(format!(
                     "{channel} sample {i} is {} (values must be finite)",
+                    values[i]
+                ));
+            }
+        }
+        for (name, values) in &self.named {
+            if let Some(i) = values.iter().position(|x| !x.is_finite()) {
+                return Err(format!(
+                    "channel `{name}` sample {i} is {} (values must be finite)",
                     values[i]
                 ));
             }
@@ -584,6 +642,30 @@ mod tests {
         assert_eq!(tail.time(), &[0.2, 0.3]);
         assert_eq!(tail.channel(Channel::NormalForce), Some(&[6.0, 6.0][..]));
         assert_eq!(tail.velocity(), &[0.5, -0.2]);
+    }
+
+    /// Named channels are cut with the record, checked like the others and listed by name.
+    #[test]
+    fn named_channels_follow_the_cuts_and_the_checks() {
+        let r = record().with_named_channel("load", vec![1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(r.named_channels(), vec!["load"]);
+        assert_eq!(
+            r.starting_at(1).named_channel("load"),
+            Some(&[2.0, 3.0, 4.0][..])
+        );
+        assert_eq!(r.ending_at(2).named_channel("load"), Some(&[1.0, 2.0][..]));
+        assert_eq!(r.named_channel("temperature"), None);
+        r.validate(4).unwrap();
+        let short = record().with_named_channel("load", vec![1.0]);
+        assert_eq!(
+            short.validate(2).unwrap_err().to_string(),
+            "record `r`: 4 time stamps but 1 samples of channel `load`"
+        );
+        let nan = record().with_named_channel("load", vec![1.0, f64::NAN, 0.0, 0.0]);
+        assert_eq!(
+            nan.validate(2).unwrap_err().to_string(),
+            "record `r`: channel `load` sample 1 is NaN (values must be finite)"
+        );
     }
 
     #[test]

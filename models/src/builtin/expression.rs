@@ -17,11 +17,20 @@
 //! | `params` | every other name in the formula with its value (SI units) |
 //! | `bounds` | physical bounds `[lower, upper]` of some parameters |
 //! | `units` | units of some parameters (text) |
+//! | `channels` | names of record channels the formula reads (`[[records]] channels`) |
+//!
+//! Besides `v` and `N` a formula may read the conditions of the motion at each instant:
+//! `x` (the displacement, m or rad), `a` (the acceleration) and `u` (the input force), unless
+//! a parameter has that name, and every record channel named in `channels` (a `load`, a
+//! `temperature`), by that name: `F = Fc * (1 + kt * (temperature - 25)) * sign(v) + b * v`
+//! with `channels = ["temperature"]`. The engine hands them the record's samples (a
+//! force-domain fit, inverse dynamics) and a missing channel is an error naming the record
+//! and the channel. Without values (the law's `force`) they read 0.
 //!
 //! The parameters are the names of `params`, ordered by their first appearance in the
-//! formula (stable for a given formula); they are fitted like any model's. A parameter that
-//! the formula does not use, or a name in the formula that is neither `v`, `N` nor a
-//! parameter, is an error naming it. Syntax and functions: see [`crate::formula`] (usual
+//! formula (stable for a given formula); they are fitted like any model's. A parameter or a
+//! channel that the formula does not use, or a name in the formula that is neither `v`, `N`,
+//! a parameter, `x`, `a`, `u` nor a channel, is an error naming it. Syntax and functions: see [`crate::formula`] (usual
 //! precedence, `^` or `**` for powers, `sign`/`sgn` with sign(0) = 0, `abs`, `exp`, `ln`,
 //! `sqrt`, `tanh`, `sin`, `cos`, `atan`, `min`, `max`, ...). The formula is parsed once, when
 //! the model is built, into an exmex flat expression; evaluation does not parse.
@@ -39,6 +48,7 @@
 //! the smooth parts of the law by the nudge). `sign` of any other argument (`sign(v - 1)`) is
 //! evaluated as written.
 
+use crate::conditions::Condition;
 use crate::error::ModelError;
 use crate::formula::{self, Formula, Parsed};
 use crate::hints::GuessHint;
@@ -69,6 +79,9 @@ pub struct ExpressionConfig {
     /// Units of some parameters.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub units: BTreeMap<String, String>,
+    /// Names of the record channels the formula reads.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub channels: Vec<String>,
 }
 
 /// One fittable parameter of a formula.
@@ -86,9 +99,14 @@ struct Param {
 pub struct Expression {
     force: String,
     params: Vec<Param>,
-    /// F(v, N, params...).
+    /// The record channels named in the config (as written, for its round trip).
+    channels: Vec<String>,
+    /// The conditions the formula reads, in order of first appearance.
+    conditions: Vec<Condition>,
+    /// F(v, N, params..., conditions...).
     compiled: Formula,
-    /// F with sign(v) replaced by the slip direction: (v, N, params..., direction); `None`
+    /// F with sign(v) replaced by the slip direction: (v, N, params..., conditions...,
+    /// direction); `None`
     /// when the formula has no sign(v).
     switched: Option<Formula>,
 }
@@ -119,24 +137,23 @@ impl Expression {
         self.switched.is_some()
     }
 
-    fn eval(&self, f: &Formula, v: f64, normal: f64, direction: Option<f64>) -> f64 {
-        // Variables in the order v, N, params..., direction (see `try_from`).
+    fn eval(&self, f: &Formula, v: f64, normal: f64, at: &[f64], direction: Option<f64>) -> f64 {
+        // Variables in the order v, N, params..., conditions..., direction (see `compile`).
+        let np = self.params.len();
+        let nc = self.conditions.len();
         f.eval_by(|i| match i {
             0 => v,
             1 => normal,
-            _ => self
-                .params
-                .get(i - 2)
-                .map(|p| p.value)
-                .or(direction)
-                .unwrap_or(f64::NAN),
+            i if i < 2 + np => self.params[i - 2].value,
+            i if i < 2 + np + nc => crate::conditions::condition_value(at, i - 2 - np),
+            _ => direction.unwrap_or(f64::NAN),
         })
     }
 
     /// The force at v -> 0+ in the switched form (sign(v) = +1).
     fn breakaway(&self, normal: f64) -> Option<f64> {
         let f = self.switched.as_ref()?;
-        let f0 = self.eval(f, 0.0, normal, Some(1.0));
+        let f0 = self.eval(f, 0.0, normal, &[], Some(1.0));
         f0.is_finite().then_some(f0.abs())
     }
 }
@@ -182,6 +199,59 @@ fn with_default_law(mut cfg: ExpressionConfig) -> (String, ExpressionConfig) {
             (DEFAULT_FORCE.to_string(), defaults)
         }
     }
+}
+
+/// Every name of `channels` is a valid name, neither `v`, `N`, `x`, `a`, `u`, a function nor
+/// a parameter, that the formula uses.
+fn check_channel_names(
+    cfg: &ExpressionConfig,
+    parsed: &Parsed,
+    force: &str,
+) -> Result<(), ModelError> {
+    for name in &cfg.channels {
+        if ["v", "N", "x", "a", "u"].contains(&name.as_str()) || formula::is_reserved(name) {
+            return Err(bad_key(
+                "channels",
+                format!(
+                    "`{name}` is reserved (v, N, x, a, u and function names cannot be channels)"
+                ),
+            ));
+        }
+        if !formula::is_identifier(name) {
+            return Err(bad_key(
+                "channels",
+                format!(
+                    "`{name}` is not a valid name (a letter or `_`, then letters, digits or `_`)"
+                ),
+            ));
+        }
+        if cfg.params.contains_key(name) {
+            return Err(bad_key(
+                "channels",
+                format!("`{name}` is both a parameter and a channel"),
+            ));
+        }
+        if !parsed.variables().iter().any(|(n, _)| n == name) {
+            return Err(bad_key(
+                "channels",
+                format!("channel `{name}` does not appear in the formula `{force}`"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The conditions the formula reads, in order of first appearance: `x`, `a`, `u` where no
+/// parameter has the name, and the channels named in `channels`.
+fn ordered_conditions(parsed: &Parsed, cfg: &ExpressionConfig) -> Vec<Condition> {
+    parsed
+        .variables()
+        .iter()
+        .map(|(name, _)| name.as_str())
+        .filter(|name| !cfg.params.contains_key(*name))
+        .filter(|name| ["x", "a", "u"].contains(name) || cfg.channels.iter().any(|c| c == name))
+        .map(Condition::from_name)
+        .collect()
 }
 
 /// Every name of `params` is a valid, unreserved name that the formula uses.
@@ -258,11 +328,16 @@ fn ordered_params(parsed: &Parsed, mut cfg: ExpressionConfig) -> Vec<Param> {
     params
 }
 
-/// The formula compiled over (v, N, params...), and its switched form with sign(v) replaced
-/// by the slip direction (an extra last variable) when it has sign(v).
-fn compile(parsed: &Parsed, params: &[Param]) -> Result<(Formula, Option<Formula>), ModelError> {
+/// The formula compiled over (v, N, params..., conditions...), and its switched form with
+/// sign(v) replaced by the slip direction (an extra last variable) when it has sign(v).
+fn compile(
+    parsed: &Parsed,
+    params: &[Param],
+    conditions: &[Condition],
+) -> Result<(Formula, Option<Formula>), ModelError> {
     let mut variables = vec!["v", "N"];
     variables.extend(params.iter().map(|p| p.name.as_str()));
+    variables.extend(conditions.iter().map(Condition::name));
     let compiled = parsed.compile(&variables)?;
     if !parsed.has_sign_of("v") {
         return Ok((compiled, None));
@@ -281,12 +356,17 @@ impl TryFrom<ExpressionConfig> for Expression {
         let (force, cfg) = with_default_law(cfg);
         let parsed: Parsed = formula::parse(&force)?;
         check_param_names(&cfg, &parsed, &force)?;
+        check_channel_names(&cfg, &parsed, &force)?;
         check_bounds_and_units(&cfg)?;
+        let conditions = ordered_conditions(&parsed, &cfg);
+        let channels = cfg.channels.clone();
         let params = ordered_params(&parsed, cfg);
-        let (compiled, switched) = compile(&parsed, &params)?;
+        let (compiled, switched) = compile(&parsed, &params, &conditions)?;
         Ok(Self {
             force,
             params,
+            channels,
+            conditions,
             compiled,
             switched,
         })
@@ -297,6 +377,7 @@ impl From<Expression> for ExpressionConfig {
     fn from(m: Expression) -> Self {
         let mut cfg = ExpressionConfig {
             force: Some(m.force),
+            channels: m.channels,
             ..ExpressionConfig::default()
         };
         for p in m.params {
@@ -346,7 +427,13 @@ impl FrictionModel for Expression {
         Ok(())
     }
     fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
-        self.eval(&self.compiled, v, normal, None)
+        self.eval(&self.compiled, v, normal, &[], None)
+    }
+    fn conditions(&self) -> Vec<Condition> {
+        self.conditions.clone()
+    }
+    fn force_in(&self, v: f64, _z: &[f64], normal: f64, at: &[f64]) -> f64 {
+        self.eval(&self.compiled, v, normal, at, None)
     }
     crate::law_groups!(switching, staging);
 }
@@ -357,7 +444,7 @@ impl SwitchedLaw for Expression {
     }
     fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
         match &self.switched {
-            Some(f) => self.eval(f, v, normal, Some(direction)),
+            Some(f) => self.eval(f, v, normal, &[], Some(direction)),
             None => self.force(v, &[], normal),
         }
     }

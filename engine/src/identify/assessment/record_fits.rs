@@ -7,7 +7,7 @@ use super::energy_check::{
 };
 use crate::axis::Axis;
 use crate::energy::{
-    analyze_record, forces_from_states, states_along, EnergyOptions, MeasuredMotion,
+    analyze_record, forces_from_states, forces_in, states_along, EnergyOptions, MeasuredMotion,
 };
 use crate::error::EngineError;
 use crate::identify::problem::inverse_dynamics::unreliable_target_finding;
@@ -17,7 +17,7 @@ use crate::identify::problem::{
 use crate::identify::values::{
     ChannelFit, Check, EnergyForce, Finding, FitSeries, NuisanceValues, RecordFit,
 };
-use crate::record::{Channel, NormalForce, Record};
+use crate::record::{Channel, ConditionSource, NormalForce, Record};
 use std::sync::Arc;
 
 /// The per-record fits and what they add up to.
@@ -267,7 +267,14 @@ fn energy_check<R: Residuals + ?Sized>(
         normal: &normal,
     };
     let states = states_along(model, motion)?;
-    let model_force = forces_from_states(model, &analysis.v, &normal, &states);
+    let model_force = if model.conditions().is_empty() {
+        forces_from_states(model, &analysis.v, &normal, &states)
+    } else {
+        let source = ConditionSource::of_record(rec, analysis.x.clone(), analysis.a.clone());
+        let conditions = source.bind(&model.conditions())?;
+        let all = 0..analysis.v.len();
+        forces_in(model, &analysis.v, &normal, &states, all, &conditions)
+    };
     let mut ef = energy_force_check(&analysis, ForceReference::ModelForce(&model_force))?;
     if let Some(damping) = damping {
         skip_ill_conditioned(&mut ef, &analysis, damping);

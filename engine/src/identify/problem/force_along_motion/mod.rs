@@ -32,14 +32,14 @@ mod checks;
 mod guards;
 mod track;
 
-pub use checks::check_force_domain;
+pub use checks::{check_force_domain, require_no_conditions};
 pub use guards::{require_mechanics, require_oscillator};
 use track::target_source;
 
 use super::inverse_dynamics::{linear_start, Balance, BalanceSamples, LinearStart};
 use super::residuals::{Evaluation, JacobianColumns, RecordCase, Residuals, Segment};
 use super::state_cache::StateCache;
-use crate::energy::forces_at;
+use crate::energy::forces_in;
 use crate::energy::model_force::{force_derivatives_checked, states_along_checked};
 use crate::energy::EnergyOptions;
 use crate::error::EngineError;
@@ -52,8 +52,8 @@ use crate::identify::values::result::{
 };
 use crate::identify::values::target_options::ForceTarget;
 use crate::oscillator::{Oscillator, OscillatorProperty};
-use crate::record::{NormalForce, Record};
-use frictionid_models::GuessHint;
+use crate::record::{ConditionSource, NormalForce, Record};
+use frictionid_models::{FrictionModel, GuessHint};
 use std::sync::Arc;
 
 /// Where a record's target force comes from.
@@ -88,6 +88,8 @@ pub struct ForceTrack {
     pub noise: f64,
     /// The oscillator's terms of an inverse-dynamics target.
     balance: Option<Balance>,
+    /// What a law's conditions read along the record (x, a, u, named channels).
+    conditions: ConditionSource,
 }
 
 /// The force-domain residual producer.
@@ -152,6 +154,16 @@ impl ForceAlongMotion {
             };
         }
         Ok(producer)
+    }
+
+    /// Every record gives `model` the conditions it reads (x, a, u, its named channels): an
+    /// error naming the first record and condition that does not.
+    pub fn check_conditions(&self, model: &dyn FrictionModel) -> Result<(), EngineError> {
+        let wanted = model.conditions();
+        for track in &self.tracks {
+            track.conditions.bind(&wanted)?;
+        }
+        Ok(())
     }
 
     /// The prepared record `index`.
@@ -256,12 +268,14 @@ impl ForceAlongMotion {
                     reason: e.to_string(),
                 })?
         };
-        Ok(forces_at(
+        let conditions = track.conditions.bind(&at.model.conditions())?;
+        Ok(forces_in(
             at.model,
             &track.velocity,
             &track.normal,
             &states,
             track.used.iter().copied(),
+            &conditions,
         ))
     }
 }
@@ -381,8 +395,9 @@ impl Residuals for ForceAlongMotion {
         let track = self.track_of(case.index, case.record)?;
         let weight = case.record.weight.sqrt() / track.noise;
         let wanted = layout.iter().any(|f| matches!(f.kind, ParamKind::Model(_)));
+        let conditions = track.conditions.bind(&at.model.conditions())?;
         let law = wanted
-            .then(|| force_derivatives_checked(at.model, track.motion(), &track.used))
+            .then(|| force_derivatives_checked(at.model, track.motion(), &track.used, &conditions))
             .flatten();
         if law.is_some() && at.model.n_states() > 0 {
             at.count_simulation();

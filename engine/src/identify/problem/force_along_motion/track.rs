@@ -5,7 +5,7 @@ use super::super::inverse_dynamics::{sliding_samples, Balance};
 use super::guards::require_mechanics;
 use super::{ForceTrack, TargetSource};
 use crate::energy::model_force::{check_motion, CheckedMotion};
-use crate::energy::{analyze_record, record_motion, EnergyOptions};
+use crate::energy::{analyze_record, central_difference, record_motion, EnergyOptions};
 use crate::error::EngineError;
 use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::ParamKind;
@@ -15,7 +15,7 @@ use crate::identify::values::result::SlidingSamples;
 use crate::identify::values::target_options::ForceTarget;
 use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::noise::noise_floor_level;
-use crate::record::{channel_list, Channel, Record};
+use crate::record::{channel_list, Channel, ConditionSource, Record};
 
 impl ForceTrack {
     /// Prepares `record`: its motion, its normal force (1 N when `unit_normal`: no normal
@@ -99,8 +99,10 @@ impl ForceTrack {
             TargetSource::InverseDynamics => Some(Channel::InputForce),
             TargetSource::EnergyBased => None,
         };
+        let conditions = track_conditions(record, &motion.v, &motion.x, balance.as_ref());
         Ok(Self {
             source,
+            conditions,
             time: record.time().to_vec(),
             velocity: motion.v,
             displacement: motion.x,
@@ -184,6 +186,23 @@ impl ForceTrack {
         }
         self.target.iter().zip(&axis).map(|(u, a)| u - a).collect()
     }
+}
+
+/// What a law's conditions read along `record`: its displacement `x`, its acceleration (the
+/// record's channel, else the balance's of inverse dynamics, else the central difference of
+/// the velocity `v`), its input force and named channels.
+fn track_conditions(
+    record: &Record,
+    v: &[f64],
+    x: &[f64],
+    balance: Option<&Balance>,
+) -> ConditionSource {
+    let acceleration = match (record.channel(Channel::Acceleration), balance) {
+        (Some(a), _) => a.to_vec(),
+        (None, Some(b)) => b.acceleration.clone(),
+        (None, None) => central_difference(record.time(), v),
+    };
+    ConditionSource::of_record(record, x.to_vec(), acceleration)
 }
 
 /// The compared samples `used` (with their `target`) where |v| >= `min_speed`, and how many
