@@ -18,6 +18,7 @@ mod force_jacobian;
 mod identify;
 mod inverse_dynamics;
 mod levels_as_forces;
+mod long_decay;
 mod pendulum;
 mod plan;
 mod polynomial_spring;
