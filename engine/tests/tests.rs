@@ -19,6 +19,7 @@ mod identify;
 mod inverse_dynamics;
 mod levels_as_forces;
 mod long_decay;
+mod nesting;
 mod pendulum;
 mod plan;
 mod polynomial_spring;
