@@ -1,4 +1,4 @@
-//! Nesting on a driven axis: a slide of 12 kg with Dahl friction (bristle stiffness 2e5 N/m,
+//! Nesting on a driven axis: a slide of 12 kg with Dahl friction (bristle stiffness 5e4 N/m,
 //! Coulomb level 8 N, linear hysteresis) and an input offset of 0.5 N under a multisine,
 //! simulated here by classical Runge-Kutta on M v' = u - offset - F, F' = sigma0 v
 //! (1 - F sgn(v) / F_c) with a step far below the bristles' time scale (not by the engine's
@@ -6,7 +6,7 @@
 //! must end at least as low as Coulomb's, stay ranked, and recover the truth.
 
 use crate::util::{inverse_dynamics_options, rel};
-use frictionid_engine::identify::compare;
+use frictionid_engine::identify::{compare, Check, Status};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::Record;
@@ -14,7 +14,7 @@ use frictionid_models::{default_model, FrictionModel};
 use std::f64::consts::PI;
 
 const MASS: f64 = 12.0;
-const SIGMA0: f64 = 2e5;
+const SIGMA0: f64 = 5e4;
 const COULOMB: f64 = 8.0;
 const OFFSET: f64 = 0.5;
 /// Sample rate [Hz], duration [s], input noise [N].
@@ -83,8 +83,9 @@ fn driven_record() -> Record {
         .with_noise(Channel::InputForce, NOISE)
 }
 
-/// Dahl, which holds Coulomb as its rigid limit, ends at least as low, stays ranked, and
-/// recovers its bristle stiffness and level.
+/// Dahl, which holds Coulomb as its rigid limit, ends at least as low, stays ranked,
+/// recovers its bristle stiffness and level and is the law compare recommends; Coulomb, the
+/// wrong law, warns or fails `goodness_of_fit`.
 #[test]
 fn dahl_on_a_dahl_drive_ends_below_the_coulomb_it_holds() {
     let (osc, opts) = inverse_dynamics_options();
@@ -126,6 +127,23 @@ fn dahl_on_a_dahl_drive_ends_below_the_coulomb_it_holds() {
     let (sigma0, mu_c) = (dahl.value("sigma0").unwrap(), dahl.value("mu_c").unwrap());
     assert!(rel(sigma0, SIGMA0) < 0.1, "sigma0 {sigma0}");
     assert!(rel(mu_c, COULOMB) < 0.02, "mu_c {mu_c}");
+    let verdict = c.verdict.as_ref().expect("a verdict");
+    assert_eq!(verdict.recommended.as_deref(), Some("dahl"));
+    let coulomb = c
+        .ranking
+        .iter()
+        .find(|f| f.model == "coulomb")
+        .expect("ranked");
+    let goodness = coulomb
+        .diagnostics
+        .iter()
+        .find(|d| d.check == Check::GoodnessOfFit)
+        .expect("a goodness-of-fit finding");
+    assert!(
+        matches!(goodness.status, Status::Warn | Status::Fail),
+        "{}",
+        goodness.message
+    );
 }
 
 /// The viscous + Coulomb drive of the inverse-dynamics tests (its own event-locating
