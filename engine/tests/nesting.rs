@@ -3,7 +3,11 @@
 //! simulated here by classical Runge-Kutta on M v' = u - offset - F, F' = sigma0 v
 //! (1 - F sgn(v) / F_c) with a step far below the bristles' time scale (not by the engine's
 //! driver). Dahl holds Coulomb friction as its rigid limit, so its fit by inverse dynamics
-//! must end at least as low as Coulomb's, stay ranked, and recover the truth.
+//! must end at least as low as Coulomb's, stay ranked, and recover the truth. On the
+//! viscous + Coulomb drive of the inverse-dynamics tests LuGre must end as low as
+//! viscous_coulomb. The `#[ignore]`d free-decay cases (records from the engine's simulator,
+//! as the recovery tests make them) check that compare's velocity route recommends the
+//! bristle law whose stiffness the records determine.
 
 use crate::util::{inverse_dynamics_options, rel};
 use frictionid_engine::identify::{compare, Check, Status};
@@ -180,4 +184,71 @@ fn lugre_on_a_viscous_coulomb_drive_ends_at_least_as_low() {
             .expect("ranked")
     };
     assert!(rms("lugre") <= rms("viscous_coulomb") * (1.0 + 1e-3));
+}
+
+/// The FMM stage's free decays (the paper's three releases, 2 s at 1 kHz, 2e-4 m/s of noise)
+/// of a LuGre truth whose bristle stiffness (1e5 N/m) the records determine: compare's
+/// velocity route recommends lugre, which holds coulomb and stribeck, and the static laws
+/// warn or fail `goodness_of_fit`.
+#[test]
+#[ignore = "slow: a compare of velocity fits with a dynamic law (about 8 s)"]
+fn a_lugre_free_decay_recommends_lugre() {
+    use crate::util::lugre_truth;
+    free_decay_recommends(&lugre_truth(), &["coulomb", "stribeck", "lugre"]);
+}
+
+/// The same for a Dahl truth (bristle stiffness 1e5 N/m, mu_c 0.22): compare recommends
+/// dahl, and coulomb, the law it holds, warns or fails `goodness_of_fit`.
+#[test]
+#[ignore = "slow: a compare of velocity fits with a dynamic law (about 8 s)"]
+fn a_dahl_free_decay_recommends_dahl() {
+    let truth = frictionid_models::Dahl {
+        sigma0: 1e5,
+        mu_c: 0.22,
+        alpha: 1.0,
+    };
+    free_decay_recommends(&truth, &["coulomb", "dahl"]);
+}
+
+/// Compares `laws` on the FMM free decays of `truth`: the truth's law (the last) is
+/// recommended and every other law warns or fails `goodness_of_fit`.
+fn free_decay_recommends(truth: &dyn FrictionModel, laws: &[&str]) {
+    use crate::util::{records, NOISE};
+    use frictionid_engine::identify::FitOptions;
+    use frictionid_engine::Oscillator;
+    let osc = Oscillator::fmm();
+    let recs = records(&osc, truth, NOISE, 3);
+    let models: Vec<Box<dyn FrictionModel>> = laws
+        .iter()
+        .map(|n| default_model(n).expect("a registered law"))
+        .collect();
+    let c = compare(&osc, &models, &recs, &FitOptions::default()).expect("a comparison");
+    for f in &c.ranking {
+        let goodness = f
+            .diagnostics
+            .iter()
+            .find(|d| d.check == Check::GoodnessOfFit)
+            .map(|d| (d.status, d.value));
+        eprintln!(
+            "{}: RMS {} m/s, goodness {goodness:?}",
+            f.model, f.rms_residual
+        );
+    }
+    let verdict = c.verdict.as_ref().expect("a verdict");
+    eprintln!("failed {:?}; {}", c.failed, verdict.message);
+    let law = truth.name();
+    assert_eq!(verdict.recommended.as_deref(), Some(law));
+    for f in c.ranking.iter().filter(|f| f.model != law) {
+        let goodness = f
+            .diagnostics
+            .iter()
+            .find(|d| d.check == Check::GoodnessOfFit)
+            .expect("a goodness-of-fit finding");
+        assert!(
+            matches!(goodness.status, Status::Warn | Status::Fail),
+            "{}: {}",
+            f.model,
+            goodness.message
+        );
+    }
 }
