@@ -19,6 +19,8 @@ mod force_jacobian;
 mod identify;
 mod inverse_dynamics;
 mod levels_as_forces;
+mod long_decay;
+mod nesting;
 mod pendulum;
 mod plan;
 mod polynomial_spring;

@@ -21,13 +21,15 @@ use super::problem::{
 use super::problem::{
     simulated_levels, FitProblem, ProblemParts, Realised, Residuals, SimulatedResponse,
 };
+use super::search::further::{search_further, Searched};
 use super::search::prefit::{prefit_finding, prefit_options, Prefit};
 use super::search::starts::{run_starts, start_count, MultiStart, StartRun};
 use super::search::strategy::{plan_fit_starts, Planned, StartPlan};
 use super::search::{build_layout, Layout};
 use super::values::search::check_f_scale;
 use super::values::{
-    check_min_speed, fits_directly, FitDomain, FitOptions, FitResult, Search, TerminationReason,
+    check_min_speed, fits_directly, Finding, FitDomain, FitOptions, FitResult, Search,
+    TerminationReason,
 };
 use crate::error::EngineError;
 use crate::oscillator::{Oscillator, OscillatorProperty};
@@ -148,6 +150,7 @@ fn fit_seeded<R: Residuals + 'static>(
         standings: &standings,
     };
     let mut result = summarise(&context, runs, clock)?;
+    result.diagnostics.extend(found.further);
     if opts.uncertainty.any() {
         add_property_uncertainty(&mut result, osc, opts, |shifted, fitted, refit_opts| {
             fit_with(residuals.clone(), shifted, fitted, records, refit_opts)
@@ -266,6 +269,8 @@ struct Found<R: Residuals> {
     reference: FitProblem<R>,
     origins: Vec<String>,
     search: Search,
+    /// What the further starts of a record that sticks found, when they ran.
+    further: Option<Finding>,
 }
 
 /// Searches for the optimum over `plan`'s layout: the number of starts and the strategy
@@ -298,8 +303,12 @@ fn search_optimum<R: Residuals + 'static>(
     };
     let reference = make_problem();
     let search = Search::resolve(opts.search.strategy, plan.model, n_model_free, simulated);
-    let (mut runs, origins) = if layout.params.is_empty() {
-        (evaluate_as_is(&reference)?, vec!["as given".to_string()])
+    let (mut runs, origins, further) = if layout.params.is_empty() {
+        (
+            evaluate_as_is(&reference)?,
+            vec!["as given".to_string()],
+            None,
+        )
     } else {
         let Planned { seeded, reachable } = plan_fit_starts(plan, search, n_starts, seed);
         let points: Vec<Vec<f64>> = seeded.iter().map(|s| layout.projected(&s.point)).collect();
@@ -312,7 +321,13 @@ fn search_optimum<R: Residuals + 'static>(
             search.promoted(),
             reachable,
         )?;
-        (runs, seeded.into_iter().map(|s| s.origin).collect())
+        let origins = seeded.into_iter().map(|s| s.origin).collect();
+        let Searched {
+            runs,
+            origins,
+            finding,
+        } = search_further(plan, &make_problem, &reference, runs, origins);
+        (runs, origins, finding)
     };
     if let Some((jac, r)) = runs.best.linearisation.take() {
         reference.adopt_linearisation(&runs.best.u, jac, r);
@@ -322,6 +337,7 @@ fn search_optimum<R: Residuals + 'static>(
         reference,
         origins,
         search,
+        further,
     })
 }
 

@@ -1,10 +1,12 @@
 //! The search for the optimum, on the problem's floor: the free parameters the options ask
 //! for ([`free_params`]), the bounded Levenberg-Marquardt solver ([`lm`]), the multi-start
 //! runs ([`starts`]), where the starts come from ([`strategy`]: local, staged from simpler
-//! laws, global) and the force-domain prefit's options and finding ([`prefit`]).
+//! laws, global), the further starts of a free decay that sticks ([`further`]) and the
+//! force-domain prefit's options and finding ([`prefit`]).
 //! Imports the values and the problem; knows nothing of statistics or findings of a fit.
 
 pub(crate) mod free_params;
+pub(crate) mod further;
 pub mod lm;
 pub(crate) mod prefit;
 pub mod starts;

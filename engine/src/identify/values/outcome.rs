@@ -214,6 +214,9 @@ pub enum Check {
     NoiseCorrelation,
     /// The force-domain prefit that gave a velocity fit one of its starts.
     Prefit,
+    /// A velocity fit of a record that sticks whose residual stays far above the noise after
+    /// the search's further starts: the optimum may be a neighbouring count of half-cycles.
+    SuspectOptimum,
     /// The fitted model is physically doubtful (e.g. mu_s < mu_c).
     PhysicalConsistency,
     /// Samples whose target is unreliable, left out of the fit.
