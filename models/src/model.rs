@@ -299,6 +299,16 @@ pub trait ParamGradients: FrictionModel {
     /// dF/dp_j at velocity `v`, states `z` and normal force `normal`, into `out` (one entry
     /// per parameter, in [`FrictionModel::params`] order).
     fn force_param_gradient(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]);
+
+    /// The states' rate's partial derivatives with respect to the parameters, states held:
+    /// d(dz_i/dt)/dp_j into `out` (n_states x n_params, row-major, parameters in
+    /// [`FrictionModel::params`] order), for the forward sensitivities of a simulation.
+    /// Returns whether it wrote them; the default does not (`false`), and the engine then
+    /// differentiates a simulated response by difference quotients. A law without states
+    /// has nothing to write and returns `true`.
+    fn state_param_gradient(&self, _v: f64, _z: &[f64], _normal: f64, _out: &mut [f64]) -> bool {
+        false
+    }
 }
 
 /// How a model starts a fit: from the data, or from a fitted simpler model.

@@ -51,6 +51,7 @@ mod recorders;
 mod rodas;
 mod root;
 mod run;
+mod sensitivity;
 mod small_lu;
 mod stepper;
 mod values;
@@ -65,6 +66,9 @@ pub use input::Input;
 pub use mechanical::MechanicalEnergy;
 pub use rodas::Rodas4;
 pub use run::{REST_SWING_ATOLS, RODAS_ATOL_SCALE, RODAS_TOL_SCALE};
+pub use sensitivity::{
+    simulate_sensitivities, Sensitivities, SensitivityParam, SENSITIVITY_STIFF_RATIO,
+};
 pub use stepper::{
     AffineMotion, IntervalStart, OdeSystem, StepCounts, StepOutcome, Stepper, Tolerance,
 };
