@@ -147,3 +147,111 @@ impl SimulatedResponse {
         )
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identify::problem::least_squares::{FitProblem, ProblemParts};
+    use crate::oscillator::Oscillator;
+    use crate::record::Record;
+    use crate::simulate::{simulate, Initial, Integrator, SimOptions};
+    use frictionid_models::LuGre;
+    use nalgebra::DVector;
+    use std::sync::Arc;
+
+    /// Two LuGre records (0.6 s at 1 kHz from 14 and 22 mm), their velocities as simulated.
+    fn records(osc: &Oscillator, model: &LuGre, opts: &SimOptions) -> Vec<Record> {
+        let time: Vec<f64> = (0..600).map(|i| i as f64 * 1e-3).collect();
+        [0.014, 0.022]
+            .iter()
+            .map(|&x0| {
+                let init = Initial {
+                    x0,
+                    v0: 0.0,
+                    z0: None,
+                };
+                let v = simulate(osc, model, &init, 0.599, &time, opts).unwrap().v;
+                Record::new(format!("{x0}"), time.clone(), v, x0)
+            })
+            .collect()
+    }
+
+    fn param(name: &str, kind: ParamKind, value: f64, log: bool) -> FreeParam {
+        FreeParam {
+            log,
+            ..FreeParam::linear(name.into(), "", kind, (-1e12, 1e12), value, 1.0)
+        }
+    }
+
+    /// The fit's Jacobian with the sensitivity columns (law, property, x0, offset, another
+    /// record's nuisance) against central differences of the residuals in internal
+    /// coordinates, column by column; the release shift's column is the fit's forward
+    /// difference either way (at a release on a sample it is one-sided: not compared).
+    #[test]
+    fn sensitivity_columns_match_central_differences_of_the_residuals() {
+        let osc = Oscillator::fmm();
+        let model = LuGre::default();
+        let opts = SimOptions {
+            integrator: Integrator::Dopri5,
+            rtol: 1e-12,
+            atol: 1e-14,
+            ..SimOptions::default()
+        };
+        let records: Arc<[Record]> = records(&osc, &model, &opts).into();
+        let nuisance = |kind, record| ParamKind::Nuisance { kind, record };
+        let layout = vec![
+            param("sigma0", ParamKind::Model(0), 1e5, true),
+            param("mu_c", ParamKind::Model(3), 0.2, false),
+            param(
+                "c",
+                ParamKind::Property(OscillatorProperty::Damping),
+                0.275,
+                false,
+            ),
+            param("off", nuisance(NuisanceKind::VelocityOffset, 0), 0.0, false),
+            param(
+                "x0",
+                nuisance(NuisanceKind::StartDisplacement, 1),
+                0.022,
+                false,
+            ),
+            param("shift", nuisance(NuisanceKind::ReleaseShift, 0), 0.0, false),
+        ];
+        let residuals =
+            Arc::new(SimulatedResponse::for_records(&records, true, true, true).unwrap());
+        let problem = FitProblem::new(
+            residuals,
+            ProblemParts {
+                oscillator: osc,
+                model: Box::new(model),
+                records,
+                layout,
+                sim: opts,
+                parallel: false,
+            },
+        );
+        let p = [1e5, 0.2, 0.275, 0.0, 0.022, 0.0];
+        let u = problem.internal(&p);
+        let r0 = problem.residuals_at(&p).unwrap();
+        let jac = problem.jacobian_internal(&u, &r0);
+        for j in 0..p.len() - 1 {
+            let h = 1e-5 * u[j].abs().max(1e-3);
+            let mut moved = u.clone();
+            moved[j] += h;
+            let plus = problem.residuals_at(&problem.physical(&moved)).unwrap();
+            moved[j] -= 2.0 * h;
+            let minus = problem.residuals_at(&problem.physical(&moved)).unwrap();
+            let expected: DVector<f64> = (plus - minus) / (2.0 * h);
+            let scale = expected.amax().max(1e-12);
+            let off = (jac.column(j) - &expected).amax() / scale;
+            assert!(off < 1e-3, "column {j}: off by {off:e} of {scale:e}");
+        }
+        // The offset's column is 1 on record 0's samples and 0 on record 1's.
+        assert!(jac
+            .column(3)
+            .iter()
+            .take(600)
+            .all(|&d| (d - 1.0).abs() < 1e-12));
+        assert!(jac.column(3).iter().skip(600).all(|&d| d == 0.0));
+    }
+}
