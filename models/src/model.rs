@@ -329,6 +329,16 @@ pub trait ParamGradients: FrictionModel {
     ) {
         self.force_param_gradient(v, z, normal, out);
     }
+
+    /// The states' rate's partial derivatives with respect to the parameters, states held:
+    /// d(dz_i/dt)/dp_j into `out` (n_states x n_params, row-major, parameters in
+    /// [`FrictionModel::params`] order), for the forward sensitivities of a simulation.
+    /// Returns whether it wrote them; the default does not (`false`), and the engine then
+    /// differentiates a simulated response by difference quotients. A law without states
+    /// has nothing to write and returns `true`.
+    fn state_param_gradient(&self, _v: f64, _z: &[f64], _normal: f64, _out: &mut [f64]) -> bool {
+        false
+    }
 }
 
 /// How a model starts a fit: from the data, or from a fitted simpler model.

@@ -132,6 +132,13 @@ impl Dopri5 {
         self
     }
 
+    /// The same stepper with its error control over the first `controlled` components only
+    /// (see [`Tolerance::control_first`](super::Tolerance::control_first)).
+    pub fn controlling_first(mut self, controlled: usize) -> Self {
+        self.ctrl.tol.control_first(controlled);
+        self
+    }
+
     /// The starting step of Hairer's DOPRI5 (two RHS evaluations, the first kept in k[0]).
     fn initial_step<S: OdeSystem>(&mut self, system: &S) -> f64 {
         let (f0, rest) = self.k.split_at_mut(1);
@@ -144,7 +151,9 @@ impl Dopri5 {
         }
         system.rhs(self.ctrl.t + h0, &self.y_next, f1);
         let mut d2 = 0.0;
-        for (i, ((&yi, &a), &b)) in self.y.iter().zip(f0.iter()).zip(f1.iter()).enumerate() {
+        let controlled = self.ctrl.tol.atol.len();
+        let pairs = self.y.iter().zip(f0.iter()).zip(f1.iter());
+        for (i, ((&yi, &a), &b)) in pairs.enumerate().take(controlled) {
             let sc = self.ctrl.tol.scale(i, yi, yi);
             d2 += ((b - a) / sc) * ((b - a) / sc);
         }

@@ -377,7 +377,7 @@ impl<R: Recorder> Driver<'_, R> {
 
 /// Locates the zero of `g` in (lo, hi] where g(hi) <= 0. At the start of a segment g(lo) may
 /// be 0; a point with g > 0 is then searched on a geometric grid towards `lo`.
-fn locate(mut g: impl FnMut(f64) -> Option<f64>, lo: f64, hi: f64) -> Option<f64> {
+pub(super) fn locate(mut g: impl FnMut(f64) -> Option<f64>, lo: f64, hi: f64) -> Option<f64> {
     let g_hi = g(hi)?;
     if g_hi == 0.0 {
         return Some(hi);

@@ -30,6 +30,11 @@
 //! form for affine laws; Dopri5 also integrates model states along a measured motion
 //! (`energy::model_force_along`). A new integrator is one more `Stepper`.
 //!
+//! # Sensitivities
+//! [`simulate_sensitivities`] integrates the forward sensitivities of the motion with respect
+//! to the law's parameters, the oscillator's properties and x0 beside the states, with their
+//! jumps at turning points and sticks (`sensitivity/`): a velocity fit's Jacobian from one run.
+//!
 //! # Cost
 //! Dopri5 is explicit: for bristle models its step is bounded by stability, about
 //! 3.3 g(v) / (sigma0 |v|) while sliding. On the FMM case (2 s from 22 mm) LuGre and Dahl need
@@ -51,6 +56,7 @@ mod recorders;
 mod rodas;
 mod root;
 mod run;
+mod sensitivity;
 mod small_lu;
 mod stepper;
 mod values;
@@ -65,6 +71,9 @@ pub use input::Input;
 pub use mechanical::MechanicalEnergy;
 pub use rodas::Rodas4;
 pub use run::{REST_SWING_ATOLS, RODAS_ATOL_SCALE, RODAS_TOL_SCALE};
+pub use sensitivity::{
+    simulate_sensitivities, Sensitivities, SensitivityParam, SENSITIVITY_STIFF_RATIO,
+};
 pub use stepper::{
     AffineMotion, IntervalStart, OdeSystem, StepCounts, StepOutcome, Stepper, Tolerance,
 };

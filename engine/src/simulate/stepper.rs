@@ -90,18 +90,26 @@ impl Tolerance {
         self.atol[i] + a.abs().max(b.abs()) * self.rtol
     }
 
-    /// The RMS over components of error / scale (Hairer's norm), for a step from `y` to
-    /// `y_new` with local error estimate `err`.
+    /// Leaves every component from `controlled` on out of the error control (the norms run
+    /// over the first `controlled` components only): forward sensitivities integrated beside
+    /// the states they differentiate follow the states' steps.
+    pub fn control_first(&mut self, controlled: usize) {
+        self.atol.truncate(controlled);
+    }
+
+    /// The RMS over the controlled components of error / scale (Hairer's norm), for a step
+    /// from `y` to `y_new` with local error estimate `err`.
     /// Inlined: a caller whose slices have a size known when compiling gets the unrolled sum.
     #[inline(always)]
     pub fn rms_norm(&self, y: &[f64], y_new: &[f64], err: &[f64]) -> f64 {
         let mut sum = 0.0;
-        let atol = &self.atol[..y.len().min(self.atol.len())];
+        let controlled = y.len().min(self.atol.len());
+        let atol = &self.atol[..controlled];
         for (((&a, &b), &e), &atol) in y.iter().zip(y_new).zip(err).zip(atol) {
             let sc = atol + a.abs().max(b.abs()) * self.rtol;
             sum += (e / sc) * (e / sc);
         }
-        (sum / y.len().max(1) as f64).sqrt()
+        (sum / controlled.max(1) as f64).sqrt()
     }
 
     /// The first guess of a starting step from the state `y` and its slope `f`:
@@ -109,7 +117,7 @@ impl Tolerance {
     /// squared norms it was made from (Hairer, Norsett & Wanner, Sec. II.4).
     pub fn first_step_guess(&self, y: &[f64], f: &[f64]) -> (f64, f64, f64) {
         let (mut d0, mut d1) = (0.0, 0.0);
-        for (i, (&yi, &fi)) in y.iter().zip(f).enumerate() {
+        for (i, (&yi, &fi)) in y.iter().zip(f).enumerate().take(self.atol.len()) {
             let sc = self.scale(i, yi, yi);
             d0 += (yi / sc) * (yi / sc);
             d1 += (fi / sc) * (fi / sc);

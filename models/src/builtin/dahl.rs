@@ -160,6 +160,32 @@ impl ParamGradients for Dahl {
     fn force_param_gradient(&self, _v: f64, _z: &[f64], _normal: f64, out: &mut [f64]) {
         out.iter_mut().for_each(|o| *o = 0.0);
     }
+
+    /// F' = sigma0 v |r|^alpha sgn(r), r = 1 - F sgn(v) / (mu_c N): d/dsigma0 = F' / sigma0,
+    /// d/dmu_c = sigma0 v alpha |r|^(alpha - 1) (1 - r) / mu_c, d/dalpha = F' ln|r|.
+    fn state_param_gradient(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) -> bool {
+        let f = z.first().copied().unwrap_or(0.0);
+        let fc = self.mu_c * normal;
+        let gradient = if fc > 0.0 {
+            let r = 1.0 - f * sgn(v) / fc;
+            let rate = self.sigma0 * v * self.shape(r.abs()) * sgn(r);
+            let slope = if self.alpha == 1.0 {
+                self.sigma0 * v
+            } else if r == 0.0 {
+                0.0
+            } else {
+                self.sigma0 * v * self.alpha * self.shape(r.abs()) / r.abs()
+            };
+            let log = if r == 0.0 { 0.0 } else { rate * r.abs().ln() };
+            [rate / self.sigma0, slope * (1.0 - r) / self.mu_c, log]
+        } else {
+            [0.0; 3]
+        };
+        for (o, d) in out.iter_mut().zip(gradient) {
+            *o = d;
+        }
+        true
+    }
 }
 
 impl Propagator for Dahl {

@@ -158,6 +158,31 @@ impl ParamGradients for LuGre {
             *o = d;
         }
     }
+
+    /// z' = v - sigma0 |v| z / g(v): d/dsigma0 = -|v| z / g, d/dp = sigma0 |v| z (dg/dp) / g^2
+    /// for the levels and v_s; sigma1 and sigma2 do not enter.
+    fn state_param_gradient(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) -> bool {
+        let z0 = z.first().copied().unwrap_or(0.0);
+        let (g, slopes) = self.g_and_slopes(v, normal);
+        let relax = if g > 0.0 { v.abs() * z0 / g } else { 0.0 };
+        let level = if g > 0.0 {
+            self.sigma0 * relax / g
+        } else {
+            0.0
+        };
+        let gradient = [
+            -relax,
+            0.0,
+            0.0,
+            level * slopes[0],
+            level * slopes[1],
+            level * slopes[2],
+        ];
+        for (o, d) in out.iter_mut().zip(gradient) {
+            *o = d;
+        }
+        true
+    }
 }
 
 impl Propagator for LuGre {

@@ -292,5 +292,56 @@ pub fn check_param_gradients(model: &Model) -> Outcome {
             )?;
         }
         Ok(())
+    })?;
+    check_state_param_gradients(model, gradients, &moved)
+}
+
+/// A parameter's step and the model moved by it up and down.
+type MovedParam = (f64, Box<dyn FrictionModel>, Box<dyn FrictionModel>);
+
+/// The states' rate's parameter gradient, where the law gives it, against central
+/// differences of `state_derivative` in each parameter (states held), as the force's.
+fn check_state_param_gradients(
+    model: &Model,
+    gradients: &dyn crate::ParamGradients,
+    moved: &[MovedParam],
+) -> Outcome {
+    let (Some(states), n_params) = (model.states(), moved.len()) else {
+        return Ok(());
+    };
+    let nz = states.n_states();
+    let mut out = vec![0.0; nz * n_params];
+    let (mut plus, mut minus, mut rate) = (vec![0.0; nz], vec![0.0; nz], vec![0.0; nz]);
+    let params = model.params();
+    for_each_probe(model, |v, z, normal| {
+        if !gradients.state_param_gradient(v, z, normal, &mut out) {
+            return Ok(());
+        }
+        states.state_derivative(v, z, normal, &mut rate);
+        for (j, (h, up, down)) in moved.iter().enumerate() {
+            let (Some(up), Some(down)) = (up.states(), down.states()) else {
+                continue;
+            };
+            up.state_derivative(v, z, normal, &mut plus);
+            down.state_derivative(v, z, normal, &mut minus);
+            for k in 0..nz {
+                let expected = (plus[k] - minus[k]) / (2.0 * h);
+                let got = out[k * n_params + j];
+                let floor = 1e-8 * rate[k].abs() / param_scale(params[j]);
+                let tol = DERIVATIVE_TOLERANCE * got.abs().max(expected.abs()) + floor;
+                ensure(
+                    model,
+                    Check::ParamGradients,
+                    (got - expected).abs() <= tol,
+                    || {
+                        format!(
+                            "d(dz{k}/dt)/dp{j} = {got} at v = {v:e}, z = {z:?}, N = {normal}; \
+                         central differences give {expected}"
+                        )
+                    },
+                )?;
+            }
+        }
+        Ok(())
     })
 }

@@ -15,9 +15,12 @@
 //! velocity channel (and needs one in every record).
 
 use super::analysis_cache::{AnalysisCache, AnalysisRequest};
-use super::residuals::{Evaluation, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE};
+use super::residuals::{
+    Evaluation, JacobianColumns, RecordCase, Residuals, Segment, STEPS_PER_SAMPLE,
+};
 use crate::energy::{record_motion, EnergyOptions};
 use crate::error::EngineError;
+use crate::identify::values::layout::FreeParam;
 use crate::identify::values::levels::{FrictionLevels, UNIT_NORMAL_FORCE};
 use crate::identify::values::nuisance::{NuisanceKind, NuisanceValues};
 use crate::oscillator::{Oscillator, OscillatorProperty};
@@ -28,6 +31,8 @@ use crate::simulate::{
 };
 use frictionid_models::GuessHint;
 use std::borrow::Cow;
+
+mod sensitivity;
 
 /// The response channels, in the order they are stacked.
 const RESPONSE: [Channel; 3] = [
@@ -488,6 +493,21 @@ impl Residuals for SimulatedResponse {
         } else {
             record.validate_channels(3)
         }
+    }
+
+    /// Columns from one augmented simulation per record where the law and the record allow
+    /// (see [`sensitivity`]), difference quotients elsewhere.
+    fn has_jacobian(&self) -> bool {
+        true
+    }
+
+    fn jacobian_columns(
+        &self,
+        at: &Evaluation<'_>,
+        case: RecordCase<'_>,
+        layout: &[FreeParam],
+    ) -> Result<JacobianColumns, EngineError> {
+        self.sensitivity_columns(at, case, layout)
     }
 
     fn segments(&self, index: usize, record: &Record) -> Vec<Segment> {

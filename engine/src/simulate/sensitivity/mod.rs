@@ -1,0 +1,122 @@
+//! Forward sensitivities of a simulated motion: the derivatives of the sampled displacement
+//! and velocity with respect to the law's parameters, the oscillator's properties and the
+//! release displacement, integrated with the states in one augmented simulation.
+//!
+//! # Method
+//! With y = [x, v, z...] and y' = f(t, y, p), each parameter's sensitivity s = dy/dp obeys
+//! s' = J s + df/dp (J = df/dy, [`Dynamics::jacobian`]), integrated beside y by Dopri5
+//! whose error control covers the states alone ([`Tolerance::control_first`]): the augmented
+//! run takes the steps of the plain one. df/dp comes from the law (its force's parameter
+//! gradient, [`ParamGradients::force_param_gradient`], and its states' rate's,
+//! [`ParamGradients::state_param_gradient`]) and from the oscillator's balance
+//! ([`OscillatorProperty::balance_column`]): d(x'')/dq = -column / m.
+//!
+//! At a turning point t_e (v(t_e) = 0, a state-dependent event) the sensitivities jump by
+//! (f- - f+) dt_e/dp with dt_e/dp = -s_v / a- (the event function is v; f- and f+ are the
+//! right-hand sides before and after, a- = x'' before): at a reversal of a switched law
+//! the force flips, at a stick the motion stops (f+ = 0, so dv/dp is 0 from there on). A
+//! smooth law's right-hand side is continuous there: no jump.
+//!
+//! # Where it applies
+//! Free vibration (no measured input), every parameter with its derivative available (a
+//! law with [`ParamGradients`], and states' rate gradients for a dynamic law; the normal
+//! force is never differentiated), not the Euler integrator (whose trajectory the
+//! sensitivities of the exact motion would not describe) and not a contact so stiff that
+//! Dopri5 is held by stability ([`SENSITIVITY_STIFF_RATIO`]). Elsewhere
+//! [`simulate_sensitivities`] returns `None` and the caller takes difference quotients.
+//!
+//! [`Tolerance::control_first`]: super::Tolerance::control_first
+//! [`ParamGradients`]: frictionid_models::ParamGradients
+//! [`ParamGradients::force_param_gradient`]: frictionid_models::ParamGradients::force_param_gradient
+//! [`ParamGradients::state_param_gradient`]: frictionid_models::ParamGradients::state_param_gradient
+
+mod run;
+mod system;
+
+use super::auto::stiffness_ratio;
+use super::dynamics::{Dynamics, Law};
+use super::values::{Integrator, RunInputs, SimStats};
+use crate::error::EngineError;
+use crate::oscillator::OscillatorProperty;
+use system::DirectTerms;
+
+/// The stiffness ratio (`auto`'s estimate, rho(J) times Dopri5's accuracy step) above which
+/// the augmented run is not attempted: Dopri5's steps are then set by stability and grow in
+/// number with the ratio, and difference quotients over the stiff integrator cost less.
+pub const SENSITIVITY_STIFF_RATIO: f64 = 200.0;
+
+/// What a sensitivity is taken with respect to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SensitivityParam {
+    /// The law's parameter at this index of its `params()`.
+    Model(usize),
+    /// A property of the oscillator.
+    Property(OscillatorProperty),
+    /// The displacement at the release.
+    StartDisplacement,
+}
+
+/// The sampled motion and its sensitivities.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Sensitivities {
+    /// Displacement at each sample time.
+    pub x: Vec<f64>,
+    /// Velocity at each sample time.
+    pub v: Vec<f64>,
+    /// dx/dp, one series per parameter (in the order asked).
+    pub dx: Vec<Vec<f64>>,
+    /// dv/dp, one series per parameter.
+    pub dv: Vec<Vec<f64>>,
+    /// The work of the augmented run.
+    pub stats: SimStats,
+}
+
+/// Simulates `inputs` with the sensitivities of the sampled displacement and velocity with
+/// respect to `params`; `None` where they are not available (see the module docs), an error
+/// where the run fails.
+pub fn simulate_sensitivities(
+    inputs: RunInputs<'_>,
+    params: &[SensitivityParam],
+) -> Result<Option<Sensitivities>, EngineError> {
+    let RunInputs {
+        osc,
+        model,
+        init,
+        input,
+        grid,
+        opts,
+    } = inputs;
+    if input.is_some() || matches!(opts.integrator, Integrator::Euler { .. }) {
+        return Ok(None);
+    }
+    osc.validate()?;
+    model.check()?;
+    let dynamics = Dynamics::new(osc, model)?;
+    let mut y0 = vec![init.x0, init.v0];
+    match &init.z0 {
+        Some(z0) if z0.len() == model.n_states() => y0.extend_from_slice(z0),
+        Some(_) => return Ok(None),
+        None => y0.resize(2 + model.n_states(), 0.0),
+    }
+    let Some(terms) = DirectTerms::new(&dynamics, params, &y0) else {
+        return Ok(None);
+    };
+    let period = osc.period().unwrap_or(grid.t_end.max(1.0));
+    if !matches!(dynamics.law, Law::Switched { .. })
+        && stiffness_ratio(&dynamics, &y0, period) > SENSITIVITY_STIFF_RATIO
+    {
+        return Ok(None);
+    }
+    run::run(run::Setup {
+        dynamics,
+        terms: &terms,
+        y0: &y0,
+        grid,
+        opts,
+        period,
+    })
+    .map(Some)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,258 @@
+//! The augmented run: segments between turning points as the plain driver takes them, the
+//! sensitivities' jumps at each turning point, and the samples.
+
+use super::super::driver::locate;
+use super::super::dynamics::{Dynamics, Law, Start};
+use super::super::stepper::{StepOutcome, Stepper};
+use super::super::values::{SampleGrid, SimOptions, SimStats};
+use super::super::{Dopri5, REST_SWING_ATOLS};
+use super::system::{Augmented, DirectTerms};
+use super::{Sensitivities, SensitivityParam};
+use crate::error::{EngineError, IntegrationFailure};
+
+/// Largest Dopri5 step as a fraction of the time scale (the plain run's).
+const H_MAX_PERIODS: f64 = 1.0 / 8.0;
+
+/// What an augmented run is made of.
+pub(super) struct Setup<'a, 'b> {
+    pub dynamics: Dynamics<'a>,
+    pub terms: &'b DirectTerms<'a>,
+    /// The states at t = 0.
+    pub y0: &'b [f64],
+    pub grid: SampleGrid<'b>,
+    pub opts: &'b SimOptions,
+    /// The run's time scale (the natural period or its length).
+    pub period: f64,
+}
+
+/// A run in progress: the output and the book-keeping of turning points.
+struct Run<'a, 'b> {
+    setup: Setup<'a, 'b>,
+    out: Sensitivities,
+    next: usize,
+    events: usize,
+    last_turn: Option<f64>,
+    /// The right-hand side of the states just before the last turning point.
+    before_turn: Option<Vec<f64>>,
+}
+
+/// Runs `setup` to its end time.
+pub(super) fn run(setup: Setup<'_, '_>) -> Result<Sensitivities, EngineError> {
+    let n = setup.y0.len();
+    let n_params = setup.terms.params().len();
+    let mut y = vec![0.0; n * (1 + n_params)];
+    y[..n].copy_from_slice(setup.y0);
+    for (j, p) in setup.terms.params().iter().enumerate() {
+        if *p == SensitivityParam::StartDisplacement {
+            y[n * (1 + j)] = 1.0;
+        }
+    }
+    let samples = setup.grid.sample_times.len();
+    let series = || vec![Vec::with_capacity(samples); n_params];
+    let mut stepper = Dopri5::new(
+        y.len(),
+        setup.opts.rtol,
+        setup.opts.atol,
+        setup.period * H_MAX_PERIODS,
+    )
+    .controlling_first(n);
+    let mut run = Run {
+        out: Sensitivities {
+            x: Vec::with_capacity(samples),
+            v: Vec::with_capacity(samples),
+            dx: series(),
+            dv: series(),
+            stats: SimStats::default(),
+        },
+        setup,
+        next: 0,
+        events: 0,
+        last_turn: None,
+        before_turn: None,
+    };
+    let result = run.segments(&mut stepper, y);
+    let counts = stepper.counts();
+    run.out.stats = SimStats {
+        rhs_evaluations: counts.rhs_evaluations,
+        steps: counts.accepted,
+        rejected_steps: counts.rejected,
+        events: run.events,
+        // Every right-hand side of the augmented system evaluates the Jacobian.
+        jacobian_evaluations: counts.rhs_evaluations,
+    };
+    result.map(|()| run.out)
+}
+
+impl Run<'_, '_> {
+    fn n(&self) -> usize {
+        self.setup.y0.len()
+    }
+
+    fn segments(&mut self, stepper: &mut Dopri5, mut y: Vec<f64>) -> Result<(), EngineError> {
+        let t_end = self.setup.grid.t_end;
+        let tiny = 1e-13 * (1.0 + t_end);
+        let mut t = 0.0;
+        loop {
+            let start = self.decide(&y);
+            self.jump(&mut y, start);
+            let Start::Slip(dir) = start else {
+                self.count_event(t)?;
+                self.fill(&y, None);
+                return Ok(());
+            };
+            if t_end - t <= tiny {
+                self.fill(&y, Some(dir));
+                return Ok(());
+            }
+            let system = Augmented::new(self.setup.dynamics, dir, self.setup.terms);
+            stepper.reset(&system, t, &y, t_end)?;
+            match self.advance(stepper, &system, &mut y)? {
+                None => return Ok(()),
+                Some(t_e) => {
+                    self.count_event(t_e)?;
+                    t = t_e;
+                }
+            }
+        }
+    }
+
+    /// Steps through one segment; at a turning point leaves the augmented state there in `y`
+    /// (v = 0) and returns its time, `None` at the end time.
+    fn advance(
+        &mut self,
+        stepper: &mut Dopri5,
+        system: &Augmented<'_, '_>,
+        y: &mut [f64],
+    ) -> Result<Option<f64>, EngineError> {
+        let dir = system.dir;
+        let n = self.n();
+        loop {
+            if stepper.counts().attempts() >= self.setup.opts.max_steps {
+                return Err(IntegrationFailure::StepBudgetExceeded {
+                    time: stepper.time(),
+                    max_steps: self.setup.opts.max_steps,
+                }
+                .into());
+            }
+            if stepper.step(system)? == StepOutcome::Rejected {
+                continue;
+            }
+            if stepper.state().iter().any(|v| !v.is_finite()) {
+                return Err(IntegrationFailure::NonFiniteState {
+                    time: stepper.time(),
+                    state: stepper.state()[..n].to_vec(),
+                }
+                .into());
+            }
+            if dir * stepper.state()[1] <= 0.0 {
+                let lo = stepper.previous_time();
+                let g = |t: f64| {
+                    stepper.interpolate(t, y);
+                    Some(dir * y[1])
+                };
+                let t_e = locate(g, lo, stepper.time())
+                    .ok_or(IntegrationFailure::EventNotLocated { time: lo })?;
+                self.write(stepper, t_e, y);
+                stepper.interpolate(t_e, y);
+                y[1] = 0.0;
+                let mut f = vec![0.0; n];
+                system.dynamics.rhs(t_e, &y[..n], &mut f, dir);
+                self.before_turn = Some(f);
+                return Ok(Some(t_e));
+            }
+            if stepper.reached_end() {
+                self.write(stepper, self.setup.grid.t_end, y);
+                y.copy_from_slice(stepper.state());
+                self.fill(y, Some(dir));
+                return Ok(None);
+            }
+            self.write(stepper, stepper.time(), y);
+        }
+    }
+
+    /// The mode at a turning point or the start, as the plain driver decides it.
+    fn decide(&mut self, y: &[f64]) -> Start {
+        let [x, v, z @ ..] = &y[..self.n()] else {
+            return Start::Rest;
+        };
+        let dynamics = &self.setup.dynamics;
+        let mut start = dynamics.start(0.0, *x, *v, z);
+        let switched = matches!(dynamics.law, Law::Switched { .. });
+        if *v == 0.0 && !dynamics.driven() && !switched {
+            let swing = REST_SWING_ATOLS * self.setup.opts.atol;
+            if self.last_turn.is_some_and(|prev| (x - prev).abs() < swing) {
+                start = Start::Rest;
+            }
+        }
+        if *v == 0.0 {
+            self.last_turn = Some(*x);
+        }
+        start
+    }
+
+    /// The sensitivities' jump at the turning point just reached (if any) into `start`:
+    /// s += (f- - f+) dt_e/dp with dt_e/dp = -s_v / a-.
+    fn jump(&mut self, y: &mut [f64], start: Start) {
+        let Some(before) = self.before_turn.take() else {
+            return;
+        };
+        let n = self.n();
+        let a_before = before[1];
+        if a_before == 0.0 || !a_before.is_finite() {
+            return;
+        }
+        let mut after = vec![0.0; n];
+        if let Start::Slip(dir) = start {
+            self.setup.dynamics.rhs(0.0, &y[..n], &mut after, dir);
+        }
+        for s in y[n..].chunks_exact_mut(n) {
+            let dt_dp = -s[1] / a_before;
+            for ((si, &b), &a) in s.iter_mut().zip(&before).zip(&after) {
+                *si += (b - a) * dt_dp;
+            }
+        }
+    }
+
+    fn count_event(&mut self, time: f64) -> Result<(), EngineError> {
+        self.events += 1;
+        if self.events > self.setup.opts.max_events {
+            return Err(IntegrationFailure::EventBudgetExceeded {
+                time,
+                max_events: self.setup.opts.max_events,
+            }
+            .into());
+        }
+        Ok(())
+    }
+
+    /// Writes the samples with time <= `until` from the last step's dense output.
+    fn write(&mut self, stepper: &Dopri5, until: f64, buf: &mut [f64]) {
+        while let Some(&ts) = self.setup.grid.sample_times.get(self.next) {
+            if ts > until {
+                break;
+            }
+            stepper.interpolate(ts, buf);
+            self.push(buf, true);
+        }
+    }
+
+    /// Writes every remaining sample with the augmented state `y`: moving in direction `dir`
+    /// at the end time, or at rest (`None`: v and its sensitivities 0).
+    fn fill(&mut self, y: &[f64], dir: Option<f64>) {
+        while self.next < self.setup.grid.sample_times.len() {
+            self.push(y, dir.is_some());
+        }
+    }
+
+    fn push(&mut self, y: &[f64], moving: bool) {
+        let n = self.n();
+        let out = &mut self.out;
+        out.x.push(y[0]);
+        out.v.push(if moving { y[1] } else { 0.0 });
+        for ((s, dx), dv) in y[n..].chunks_exact(n).zip(&mut out.dx).zip(&mut out.dv) {
+            dx.push(s[0]);
+            dv.push(if moving { s[1] } else { 0.0 });
+        }
+        self.next += 1;
+    }
+}

@@ -1,0 +1,179 @@
+//! The augmented equation of motion [y, s_1, ..., s_n]: the states and, for each parameter,
+//! s_j' = J s_j + df/dp_j.
+
+use super::super::dynamics::{Dynamics, Law};
+use super::super::stepper::OdeSystem;
+use super::SensitivityParam;
+use frictionid_models::ParamGradients;
+use std::cell::RefCell;
+
+/// The direct terms df/dp of each parameter: what they need from the law and the oscillator.
+pub(super) struct DirectTerms<'a> {
+    params: Vec<SensitivityParam>,
+    /// The law's parameter gradients (when a law parameter is among `params`).
+    gradients: Option<&'a dyn ParamGradients>,
+    /// The law's parameter count.
+    n_model: usize,
+}
+
+impl<'a> DirectTerms<'a> {
+    /// The terms of `params` for `dynamics` starting from `y0`; `None` where one of them has
+    /// no derivative (a law without gradients, a states' rate without them, the normal force,
+    /// a restoring-law property whose balance column is not its exact derivative).
+    pub fn new(dynamics: &Dynamics<'a>, params: &[SensitivityParam], y0: &[f64]) -> Option<Self> {
+        let n_model = dynamics.model.params().len();
+        let mut gradients = None;
+        for &p in params {
+            match p {
+                SensitivityParam::Model(i) => {
+                    let g = dynamics.model.param_gradients()?;
+                    if i >= n_model || !rate_gradient_given(dynamics, g, y0, n_model) {
+                        return None;
+                    }
+                    gradients = Some(g);
+                }
+                SensitivityParam::Property(q) => {
+                    if !q.balance_column_exact(&dynamics.osc) {
+                        return None;
+                    }
+                }
+                SensitivityParam::StartDisplacement => {}
+            }
+        }
+        Some(Self {
+            params: params.to_vec(),
+            gradients,
+            n_model,
+        })
+    }
+
+    /// The parameters, in order.
+    pub fn params(&self) -> &[SensitivityParam] {
+        &self.params
+    }
+}
+
+/// Whether the law's states' rate has its parameter gradient (a law without states needs
+/// none).
+fn rate_gradient_given(
+    dynamics: &Dynamics<'_>,
+    gradients: &dyn ParamGradients,
+    y0: &[f64],
+    n_model: usize,
+) -> bool {
+    let Law::Dynamic { .. } = dynamics.law else {
+        return true;
+    };
+    let (v, z) = (
+        y0.get(1).copied().unwrap_or(0.0),
+        y0.get(2..).unwrap_or(&[]),
+    );
+    let mut probe = vec![0.0; z.len() * n_model];
+    gradients.state_param_gradient(v, z, dynamics.normal, &mut probe)
+}
+
+/// Scratch of one right-hand side.
+#[derive(Default)]
+struct Scratch {
+    jac: Vec<f64>,
+    force: Vec<f64>,
+    rate: Vec<f64>,
+    direct: Vec<f64>,
+}
+
+/// The augmented system of one segment (slip direction `dir`).
+pub(super) struct Augmented<'a, 'b> {
+    pub dynamics: Dynamics<'a>,
+    pub dir: f64,
+    pub terms: &'b DirectTerms<'a>,
+    scratch: RefCell<Scratch>,
+}
+
+impl<'a, 'b> Augmented<'a, 'b> {
+    pub fn new(dynamics: Dynamics<'a>, dir: f64, terms: &'b DirectTerms<'a>) -> Self {
+        Self {
+            dynamics,
+            dir,
+            terms,
+            scratch: RefCell::new(Scratch::default()),
+        }
+    }
+
+    /// The states' dimension n of y = [x, v, z...].
+    pub fn n(&self) -> usize {
+        2 + self.dynamics.model.n_states()
+    }
+
+    /// Writes df/dp_j at (t, y) into column j of `out` (n x n_params, column-major).
+    fn direct_terms(&self, t: f64, y: &[f64], scratch: &mut Scratch) {
+        let n = y.len();
+        let [x, v, z @ ..] = y else {
+            return;
+        };
+        let Scratch {
+            force,
+            rate,
+            direct,
+            ..
+        } = scratch;
+        direct.clear();
+        direct.resize(n * self.terms.params.len(), 0.0);
+        let mass = self.dynamics.osc.mass;
+        if let Some(g) = self.terms.gradients {
+            // A switched law slips in its segment's direction even at v = 0 (as its force).
+            let v_law = match self.dynamics.law {
+                Law::Switched { .. } if self.dir * v <= 0.0 => self.dir * f64::MIN_POSITIVE,
+                _ => *v,
+            };
+            force.resize(self.terms.n_model, 0.0);
+            g.force_param_gradient(v_law, z, self.dynamics.normal, force);
+            if !z.is_empty() {
+                rate.resize(z.len() * self.terms.n_model, 0.0);
+                g.state_param_gradient(*v, z, self.dynamics.normal, rate);
+            }
+        }
+        let accel = || {
+            let f = self.dynamics.force(*v, z, self.dir);
+            self.dynamics.accel(t, *x, *v, f)
+        };
+        for (j, p) in self.terms.params.iter().enumerate() {
+            let col = &mut direct[j * n..(j + 1) * n];
+            match *p {
+                SensitivityParam::Model(i) => {
+                    col[1] = -force[i] / mass;
+                    for (k, c) in col[2..].iter_mut().enumerate() {
+                        *c = rate[k * self.terms.n_model + i];
+                    }
+                }
+                SensitivityParam::Property(q) => {
+                    col[1] = -q.balance_column(accel(), *v, *x) / mass;
+                }
+                SensitivityParam::StartDisplacement => {}
+            }
+        }
+    }
+}
+
+impl OdeSystem for Augmented<'_, '_> {
+    fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+        let n = self.n();
+        let (state, sens) = y.split_at(n);
+        let (d_state, d_sens) = dy.split_at_mut(n);
+        self.dynamics.rhs(t, state, d_state, self.dir);
+        let mut scratch = self.scratch.borrow_mut();
+        scratch.jac.resize(n * n, 0.0);
+        self.dynamics.jacobian(state, self.dir, &mut scratch.jac);
+        self.direct_terms(t, state, &mut scratch);
+        let Scratch { jac, direct, .. } = &*scratch;
+        for ((s, ds), d) in sens
+            .chunks_exact(n)
+            .zip(d_sens.chunks_exact_mut(n))
+            .zip(direct.chunks_exact(n))
+        {
+            for (i, (o, &di)) in ds.iter_mut().zip(d).enumerate() {
+                let row = &jac[i * n..(i + 1) * n];
+                *o = di + row.iter().zip(s).map(|(a, b)| a * b).sum::<f64>();
+            }
+        }
+    }
+}

@@ -1,0 +1,265 @@
+//! The sensitivities against independent differences of plain simulations: central
+//! differences away from turning points for smooth responses (LuGre, Stribeck with an
+//! oscillator property free), and a brute-force perturbation p +- h over a whole record that
+//! sticks and slips (Coulomb), where the jumps at the events carry the sensitivities across.
+
+use super::*;
+use crate::oscillator::Oscillator;
+use crate::simulate::{simulate, Initial, SampleGrid, SimOptions, Trajectory};
+use frictionid_models::{Coulomb, FrictionModel, LuGre, Stribeck};
+
+/// Tight options, so that the differences of plain runs are accurate.
+fn tight() -> SimOptions {
+    SimOptions {
+        integrator: Integrator::Dopri5,
+        rtol: 1e-12,
+        atol: 1e-14,
+        ..SimOptions::default()
+    }
+}
+
+fn times(seconds: f64) -> Vec<f64> {
+    (0..=(seconds * 1e3) as usize)
+        .map(|i| i as f64 * 1e-3)
+        .collect()
+}
+
+/// A world: the oscillator, the law and the release displacement.
+#[derive(Clone)]
+struct World {
+    osc: Oscillator,
+    model: Box<dyn FrictionModel>,
+    x0: f64,
+}
+
+impl World {
+    fn plain(&self, time: &[f64]) -> Trajectory {
+        let init = Initial {
+            x0: self.x0,
+            v0: 0.0,
+            z0: None,
+        };
+        let t_end = time.last().copied().unwrap_or(0.0);
+        simulate(&self.osc, self.model.as_ref(), &init, t_end, time, &tight()).unwrap()
+    }
+
+    fn sensitivities(&self, time: &[f64], params: &[SensitivityParam]) -> Sensitivities {
+        let init = Initial {
+            x0: self.x0,
+            v0: 0.0,
+            z0: None,
+        };
+        let inputs = RunInputs {
+            osc: &self.osc,
+            model: self.model.as_ref(),
+            init: &init,
+            input: None,
+            grid: SampleGrid {
+                t_end: time.last().copied().unwrap_or(0.0),
+                sample_times: time,
+            },
+            opts: &tight(),
+        };
+        simulate_sensitivities(inputs, params).unwrap().unwrap()
+    }
+
+    /// The world with `p` moved by `by`.
+    fn moved(&self, p: SensitivityParam, by: f64) -> World {
+        let mut w = self.clone();
+        match p {
+            SensitivityParam::Model(i) => {
+                let mut values = w.model.params();
+                values[i] += by;
+                w.model.set_params(&values).unwrap();
+            }
+            SensitivityParam::Property(q) => w.osc = q.shifted(&w.osc, by),
+            SensitivityParam::StartDisplacement => w.x0 += by,
+        }
+        w
+    }
+
+    fn value(&self, p: SensitivityParam) -> f64 {
+        match p {
+            SensitivityParam::Model(i) => self.model.params()[i],
+            SensitivityParam::Property(q) => q.value(&self.osc).unwrap(),
+            SensitivityParam::StartDisplacement => self.x0,
+        }
+    }
+
+    /// Central differences of the sampled (x, v) along `p` with relative step `rel`.
+    fn differences(&self, time: &[f64], p: SensitivityParam, rel: f64) -> (Vec<f64>, Vec<f64>) {
+        let h = rel * self.value(p).abs().max(1e-3);
+        let (plus, minus) = (self.moved(p, h).plain(time), self.moved(p, -h).plain(time));
+        let quotient = |a: &[f64], b: &[f64]| -> Vec<f64> {
+            a.iter().zip(b).map(|(a, b)| (a - b) / (2.0 * h)).collect()
+        };
+        (quotient(&plus.x, &minus.x), quotient(&plus.v, &minus.v))
+    }
+}
+
+/// Whether sample `i` lies within `margin` samples of an event of `events`.
+fn near_event(time: &[f64], events: &[f64], i: usize, margin: f64) -> bool {
+    let dt = time.get(1).map_or(1.0, |t1| t1 - time[0]);
+    events.iter().any(|&e| (time[i] - e).abs() <= margin * dt)
+}
+
+/// The largest difference between `got` and `expected` over the samples not excluded,
+/// relative to the largest |expected|.
+fn worst(got: &[f64], expected: &[f64], excluded: impl Fn(usize) -> bool) -> f64 {
+    let scale = expected
+        .iter()
+        .fold(0.0f64, |m, e| m.max(e.abs()))
+        .max(1e-300);
+    let diff = got
+        .iter()
+        .zip(expected)
+        .enumerate()
+        .filter(|(i, _)| !excluded(*i))
+        .fold(0.0f64, |m, (_, (g, e))| m.max((g - e).abs()));
+    diff / scale
+}
+
+/// Checks every parameter's sampled sensitivities against central differences, away from
+/// the turning points (a sample on each side), to `tol` of each column's scale.
+fn check_against_differences(world: &World, time: &[f64], params: &[SensitivityParam], tol: f64) {
+    let sens = world.sensitivities(time, params);
+    let plain = world.plain(time);
+    let events: Vec<f64> = plain.events.iter().map(|e| e.time).collect();
+    assert!(events.len() >= 2, "the record holds turning points");
+    for (i, (got, expected)) in sens.v.iter().zip(&plain.v).enumerate() {
+        assert!((got - expected).abs() < 1e-7, "v[{i}] {got} vs {expected}");
+    }
+    for (j, &p) in params.iter().enumerate() {
+        let (dx, dv) = world.differences(time, p, 1e-5);
+        let away = |i: usize| near_event(time, &events, i, 1.0);
+        let ex = worst(&sens.dx[j], &dx, away);
+        let ev = worst(&sens.dv[j], &dv, away);
+        assert!(
+            ex < tol && ev < tol,
+            "{p:?}: dx off by {ex:e}, dv by {ev:e}"
+        );
+    }
+}
+
+#[test]
+fn lugre_sensitivities_match_central_differences() {
+    let world = World {
+        osc: Oscillator::fmm(),
+        model: Box::new(LuGre::default()),
+        x0: 0.022,
+    };
+    let params = [
+        SensitivityParam::Model(0),
+        SensitivityParam::Model(1),
+        SensitivityParam::Model(3),
+        SensitivityParam::Model(5),
+        SensitivityParam::Property(OscillatorProperty::Stiffness),
+        SensitivityParam::StartDisplacement,
+    ];
+    check_against_differences(&world, &times(0.6), &params, 1e-4);
+}
+
+#[test]
+fn stribeck_sensitivities_with_a_free_damping_match_central_differences() {
+    let world = World {
+        osc: Oscillator::fmm(),
+        model: Box::new(Stribeck::default()),
+        x0: 0.022,
+    };
+    let params = [
+        SensitivityParam::Model(0),
+        SensitivityParam::Model(1),
+        SensitivityParam::Model(2),
+        SensitivityParam::Model(4),
+        SensitivityParam::Property(OscillatorProperty::Damping),
+        SensitivityParam::Property(OscillatorProperty::Mass),
+    ];
+    check_against_differences(&world, &times(0.6), &params, 1e-4);
+}
+
+/// Coulomb on the FMM stage from 10 mm reverses a few times and sticks for good: over the
+/// whole record (rest included) the sensitivities equal the difference of two simulations at
+/// p +- h, but for the samples between the events of the two (one on each side of each
+/// event).
+#[test]
+fn coulomb_sensitivities_carry_across_reversals_and_the_stick() {
+    let world = World {
+        osc: Oscillator::fmm(),
+        model: Box::new(Coulomb { mu: 0.24 }),
+        x0: 0.010,
+    };
+    let time = times(1.5);
+    let params = [
+        SensitivityParam::Model(0),
+        SensitivityParam::StartDisplacement,
+        SensitivityParam::Property(OscillatorProperty::Stiffness),
+    ];
+    let sens = world.sensitivities(&time, &params);
+    let plain = world.plain(&time);
+    assert!(plain.rest.is_some(), "the motion sticks");
+    let events: Vec<f64> = plain.events.iter().map(|e| e.time).collect();
+    assert!(events.len() >= 3, "{events:?}");
+    for (j, &p) in params.iter().enumerate() {
+        let (dx, dv) = world.differences(&time, p, 1e-6);
+        let near = |i: usize| near_event(&time, &events, i, 1.0);
+        let (ex, ev) = (worst(&sens.dx[j], &dx, near), worst(&sens.dv[j], &dv, near));
+        assert!(
+            ex < 1e-5 && ev < 1e-5,
+            "{p:?}: dx off by {ex:e}, dv by {ev:e}"
+        );
+        // At rest the velocity's sensitivity is zero and the displacement's that of the rest
+        // position.
+        let last = time.len() - 1;
+        assert_eq!(sens.dv[j][last], 0.0);
+        assert!((sens.dx[j][last] - dx[last]).abs() <= 1e-5 * dx[last].abs().max(1e-9));
+    }
+    // The stiffness moves the reversals (the half-period is pi / omega_n whatever mu and
+    // x0): dv/dk jumps there by (a- - a+) dt_e/dk, a good part of its scale, which the
+    // comparison above holds one sample after each event.
+    let dv_dk = &sens.dv[2];
+    let scale = dv_dk.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let first = time.partition_point(|&t| t < events[0]);
+    let continued = 2.0 * dv_dk[first - 2] - dv_dk[first - 3];
+    let jump = dv_dk[first + 1] - continued;
+    assert!(jump.abs() > 0.2 * scale, "jump {jump:e}, scale {scale:e}");
+}
+
+/// A plugin-like law without parameter gradients, a measured input or the Euler integrator:
+/// no sensitivities, the caller takes differences.
+#[test]
+fn laws_without_gradients_and_driven_or_euler_runs_give_none() {
+    let osc = Oscillator::fmm();
+    let built = frictionid_models::build_json(&serde_json::json!({
+        "type": "expression", "force": "mu * N * v / abs(v)", "params": { "mu": 0.2 }
+    }))
+    .unwrap();
+    let init = Initial {
+        x0: 0.01,
+        v0: 0.0,
+        z0: None,
+    };
+    let time = times(0.2);
+    let run = |model: &dyn FrictionModel, opts: &SimOptions| {
+        let inputs = RunInputs {
+            osc: &osc,
+            model,
+            init: &init,
+            input: None,
+            grid: SampleGrid {
+                t_end: 0.2,
+                sample_times: &time,
+            },
+            opts,
+        };
+        simulate_sensitivities(inputs, &[SensitivityParam::Model(0)]).unwrap()
+    };
+    assert!(run(built.model.as_ref(), &tight()).is_none());
+    let euler = SimOptions {
+        integrator: Integrator::Euler {
+            steps_per_period: 1e4,
+        },
+        ..tight()
+    };
+    assert!(run(&Coulomb { mu: 0.2 }, &euler).is_none());
+    assert!(run(&Coulomb { mu: 0.2 }, &tight()).is_some());
+}
