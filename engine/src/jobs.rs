@@ -7,8 +7,8 @@
 use crate::campaign::table::FitSummary;
 use crate::campaign::{CampaignRow, CampaignSpec, GroupResult, GroupTask, RowVerdict};
 use crate::energy::{
-    analyze_record, mean_abs_where_defined, model_force_along, percent_difference, EnergyAnalysis,
-    EnergyOptions,
+    analyze_record, forces_in, mean_abs_where_defined, model_force_along, percent_difference,
+    states_along, EnergyAnalysis, EnergyOptions, MeasuredMotion,
 };
 use crate::error::EngineError;
 use crate::identify::{
@@ -16,7 +16,7 @@ use crate::identify::{
     FitResult, PropertyUncertainty, Status,
 };
 use crate::oscillator::Oscillator;
-use crate::record::{channel_list, Channel, Record};
+use crate::record::{channel_list, Channel, ConditionSource, NormalForce, Record};
 use crate::report::{
     CompareReport, EnergyRecord, EnergyReport, FitReport, GroupReport, InputSeries, SimulateReport,
 };
@@ -295,6 +295,31 @@ pub fn record_reference(given: Option<f64>, model_force: Option<&[f64]>, frictio
     }
 }
 
+/// The force of `model` along the analysed motion of `record`; a law that reads conditions
+/// takes them from the analysis (x, a) and the record (u, named channels).
+fn analysed_model_force(
+    model: &dyn FrictionModel,
+    osc: &Oscillator,
+    record: &Record,
+    analysis: &EnergyAnalysis,
+) -> Result<Vec<f64>, EngineError> {
+    let conditions = model.conditions();
+    if conditions.is_empty() {
+        return model_force_along(model, osc, &analysis.time, &analysis.v);
+    }
+    let source = ConditionSource::of_record(record, analysis.x.clone(), analysis.a.clone());
+    let bound = source.bind(&conditions)?;
+    let normal = NormalForce::Constant(osc.normal_force);
+    let motion = MeasuredMotion {
+        time: &analysis.time,
+        v: &analysis.v,
+        normal: &normal,
+    };
+    let states = states_along(model, motion)?;
+    let all = 0..analysis.v.len();
+    Ok(forces_in(model, &analysis.v, &normal, &states, all, &bound))
+}
+
 /// The energy analysis of one record against its reference.
 fn energy_record(
     record: &Record,
@@ -309,7 +334,7 @@ fn energy_record(
     };
     let analysis: EnergyAnalysis = analyze_record(record, osc, opts).map_err(in_record)?;
     let model_force = model
-        .map(|m| model_force_along(m, osc, &analysis.time, &analysis.v))
+        .map(|m| analysed_model_force(m, osc, record, &analysis))
         .transpose()
         .map_err(in_record)?;
     let reference = record_reference(given, model_force.as_deref(), &analysis.friction);
