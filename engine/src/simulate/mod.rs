@@ -70,7 +70,7 @@ pub use euler::Euler;
 pub use input::Input;
 pub use mechanical::MechanicalEnergy;
 pub use rodas::Rodas4;
-pub use run::{REST_SWING_ATOLS, RODAS_ATOL_SCALE, RODAS_TOL_SCALE};
+pub use run::{require_no_conditions, REST_SWING_ATOLS, RODAS_ATOL_SCALE, RODAS_TOL_SCALE};
 pub use sensitivity::{
     simulate_sensitivities, Sensitivities, SensitivityParam, SENSITIVITY_STIFF_RATIO,
 };

@@ -70,6 +70,18 @@ impl FrictionModel for PositionRipple {
         self.force_at(v, normal, condition_value(at, 0))
     }
     crate::law_groups!(staging, param_gradients);
+    /// A ripple larger than the mean level makes the level negative at some positions: the
+    /// friction would push along the motion there.
+    fn validate(&self) -> Result<Vec<String>, crate::error::ModelError> {
+        if self.ripple > self.mu {
+            return Ok(vec![format!(
+                "position_ripple: ripple {} exceeds mu {}: the friction level turns negative \
+                 at some positions",
+                self.ripple, self.mu
+            )]);
+        }
+        Ok(Vec::new())
+    }
 }
 
 impl ParamGradients for PositionRipple {

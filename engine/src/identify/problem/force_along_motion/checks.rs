@@ -5,25 +5,6 @@ use crate::error::EngineError;
 use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::target_options::{FitDomain, ForceTarget};
 use crate::oscillator::OscillatorProperty;
-use frictionid_models::FrictionModel;
-
-/// A velocity-domain fit simulates the motion, whose simulation does not hand a law its
-/// conditions: a law that reads any (x, a, u, a named channel) is fitted along the measured
-/// motion, where every condition has its samples.
-pub fn require_no_conditions(model: &dyn FrictionModel) -> Result<(), EngineError> {
-    let conditions = model.conditions();
-    if conditions.is_empty() {
-        return Ok(());
-    }
-    let names: Vec<String> = conditions.iter().map(|c| format!("`{c}`")).collect();
-    Err(EngineError::InvalidInput(format!(
-        "model `{}` reads {} besides the speed: fit it along the measured motion with \
-         [fit.options] domain = \"force\" (a measured force or force_target = \
-         \"inverse_dynamics\"); a velocity-domain simulation does not give it these",
-        model.name(),
-        names.join(", ")
-    )))
-}
 
 /// Options that only a velocity fit has, as the `[fit.options]` keys they are.
 fn velocity_only_options(opts: &FitOptions) -> Vec<&'static str> {

@@ -32,7 +32,8 @@ mod checks;
 mod guards;
 mod track;
 
-pub use checks::{check_force_domain, require_no_conditions};
+pub use crate::simulate::require_no_conditions;
+pub use checks::check_force_domain;
 pub use guards::{require_mechanics, require_oscillator};
 use track::target_source;
 
