@@ -15,6 +15,7 @@ mod false_alarms_driven;
 mod findings_judgement;
 mod force_domain;
 mod force_jacobian;
+mod held_out_states;
 mod identify;
 mod inverse_dynamics;
 mod levels_as_forces;
