@@ -12,6 +12,7 @@ mod driven_axis;
 mod dynamic;
 mod false_alarms;
 mod false_alarms_driven;
+mod false_alarms_rigs;
 mod findings_judgement;
 mod force_domain;
 mod force_jacobian;
