@@ -8,6 +8,7 @@ mod cli;
 mod compare_report;
 mod defects;
 mod driven_keys;
+mod excluded_marks;
 mod export;
 mod fit_compare;
 mod fixtures;

@@ -9,7 +9,7 @@ use std::fmt::Write;
 use std::path::Path;
 use std::process::Command;
 
-fn frictionid() -> Command {
+pub(crate) fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
 }
 
@@ -53,7 +53,7 @@ fn multisine(t: f64) -> f64 {
 /// A driven slide (M 12 kg, viscous 30 N s/m, Coulomb 8 N, offset 0.5 N) simulated under
 /// the multisine, its position quantised to 1 um and written in metres (`unit` 1) or
 /// millimetres (`unit` 1000) beside the input.
-fn drive_csv(dir: &Path, unit: f64) -> String {
+pub(crate) fn drive_csv(dir: &Path, unit: f64) -> String {
     let mut input = String::from("time,u\n");
     for i in 0..=2000 {
         let t = i as f64 * 1e-3;
@@ -77,7 +77,7 @@ fn drive_csv(dir: &Path, unit: f64) -> String {
 
 /// The drive fitted with its mass (start 10 kg), damping and offset free, by inverse
 /// dynamics or by its velocity.
-fn drive_config(domain: &str, mass_line: &str) -> String {
+pub(crate) fn drive_config(domain: &str, mass_line: &str) -> String {
     let target = if domain == "force" {
         "force_target = \"inverse_dynamics\"\n"
     } else {

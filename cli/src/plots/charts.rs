@@ -186,12 +186,14 @@ pub fn friction_force(
 /// The force balance of an inverse-dynamics fit over time: in the upper panel the input u
 /// with the inertial force J a and the restoring force R(q); in the lower panel the friction
 /// force the balance leaves (u - J a - c v - R(q) - offset) and the fitted law's. Lines break
-/// across the samples left out (at rest). Units are shown on `axis`.
+/// across the samples left out (at rest); the samples left out for an unreliable target
+/// (`excluded`, their times) are marked at zero friction force. Units are shown on `axis`.
 pub fn force_balance(
     path: &Path,
     title: &str,
     time: &[f64],
     balance: &ForceBalance,
+    excluded: &[f64],
     model: &str,
     axis: Axis,
 ) -> Result<(), CliError> {
@@ -215,7 +217,8 @@ pub fn force_balance(
         ("from the balance", &from_balance),
         &fitted,
         model,
-    );
+    )
+    .with_marks("left out: unreliable target", excluded, 0.0);
     draw(
         path,
         &Figure::over_time(title, vec![forces, friction]).on(axis),

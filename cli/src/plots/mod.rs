@@ -69,6 +69,12 @@ fn finish_with_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
 /// The grey of reference levels (both signs of +-mu N alike).
 pub const REFERENCE_GREY: RGBColor = RGBColor(90, 90, 90);
 
+/// Colour of marked samples (those a fit left out).
+pub const MARKED: RGBColor = RGBColor(230, 0, 120);
+
+/// Radius of a marked sample's circle [px].
+pub const MARK_RADIUS: i32 = 3;
+
 /// The laws that get the strongest colours, in this order; other registered laws follow in
 /// their registry order.
 const COLOUR_ORDER: [&str; 9] = [
@@ -175,6 +181,18 @@ pub struct RefLine {
     pub y: f64,
 }
 
+/// Samples marked on a panel at one level, each by a small filled circle (e.g. the samples a
+/// fit left out of its comparison).
+#[derive(Debug, Clone)]
+pub struct Marks<'a> {
+    /// Legend label.
+    pub label: String,
+    /// Abscissa of each marked sample.
+    pub x: &'a [f64],
+    /// The level they are marked at on the panel's y axis.
+    pub y: f64,
+}
+
 /// One chart panel: its y axis and its lines.
 #[derive(Debug, Clone)]
 pub struct Panel<'a> {
@@ -186,6 +204,8 @@ pub struct Panel<'a> {
     pub series: Vec<Series<'a>>,
     /// Dashed horizontal reference lines.
     pub reference: Vec<RefLine>,
+    /// Marked samples.
+    pub marks: Vec<Marks<'a>>,
 }
 
 impl<'a> Panel<'a> {
@@ -196,12 +216,25 @@ impl<'a> Panel<'a> {
             y_unit: y_unit.into(),
             series: Vec::new(),
             reference: Vec::new(),
+            marks: Vec::new(),
         }
     }
 
     /// Adds a line.
     pub fn with(mut self, s: Series<'a>) -> Self {
         self.series.push(s);
+        self
+    }
+
+    /// Marks the samples at abscissae `x` at the level `y` (nothing when `x` is empty).
+    pub fn with_marks(mut self, label: impl Into<String>, x: &'a [f64], y: f64) -> Self {
+        if !x.is_empty() {
+            self.marks.push(Marks {
+                label: label.into(),
+                x,
+                y,
+            });
+        }
         self
     }
 
@@ -339,8 +372,11 @@ pub fn render(fig: &Figure<'_>) -> Result<String, String> {
             range(
                 fig.panels
                     .iter()
-                    .flat_map(|p| p.series.iter())
-                    .flat_map(|s| s.x.iter().copied()),
+                    .flat_map(|p| {
+                        let lines = p.series.iter().flat_map(|s| s.x.iter());
+                        lines.chain(p.marks.iter().flat_map(|m| m.x.iter()))
+                    })
+                    .copied(),
                 false,
             )
         });
@@ -482,6 +518,24 @@ mod tests {
         ] {
             assert!(svg.contains(text), "missing {text}");
         }
+    }
+
+    #[test]
+    fn marked_samples_are_one_circle_each_and_widen_the_time_axis() {
+        let t = [0.2, 0.5, 0.8];
+        let y = [0.0, 1.0, 0.0];
+        let circles = |marked: &[f64]| {
+            let fig = Figure::over_time(
+                "T",
+                vec![Panel::new("friction force", "N")
+                    .with(Series::solid("fitted", &t, &y))
+                    .with_marks("left out", marked, 0.0)],
+            );
+            render(&fig).unwrap().matches("<circle").count()
+        };
+        // Two of them lie outside the lines' time span: the axis takes them in.
+        assert_eq!(circles(&[0.0, 0.5, 0.51, 1.0]), 4);
+        assert_eq!(circles(&[]), 0);
     }
     /// A figure drawn on a rotary axis labels its velocity in rad/s, its friction as a torque
     /// in N m and its displacement as an angle in rad.

@@ -1,6 +1,6 @@
 //! Drawing one panel of a figure: axes, lines, reference levels and the legend.
 
-use super::{symlog_inverse, Figure, Panel, XTicks, PALETTE, REFERENCE_GREY};
+use super::{symlog_inverse, Figure, Panel, XTicks, MARKED, MARK_RADIUS, PALETTE, REFERENCE_GREY};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -168,11 +168,14 @@ fn legend_entries(panel: &Panel<'_>) -> usize {
             .iter()
             .filter(|r| !r.label.is_empty())
             .count()
+        + panel.marks.len()
 }
 
 /// A legend is drawn for more than one labelled line, or any labelled reference line.
 fn shows_legend(panel: &Panel<'_>) -> bool {
-    legend_entries(panel) > 1 || panel.reference.iter().any(|r| !r.label.is_empty())
+    legend_entries(panel) > 1
+        || panel.reference.iter().any(|r| !r.label.is_empty())
+        || !panel.marks.is_empty()
 }
 
 /// The y range of the panel's lines (within the x range shown) and levels, padded. The
@@ -252,7 +255,12 @@ fn entries(panel: &Panel<'_>) -> Vec<Entry> {
             style: REFERENCE_GREY.stroke_width(1),
             dashed: true,
         });
-    lines.chain(levels).collect()
+    let marks = panel.marks.iter().map(|m| Entry {
+        label: m.label.clone(),
+        style: MARKED.stroke_width(2),
+        dashed: false,
+    });
+    lines.chain(levels).chain(marks).collect()
 }
 
 /// The stroke of the `i`-th line of a panel: its colour (else the palette's), opacity and
@@ -397,5 +405,23 @@ pub(super) fn draw_panel(
     draw_mesh(&mut chart, fig, panel, spans, is_last)?;
     draw_references(&mut chart, panel, x_range)?;
     draw_lines(&mut chart, panel, x_range)?;
+    draw_marks(&mut chart, panel, x_range)?;
+    Ok(())
+}
+
+/// The panel's marked samples within the x range shown, one filled circle each, over the
+/// lines.
+fn draw_marks<'a, 'b: 'a>(
+    chart: &mut Chart<'a, 'b>,
+    panel: &Panel<'_>,
+    x_range: (f64, f64),
+) -> PlotResult<()> {
+    for m in &panel.marks {
+        let shown =
+            m.x.iter()
+                .filter(|x| x.is_finite() && (x_range.0..=x_range.1).contains(*x))
+                .map(|&x| Circle::new((x, m.y), MARK_RADIUS, MARKED.filled()));
+        chart.draw_series(shown).map_err(|e| e.to_string())?;
+    }
     Ok(())
 }

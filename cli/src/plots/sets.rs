@@ -276,6 +276,7 @@ fn force_record_plots(
             &format!("{}: force balance", r.file),
             &r.axes.time,
             balance,
+            r.unreliable_target.as_ref().map_or(&[][..], |u| &u.times),
             &fit.model,
             fit.oscillator.axis,
         )?;

@@ -69,6 +69,11 @@ pub struct Record {
     /// the instant found only to a part of a sample.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub release_found: bool,
+    /// How many first samples only drive a replay along the measured motion (a law's states)
+    /// and are compared with nothing: a force-domain fit of a piece whose states must enter it
+    /// as the samples before it left them. 0 for a record read from a file.
+    #[serde(skip)]
+    pub run_in: usize,
     /// What was worked out from the samples (noise levels, checks), kept until they change.
     #[serde(skip)]
     derived: SampleFacts,
@@ -147,6 +152,7 @@ impl Record {
             weight: 1.0,
             release_time: None,
             release_found: false,
+            run_in: 0,
             derived: SampleFacts::default(),
         }
     }
@@ -340,6 +346,7 @@ impl Record {
             weight: self.weight,
             release_time: self.release_time,
             release_found: self.release_found,
+            run_in: self.run_in.saturating_sub(first),
             derived: SampleFacts::default(),
         }
     }

@@ -16,6 +16,11 @@
 //! Residuals smoother than any noise at the sample scale (low-pass filtered records, or a
 //! misfit that hides the noise: [`SMOOTH_RESIDUALS`]) give only a lower bound of the floor,
 //! so their ratio warns at most.
+//!
+//! A force compared along the measured motion is judged where the sampled motion defines it:
+//! the samples within two of a change of the velocity's sign are set aside, since a switched law's
+//! force there follows the sign of a velocity the noise decides (a correct Coulomb law
+//! replayed along a differentiated displacement leaves a full 2 F_c step at such a sample).
 
 use super::diagnostics::{self, NUMERICAL_FLOOR, SMOOTH_RESIDUALS};
 use crate::identify::values::outcome::{Check, Finding, Status};
@@ -28,6 +33,9 @@ pub const FIT_WARN_RATIO: f64 = 2.0;
 pub const FIT_FAIL_RATIO: f64 = 4.0;
 /// Fewer residuals than this cannot give a noise floor.
 pub const MIN_SAMPLES: usize = 20;
+/// The samples set aside on each side of a change of the velocity's sign (a force compared
+/// along the motion): the noise can shift the sampled reversal by a sample or two.
+const REVERSAL_BAND: usize = 2;
 /// The largest lag-1 noise correlation granted (its correction is at most 10x).
 const MAX_CORRELATION: f64 = 0.99;
 
@@ -75,14 +83,14 @@ pub fn noise_floor(residual: &[f64], measured: &[f64], given: Option<f64>) -> Op
 /// The goodness of fit of one record's compared channel (its first), with `given` the
 /// noise level the record gives for it.
 pub fn record_goodness(fit: &RecordFit, given: Option<f64>) -> RecordGoodness {
-    let (measured, fitted) = (&fit.series.measured, &fit.series.fitted);
-    let residual: Vec<f64> = fitted.iter().zip(measured).map(|(f, m)| f - m).collect();
+    let (measured, fitted) = defined_samples(fit);
+    let residual: Vec<f64> = fitted.iter().zip(&measured).map(|(f, m)| f - m).collect();
     let rms = root_mean_square(&residual);
-    let response = root_mean_square(fitted).max(root_mean_square(measured));
+    let response = root_mean_square(&fitted).max(root_mean_square(&measured));
     if response > 0.0 && rms <= NUMERICAL_FLOOR * response {
         return RecordGoodness::Numerical(rms / response);
     }
-    match noise_floor(&residual, measured, given) {
+    match noise_floor(&residual, &measured, given) {
         Some((floor, phi)) => RecordGoodness::Ratio {
             rms,
             floor,
@@ -94,6 +102,29 @@ pub fn record_goodness(fit: &RecordFit, given: Option<f64>) -> RecordGoodness {
             residual.len()
         )),
     }
+}
+
+/// The measured and fitted values of `fit` where its compared quantity is defined by the
+/// sampled motion: a force compared along the motion loses the samples within
+/// [`REVERSAL_BAND`] of a change of the velocity's sign (module docs); any other channel
+/// keeps every sample.
+fn defined_samples(fit: &RecordFit) -> (Vec<f64>, Vec<f64>) {
+    let (measured, fitted) = (&fit.series.measured, &fit.series.fitted);
+    let v = &fit.axes.velocity;
+    if !fit.channel.ends_with("force") || v.len() != measured.len() || v.len() < 2 {
+        return (measured.clone(), fitted.clone());
+    }
+    let mut defined = vec![true; v.len()];
+    for i in 1..v.len() {
+        if v[i - 1] * v[i] <= 0.0 {
+            let band = i.saturating_sub(REVERSAL_BAND)..(i + REVERSAL_BAND).min(v.len());
+            defined[band].iter_mut().for_each(|d| *d = false);
+        }
+    }
+    (0..v.len())
+        .filter(|&i| defined[i])
+        .filter_map(|i| Some((*measured.get(i)?, *fitted.get(i)?)))
+        .unzip()
 }
 
 fn root_mean_square(values: &[f64]) -> f64 {
@@ -234,6 +265,47 @@ mod tests {
             RecordGoodness::Ratio { rms, floor, .. } => rms / floor,
             other => panic!("{other:?}"),
         }
+    }
+
+    /// A Coulomb force along a noisy velocity: where the noise flips the velocity's sign next
+    /// to a reversal the fitted force steps by 2 F_c, a sample the motion does not define;
+    /// set aside, the correct law passes, and a missing viscous term still fails.
+    #[test]
+    fn a_force_is_judged_where_the_motion_defines_its_sign() {
+        let n = 2000;
+        let v: Vec<f64> = sine(n, 0.01, 8.0)
+            .iter()
+            .zip(ar1(n, 1e-4, 0.0, 11))
+            .map(|(v, e)| v + e)
+            .collect();
+        let noise = ar1(n, 0.05, 0.0, 12);
+        let truth: Vec<f64> = sine(n, 0.01, 8.0)
+            .iter()
+            .map(|v| 3.0 * v.signum())
+            .collect();
+        let along = |viscous: f64| -> Vec<f64> {
+            v.iter().map(|v| 3.0 * v.signum() + viscous * v).collect()
+        };
+        let measured: Vec<f64> = truth.iter().zip(&noise).map(|(t, e)| t + e).collect();
+        let mut fit = record("force", measured, along(0.0));
+        fit.axes.velocity = v.clone();
+        assert!(fit.series.fitted.iter().zip(&truth).any(|(f, t)| f != t));
+        assert_eq!(
+            goodness_of_fit(&[judged_record(&fit, None)]).status,
+            Status::Pass
+        );
+        // The record's force has a viscous term the fitted law lacks.
+        let measured: Vec<f64> = along(100.0)
+            .iter()
+            .zip(&noise)
+            .map(|(t, e)| t + e)
+            .collect();
+        let mut wrong = record("force", measured, along(0.0));
+        wrong.axes.velocity = v;
+        assert_eq!(
+            goodness_of_fit(&[judged_record(&wrong, None)]).status,
+            Status::Fail
+        );
     }
 
     /// White and AR(1) noise (0.6, 0.9, 0.95) around the right curve pass: the ratio stays

@@ -5,7 +5,11 @@
 //! - several records: leave records out (record i in fold i mod K, K at most
 //!   [`MAX_FOLDS`]);
 //! - one record fitted along the measured motion (the force domain): K contiguous blocks,
-//!   each left out in turn (the rest fitted as its pieces before and after the block);
+//!   each left out in turn (the rest fitted as its pieces before and after the block); a law
+//!   with states is scored on its block replayed on from the record's start, so the block
+//!   starts from the state the samples before it left, not from a relaxed one, and is fitted
+//!   to the piece after the block replayed on from the block's start (the block's motion
+//!   drives the states, its force is compared with nothing);
 //! - one record whose response is simulated from the release: the simulation cannot start
 //!   inside the record, so each fold fits the record up to a split and scores the response
 //!   simulated on from the release with those parameters on the samples after the split.
@@ -84,6 +88,17 @@ struct Fold {
     test: Vec<Record>,
     /// Score only samples at or after this time of each test record (the later-part scheme).
     scored_from: Option<f64>,
+    /// For a law with states (the blocks scheme): the training records with the piece after
+    /// the block run in from the block's start, the test block extended back to the
+    /// record's start, and the time of the block's first sample.
+    with_history: Option<History>,
+}
+
+/// A block fold's records for a law with states.
+struct History {
+    train: Vec<Record>,
+    test: Record,
+    block_start: f64,
 }
 
 /// The scheme and folds for `records` fitted with `opts` (`None` when the records are too
@@ -99,6 +114,7 @@ fn plan(records: &[Record], opts: &FitOptions) -> Option<(ValidationScheme, Vec<
                     train: train.into_iter().map(|(_, r)| r.clone()).collect(),
                     test: test.into_iter().map(|(_, r)| r.clone()).collect(),
                     scored_from: None,
+                    with_history: None,
                 }
             })
             .collect();
@@ -123,16 +139,26 @@ fn block_folds(record: &Record) -> Vec<Fold> {
         .map(|f| {
             let (a, b) = (f * n / MAX_FOLDS, (f + 1) * n / MAX_FOLDS);
             let mut train = Vec::new();
+            let mut run_in_train = Vec::new();
             if a >= MIN_PIECE {
                 train.push(piece(record, 0, a));
+                run_in_train.push(piece(record, 0, a));
             }
             if n - b >= MIN_PIECE {
                 train.push(piece(record, b, n));
+                let mut after = piece(record, a, n);
+                after.run_in = b - a;
+                run_in_train.push(after);
             }
             Fold {
                 train,
                 test: vec![piece(record, a, b)],
                 scored_from: None,
+                with_history: record.time().get(a).map(|&block_start| History {
+                    train: run_in_train,
+                    test: piece(record, 0, b),
+                    block_start,
+                }),
             }
         })
         .collect()
@@ -150,6 +176,7 @@ fn later_part_folds(record: &Record) -> Vec<Fold> {
                 train: vec![record.ending_at(split)],
                 test: vec![record.clone()],
                 scored_from: time.get(split).copied(),
+                with_history: None,
             }
         })
         .collect()
@@ -237,9 +264,14 @@ fn held_out(
     let mut refit = refit_options(opts, model);
     refit.search.prefit = false;
     refit.search.max_iterations = refit.search.max_iterations.min(REFIT_ITERATIONS);
-    let trained = lean_fit(&fitted.oscillator, model, &fold.train, &refit)?;
+    let history = fold.with_history.as_ref().filter(|_| model.n_states() > 0);
+    let train = history.map_or(&fold.train, |h| &h.train);
+    let trained = lean_fit(&fitted.oscillator, model, train, &refit)?;
     let mut eval = evaluation_options(&refit);
-    let mut test = fold.test.clone();
+    let (mut test, scored_from) = match history {
+        Some(h) => (vec![h.test.clone()], Some(h.block_start)),
+        None => (fold.test.clone(), fold.scored_from),
+    };
     if fold.scored_from.is_some() {
         // The scored samples must not set the release state: it is the training fit's.
         eval.params.x0 = false;
@@ -259,7 +291,7 @@ fn held_out(
     Ok(evaluated
         .records
         .iter()
-        .map(|(r, t)| scored(r, t, fold.scored_from))
+        .map(|(r, t)| scored(r, t, scored_from))
         .fold((0.0, 0), |(s, n), (a, b)| (s + a, n + b)))
 }
 

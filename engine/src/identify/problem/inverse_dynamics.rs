@@ -112,9 +112,11 @@ impl Balance {
             return None;
         }
         let mut ranges: Vec<[f64; 2]> = Vec::new();
+        let mut times = Vec::with_capacity(out.len());
         let mut previous: Option<usize> = None;
         for &i in &out {
             let t = time.get(i).copied().unwrap_or(f64::NAN);
+            times.push(t);
             match (previous, ranges.last_mut()) {
                 (Some(p), Some(last)) if i == p + 1 => last[1] = t,
                 _ => ranges.push([t, t]),
@@ -125,6 +127,7 @@ impl Balance {
             count: out.len(),
             of: sliding.len(),
             ranges,
+            times,
         })
     }
 

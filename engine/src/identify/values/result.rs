@@ -84,6 +84,9 @@ pub struct UnreliableSamples {
     pub of: usize,
     /// The time ranges \[s\] of the samples left out, \[first, last\] of each contiguous run.
     pub ranges: Vec<[f64; 2]>,
+    /// The time \[s\] of each sample left out (for plots).
+    #[serde(skip)]
+    pub times: Vec<f64>,
 }
 
 /// The samples of a force-domain record compared under `[fit.options] min_speed`: those

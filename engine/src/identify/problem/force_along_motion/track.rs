@@ -76,6 +76,7 @@ impl ForceTrack {
             }
         };
         check_motion(record.time(), &motion.v, &normal).map_err(|e| err(e.to_string()))?;
+        let (used, target) = after_run_in(used, target, record.run_in);
         let (used, target, sliding) = keep_sliding(used, target, &motion.v, opts.target.min_speed);
         if sliding.is_some_and(|s| s.kept < 2) {
             return Err(err(format!(
@@ -203,6 +204,18 @@ fn track_conditions(
         (None, None) => central_difference(record.time(), v),
     };
     ConditionSource::of_record(record, x.to_vec(), acceleration)
+}
+
+/// The compared samples `used` (with their `target`) from sample `run_in` on (the samples
+/// before only drive the states).
+fn after_run_in(used: Vec<usize>, target: Vec<f64>, run_in: usize) -> (Vec<usize>, Vec<f64>) {
+    if run_in == 0 {
+        return (used, target);
+    }
+    used.into_iter()
+        .zip(target)
+        .filter(|(i, _)| *i >= run_in)
+        .unzip()
 }
 
 /// The compared samples `used` (with their `target`) where |v| >= `min_speed`, and how many
