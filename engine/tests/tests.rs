@@ -28,6 +28,7 @@ mod plan;
 mod polynomial_spring;
 mod records;
 mod replay;
+mod replay_path;
 mod robot_joint;
 mod robust_targets;
 mod simulate;

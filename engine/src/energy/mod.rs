@@ -79,9 +79,10 @@ pub use differentiate::{
 };
 pub use halfcycle::{HalfCycle, MIN_RUN};
 pub use model_force::{
-    force_derivatives_along, force_residuals, forces_at, forces_from_states, forces_in,
-    model_force_along, model_force_with_normal, replay_interval, states_along, ForceDerivatives,
-    ForceResiduals, MeasuredMotion, SETTLED_RELAXATIONS, STEPS_PER_INTERVAL,
+    force_derivatives_along, force_derivatives_along_path, force_residuals, forces_at,
+    forces_from_states, forces_in, model_force_along, model_force_with_normal, path_interval,
+    replay_interval, states_along, states_along_path, ForceDerivatives, ForceResiduals,
+    MeasuredMotion, SETTLED_RELAXATIONS, STEPS_PER_INTERVAL,
 };
 
 use crate::error::EngineError;

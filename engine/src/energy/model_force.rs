@@ -13,6 +13,21 @@
 //! Every replay, exact or numerical, follows this convention, so the replayed states are one
 //! function of the data whichever way they are computed.
 //!
+//! # The path convention
+//! Where a record measures its displacement, the replay can follow it instead
+//! ([`states_along_path`], [`path_interval`]): between samples i-1 and i the states travel the
+//! displacement's increment dx = x\[i\] - x\[i-1\], in its direction, while the laws'
+//! rate-dependent terms (LuGre's and GMS's Stribeck curve) still read the speed |v̄| of the
+//! velocity convention. The interval handed to the law is the one that does both: velocity
+//! sgn(dx) |v̄| for |dx| / |v̄| (at |dx| / dt where v̄ = 0), so every law, stepped exactly or
+//! integrated, with or without its sensitivities, follows it unchanged. A noisy velocity
+//! channel whose v̄ dt flips sign near a reversal, where the displacement does not, no longer
+//! moves the states back and forth there. The states of every built-in law evolve with the
+//! distance travelled (their rates are |v| times a function of the direction, the states and
+//! the speed), for which this is exact; a plugin law whose states also evolve with time sees
+//! the interval's duration as |dx| / |v̄|. With a velocity-only record the displacement is
+//! the velocity's trapezoid, whose increments are v̄ dt: the two conventions agree.
+//!
 //! # Exact steps
 //! At constant v and N a law's states often have a closed form over the interval (LuGre's
 //! bristle relaxes exponentially in the distance travelled; Dahl's force, and each GMS element
@@ -117,27 +132,47 @@ pub struct MeasuredMotion<'a> {
 }
 
 impl<'a> MeasuredMotion<'a> {
-    /// The motion once [`check_motion`] accepts it.
+    /// The motion once [`check_motion`] accepts it, following its velocity.
     fn checked(self) -> Result<CheckedMotion<'a>, EngineError> {
         let MeasuredMotion { time, v, normal } = self;
         check_motion(time, v, normal)?;
-        Ok(CheckedMotion { time, v, normal })
+        Ok(CheckedMotion {
+            time,
+            v,
+            normal,
+            displacement: None,
+        })
     }
 }
 
 /// A motion already checked by [`check_motion`]: its sample times, velocities and normal
-/// force.
+/// force, and the displacement whose increments it travels (`None`: it follows the velocity).
 #[derive(Clone, Copy)]
 pub(crate) struct CheckedMotion<'a> {
     pub time: &'a [f64],
     pub v: &'a [f64],
     pub normal: &'a NormalForce,
+    pub displacement: Option<&'a [f64]>,
 }
 
-impl CheckedMotion<'_> {
-    /// The replay's interval ending at sample `i` (>= 1), see [`replay_interval`].
+impl<'a> CheckedMotion<'a> {
+    /// The replay's interval ending at sample `i` (>= 1): [`path_interval`] along the
+    /// displacement where the motion follows one, else [`replay_interval`].
     pub fn interval(&self, i: usize) -> Interval {
-        replay_interval(self.time, self.v, self.normal, i)
+        match self.displacement {
+            Some(x) => path_interval(self.time, self.v, x, self.normal, i),
+            None => replay_interval(self.time, self.v, self.normal, i),
+        }
+    }
+
+    /// The motion travelling the increments of `displacement`, once it has a finite value per
+    /// sample.
+    pub fn along(self, displacement: &'a [f64]) -> Result<Self, EngineError> {
+        check_displacement(self.time, displacement)?;
+        Ok(Self {
+            displacement: Some(displacement),
+            ..self
+        })
     }
 
     /// Number of samples.
@@ -155,6 +190,48 @@ pub fn replay_interval(time: &[f64], v: &[f64], normal: &NormalForce, i: usize) 
         normal: 0.5 * (normal.at(i - 1) + normal.at(i)),
         dt: time[i] - time[i - 1],
     }
+}
+
+/// The interval the replay moves through between samples `i - 1` and `i` (`i` >= 1) along
+/// the displacement `x`: the travel is its increment dx, in its direction, at the speed of
+/// the velocity's interval ([`replay_interval`]: the mean |v| of its ends, which the laws'
+/// rate-dependent terms read), for the time that speed takes over |dx|; where that speed is
+/// zero, at the displacement's own rate |dx| / dt. An interval without travel is a stop for
+/// its duration. The one place of the path convention (module docs).
+pub fn path_interval(
+    time: &[f64],
+    v: &[f64],
+    x: &[f64],
+    normal: &NormalForce,
+    i: usize,
+) -> Interval {
+    let along_v = replay_interval(time, v, normal, i);
+    let dx = x[i] - x[i - 1];
+    let travel = dx.abs();
+    if travel == 0.0 {
+        return Interval { v: 0.0, ..along_v };
+    }
+    let speed = along_v.v.abs();
+    let speed = if speed > 0.0 && (travel / speed).is_finite() {
+        speed
+    } else {
+        travel / along_v.dt
+    };
+    Interval {
+        v: speed.copysign(dx),
+        normal: along_v.normal,
+        dt: travel / speed,
+    }
+}
+
+/// [`states_along`] with the travel between samples taken from `displacement` (one value per
+/// sample), the path convention of the module docs ([`path_interval`]).
+pub fn states_along_path(
+    model: &dyn FrictionModel,
+    motion: MeasuredMotion<'_>,
+    displacement: &[f64],
+) -> Result<Vec<f64>, EngineError> {
+    states_along_checked(model, motion.checked()?.along(displacement)?)
 }
 
 /// [`states_along`] of a motion already checked by [`check_motion`] (a fit checks it once,
@@ -199,6 +276,34 @@ fn exact_replay(propagator: &dyn Propagator, motion: CheckedMotion<'_>) -> Vec<f
     out
 }
 
+/// [`force_derivatives_along`] with the travel between samples taken from `displacement`
+/// (one value per sample), the path convention of the module docs ([`path_interval`]).
+pub fn force_derivatives_along_path(
+    model: &dyn FrictionModel,
+    motion: MeasuredMotion<'_>,
+    displacement: &[f64],
+    samples: &[usize],
+) -> Result<Option<ForceDerivatives>, EngineError> {
+    let motion = motion.checked()?.along(displacement)?;
+    check_samples(samples, motion.len())?;
+    Ok(force_derivatives_checked(
+        model,
+        motion,
+        samples,
+        &ConditionColumns::none(),
+    ))
+}
+
+/// Every sample index of `samples` lies within a motion of `len` samples.
+fn check_samples(samples: &[usize], len: usize) -> Result<(), EngineError> {
+    match samples.iter().find(|&&i| i >= len) {
+        Some(bad) => Err(EngineError::InvalidInput(format!(
+            "sample {bad} of a motion of {len} samples"
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// The model's force at some samples of a replayed motion and its derivatives with respect to
 /// every model parameter there ([`force_derivatives_along`]).
 #[derive(Debug, Clone, PartialEq)]
@@ -230,12 +335,7 @@ pub fn force_derivatives_along(
     samples: &[usize],
 ) -> Result<Option<ForceDerivatives>, EngineError> {
     let motion = motion.checked()?;
-    if let Some(&bad) = samples.iter().find(|&&i| i >= motion.len()) {
-        return Err(EngineError::InvalidInput(format!(
-            "sample {bad} of a motion of {} samples",
-            motion.len()
-        )));
-    }
+    check_samples(samples, motion.len())?;
     Ok(force_derivatives_checked(
         model,
         motion,
@@ -433,6 +533,24 @@ pub(crate) fn check_motion(
     Ok(())
 }
 
+/// A displacement to replay along: one finite value per sample of `time`.
+pub(crate) fn check_displacement(time: &[f64], x: &[f64]) -> Result<(), EngineError> {
+    if time.len() != x.len() {
+        return Err(EngineError::InvalidInput(format!(
+            "{} time stamps but {} displacements",
+            time.len(),
+            x.len()
+        )));
+    }
+    match x.iter().position(|x| !x.is_finite()) {
+        Some(i) => Err(EngineError::InvalidInput(format!(
+            "displacement sample {i} is not finite ({})",
+            x[i]
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// The model's force along the analysed motion against the energy-based force, on the samples
 /// where the latter is not masked.
 pub fn force_residuals(
@@ -476,4 +594,99 @@ pub fn force_residuals(
         rms,
         used,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use frictionid_models::{Dahl, Gms, LuGre};
+    use std::f64::consts::PI;
+
+    /// A 3 s stroke at 1 kHz: its displacement, and a velocity channel whose noise (a
+    /// deterministic jitter of 4 mm/s, a fifth of the peak speed) flips its sign near each
+    /// reversal, under a normal force swinging around 14.5 N.
+    fn noisy_stroke() -> (Vec<f64>, Vec<f64>, Vec<f64>, NormalForce) {
+        let time: Vec<f64> = (0..3000).map(|i| i as f64 * 1e-3).collect();
+        let w = 2.0 * PI * 1.5;
+        let x = time.iter().map(|&t| 2e-3 * (w * t).sin()).collect();
+        let v = time
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| 2e-3 * w * (w * t).cos() + 4e-3 * (i as f64 * 2.399_963).sin())
+            .collect();
+        let normal = time
+            .iter()
+            .map(|&t| 14.5 + 2.0 * (2.0 * PI * 0.3 * t).sin())
+            .collect();
+        (time, x, v, NormalForce::Sampled(normal))
+    }
+
+    /// Along the displacement each interval travels the displacement's increment in its
+    /// direction at the velocity's speed; an interval whose velocity is zero moves at the
+    /// displacement's rate, one without travel stops.
+    #[test]
+    fn path_intervals_travel_the_displacement_at_the_velocitys_speed() {
+        let time = [0.0, 1e-3, 2e-3, 3e-3, 4e-3];
+        let v = [0.02, -0.01, 0.01, 0.0, 0.0];
+        let x = [0.0, 1e-5, 1.2e-5, 0.7e-5, 0.7e-5];
+        let normal = NormalForce::Constant(2.0);
+        let at = |i| path_interval(&time, &v, &x, &normal, i);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+        // (v, travel, dt) of each interval.
+        let expected = [
+            (0.005, 1e-5, 2e-3),
+            (2e-3, 2e-6, 1e-3),
+            (-0.005, 5e-6, 1e-3),
+            (0.0, 0.0, 1e-3),
+        ];
+        for (i, (v, travel, dt)) in (1..).zip(expected) {
+            let interval = at(i);
+            assert!(
+                close(interval.v, v) && close(interval.travel(), travel) && close(interval.dt, dt),
+                "interval {i}: {interval:?}"
+            );
+            assert_eq!(interval.normal, 2.0);
+        }
+    }
+
+    /// Every law's numerical replay along the displacement gives its exact steps' states:
+    /// the interval is the same for both.
+    #[test]
+    fn exact_and_numerical_replays_agree_along_the_displacement() {
+        let (time, x, v, normal) = noisy_stroke();
+        let motion = CheckedMotion {
+            time: &time,
+            v: &v,
+            normal: &normal,
+            displacement: None,
+        }
+        .along(&x)
+        .expect("a valid displacement");
+        let laws: [Box<dyn FrictionModel>; 3] = [
+            Box::new(Dahl::default()),
+            Box::new(LuGre::default()),
+            Box::new(Gms::default()),
+        ];
+        for model in laws {
+            let law = model.states().expect("a law with states");
+            let exact = states_along_checked(model.as_ref(), motion).expect("exact steps");
+            let numerical =
+                numerical_replay(law, &time, |i| motion.interval(i)).expect("a numerical replay");
+            let ns = law.n_states();
+            for j in 0..ns {
+                let state = |z: &[f64]| z.iter().skip(j).step_by(ns).copied().collect::<Vec<_>>();
+                let (a, b) = (state(&exact), state(&numerical));
+                let scale = a.iter().fold(0.0f64, |m, z| m.max(z.abs()));
+                let worst = a
+                    .iter()
+                    .zip(&b)
+                    .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+                assert!(
+                    worst <= 1e-6 * scale + 1e-12 * time.len() as f64,
+                    "{} state {j}: {worst:e} of {scale:e}",
+                    model.name()
+                );
+            }
+        }
+    }
 }

@@ -31,5 +31,5 @@ pub use result::{
     Identifiability, Rank, RecordFit, SampleAxes, SlidingSamples, UnreliableSamples, Verdict,
 };
 pub use search::{fits_directly, Search, SearchOptions, DEFAULT_MAX_ITERATIONS, PROMOTED_STARTS};
-pub use target_options::{check_min_speed, FitDomain, ForceTarget, TargetOptions};
+pub use target_options::{check_min_speed, FitDomain, ForceTarget, ReplayPath, TargetOptions};
 pub use uncertainty::{PropertyUncertainty, StdErrorComponents};

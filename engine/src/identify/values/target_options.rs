@@ -1,6 +1,6 @@
 //! What a fit compares: the velocity response or a force along the measured motion, which
-//! force, on which samples (`[fit.options] domain`, `force_target`, `force_offset`,
-//! `min_speed`), and which oscillator properties the config left unknown.
+//! force, on which samples and along which path (`[fit.options] domain`, `force_target`,
+//! `force_offset`, `min_speed`, `replay_path`), and which oscillator properties the config left unknown.
 
 use super::option_keys::option_keys;
 use crate::oscillator::OscillatorProperty;
@@ -33,6 +33,21 @@ pub enum ForceTarget {
     /// measured motion, with the oscillator properties named in `oscillator` fitted jointly
     /// (the inverse-dynamics identification of drives and robot joints).
     InverseDynamics,
+}
+
+/// What a force-domain replay travels between samples (`[fit.options] replay_path`; see
+/// [`crate::energy::path_interval`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ReplayPath {
+    /// The displacement channel's increments where a record has one, else the velocity's.
+    #[default]
+    Auto,
+    /// The displacement channel's increments (an error for a record without one); the
+    /// rate-dependent terms read the velocity channel, or the displacement's derivative.
+    Displacement,
+    /// The velocity channel's: the mean velocity of each interval's ends for its duration.
+    Velocity,
 }
 
 /// `[fit.options] min_speed` is a speed >= 0 given for a force-domain fit (only it compares
@@ -68,6 +83,8 @@ pub struct TargetOptions {
     /// `min_speed` \[m/s\] (stick phases at reversals hold a force below the sliding level
     /// that a static law cannot follow); `None`: every sample.
     pub min_speed: Option<f64>,
+    /// What the replay travels between samples (`replay_path`).
+    pub replay_path: ReplayPath,
     /// `[oscillator]` properties that were not given (their values are placeholders): fits
     /// that need them fail with a message naming them. Not a key: the spec fills it from
     /// `[oscillator]`.
@@ -81,6 +98,7 @@ option_keys!(TargetOptions {
         "force_target" => force_target,
         "force_offset" => force_offset,
         "min_speed" => min_speed,
+        "replay_path" => replay_path,
     ],
 });
 

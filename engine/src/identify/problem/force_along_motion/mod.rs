@@ -1,10 +1,13 @@
 //! The force domain's residuals: the model's friction force along the measured motion against a
 //! target force ([`ForceAlongMotion`]).
 //!
-//! The measured motion is replayed, not simulated: the velocity channel (or the differentiated
-//! displacement when only a displacement is measured) drives the model's internal states,
-//! integrated along it by [`crate::energy::model_force_with_normal`] under the record's normal
-//! force (its channel where there is one). The target is, per record,
+//! The measured motion is replayed, not simulated: the model's internal states travel the
+//! measured displacement's increments between samples where a record has a displacement
+//! channel, else the velocity channel's (`[fit.options] replay_path`, the conventions of
+//! [`crate::energy::model_force`]), under the record's normal force (its channel where there
+//! is one); the laws' rate-dependent terms and the force read the velocity channel (or the
+//! differentiated displacement when only a displacement is measured). The target is, per
+//! record,
 //!
 //! - the measured `force` channel (a tribometer, a driven rig), optionally with a constant
 //!   offset per record (a load cell's zero, [`NuisanceKind::ForceOffset`]); or
@@ -76,6 +79,9 @@ pub struct ForceTrack {
     time: Vec<f64>,
     velocity: Vec<f64>,
     displacement: Vec<f64>,
+    /// Whether the replay travels the displacement's increments (`[fit.options]
+    /// replay_path`), else the velocity's.
+    follows_displacement: bool,
     normal: NormalForce,
     /// Indices of the compared samples (all, or those where Eq. 7 is defined).
     used: Vec<usize>,

@@ -4,15 +4,17 @@
 use super::super::inverse_dynamics::{sliding_samples, Balance};
 use super::guards::require_mechanics;
 use super::{ForceTrack, TargetSource};
-use crate::energy::model_force::{check_motion, CheckedMotion};
-use crate::energy::{analyze_record, central_difference, record_motion, EnergyOptions};
+use crate::energy::model_force::{check_displacement, check_motion, CheckedMotion};
+use crate::energy::{
+    analyze_record, central_difference, record_motion, EnergyOptions, SeriesSource,
+};
 use crate::error::EngineError;
 use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::ParamKind;
 use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::nuisance::NuisanceKind;
 use crate::identify::values::result::SlidingSamples;
-use crate::identify::values::target_options::ForceTarget;
+use crate::identify::values::target_options::{ForceTarget, ReplayPath};
 use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::noise::noise_floor_level;
 use crate::record::{channel_list, Channel, ConditionSource, Record};
@@ -76,6 +78,12 @@ impl ForceTrack {
             }
         };
         check_motion(record.time(), &motion.v, &normal).map_err(|e| err(e.to_string()))?;
+        let follows_displacement =
+            follows_displacement(record, motion.displacement, opts.target.replay_path)
+                .map_err(err)?;
+        if follows_displacement {
+            check_displacement(record.time(), &motion.x).map_err(|e| err(e.to_string()))?;
+        }
         let (used, target) = after_run_in(used, target, record.run_in);
         let (used, target, sliding) = keep_sliding(used, target, &motion.v, opts.target.min_speed);
         if sliding.is_some_and(|s| s.kept < 2) {
@@ -107,6 +115,7 @@ impl ForceTrack {
             time: record.time().to_vec(),
             velocity: motion.v,
             displacement: motion.x,
+            follows_displacement,
             normal,
             noise: noise_channel
                 .and_then(|c| record.given_noise(c))
@@ -119,13 +128,22 @@ impl ForceTrack {
         })
     }
 
-    /// The record's motion and normal force, checked when the track was prepared.
+    /// The record's motion and normal force, checked when the track was prepared, and the
+    /// displacement it travels where it follows one.
     pub(super) fn motion(&self) -> CheckedMotion<'_> {
         CheckedMotion {
             time: &self.time,
             v: &self.velocity,
             normal: &self.normal,
+            displacement: self
+                .follows_displacement
+                .then_some(self.displacement.as_slice()),
         }
+    }
+
+    /// Whether the replay travels the measured displacement's increments.
+    pub fn follows_displacement(&self) -> bool {
+        self.follows_displacement
     }
 
     /// The derivative of the prediction at the compared samples with respect to the
@@ -253,6 +271,26 @@ fn has_restoring(osc: &Oscillator, opts: &FitOptions) -> bool {
             .oscillator
             .contains(&OscillatorProperty::Stiffness)
         || !opts.target.is_unknown(OscillatorProperty::Stiffness)
+}
+
+/// Whether the replay of `record` travels its displacement channel's increments under
+/// `replay_path` (`displacement`: where its displacement came from).
+fn follows_displacement(
+    record: &Record,
+    displacement: SeriesSource,
+    replay_path: ReplayPath,
+) -> Result<bool, String> {
+    let measured = displacement == SeriesSource::Measured;
+    match replay_path {
+        ReplayPath::Auto => Ok(measured),
+        ReplayPath::Velocity => Ok(false),
+        ReplayPath::Displacement if measured => Ok(true),
+        ReplayPath::Displacement => Err(format!(
+            "[fit.options] replay_path = \"displacement\" but the record has no displacement \
+             channel (it has: {}; name its column with `displacement_column`)",
+            channel_list(&record.channels())
+        )),
+    }
 }
 
 /// The target of a record under `force_target`.
