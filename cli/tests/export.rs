@@ -67,9 +67,11 @@ const FORCE_LAWS: [(&str, &str); 8] = [
     ),
 ];
 
+/// The force-domain fit of `model` along `record`, replayed along its velocity: the
+/// convention the exports' `update` follows sample by sample.
 fn force_config(record: &Path, model: &str) -> String {
     format!(
-        "[oscillator]\n\n[model]\n{model}\n\n[fit.options]\ndomain = \"force\"\nforce_offset = true\n\n\
+        "[oscillator]\n\n[model]\n{model}\n\n[fit.options]\ndomain = \"force\"\nforce_offset = true\nreplay_path = \"velocity\"\n\n\
          [[records]]\nfile = \"{}\"\ntime_column = \"Time [s]\"\ndisplacement_column = \"Position [mm]\"\n\
          displacement_scale = 1e-3\nforce_column = \"Friction [uN]\"\nforce_scale = -1e-6\n\
          normal_force_column = \"Normal [uN]\"\nnormal_force_scale = 1e-6\n",
