@@ -10,8 +10,8 @@ use frictionid_engine::identify::{fit, FitOptions, Hooks};
 use frictionid_engine::simulate::{simulate, Initial, SimOptions, Trajectory};
 use frictionid_engine::synthetic::uniform_times;
 use frictionid_engine::{Oscillator, Record};
-use frictionid_models::testing::motion::{first_energy_rise, first_unmirrored};
-use frictionid_models::{default_model, names, Coulomb, FrictionModel, ViscousCoulomb};
+use frictionid_models::testing::motion::{first_energy_rise, first_unmirrored, simulable_names};
+use frictionid_models::{default_model, Coulomb, FrictionModel, ViscousCoulomb};
 use proptest::prelude::*;
 use proptest::test_runner::{RngSeed, TestCaseError};
 
@@ -107,16 +107,6 @@ fn with_equal_levels(mut model: Box<dyn FrictionModel>) -> Box<dyn FrictionModel
             .expect("parameter count from param_info");
     }
     model
-}
-
-/// The registered laws a simulation can run: those that read nothing but the speed, the
-/// normal force and their states (a law reading the position or a channel is fitted along
-/// measured motion and refused by the simulator).
-fn simulable_names() -> Vec<String> {
-    names()
-        .into_iter()
-        .filter(|name| default_model(name).is_ok_and(|m| m.conditions().is_empty()))
-        .collect()
 }
 
 fn any_model() -> impl Strategy<Value = (String, Vec<f64>)> {

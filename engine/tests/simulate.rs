@@ -11,7 +11,9 @@ use frictionid_engine::{
     simulate, simulate_velocity, EngineError, EventKind, Initial, Integrator, Oscillator,
     SimOptions, Trajectory,
 };
-use frictionid_models::testing::motion::{first_energy_rise, first_mismatch, first_unmirrored};
+use frictionid_models::testing::motion::{
+    first_energy_rise, first_mismatch, first_unmirrored, simulable_names,
+};
 use frictionid_models::{default_model, names, Coulomb, FrictionModel};
 
 /// The paper's Fig. 2/3 oscillator: N = m g.
@@ -111,7 +113,7 @@ const ADAPTIVE: [Integrator; 2] = [Integrator::Dopri5, Integrator::Rodas];
 /// Every built-in model at its defaults, paired with each adaptive integrator.
 fn every_model_with_each_adaptive_integrator() -> Vec<(String, Box<dyn FrictionModel>, Integrator)>
 {
-    names()
+    simulable_names()
         .into_iter()
         .flat_map(|n| ADAPTIVE.map(|i| (n.clone(), default_model(&n).unwrap(), i)))
         .collect()
@@ -387,7 +389,7 @@ fn bristle_models_complete_over_four_decades_of_stiffness() {
 fn velocity_only_variant_matches_the_full_trajectory() {
     let times = uniform_times(2.0, 1000.0);
     let mut buf = vec![1.0; 3];
-    for name in names() {
+    for name in simulable_names() {
         let model = default_model(&name).unwrap();
         let full = fmm_run(model.as_ref(), 0.022, 2.0);
         let inputs = RunInputs {
@@ -591,7 +593,7 @@ fn euler_converges_to_the_adaptive_solution_for_every_model() {
     // shrink tenfold from n = 1e4 to n = 1e5 steps per period.
     let osc = Oscillator::fmm();
     let times = uniform_times(1.0, 1000.0);
-    for name in names() {
+    for name in simulable_names() {
         let model = default_model(&name).unwrap();
         let reference = fmm_run(model.as_ref(), 0.022, 1.0);
         let err = |n: f64| {
@@ -918,7 +920,7 @@ fn rodas_completes_at_the_stiffest_bristles() {
 fn every_model_gives_the_same_trajectory_with_each_integrator() {
     // Default parameters (bristle models at sigma0 = 1e5 N/m: moderately stiff). Each pair
     // of integrators agrees to a few times their tolerance-level error (about 1e-9 m each).
-    for name in names() {
+    for name in simulable_names() {
         let model = default_model(&name).unwrap();
         let dopri = fmm_run_with(model.as_ref(), 0.022, 2.0, Integrator::Dopri5);
         let rodas = fmm_run_with(model.as_ref(), 0.022, 2.0, Integrator::Rodas);
@@ -937,4 +939,34 @@ fn every_model_gives_the_same_trajectory_with_each_integrator() {
             assert!(gap <= 2e-8, "{name}: exact vs rodas {gap} m");
         }
     }
+}
+
+/// A law that reads the position or a channel cannot be simulated (the simulation would give
+/// it x = 0 and no load): every such registered law is refused with a message that names
+/// the force domain, and every other law runs.
+#[test]
+fn the_simulator_refuses_exactly_the_laws_that_read_conditions() {
+    let runnable = simulable_names();
+    let times = uniform_times(0.1, 1000.0);
+    for name in names() {
+        let model = default_model(&name).unwrap();
+        let run = simulate(
+            &Oscillator::fmm(),
+            model.as_ref(),
+            &Initial::new(0.022, 0.0),
+            0.1,
+            &times,
+            &SimOptions::default(),
+        );
+        if runnable.contains(&name) {
+            assert!(run.is_ok(), "{name}: {:?}", run.err());
+        } else {
+            let message = run.err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(message.contains("domain = \"force\""), "{name}: {message}");
+        }
+    }
+    assert!(
+        runnable.len() < names().len(),
+        "some registered law reads conditions"
+    );
 }

@@ -72,7 +72,7 @@ pub use mechanical::MechanicalEnergy;
 pub use rodas::Rodas4;
 pub use run::{require_no_conditions, REST_SWING_ATOLS, RODAS_ATOL_SCALE, RODAS_TOL_SCALE};
 pub use sensitivity::{
-    simulate_sensitivities, Sensitivities, SensitivityParam, SENSITIVITY_STIFF_RATIO,
+    simulate_sensitivities, SampledSeries, Sensitivities, SensitivityParam, SENSITIVITY_STIFF_RATIO,
 };
 pub use stepper::{
     AffineMotion, IntervalStart, OdeSystem, StepCounts, StepOutcome, Stepper, Tolerance,

@@ -8,7 +8,7 @@
 //! | `mu` | 1 | 0.2 | [0, 10] | free | mean Coulomb friction coefficient |
 //! | `ripple` | 1 | 0.02 | [0, 10] | free | amplitude of the level's ripple |
 //! | `period` | m | 0.01 | (0, inf) | free | period of the ripple along the travel |
-//! | `phase` | 1 | 0 | [-7, 7] | free | phase of the ripple at x = 0, in radians |
+//! | `phase` | 1 | 0 | [-7, 7] | free | phase angle of the ripple at x = 0 |
 //! | `viscous` | N s/m | 0.5 | [0, inf) | free | viscous friction coefficient |
 //!
 //! The period is in rad on a rotary axis. The phase may run a little over a turn either way,
@@ -36,7 +36,7 @@ crate::declare_params! {
         mu: new("1", 0.2, (0.0, 10.0), "mean Coulomb friction coefficient"),
         ripple: new("1", 0.02, (0.0, 10.0), "amplitude of the level's ripple"),
         period: positive("m", 0.01, f64::INFINITY, "period of the ripple along the travel"),
-        phase: new("1", 0.0, (-7.0, 7.0), "phase of the ripple at x = 0, in radians"),
+        phase: new("1", 0.0, (-7.0, 7.0), "phase angle of the ripple at x = 0"),
         viscous: non_negative("N s/m", 0.5, "viscous friction coefficient"),
     }
 }

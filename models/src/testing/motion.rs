@@ -239,3 +239,13 @@ pub fn check_integrators_agree(sim: &dyn Simulator, model: &Model, x0: f64, t_en
         },
     )
 }
+
+/// The registered laws a simulation can run: those that read nothing besides the speed, the
+/// normal force and their states (a law that reads the position, the acceleration or a
+/// channel is fitted along measured motion, and the simulator refuses it).
+pub fn simulable_names() -> Vec<String> {
+    crate::names()
+        .into_iter()
+        .filter(|name| crate::default_model(name).is_ok_and(|m| m.conditions().is_empty()))
+        .collect()
+}

@@ -56,6 +56,17 @@ pub enum SensitivityParam {
     StartDisplacement,
 }
 
+/// Which series an augmented run keeps at the samples: a fit that compares only the
+/// velocity needs only its sensitivities, and holding no more keeps a long record's fit
+/// within its memory bound.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SampledSeries {
+    /// dv/dp alone (`x`, `v` and `dx` stay empty).
+    VelocitySensitivities,
+    /// The displacement, the velocity and both their sensitivities.
+    All,
+}
+
 /// The sampled motion and its sensitivities.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Sensitivities {
@@ -77,6 +88,7 @@ pub struct Sensitivities {
 pub fn simulate_sensitivities(
     inputs: RunInputs<'_>,
     params: &[SensitivityParam],
+    kept: SampledSeries,
 ) -> Result<Option<Sensitivities>, EngineError> {
     let RunInputs {
         osc,
@@ -114,6 +126,7 @@ pub fn simulate_sensitivities(
         grid,
         opts,
         period,
+        kept,
     })
     .map(Some)
 }

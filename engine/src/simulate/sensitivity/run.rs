@@ -7,7 +7,7 @@ use super::super::stepper::{StepOutcome, Stepper};
 use super::super::values::{SampleGrid, SimOptions, SimStats};
 use super::super::{Dopri5, REST_SWING_ATOLS};
 use super::system::{Augmented, DirectTerms};
-use super::{Sensitivities, SensitivityParam};
+use super::{SampledSeries, Sensitivities, SensitivityParam};
 use crate::error::{EngineError, IntegrationFailure};
 
 /// Largest Dopri5 step as a fraction of the time scale (the plain run's).
@@ -23,6 +23,8 @@ pub(super) struct Setup<'a, 'b> {
     pub opts: &'b SimOptions,
     /// The run's time scale (the natural period or its length).
     pub period: f64,
+    /// The series kept at the samples.
+    pub kept: SampledSeries,
 }
 
 /// A run in progress: the output and the book-keeping of turning points.
@@ -48,7 +50,9 @@ pub(super) fn run(setup: Setup<'_, '_>) -> Result<Sensitivities, EngineError> {
         }
     }
     let samples = setup.grid.sample_times.len();
-    let series = || vec![Vec::with_capacity(samples); n_params];
+    let all = setup.kept == SampledSeries::All;
+    let kept = |keep: bool| if keep { samples } else { 0 };
+    let series = |keep: bool| vec![Vec::with_capacity(kept(keep)); n_params];
     let mut stepper = Dopri5::new(
         y.len(),
         setup.opts.rtol,
@@ -58,10 +62,10 @@ pub(super) fn run(setup: Setup<'_, '_>) -> Result<Sensitivities, EngineError> {
     .controlling_first(n);
     let mut run = Run {
         out: Sensitivities {
-            x: Vec::with_capacity(samples),
-            v: Vec::with_capacity(samples),
-            dx: series(),
-            dv: series(),
+            x: Vec::with_capacity(kept(all)),
+            v: Vec::with_capacity(kept(all)),
+            dx: series(all),
+            dv: series(true),
             stats: SimStats::default(),
         },
         setup,
@@ -246,12 +250,17 @@ impl Run<'_, '_> {
 
     fn push(&mut self, y: &[f64], moving: bool) {
         let n = self.n();
+        let all = self.setup.kept == SampledSeries::All;
         let out = &mut self.out;
-        out.x.push(y[0]);
-        out.v.push(if moving { y[1] } else { 0.0 });
-        for ((s, dx), dv) in y[n..].chunks_exact(n).zip(&mut out.dx).zip(&mut out.dv) {
-            dx.push(s[0]);
-            dv.push(if moving { s[1] } else { 0.0 });
+        if all {
+            out.x.push(y[0]);
+            out.v.push(if moving { y[1] } else { 0.0 });
+        }
+        for (j, s) in y[n..].chunks_exact(n).enumerate() {
+            if all {
+                out.dx[j].push(s[0]);
+            }
+            out.dv[j].push(if moving { s[1] } else { 0.0 });
         }
         self.next += 1;
     }

@@ -60,7 +60,9 @@ impl World {
             },
             opts: &tight(),
         };
-        simulate_sensitivities(inputs, params).unwrap().unwrap()
+        simulate_sensitivities(inputs, params, SampledSeries::All)
+            .unwrap()
+            .unwrap()
     }
 
     /// The world with `p` moved by `by`.
@@ -251,7 +253,7 @@ fn laws_without_gradients_and_driven_or_euler_runs_give_none() {
             },
             opts,
         };
-        simulate_sensitivities(inputs, &[SensitivityParam::Model(0)]).unwrap()
+        simulate_sensitivities(inputs, &[SensitivityParam::Model(0)], SampledSeries::All).unwrap()
     };
     assert!(run(built.model.as_ref(), &tight()).is_none());
     let euler = SimOptions {

@@ -17,7 +17,7 @@ use crate::identify::values::nuisance::NuisanceKind;
 use crate::oscillator::OscillatorProperty;
 use crate::record::Channel;
 use crate::simulate::{
-    simulate_sensitivities, RunInputs, SampleGrid, Sensitivities, SensitivityParam,
+    simulate_sensitivities, RunInputs, SampleGrid, SampledSeries, Sensitivities, SensitivityParam,
 };
 
 /// Where one free parameter's column comes from, for one record.
@@ -127,6 +127,14 @@ impl SimulatedResponse {
         params: &[SensitivityParam],
     ) -> Result<Option<Sensitivities>, EngineError> {
         let record = case.record;
+        let kept = if self
+            .channels_of(case.index)
+            .contains(&Channel::Displacement)
+        {
+            SampledSeries::All
+        } else {
+            SampledSeries::VelocitySensitivities
+        };
         at.count_simulation();
         let init = super::initial(record, case.nuisance);
         let opts = super::within_allowance(at, case.index, record, clock.times.len());
@@ -144,6 +152,7 @@ impl SimulatedResponse {
                 opts: &opts,
             },
             params,
+            kept,
         )
     }
 }
