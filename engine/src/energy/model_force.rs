@@ -285,6 +285,16 @@ pub fn force_derivatives_along_path(
     samples: &[usize],
 ) -> Result<Option<ForceDerivatives>, EngineError> {
     let motion = motion.checked()?.along(displacement)?;
+    derivatives_without_conditions(model, motion, samples)
+}
+
+/// [`force_derivatives_checked`] at `samples` checked against the motion, for a law that
+/// reads no conditions.
+fn derivatives_without_conditions(
+    model: &dyn FrictionModel,
+    motion: CheckedMotion<'_>,
+    samples: &[usize],
+) -> Result<Option<ForceDerivatives>, EngineError> {
     check_samples(samples, motion.len())?;
     Ok(force_derivatives_checked(
         model,
@@ -335,13 +345,7 @@ pub fn force_derivatives_along(
     samples: &[usize],
 ) -> Result<Option<ForceDerivatives>, EngineError> {
     let motion = motion.checked()?;
-    check_samples(samples, motion.len())?;
-    Ok(force_derivatives_checked(
-        model,
-        motion,
-        samples,
-        &ConditionColumns::none(),
-    ))
+    derivatives_without_conditions(model, motion, samples)
 }
 
 /// [`force_derivatives_along`] of a checked motion and samples within it, the law reading

@@ -85,24 +85,8 @@ impl ForceTrack {
             check_displacement(record.time(), &motion.x).map_err(|e| err(e.to_string()))?;
         }
         let (used, target) = after_run_in(used, target, record.run_in);
-        let (used, target, sliding) = keep_sliding(used, target, &motion.v, opts.target.min_speed);
-        if sliding.is_some_and(|s| s.kept < 2) {
-            return Err(err(format!(
-                "{} samples slide with |v| >= [fit.options] min_speed = {} {}; lower it",
-                target.len(),
-                opts.target.min_speed.unwrap_or_default(),
-                osc.axis.unit("m/s")
-            )));
-        }
-        if target.len() < 2 {
-            return Err(err(format!(
-                "{} samples to compare the model force with (Eq. 7 and the inverse-dynamics \
-                 force are masked where |v| <= [energy] velocity_threshold = {} {})",
-                target.len(),
-                opts.energy.velocity_threshold,
-                osc.axis.unit("m/s")
-            )));
-        }
+        let (used, target, sliding) =
+            enough_compared(used, target, &motion.v, osc, opts).map_err(err)?;
         let noise_channel = match source {
             TargetSource::Measured => Some(Channel::Force),
             TargetSource::InverseDynamics => Some(Channel::InputForce),
@@ -234,6 +218,39 @@ fn after_run_in(used: Vec<usize>, target: Vec<f64>, run_in: usize) -> (Vec<usize
         .zip(target)
         .filter(|(i, _)| *i >= run_in)
         .unzip()
+}
+
+/// The compared samples, their target values, and what `min_speed` kept of them.
+type Compared = (Vec<usize>, Vec<f64>, Option<SlidingSamples>);
+
+/// The compared samples kept by `[fit.options] min_speed` (and how many it kept), refused
+/// with the reason when fewer than two remain.
+fn enough_compared(
+    used: Vec<usize>,
+    target: Vec<f64>,
+    velocity: &[f64],
+    osc: &Oscillator,
+    opts: &FitOptions,
+) -> Result<Compared, String> {
+    let (used, target, sliding) = keep_sliding(used, target, velocity, opts.target.min_speed);
+    if sliding.is_some_and(|s| s.kept < 2) {
+        return Err(format!(
+            "{} samples slide with |v| >= [fit.options] min_speed = {} {}; lower it",
+            target.len(),
+            opts.target.min_speed.unwrap_or_default(),
+            osc.axis.unit("m/s")
+        ));
+    }
+    if target.len() < 2 {
+        return Err(format!(
+            "{} samples to compare the model force with (Eq. 7 and the inverse-dynamics \
+             force are masked where |v| <= [energy] velocity_threshold = {} {})",
+            target.len(),
+            opts.energy.velocity_threshold,
+            osc.axis.unit("m/s")
+        ));
+    }
+    Ok((used, target, sliding))
 }
 
 /// The compared samples `used` (with their `target`) where |v| >= `min_speed`, and how many
