@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 /// The `[[records]]` keys that state a run's physical condition: carried into the results
 /// as conditions (when constant within a group) besides setting the record's key.
-pub const CONDITION_KEYS: [&str; 3] = ["x0", "v0", "normal_force"];
+pub(crate) const CONDITION_KEYS: [&str; 3] = ["x0", "v0", "normal_force"];
 
 /// One group: everything a worker needs to fit it, as plain data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -41,7 +41,7 @@ impl GroupTask {
 
 /// The condition columns of `manifest`: every column that is not a `[[records]]` key, and
 /// the keys of [`CONDITION_KEYS`], in manifest order.
-pub fn condition_columns(manifest: &Manifest) -> Vec<usize> {
+pub(crate) fn condition_columns(manifest: &Manifest) -> Vec<usize> {
     (0..manifest.columns.len())
         .filter(|&i| {
             !manifest.record_key[i] || CONDITION_KEYS.contains(&manifest.columns[i].as_str())
@@ -207,7 +207,7 @@ fn group_task(
 }
 
 /// Whether each column is numeric: every non-empty cell reads as a finite number.
-pub fn numeric_columns(manifest: &Manifest) -> Vec<bool> {
+pub(crate) fn numeric_columns(manifest: &Manifest) -> Vec<bool> {
     (0..manifest.columns.len())
         .map(|c| {
             manifest

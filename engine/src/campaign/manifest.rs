@@ -13,10 +13,10 @@ use std::io::Read;
 use std::path::Path;
 
 /// Largest manifest read \[bytes\] (64 MiB).
-pub const MAX_MANIFEST_BYTES: u64 = 64 * 1024 * 1024;
+pub(crate) const MAX_MANIFEST_BYTES: u64 = 64 * 1024 * 1024;
 
 /// The column that names each row's data file.
-pub const FILE_COLUMN: &str = "file";
+pub(crate) const FILE_COLUMN: &str = "file";
 
 /// A read and typed manifest.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,7 +43,7 @@ pub struct ManifestRow {
 }
 
 /// The names of every `[[records]]` key, from the entry's own declaration.
-pub fn record_key_names() -> Vec<String> {
+pub(crate) fn record_key_names() -> Vec<String> {
     match serde_json::to_value(RecordSource::default()) {
         Ok(Value::Object(map)) => map.keys().cloned().collect(),
         _ => vec![FILE_COLUMN.to_string()],
@@ -195,7 +195,7 @@ fn typed_key(key: &str, cell: &str) -> Result<RecordSource, String> {
 }
 
 /// The cells of one CSV line, trimmed; a quoted cell keeps its commas, `""` is a quote.
-pub fn split_cells(line: &str) -> Vec<String> {
+pub(crate) fn split_cells(line: &str) -> Vec<String> {
     let mut cells = Vec::new();
     let mut cell = String::new();
     let mut quoted = false;

@@ -1,6 +1,6 @@
 //! The results table of a campaign: one row per group and model, and its CSV form.
 
-pub use super::cell::CellValue;
+pub(crate) use super::cell::CellValue;
 use super::groups::GroupTask;
 use crate::identify::{FitResult, FittedParam, Verdict};
 use crate::oscillator::OscillatorProperty;
@@ -248,7 +248,7 @@ const FIXED_COLUMNS: [&str; 9] = [
 ];
 
 /// The parameter names of `rows`, in order of first appearance.
-pub fn parameter_names(rows: &[CampaignRow]) -> Vec<String> {
+pub(crate) fn parameter_names(rows: &[CampaignRow]) -> Vec<String> {
     let mut names: Vec<String> = Vec::new();
     for p in rows.iter().flat_map(|r| &r.parameters) {
         if !names.contains(&p.name) {
@@ -261,7 +261,7 @@ pub fn parameter_names(rows: &[CampaignRow]) -> Vec<String> {
 /// campaign.csv: `group`, the conditions, `file`, `model`, `records`, `rms_residual`,
 /// `aic`, `delta_aic`, `converged`, `verdict`, `error`, then per parameter `<name>`,
 /// `<name>_std_error`, `<name>_status`. Numbers are written in their shortest exact form.
-pub fn campaign_csv(rows: &[CampaignRow], conditions: &[String]) -> String {
+pub(crate) fn campaign_csv(rows: &[CampaignRow], conditions: &[String]) -> String {
     let params = parameter_names(rows);
     let mut header: Vec<String> = vec!["group".into()];
     header.extend(conditions.iter().cloned());

@@ -103,7 +103,7 @@ pub fn campaign_trends(rows: &[CampaignRow], numeric: &[String]) -> Vec<Trend> {
 }
 
 /// The points (condition, value, standard error) of one parameter against one condition.
-pub fn trend_points(
+pub(crate) fn trend_points(
     rows: &[&CampaignRow],
     param: &str,
     condition: &str,
@@ -221,7 +221,7 @@ fn power_law(points: &[Point]) -> Option<LineFit> {
 
 /// The weighted least-squares line y = a + b x and the standard errors of a and b (the
 /// covariance (X' W X)^-1 scaled by chi² / (n - 2)); `None` when the x do not vary.
-pub fn weighted_line(points: &[Point]) -> Option<(f64, f64, Option<f64>, Option<f64>)> {
+pub(crate) fn weighted_line(points: &[Point]) -> Option<(f64, f64, Option<f64>, Option<f64>)> {
     let (mut s, mut sx, mut sy) = (0.0, 0.0, 0.0);
     for &(x, y, w) in points {
         s += w;

@@ -52,16 +52,16 @@ impl Default for Differentiator {
 pub const AUTO_ORDER: usize = 4;
 /// The share of the natural period [`Differentiator::Auto`]'s window spans before any
 /// widening.
-pub const AUTO_PERIOD_SHARE: f64 = 1.0 / 15.0;
+pub(crate) const AUTO_PERIOD_SHARE: f64 = 1.0 / 15.0;
 /// The largest share of the natural period the automatic window widens to (half a
 /// half-cycle: a quartic still follows a sine over it to 1e-3).
-pub const AUTO_MAX_PERIOD_SHARE: f64 = 0.25;
+pub(crate) const AUTO_MAX_PERIOD_SHARE: f64 = 0.25;
 /// The most samples in an automatic window (its weight table grows with the square).
-pub const MAX_AUTO_WINDOW: usize = 1001;
+pub(crate) const MAX_AUTO_WINDOW: usize = 1001;
 /// The share of the friction level the derivative's noise (times the mass) may reach before
 /// the automatic window widens: below a quarter of the level, the mean |F| of Eq. 7 is
 /// biased by less than 0.01 % by the noise's absolute value.
-pub const AUTO_NOISE_SHARE: f64 = 0.25;
+pub(crate) const AUTO_NOISE_SHARE: f64 = 0.25;
 
 /// What [`auto_window`] chooses from.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -104,7 +104,7 @@ pub fn auto_window(inputs: &WindowInputs) -> Result<(usize, f64), EngineError> {
 /// The automatic window before any widening: the odd sample count nearest to
 /// [`AUTO_PERIOD_SHARE`] of the natural `period` at spacing `dt`, within `AUTO_ORDER + 3`
 /// and [`MAX_AUTO_WINDOW`]; also the fewest samples a record needs for it.
-pub fn auto_base_window(dt: f64, period: f64) -> usize {
+pub(crate) fn auto_base_window(dt: f64, period: f64) -> usize {
     nearest_odd(period * AUTO_PERIOD_SHARE / dt).clamp(AUTO_ORDER + 3, MAX_AUTO_WINDOW)
 }
 
@@ -136,7 +136,7 @@ pub fn centre_weight_norm(window: usize, order: usize) -> Result<f64, EngineErro
 
 /// The norm of the paper's derivative weights (unit spacing): a central difference averaged
 /// over 9 samples telescopes to (v\[i+5\] + v\[i+4\] - v\[i-4\] - v\[i-5\]) / 18.
-pub const PAPER_WEIGHT_NORM: f64 = 2.0 / 18.0;
+pub(crate) const PAPER_WEIGHT_NORM: f64 = 2.0 / 18.0;
 
 impl Differentiator {
     /// The fewest samples a record needs for this method.

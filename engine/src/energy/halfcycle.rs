@@ -101,7 +101,7 @@ pub(crate) struct Motion {
 
 impl Motion {
     /// The first sample index at or after each break (segment starts for differentiation).
-    pub fn break_indices(&self, time: &[f64]) -> Vec<usize> {
+    pub(crate) fn break_indices(&self, time: &[f64]) -> Vec<usize> {
         self.breaks
             .iter()
             .map(|b| {

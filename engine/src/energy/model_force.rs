@@ -158,7 +158,7 @@ pub(crate) struct CheckedMotion<'a> {
 impl<'a> CheckedMotion<'a> {
     /// The replay's interval ending at sample `i` (>= 1): [`path_interval`] along the
     /// displacement where the motion follows one, else [`replay_interval`].
-    pub fn interval(&self, i: usize) -> Interval {
+    pub(crate) fn interval(&self, i: usize) -> Interval {
         match self.displacement {
             Some(x) => path_interval(self.time, self.v, x, self.normal, i),
             None => replay_interval(self.time, self.v, self.normal, i),
@@ -167,7 +167,7 @@ impl<'a> CheckedMotion<'a> {
 
     /// The motion travelling the increments of `displacement`, once it has a finite value per
     /// sample.
-    pub fn along(self, displacement: &'a [f64]) -> Result<Self, EngineError> {
+    pub(crate) fn along(self, displacement: &'a [f64]) -> Result<Self, EngineError> {
         check_displacement(self.time, displacement)?;
         Ok(Self {
             displacement: Some(displacement),
@@ -176,7 +176,7 @@ impl<'a> CheckedMotion<'a> {
     }
 
     /// Number of samples.
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.time.len()
     }
 }

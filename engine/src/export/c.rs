@@ -63,7 +63,7 @@ fn valid_prefix(prefix: &str) -> bool {
 
 /// The constants' macro names: the prefix and the parameter's name in upper case. Errors:
 /// two names the same in upper case, a value not finite.
-pub fn constant_names(
+pub(crate) fn constant_names(
     desc: &LawDescription,
     upper_prefix: &str,
 ) -> Result<Vec<String>, ExportError> {
@@ -99,7 +99,7 @@ fn unused(body: &[Stmt], args: &[(&str, Expr)]) -> String {
 }
 
 /// The law as one C99 file.
-pub fn emit(desc: &LawDescription, prefix: &str) -> Result<String, ExportError> {
+pub(crate) fn emit(desc: &LawDescription, prefix: &str) -> Result<String, ExportError> {
     if !valid_prefix(prefix) {
         return Err(ExportError::Options(format!(
             "--prefix `{prefix}` does not start a C identifier (letters, digits, `_`)"

@@ -186,22 +186,22 @@ pub struct LawCode {
 // Builders, so that the laws read close to their equations.
 
 /// A number.
-pub fn num(x: f64) -> Expr {
+pub(crate) fn num(x: f64) -> Expr {
     Expr::Num(x)
 }
 
 /// Constant `i`.
-pub fn p(i: usize) -> Expr {
+pub(crate) fn p(i: usize) -> Expr {
     Expr::Param(i)
 }
 
 /// A local.
-pub fn local(name: &str) -> Expr {
+pub(crate) fn local(name: &str) -> Expr {
     Expr::Local(name.to_string())
 }
 
 /// State `i`.
-pub fn state(i: usize) -> Expr {
+pub(crate) fn state(i: usize) -> Expr {
     Expr::State(i)
 }
 
@@ -210,81 +210,81 @@ fn bin(op: Op, a: Expr, b: Expr) -> Expr {
 }
 
 /// a + b.
-pub fn add(a: Expr, b: Expr) -> Expr {
+pub(crate) fn add(a: Expr, b: Expr) -> Expr {
     bin(Op::Add, a, b)
 }
 
 /// a - b.
-pub fn sub(a: Expr, b: Expr) -> Expr {
+pub(crate) fn sub(a: Expr, b: Expr) -> Expr {
     bin(Op::Sub, a, b)
 }
 
 /// a * b.
-pub fn mul(a: Expr, b: Expr) -> Expr {
+pub(crate) fn mul(a: Expr, b: Expr) -> Expr {
     bin(Op::Mul, a, b)
 }
 
 /// a / b.
-pub fn div(a: Expr, b: Expr) -> Expr {
+pub(crate) fn div(a: Expr, b: Expr) -> Expr {
     bin(Op::Div, a, b)
 }
 
 /// -a.
-pub fn neg(a: Expr) -> Expr {
+pub(crate) fn neg(a: Expr) -> Expr {
     Expr::Neg(Box::new(a))
 }
 
 /// f(a).
-pub fn call(f: Func, a: Expr) -> Expr {
+pub(crate) fn call(f: Func, a: Expr) -> Expr {
     Expr::Call(f, vec![a])
 }
 
 /// f(a, b).
-pub fn call2(f: Func, a: Expr, b: Expr) -> Expr {
+pub(crate) fn call2(f: Func, a: Expr, b: Expr) -> Expr {
     Expr::Call(f, vec![a, b])
 }
 
 /// a `cmp` b.
-pub fn cmp(c: Cmp, a: Expr, b: Expr) -> Cond {
+pub(crate) fn cmp(c: Cmp, a: Expr, b: Expr) -> Cond {
     Cond::Cmp(c, a, b)
 }
 
 /// a and b.
-pub fn and(a: Cond, b: Cond) -> Cond {
+pub(crate) fn and(a: Cond, b: Cond) -> Cond {
     Cond::And(Box::new(a), Box::new(b))
 }
 
 /// a or b.
-pub fn or(a: Cond, b: Cond) -> Cond {
+pub(crate) fn or(a: Cond, b: Cond) -> Cond {
     Cond::Or(Box::new(a), Box::new(b))
 }
 
 /// not a.
-pub fn not(a: Cond) -> Cond {
+pub(crate) fn not(a: Cond) -> Cond {
     Cond::Not(Box::new(a))
 }
 
 /// `then` where `c` holds, else `otherwise`.
-pub fn cond(c: Cond, then: Expr, otherwise: Expr) -> Expr {
+pub(crate) fn cond(c: Cond, then: Expr, otherwise: Expr) -> Expr {
     Expr::If(Box::new(c), Box::new(then), Box::new(otherwise))
 }
 
 /// let `name` = `e`.
-pub fn let_(name: &str, e: Expr) -> Stmt {
+pub(crate) fn let_(name: &str, e: Expr) -> Stmt {
     Stmt::Let(name.to_string(), e)
 }
 
 /// A mutable local `name` starting at `e`.
-pub fn var(name: &str, e: Expr) -> Stmt {
+pub(crate) fn var(name: &str, e: Expr) -> Stmt {
     Stmt::Var(name.to_string(), e)
 }
 
 /// `name` = `e` (a local declared by [`var`]).
-pub fn assign(name: &str, e: Expr) -> Stmt {
+pub(crate) fn assign(name: &str, e: Expr) -> Stmt {
     Stmt::Assign(name.to_string(), e)
 }
 
 /// Sum of the terms, left to right (0 when empty).
-pub fn sum(terms: Vec<Expr>) -> Expr {
+pub(crate) fn sum(terms: Vec<Expr>) -> Expr {
     terms.into_iter().reduce(add).unwrap_or(num(0.0))
 }

@@ -321,7 +321,7 @@ impl LawDescription {
 
 /// Whether `stmts` read the input or state `leaf` (`Expr::V`, `Expr::N`, `Expr::Dt`, or any
 /// state for `Expr::State(_)`).
-pub fn reads(stmts: &[Stmt], leaf: &Expr) -> bool {
+pub(super) fn reads(stmts: &[Stmt], leaf: &Expr) -> bool {
     let is = |e: &Expr| match (e, leaf) {
         (Expr::State(_), Expr::State(_)) => true,
         _ => e == leaf,
@@ -365,7 +365,7 @@ fn expr_uses(e: &Expr, f: &dyn Fn(&Expr) -> bool) -> bool {
 
 /// A number as a literal every target reads back to the same double (Rust's shortest
 /// round-trip form: `0.2`, `100000.0`, `1e-7`).
-pub fn literal(x: f64) -> String {
+pub(super) fn literal(x: f64) -> String {
     let text = format!("{x:?}");
     if text.contains(['.', 'e']) {
         text

@@ -8,7 +8,7 @@ use super::ExportError;
 use frictionid_models::formula::{self, BinKind, Func as FormulaFunc, Node};
 
 /// The fitted parameters of a law, by name.
-pub struct Params<'a> {
+pub(crate) struct Params<'a> {
     /// The law's name (for errors).
     pub model: &'a str,
     /// Names, in the law's vector order.
@@ -41,7 +41,7 @@ impl Params<'_> {
 }
 
 /// The code of the law `model` at `params`; `formula` is an expression law's formula.
-pub fn law_code(params: &Params, formula: Option<&str>) -> Result<LawCode, ExportError> {
+pub(crate) fn law_code(params: &Params, formula: Option<&str>) -> Result<LawCode, ExportError> {
     match params.model {
         "none" => Ok(static_law(Expr::Num(0.0))),
         "coulomb" => coulomb(params),
@@ -57,7 +57,7 @@ pub fn law_code(params: &Params, formula: Option<&str>) -> Result<LawCode, Expor
 }
 
 /// The names of the laws this module writes.
-pub const EXPORTABLE: [&str; 9] = [
+pub(crate) const EXPORTABLE: [&str; 9] = [
     "none",
     "coulomb",
     "viscous_coulomb",

@@ -5,7 +5,7 @@ use super::code::{Cond, Expr, Func, Stmt};
 use super::description::literal;
 
 /// How a target spells the pieces of the export language.
-pub trait Syntax {
+pub(super) trait Syntax {
     /// Constant `index`.
     fn param(&self, index: usize) -> String;
     /// State `index` (read or written).
@@ -31,7 +31,7 @@ pub trait Syntax {
 }
 
 /// An expression, fully parenthesised.
-pub fn expr(s: &dyn Syntax, e: &Expr) -> String {
+pub(super) fn expr(s: &dyn Syntax, e: &Expr) -> String {
     match e {
         Expr::Num(x) if *x < 0.0 => format!("({})", literal(*x)),
         Expr::Num(x) => literal(*x),
@@ -53,7 +53,7 @@ pub fn expr(s: &dyn Syntax, e: &Expr) -> String {
 
 /// `text` without the parentheses around all of it, if it has them (the top of an
 /// argument, a binding, a return value or a condition needs none; Rust warns about them).
-pub fn bare(text: &str) -> &str {
+pub(super) fn bare(text: &str) -> &str {
     let Some(inner) = text.strip_prefix('(').and_then(|t| t.strip_suffix(')')) else {
         return text;
     };
@@ -72,7 +72,7 @@ pub fn bare(text: &str) -> &str {
 }
 
 /// A condition, fully parenthesised.
-pub fn cond(s: &dyn Syntax, c: &Cond) -> String {
+pub(super) fn cond(s: &dyn Syntax, c: &Cond) -> String {
     let [and, or, not] = s.logic();
     match c {
         Cond::Cmp(op, a, b) => format!("({} {} {})", expr(s, a), op.symbol(), expr(s, b)),
@@ -98,7 +98,7 @@ fn assigned(stmts: &[Stmt], out: &mut Vec<String>) {
 }
 
 /// A function body at indentation `depth` (four spaces each).
-pub fn body(s: &dyn Syntax, stmts: &[Stmt], depth: usize) -> String {
+pub(super) fn body(s: &dyn Syntax, stmts: &[Stmt], depth: usize) -> String {
     let mut out = String::new();
     let mut mutable = Vec::new();
     assigned(stmts, &mut mutable);

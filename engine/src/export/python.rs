@@ -57,7 +57,7 @@ impl Syntax for Python {
 }
 
 /// The law as one Python module.
-pub fn emit(desc: &LawDescription) -> Result<String, ExportError> {
+pub(crate) fn emit(desc: &LawDescription) -> Result<String, ExportError> {
     let syntax = Python {
         constants: constant_names(desc, "")?,
     };

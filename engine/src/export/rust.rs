@@ -64,7 +64,7 @@ impl Syntax for Rust {
 }
 
 /// The law as one Rust module.
-pub fn emit(desc: &LawDescription) -> Result<String, ExportError> {
+pub(crate) fn emit(desc: &LawDescription) -> Result<String, ExportError> {
     let syntax = Rust {
         constants: constant_names(desc, "")?,
     };

@@ -37,7 +37,7 @@ fn breakpoints(desc: &LawDescription) -> Vec<f64> {
 }
 
 /// The velocity grid, ascending, symmetric about zero.
-pub fn grid(desc: &LawDescription) -> (Vec<f64>, bool) {
+pub(crate) fn grid(desc: &LawDescription) -> (Vec<f64>, bool) {
     let bends = breakpoints(desc);
     let (top, given) = match desc.max_speed.filter(|s| *s > 0.0) {
         Some(s) => (s, true),
@@ -71,7 +71,10 @@ pub fn grid(desc: &LawDescription) -> (Vec<f64>, bool) {
 
 /// The table as CSV: `#` comment lines, then a header naming the units, then one row per
 /// grid velocity.
-pub fn emit(desc: &LawDescription, normal_force: Option<f64>) -> Result<String, ExportError> {
+pub(crate) fn emit(
+    desc: &LawDescription,
+    normal_force: Option<f64>,
+) -> Result<String, ExportError> {
     let n = match (normal_force, desc.levels_as_forces, desc.normal_force) {
         (Some(n), _, _) if !(n.is_finite() && n >= 0.0) => {
             return Err(ExportError::Options(format!(

@@ -9,21 +9,21 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Whether the samples passed their checks.
 #[derive(Debug, Default)]
-pub struct SampleCheck(AtomicBool);
+pub(crate) struct SampleCheck(AtomicBool);
 
 impl SampleCheck {
     /// Whether the samples passed their checks since they last changed.
-    pub fn passed(&self) -> bool {
+    pub(crate) fn passed(&self) -> bool {
         self.0.load(Ordering::Relaxed)
     }
 
     /// Notes that the samples passed.
-    pub fn pass(&self) {
+    pub(crate) fn pass(&self) {
         self.0.store(true, Ordering::Relaxed);
     }
 
     /// Forgets the checks (the samples changed).
-    pub fn clear(&mut self) {
+    pub(crate) fn clear(&mut self) {
         *self.0.get_mut() = false;
     }
 }

@@ -14,11 +14,11 @@ use std::collections::BTreeMap;
 /// Difference order for response channels (velocity, displacement, acceleration): third
 /// differences of the FMM motion (1 kHz, 2.2 Hz) are 1e-6 of the signal, far below any
 /// instrument's noise.
-pub const RESPONSE_ORDER: usize = 3;
+pub(crate) const RESPONSE_ORDER: usize = 3;
 
 /// Robust white-noise standard deviation of `values` from their `order`-th differences (see
 /// the module docs); 0 when there are too few samples.
-pub fn difference_noise(values: &[f64], order: usize) -> f64 {
+pub(crate) fn difference_noise(values: &[f64], order: usize) -> f64 {
     let d = differences(values, order);
     if d.is_empty() {
         return 0.0;
@@ -44,7 +44,7 @@ fn differences(values: &[f64], order: usize) -> Vec<f64> {
 /// differences over sqrt(C(2k, k)). Where the median-based level ignores bursts (a force that
 /// chatters on a few stretches of a record), this one counts them; 0 when there are too few
 /// samples.
-pub fn rms_difference_noise(values: &[f64], order: usize) -> f64 {
+pub(crate) fn rms_difference_noise(values: &[f64], order: usize) -> f64 {
     let d = differences(values, order);
     if d.is_empty() {
         return 0.0;
@@ -55,12 +55,12 @@ pub fn rms_difference_noise(values: &[f64], order: usize) -> f64 {
 
 /// [`difference_noise`], never below 1e-6 of the values' RMS (noise-free records) nor zero:
 /// a level to divide residuals by.
-pub fn noise_floor_level(values: &[f64], order: usize) -> f64 {
+pub(crate) fn noise_floor_level(values: &[f64], order: usize) -> f64 {
     difference_noise(values, order).max(noise_floor(values))
 }
 
 /// The smallest level [`noise_floor_level`] returns: 1e-6 of the values' RMS, 1 for zeros.
-pub fn noise_floor(values: &[f64]) -> f64 {
+pub(crate) fn noise_floor(values: &[f64]) -> f64 {
     let rms = (values.iter().map(|f| f * f).sum::<f64>() / values.len().max(1) as f64).sqrt();
     if rms > 0.0 {
         1e-6 * rms
@@ -74,7 +74,7 @@ pub fn noise_floor(values: &[f64]) -> f64 {
 /// least 99 % of the samples lie within 5 % of a step of the grid through the first sample.
 /// `None` for values that are not quantised (their smallest difference is a grazing one that
 /// the other samples do not share), and for fewer than 10 non-zero differences.
-pub fn quantisation_step(values: &[f64]) -> Option<f64> {
+pub(crate) fn quantisation_step(values: &[f64]) -> Option<f64> {
     let step = values
         .windows(2)
         .map(|w| (w[1] - w[0]).abs())
@@ -135,12 +135,17 @@ fn from_order_key(key: u64) -> f64 {
 /// energy check). One of the facts a record derives from its samples (`SampleFacts`), not
 /// part of its value.
 #[derive(Debug, Default)]
-pub struct NoiseCache(std::sync::Mutex<BTreeMap<(Channel, usize), f64>>);
+pub(crate) struct NoiseCache(std::sync::Mutex<BTreeMap<(Channel, usize), f64>>);
 
 impl NoiseCache {
     /// The cached noise of `channel`'s differences of `order`, else `estimate()` (then
     /// cached).
-    pub fn get_or(&self, channel: Channel, order: usize, estimate: impl FnOnce() -> f64) -> f64 {
+    pub(crate) fn get_or(
+        &self,
+        channel: Channel,
+        order: usize,
+        estimate: impl FnOnce() -> f64,
+    ) -> f64 {
         let key = (channel, order);
         if let Some(level) = self.levels().and_then(|l| l.get(&key).copied()) {
             return level;
@@ -153,7 +158,7 @@ impl NoiseCache {
     }
 
     /// Forgets every level (the samples changed).
-    pub fn clear(&mut self) {
+    pub(crate) fn clear(&mut self) {
         if let Ok(levels) = self.0.get_mut() {
             levels.clear();
         }

@@ -29,13 +29,13 @@ use crate::oscillator::Oscillator;
 use thiserror::Error;
 
 /// Largest accepted ratio of the peak speed to what x0, v0 and k/m allow.
-pub const MAX_SPEED_RATIO: f64 = 3.0;
+pub(crate) const MAX_SPEED_RATIO: f64 = 3.0;
 
 /// Smallest accepted ratio of the peak speed to what x0, v0 and k/m allow.
-pub const MIN_SPEED_RATIO: f64 = 0.1;
+pub(crate) const MIN_SPEED_RATIO: f64 = 0.1;
 
 /// Largest accepted ratio (either way) of the measured oscillation period to 2 pi sqrt(m/k).
-pub const MAX_PERIOD_RATIO: f64 = 3.0;
+pub(crate) const MAX_PERIOD_RATIO: f64 = 3.0;
 
 /// A record whose units disagree with its oscillator.
 #[derive(Debug, Clone, PartialEq, Error)]

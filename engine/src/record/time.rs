@@ -9,7 +9,7 @@ use std::sync::Arc;
 use thiserror::Error;
 
 /// Fewest samples a time base holds (a step needs two).
-pub const MIN_TIME_SAMPLES: usize = 2;
+pub(crate) const MIN_TIME_SAMPLES: usize = 2;
 
 /// Why a sequence of time stamps is not a valid time base. Indices are 0-based sample indices.
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
@@ -56,13 +56,13 @@ fn check_order(time: &[f64], strict: bool) -> Result<(), TimeError> {
 }
 
 /// Checks [`check_time`] and that there are at least `min_samples` samples.
-pub fn check_time_base(time: &[f64], min_samples: usize) -> Result<(), TimeError> {
+pub(crate) fn check_time_base(time: &[f64], min_samples: usize) -> Result<(), TimeError> {
     check_count(time, min_samples)?;
     check_time(time)
 }
 
 /// Checks that there are at least `min_samples` time stamps.
-pub fn check_count(time: &[f64], min_samples: usize) -> Result<(), TimeError> {
+pub(crate) fn check_count(time: &[f64], min_samples: usize) -> Result<(), TimeError> {
     if time.len() < min_samples {
         return Err(TimeError::TooFew {
             found: time.len(),

@@ -17,10 +17,10 @@
 use crate::axis::Axis;
 
 /// Significant digits of a figure.
-pub const SIGNIFICANT: i32 = 4;
+pub(crate) const SIGNIFICANT: i32 = 4;
 
 /// The text of an undefined value.
-pub const UNDEFINED: &str = "-";
+pub(crate) const UNDEFINED: &str = "-";
 
 /// Decimal exponent of `a > 0`.
 fn exponent(a: f64) -> i32 {
@@ -89,12 +89,12 @@ pub fn fmt_num(x: f64) -> String {
 }
 
 /// `Some(x)` as [`fmt_num`], `None` as `-`.
-pub fn fmt_opt(x: Option<f64>) -> String {
+pub(crate) fn fmt_opt(x: Option<f64>) -> String {
     x.map(fmt_num).unwrap_or_else(|| UNDEFINED.into())
 }
 
 /// A percentage to two decimals; `-` when not finite.
-pub fn fmt_percent(x: f64) -> String {
+pub(crate) fn fmt_percent(x: f64) -> String {
     if x.is_finite() {
         format!("{x:.2}")
     } else {
@@ -104,7 +104,7 @@ pub fn fmt_percent(x: f64) -> String {
 
 /// An information criterion (AIC, BIC or a difference of them) to one decimal; `-` when
 /// not finite.
-pub fn fmt_criterion(x: f64) -> String {
+pub(crate) fn fmt_criterion(x: f64) -> String {
     if x.is_finite() {
         format!("{x:.1}")
     } else {
@@ -128,7 +128,7 @@ fn last_digit(se: f64) -> i32 {
 }
 
 /// A standard error to 1 or 2 significant digits; `-` when absent or not positive.
-pub fn fmt_std_error(se: Option<f64>) -> String {
+pub(crate) fn fmt_std_error(se: Option<f64>) -> String {
     match se.filter(|s| s.is_finite() && *s > 0.0) {
         Some(s) => {
             let digits = error_digits(s) as usize;
@@ -147,7 +147,7 @@ pub fn fmt_std_error(se: Option<f64>) -> String {
 
 /// `x` rounded to the last digit `se` supports (for interval ends); [`fmt_num`] without a
 /// usable error.
-pub fn fmt_to_error(x: f64, se: Option<f64>) -> String {
+pub(crate) fn fmt_to_error(x: f64, se: Option<f64>) -> String {
     match se.filter(|s| s.is_finite() && *s > 0.0) {
         Some(s) if x.is_finite() => {
             let last = last_digit(s);
@@ -164,7 +164,7 @@ pub fn fmt_to_error(x: f64, se: Option<f64>) -> String {
 
 /// A fitted value with its standard error in parentheses, in units of the value's last
 /// digit: `0.239978(9)`, `1.51(12)e5`; [`fmt_num`] without a usable error.
-pub fn fmt_estimate(x: f64, se: Option<f64>) -> String {
+pub(crate) fn fmt_estimate(x: f64, se: Option<f64>) -> String {
     let Some(s) = se.filter(|s| s.is_finite() && *s > 0.0 && x.is_finite()) else {
         return fmt_num(x);
     };
@@ -178,12 +178,12 @@ pub fn fmt_estimate(x: f64, se: Option<f64>) -> String {
 }
 
 /// `unit`, written for a linear axis, on `axis` (rad, N m, kg m^2 on a rotary one).
-pub fn on_axis(axis: Axis, unit: &str) -> String {
+pub(crate) fn on_axis(axis: Axis, unit: &str) -> String {
     axis.unit(unit)
 }
 
 /// A column header `quantity [unit]`, the unit written for a linear axis and shown on `axis`.
-pub fn column(axis: Axis, quantity: &str, unit: &str) -> String {
+pub(crate) fn column(axis: Axis, quantity: &str, unit: &str) -> String {
     format!("{quantity} [{}]", on_axis(axis, unit))
 }
 

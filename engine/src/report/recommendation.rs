@@ -15,7 +15,7 @@ use crate::identify::{
 /// `reasons` is one ground it rests on, `status` is the recommended fit's own (its checks
 /// decide the colour of a verdict box, never another law's).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Recommendation {
+pub(crate) struct Recommendation {
     /// The recommended fit's status (`Fail` when no law can be recommended).
     pub status: Status,
     /// The law to use (`` `coulomb` ``), or why none can be; writers put it after
@@ -28,7 +28,7 @@ pub struct Recommendation {
 }
 
 /// The recommendation of `c` (`None` when no model could be fitted).
-pub fn recommendation(c: &Comparison) -> Option<Recommendation> {
+pub(crate) fn recommendation(c: &Comparison) -> Option<Recommendation> {
     let verdict = c.verdict.as_ref()?;
     let Some(fit) = recommended_fit(c) else {
         return Some(nothing_to_recommend(c, verdict));
@@ -51,7 +51,7 @@ pub fn recommendation(c: &Comparison) -> Option<Recommendation> {
 }
 
 /// The fit the verdict recommends.
-pub fn recommended_fit(c: &Comparison) -> Option<&FitResult> {
+pub(crate) fn recommended_fit(c: &Comparison) -> Option<&FitResult> {
     let name = c.verdict.as_ref()?.recommended.as_deref()?;
     c.ranking.iter().find(|f| f.model == name)
 }

@@ -18,7 +18,7 @@ pub(crate) struct BlockBuffer {
 }
 
 impl BlockBuffer {
-    pub fn new() -> Self {
+    pub(super) fn new() -> Self {
         Self {
             x: [0.0; BLOCK],
             v: [0.0; BLOCK],
@@ -30,7 +30,7 @@ impl BlockBuffer {
     /// The moving state at `times` (at most [`BLOCK`]) from the stepper's last step; with
     /// `forces`, the friction force of slip direction `dir` and the acceleration as well (the
     /// law's affine form a + b v where it declares one, `slip_force` otherwise).
-    pub fn moving<S: Stepper>(
+    pub(super) fn moving<S: Stepper>(
         &mut self,
         stepper: &S,
         times: &[f64],
@@ -58,7 +58,7 @@ impl BlockBuffer {
 
     /// `n` samples at rest at `x`, the friction of row i `friction(i)` (what holds the mass
     /// against the restoring force and the input), no acceleration.
-    pub fn at_rest(&mut self, n: usize, x: f64, friction: impl Fn(usize) -> f64) {
+    pub(super) fn at_rest(&mut self, n: usize, x: f64, friction: impl Fn(usize) -> f64) {
         let n = n.min(BLOCK);
         self.x[..n].fill(x);
         self.v[..n].fill(0.0);
@@ -69,7 +69,7 @@ impl BlockBuffer {
     }
 
     /// The first `times.len()` rows with their times.
-    pub fn view<'a>(&'a self, times: &'a [f64]) -> SampleBlock<'a> {
+    pub(super) fn view<'a>(&'a self, times: &'a [f64]) -> SampleBlock<'a> {
         let n = times.len().min(BLOCK);
         SampleBlock {
             t: &times[..n],

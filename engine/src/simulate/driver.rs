@@ -67,7 +67,7 @@ pub(crate) struct Driver<'s, R: Recorder> {
 
 impl<R: Recorder> Driver<'_, R> {
     /// Runs the whole simulation from `y0` at t = 0 to `t_end` with `stepper`.
-    pub fn run<S: Stepper>(
+    pub(super) fn run<S: Stepper>(
         &mut self,
         stepper: &mut S,
         y0: &[f64],

@@ -69,7 +69,7 @@ impl<'a> Dynamics<'a> {
 impl Dynamics<'_> {
     /// The friction force in slip direction `dir` (static laws) or from the states (dynamic).
     #[inline]
-    pub fn force(&self, v: f64, z: &[f64], dir: f64) -> f64 {
+    pub(crate) fn force(&self, v: f64, z: &[f64], dir: f64) -> f64 {
         match self.law {
             Law::Dynamic { .. } => self.model.force(v, z, self.normal),
             _ => self.slip_force(v, dir),
@@ -79,7 +79,7 @@ impl Dynamics<'_> {
     /// The force of a static law slipping in direction `dir` (its force at `v` when it is
     /// not a switched law).
     #[inline]
-    pub fn slip_force(&self, v: f64, dir: f64) -> f64 {
+    pub(crate) fn slip_force(&self, v: f64, dir: f64) -> f64 {
         match self.switching {
             Some(law) => law.slip_force(v, dir, self.normal),
             None => self.model.force(v, &[], self.normal),
@@ -88,32 +88,32 @@ impl Dynamics<'_> {
 
     /// The restoring force R(x) ([`Oscillator::restoring_force`]).
     #[inline]
-    pub fn restoring_force(&self, x: f64) -> f64 {
+    pub(crate) fn restoring_force(&self, x: f64) -> f64 {
         self.osc.restoring_force(x)
     }
 
     /// dR/dx at x ([`Oscillator::restoring_stiffness`]).
     #[inline]
-    pub fn restoring_stiffness(&self, x: f64) -> f64 {
+    pub(crate) fn restoring_stiffness(&self, x: f64) -> f64 {
         self.osc.restoring_stiffness(x)
     }
 
     /// The external force u(t) - F_0 (0 in free vibration).
     #[inline]
-    pub fn input_at(&self, t: f64) -> f64 {
+    pub(crate) fn input_at(&self, t: f64) -> f64 {
         self.input.map_or(0.0, |u| u.at(t)) - self.osc.input_offset
     }
 
     /// Whether an input or a constant force acts (else the motion is free vibration).
     #[inline]
-    pub fn driven(&self) -> bool {
+    pub(crate) fn driven(&self) -> bool {
         self.input.is_some() || self.osc.input_offset != 0.0
     }
 
     /// The force the contact holds at rest at (t, x): u(t) - F_0 - R(x) (the static
     /// friction that keeps the mass where it is).
     #[inline]
-    pub fn held_force(&self, t: f64, x: f64) -> f64 {
+    pub(crate) fn held_force(&self, t: f64, x: f64) -> f64 {
         if self.driven() {
             self.input_at(t) - self.restoring_force(x)
         } else {
@@ -123,14 +123,14 @@ impl Dynamics<'_> {
 
     /// The acceleration at time `t` for friction force `f`.
     #[inline]
-    pub fn accel(&self, t: f64, x: f64, v: f64, f: f64) -> f64 {
+    pub(crate) fn accel(&self, t: f64, x: f64, v: f64, f: f64) -> f64 {
         -(self.osc.damping * v + self.restoring_force(x) + f - self.input_at(t)) / self.osc.mass
     }
 
     /// The right-hand side of the first-order system y = [x, v, z...] at time `t` in
     /// direction `dir`.
     #[inline]
-    pub fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64], dir: f64) {
+    pub(crate) fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64], dir: f64) {
         let ([x, v, z @ ..], [dx, dv, dz @ ..]) = (y, dy) else {
             return;
         };
@@ -146,7 +146,7 @@ impl Dynamics<'_> {
 
     /// The segment's linear equation when the law is affine in v in direction `dir`, on a
     /// linear spring in free vibration.
-    pub fn affine_motion(&self, dir: f64) -> Option<AffineMotion> {
+    pub(crate) fn affine_motion(&self, dir: f64) -> Option<AffineMotion> {
         if matches!(self.law, Law::Dynamic { .. }) || self.driven() || !self.osc.has_linear_spring()
         {
             return None;
@@ -161,7 +161,7 @@ impl Dynamics<'_> {
     }
 
     /// Whether every sliding mode of this law is solved in closed form.
-    pub fn closed_form_applies(&self) -> bool {
+    pub(crate) fn closed_form_applies(&self) -> bool {
         [1.0, -1.0].into_iter().all(|dir| {
             self.affine_motion(dir)
                 .is_some_and(|m| ClosedForm::supports(&m))
@@ -171,7 +171,7 @@ impl Dynamics<'_> {
     /// The mode at the start of a segment from state (x, v, z) at time `t`: with a
     /// set-valued law the mass sticks while the force it must hold, |u - R(x)|, is within
     /// the static limit.
-    pub fn start(&self, t: f64, x: f64, v: f64, z: &[f64]) -> Start {
+    pub(crate) fn start(&self, t: f64, x: f64, v: f64, z: &[f64]) -> Start {
         if v != 0.0 {
             return Start::Slip(sgn(v));
         }

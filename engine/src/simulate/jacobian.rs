@@ -21,7 +21,7 @@ impl Dynamics<'_> {
     /// Writes the Jacobian of [`Dynamics::rhs`] at `y` in slip direction `dir`, row-major,
     /// into `jac` (len(y)^2 entries). Allocates nothing beyond what the model's derivative
     /// methods do, up to [`STACK_STATES`] internal states.
-    pub fn jacobian(&self, y: &[f64], dir: f64, jac: &mut [f64]) {
+    pub(crate) fn jacobian(&self, y: &[f64], dir: f64, jac: &mut [f64]) {
         let n = y.len();
         let ([x, v, z @ ..], true) = (y, jac.len() == n * n) else {
             return;

@@ -22,7 +22,7 @@ pub(crate) struct SmallLu {
 
 impl SmallLu {
     /// Room for the factors of an `n` x `n` matrix.
-    pub fn new(n: usize) -> Self {
+    pub(super) fn new(n: usize) -> Self {
         Self {
             n,
             lu: vec![0.0; n * n],
@@ -38,7 +38,7 @@ impl SmallLu {
     /// of its time in the general loops); the operations and their order are the same for
     /// every size.
     #[inline(always)]
-    pub fn factor_shifted(&mut self, diag: f64, m: &[f64]) -> bool {
+    pub(super) fn factor_shifted(&mut self, diag: f64, m: &[f64]) -> bool {
         match m.len() {
             4 => self.factor_sized(diag, m, 2),
             9 => self.factor_sized(diag, m, 3),
@@ -72,7 +72,7 @@ impl SmallLu {
     /// Inlined, dispatching on `b`'s length: a caller whose slice has a size known when
     /// compiling gets the unrolled substitution of that size.
     #[inline(always)]
-    pub fn solve(&self, b: &mut [f64]) {
+    pub(super) fn solve(&self, b: &mut [f64]) {
         if !self.invertible || b.len() != self.n {
             return;
         }

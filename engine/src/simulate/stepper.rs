@@ -141,7 +141,7 @@ pub enum StepOutcome {
 }
 
 /// What the fallible [`Stepper`] operations return.
-pub type StepResult<T> = Result<T, IntegrationFailure>;
+pub(super) type StepResult<T> = Result<T, IntegrationFailure>;
 
 /// Fails when a step of size `h` at time `t` is lost in round-off (or is NaN).
 pub(crate) fn ensure_resolvable(t: f64, h: f64) -> StepResult<()> {
@@ -230,7 +230,7 @@ pub(crate) struct StepControl {
 impl StepControl {
     /// A control for `dim` components with tolerances `rtol`, `atol` and largest step
     /// |`h_max`|.
-    pub fn new(dim: usize, rtol: f64, atol: f64, h_max: f64) -> Self {
+    pub(super) fn new(dim: usize, rtol: f64, atol: f64, h_max: f64) -> Self {
         Self {
             tol: Tolerance::uniform(dim, rtol, atol),
             h_max: h_max.abs(),
@@ -246,18 +246,18 @@ impl StepControl {
     }
 
     /// Whether a step size was learnt (a restart keeps it; none yet before the first reset).
-    pub fn has_step(&self) -> bool {
+    pub(super) fn has_step(&self) -> bool {
         self.h > 0.0
     }
 
     /// Starts over at `t` in an interval ending at `t_end` (step sizes kept).
-    pub fn restart(&mut self, t: f64, t_end: f64) {
+    pub(super) fn restart(&mut self, t: f64, t_end: f64) {
         (self.t, self.t_prev, self.t_end) = (t, t, t_end);
         (self.after_reject, self.last, self.reached) = (false, false, false);
     }
 
     /// Moves the end of the interval on to `t_end`; the next step starts where the last ended.
-    pub fn extend_to(&mut self, t_end: f64) {
+    pub(super) fn extend_to(&mut self, t_end: f64) {
         self.t_end = t_end;
         self.last = false;
         self.reached = false;
@@ -265,7 +265,7 @@ impl StepControl {
 
     /// The size of the next attempt: an error when it is too small to resolve at the current
     /// time; shortened to the rest of the interval (and marked last) near its end.
-    pub fn next_attempt(&mut self) -> StepResult<f64> {
+    pub(super) fn next_attempt(&mut self) -> StepResult<f64> {
         ensure_resolvable(self.t, self.h)?;
         if let Some(rest) = last_step(self.t, self.h, self.t_end) {
             self.h = rest;
@@ -275,7 +275,7 @@ impl StepControl {
     }
 
     /// Moves past an accepted step of size `h`.
-    pub fn advance(&mut self, h: f64) {
+    pub(super) fn advance(&mut self, h: f64) {
         self.t_prev = self.t;
         self.t += h;
         self.h_last = h;
@@ -283,7 +283,7 @@ impl StepControl {
     }
 
     /// The theta in [0, 1] of `t` within the last accepted step (1 before any step).
-    pub fn fraction_of_last_step(&self, t: f64) -> f64 {
+    pub(super) fn fraction_of_last_step(&self, t: f64) -> f64 {
         if self.h_last > 0.0 {
             (t.clamp(self.t_prev, self.t) - self.t_prev) / self.h_last
         } else {

@@ -25,19 +25,19 @@ use crate::oscillator::Oscillator;
 use crate::record::noise::{difference_noise, quantisation_step, RESPONSE_ORDER};
 
 /// An energy-balance difference above this many percent warns.
-pub const ENERGY_WARN_PERCENT: f64 = 5.0;
+pub(crate) const ENERGY_WARN_PERCENT: f64 = 5.0;
 /// An energy-balance difference above this many percent fails.
-pub const ENERGY_FAIL_PERCENT: f64 = 20.0;
+pub(crate) const ENERGY_FAIL_PERCENT: f64 = 20.0;
 /// A residual-structure statistic (in standard errors under no structure, with the effective
 /// sample size) above this warns.
-pub const STRUCTURE_WARN_Z: f64 = 4.0;
+pub(crate) const STRUCTURE_WARN_Z: f64 = 4.0;
 /// ... and above this fails, when the effect is also at least [`STRUCTURE_FAIL_EFFECT`].
-pub const STRUCTURE_FAIL_Z: f64 = 5.0;
+pub(crate) const STRUCTURE_FAIL_Z: f64 = 5.0;
 /// The smallest correlation (or mean / RMS) that fails the residual-structure check.
-pub const STRUCTURE_FAIL_EFFECT: f64 = 0.3;
+pub(crate) const STRUCTURE_FAIL_EFFECT: f64 = 0.3;
 /// A converged start whose SSR exceeds the best by more than this many residual variances
 /// ended in a different minimum.
-pub const START_DISAGREEMENT: f64 = 4.0;
+pub(crate) const START_DISAGREEMENT: f64 = 4.0;
 
 fn status_of(value: f64, warn: f64, fail: f64) -> Status {
     if value > fail {
@@ -52,7 +52,7 @@ fn status_of(value: f64, warn: f64, fail: f64) -> Status {
 /// The energy-balance finding of one record: the larger of the Eq. 7 and the dissipated
 /// energy differences (in percent) decides among the parts that can judge; with neither,
 /// the finding is skipped with the reasons. Forces in the units of `axis`.
-pub fn energy_balance(record: &str, ef: &EnergyForce, axis: Axis) -> Finding {
+pub(crate) fn energy_balance(record: &str, ef: &EnergyForce, axis: Axis) -> Finding {
     let eq7 = ef.percent_difference.abs();
     let energies = ef.dissipation_percent_difference.abs();
     let judged = [
@@ -119,7 +119,7 @@ fn energy_skips(ef: &EnergyForce, axis: Axis) -> Vec<String> {
 /// Lag-1 correlation (from the residuals' differences, [`residual_smoothness`]) at or above
 /// which the residuals are smoother than measurement noise: a model error (or low-pass
 /// filtered data), reported as such instead of corrected for.
-pub const SMOOTH_RESIDUALS: f64 = 0.98;
+pub(crate) const SMOOTH_RESIDUALS: f64 = 0.98;
 
 /// Lag-`lag` autocorrelation of the residual segments (pairs within a segment only).
 fn autocorrelation<S: AsRef<[f64]>>(segments: &[S], lag: usize) -> f64 {
@@ -193,7 +193,7 @@ fn demeaned(mut v: Vec<f64>) -> Vec<f64> {
 }
 
 /// Noise levels of the velocity read above which a sample counts as moving.
-pub const MOVING_NOISE_LEVELS: f64 = 5.0;
+pub(crate) const MOVING_NOISE_LEVELS: f64 = 5.0;
 
 /// The speed above which a record's velocity `v` counts as moving: the `configured`
 /// threshold, raised to [`MOVING_NOISE_LEVELS`] noise levels of `v` (from its third
@@ -331,7 +331,11 @@ struct Statistic {
 /// Residual structure over all records: correlation with sgn(v) and with x, autocorrelation
 /// at one oscillation period (on the moving parts), and the residual mean (whole records).
 /// `threshold` is the speed below which the mass counts as at rest.
-pub fn residual_structure(records: &[RecordFit], osc: &Oscillator, threshold: f64) -> Finding {
+pub(crate) fn residual_structure(
+    records: &[RecordFit],
+    osc: &Oscillator,
+    threshold: f64,
+) -> Finding {
     let mut moving = Vec::new();
     let mut unjudged = Vec::new();
     for r in records {
@@ -399,7 +403,7 @@ pub fn residual_structure(records: &[RecordFit], osc: &Oscillator, threshold: f6
 /// The largest residual RMS, as a share of the fitted response's RMS, that is the
 /// simulations' own round-off and tolerance (the noise floor of a noise-free record):
 /// residuals that small are locked to the motion by construction.
-pub const NUMERICAL_FLOOR: f64 = 1e-6;
+pub(crate) const NUMERICAL_FLOOR: f64 = 1e-6;
 
 /// The residuals' RMS over the fitted response's on the moving parts, when at most
 /// [`NUMERICAL_FLOOR`].
@@ -467,7 +471,7 @@ fn structure_finding(stats: &[Statistic]) -> Finding {
 
 /// A warning per free parameter that ended at one of its (finite) bounds, or collapsed onto
 /// its open lower bound 0 (reported as 0, never as a fitted 2.2e-308), saying what to do.
-pub fn parameters_at_bounds(layout: &[FreeParam], values: &[f64]) -> Vec<Finding> {
+pub(crate) fn parameters_at_bounds(layout: &[FreeParam], values: &[f64]) -> Vec<Finding> {
     let mut out = Vec::new();
     for (f, &p) in layout.iter().zip(values) {
         let Some(side) = f.bound_side(p) else {
@@ -504,13 +508,13 @@ fn unit_suffix(unit: &str) -> String {
 
 /// The largest change of any weighted residual (in units of its noise) that a change of a
 /// free parameter by its own magnitude may make for the parameter to count as without effect.
-pub const NO_EFFECT: f64 = 1e-8;
+pub(crate) const NO_EFFECT: f64 = 1e-8;
 
 /// A failure naming the free parameters whose Jacobian column `jac` (physical coordinates,
 /// weighted residuals) is zero everywhere at `values`: changed by their own magnitude (or
 /// scale, when zero), none moves a residual by [`NO_EFFECT`] of its noise. `None` when every
 /// parameter acts on the records.
-pub fn parameters_without_effect(
+pub(crate) fn parameters_without_effect(
     layout: &[FreeParam],
     values: &[f64],
     jac: &nalgebra::DMatrix<f64>,
@@ -550,7 +554,7 @@ fn at_bound_advice(f: &FreeParam) -> String {
 
 /// Whether every free parameter has a standard error; a rank-deficient Jacobian is named as
 /// such.
-pub fn standard_errors(parameters: &[FittedParam], singular: bool) -> Finding {
+pub(crate) fn standard_errors(parameters: &[FittedParam], singular: bool) -> Finding {
     let missing: Vec<&str> = parameters
         .iter()
         .filter(|p| p.free && p.std_error.is_none())
@@ -588,7 +592,7 @@ pub fn standard_errors(parameters: &[FittedParam], singular: bool) -> Finding {
 /// Whether converged starts agree on the minimum: a start that converged with an SSR more
 /// than [`START_DISAGREEMENT`] residual variances above the best found another minimum.
 /// `None` for a single start.
-pub fn start_agreement(
+pub(crate) fn start_agreement(
     outcomes: &[StartOutcome],
     best_cost: f64,
     residual_variance: f64,
@@ -635,7 +639,7 @@ pub fn start_agreement(
 }
 
 /// Pass when the solver converged, else fail.
-pub fn convergence(termination: &TerminationReason, model_params: &[String]) -> Finding {
+pub(crate) fn convergence(termination: &TerminationReason, model_params: &[String]) -> Finding {
     if let TerminationReason::ConvergedExceptUnbounded { parameters } = termination {
         let settled = model_params
             .iter()
@@ -672,7 +676,11 @@ pub fn convergence(termination: &TerminationReason, model_params: &[String]) -> 
 
 /// Starts whose cost is within the statistical tolerance of the best: a cost difference of
 /// at most chi²(1 dof, 95 %) / 2 residual variances (at least 1: the best itself).
-pub fn starts_at_best(outcomes: &[StartOutcome], best_cost: f64, residual_variance: f64) -> usize {
+pub(crate) fn starts_at_best(
+    outcomes: &[StartOutcome],
+    best_cost: f64,
+    residual_variance: f64,
+) -> usize {
     let tolerance = if residual_variance.is_finite() && residual_variance > 0.0 {
         PROFILE_DELTA * residual_variance
     } else {

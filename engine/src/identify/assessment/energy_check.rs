@@ -34,22 +34,22 @@ use crate::record::noise::{difference_noise, rms_difference_noise};
 /// The fewest samples in the median half-cycle for either part of the check: a 31-sample
 /// derivative window needs a few windows per half-cycle, and the trapezoidal work of a
 /// half-sine over 20 samples is within 0.5 %.
-pub const MIN_HALF_CYCLE_SAMPLES: usize = 20;
+pub(crate) const MIN_HALF_CYCLE_SAMPLES: usize = 20;
 /// The largest uncertainty of the dissipated energy from the displacement's quantisation,
 /// as a share of it, that the energies are judged with: half the warning threshold.
-pub const MAX_QUANTISATION_SHARE: f64 = 0.025;
+pub(crate) const MAX_QUANTISATION_SHARE: f64 = 0.025;
 /// The largest noise of the Eq. 7 force, as a share of the friction level, that its mean is
 /// judged with: E|F + e| exceeds F by under 0.1 % while sd(e) <= F / 3.
-pub const MAX_NOISE_SHARE: f64 = 1.0 / 3.0;
+pub(crate) const MAX_NOISE_SHARE: f64 = 1.0 / 3.0;
 
 /// The largest share of the friction's part (the Eq. 7 mean, the dissipated energy) that the
 /// standard error of a fitted damping alone may move for the part to be judged: half the
 /// warning threshold, as for the quantisation.
-pub const MAX_CONDITION_SHARE: f64 = 0.025;
+pub(crate) const MAX_CONDITION_SHARE: f64 = 0.025;
 
 /// A fitted damping: its value and standard error \[N s/m\].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FittedDamping {
+pub(crate) struct FittedDamping {
     /// The value.
     pub value: f64,
     /// Its standard error.
@@ -62,7 +62,7 @@ pub struct FittedDamping {
 /// sigma_c mean|v| and the dissipated energy by sigma_c int v^2 dt; above
 /// [`MAX_CONDITION_SHARE`] of the part, the part cannot judge the law (a damping fitted as
 /// an oscillator property that trades with the friction).
-pub fn skip_ill_conditioned(
+pub(crate) fn skip_ill_conditioned(
     ef: &mut EnergyForce,
     analysis: &EnergyAnalysis,
     damping: FittedDamping,

@@ -28,11 +28,11 @@ use crate::identify::values::result::RecordFit;
 use crate::record::noise::{difference_noise, quantisation_step, rms_difference_noise};
 
 /// A residual RMS above this many noise floors warns: the law leaves a misfit.
-pub const FIT_WARN_RATIO: f64 = 2.0;
+pub(crate) const FIT_WARN_RATIO: f64 = 2.0;
 /// ... and above this many fails: the law does not follow the record.
-pub const FIT_FAIL_RATIO: f64 = 4.0;
+pub(crate) const FIT_FAIL_RATIO: f64 = 4.0;
 /// Fewer residuals than this cannot give a noise floor.
-pub const MIN_SAMPLES: usize = 20;
+pub(crate) const MIN_SAMPLES: usize = 20;
 /// The samples set aside on each side of a change of the velocity's sign (a force compared
 /// along the motion): the noise can shift the sampled reversal by a sample or two.
 const REVERSAL_BAND: usize = 2;
@@ -41,7 +41,7 @@ const MAX_CORRELATION: f64 = 0.99;
 
 /// How one record's residual compares with its noise floor.
 #[derive(Debug, Clone, PartialEq)]
-pub enum RecordGoodness {
+pub(crate) enum RecordGoodness {
     /// Residual RMS over the noise floor, with both.
     Ratio {
         /// The residual RMS.
@@ -62,7 +62,11 @@ pub enum RecordGoodness {
 /// The noise floor of `residual` (see the module docs) and the lag-1 correlation granted,
 /// at least `given` and the step of `measured` over sqrt(12) when quantised; `None` with
 /// too few samples or residuals without differences.
-pub fn noise_floor(residual: &[f64], measured: &[f64], given: Option<f64>) -> Option<(f64, f64)> {
+pub(crate) fn noise_floor(
+    residual: &[f64],
+    measured: &[f64],
+    given: Option<f64>,
+) -> Option<(f64, f64)> {
     let n = residual.len();
     if n < MIN_SAMPLES {
         return None;
@@ -82,7 +86,7 @@ pub fn noise_floor(residual: &[f64], measured: &[f64], given: Option<f64>) -> Op
 
 /// The goodness of fit of one record's compared channel (its first), with `given` the
 /// noise level the record gives for it.
-pub fn record_goodness(fit: &RecordFit, given: Option<f64>) -> RecordGoodness {
+pub(crate) fn record_goodness(fit: &RecordFit, given: Option<f64>) -> RecordGoodness {
     let (measured, fitted) = defined_samples(fit);
     let residual: Vec<f64> = fitted.iter().zip(&measured).map(|(f, m)| f - m).collect();
     let rms = root_mean_square(&residual);
@@ -142,12 +146,12 @@ fn status_of(ratio: f64, smooth: bool) -> Status {
 }
 
 /// A judged record: its name, compared channel and unit, and its [`RecordGoodness`].
-pub type JudgedRecord = (String, String, String, RecordGoodness);
+pub(crate) type JudgedRecord = (String, String, String, RecordGoodness);
 
 /// The goodness-of-fit finding over the records: `judged` holds each record's name, its
 /// compared channel and unit, and its [`RecordGoodness`]. The worst judged record decides;
 /// with none judged, the finding is skipped with the reasons.
-pub fn goodness_of_fit(judged: &[JudgedRecord]) -> Finding {
+pub(crate) fn goodness_of_fit(judged: &[JudgedRecord]) -> Finding {
     let mut worst: Option<(f64, Status, String)> = None;
     let mut flagged = Vec::new();
     let mut skipped = Vec::new();
@@ -226,7 +230,7 @@ pub fn goodness_of_fit(judged: &[JudgedRecord]) -> Finding {
 
 /// The judged record of `fit`: its name, channel, unit and goodness, with `given` the noise
 /// level the record gives for its channel.
-pub fn judged_record(fit: &RecordFit, given: Option<f64>) -> JudgedRecord {
+pub(crate) fn judged_record(fit: &RecordFit, given: Option<f64>) -> JudgedRecord {
     let unit = fit
         .channels
         .first()

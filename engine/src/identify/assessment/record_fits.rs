@@ -21,7 +21,7 @@ use crate::record::{Channel, ConditionSource, NormalForce, Record};
 use std::sync::Arc;
 
 /// The per-record fits and what they add up to.
-pub struct RecordFits {
+pub(crate) struct RecordFits {
     /// Each record's fit.
     pub records: Vec<RecordFit>,
     /// Sum of squared residuals of every record's first channel.
@@ -34,7 +34,7 @@ pub struct RecordFits {
 
 /// Per-record residuals, fitted series and the energy-based force check (one record after
 /// the other: on rayon's pool the Coulomb fit on three records took 15-30 % longer).
-pub fn record_fits<R: Residuals>(
+pub(crate) fn record_fits<R: Residuals>(
     problem: &FitProblem<R>,
     world: &Realised,
     energy: &EnergyOptions,

@@ -24,10 +24,10 @@ use nalgebra::DMatrix;
 use std::time::Instant;
 
 /// Correlations above this magnitude are reported as warnings.
-pub const CORRELATION_WARNING: f64 = 0.95;
+pub(crate) const CORRELATION_WARNING: f64 = 0.95;
 
 /// What the final phase needs besides the runs.
-pub struct FinishContext<'a, R: Residuals> {
+pub(crate) struct FinishContext<'a, R: Residuals> {
     /// Which parameters are free (the oscillator's among them).
     pub params: &'a ParamOptions,
     /// The energy-analysis options (the energy checks).
@@ -107,9 +107,9 @@ fn statistics<R: Residuals>(
 /// The smallest widening of a standard error that is applied and reported: below, the
 /// HAC estimate's own scatter on white noise (a few per cent) would move the errors of
 /// every well-fitted record.
-pub const MIN_WIDENING: f64 = 1.1;
+pub(crate) const MIN_WIDENING: f64 = 1.1;
 
-pub use super::diagnostics::SMOOTH_RESIDUALS;
+pub(crate) use super::diagnostics::SMOOTH_RESIDUALS;
 
 /// Widens the covariance for autocorrelated residuals: each standard error becomes the
 /// larger of the classical and the HAC one ([`stats::hac_covariance`]: Newey-West on each
@@ -226,7 +226,7 @@ fn smooth_residuals_finding(smoothness: f64, widening: Option<Widening>) -> Find
 }
 
 /// Statistics, per-record fits, the energy check and the findings at the best start.
-pub fn summarise<R: Residuals>(
+pub(crate) fn summarise<R: Residuals>(
     ctx: &FinishContext<'_, R>,
     runs: MultiStart,
     clock: Instant,

@@ -32,7 +32,7 @@ pub struct FailedFit {
 
 /// Models whose AIC is within this of the best are indistinguishable on the data (Burnham
 /// and Anderson's rule of thumb: substantial support).
-pub const INDISTINGUISHABLE_DELTA_AIC: f64 = 2.0;
+pub(crate) const INDISTINGUISHABLE_DELTA_AIC: f64 = 2.0;
 
 /// Models ranked by AIC (best first), with BIC and RMS in each fit.
 #[derive(Debug, Clone, Serialize)]

@@ -32,7 +32,7 @@ const STEADY_SPEEDS: [f64; 6] = [1e-4, 1e-3, 1e-2, 0.1, 0.5, 1.0];
 const STEADY_TOLERANCE: f64 = 1e-6;
 /// A law whose search ended above a law it holds.
 #[derive(Debug, Clone)]
-pub struct NestingFailure {
+pub(super) struct NestingFailure {
     /// The law.
     pub model: String,
     /// Why it is not ranked.
@@ -42,7 +42,7 @@ pub struct NestingFailure {
 /// Checks every fit of `fits` against the simpler fits it holds, refits those that end
 /// above from the simpler law's optimum (keeping the better fit), and takes out those that
 /// still end above.
-pub fn enforce_nesting(
+pub(super) fn enforce_nesting(
     fits: Vec<FitResult>,
     osc: &Oscillator,
     records: &[Record],

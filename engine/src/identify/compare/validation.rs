@@ -27,7 +27,7 @@ use frictionid_models::{clone_model, FrictionModel};
 use serde::Serialize;
 
 /// The most folds a comparison scores (each costs one local refit and one evaluation per law).
-pub const MAX_FOLDS: usize = 3;
+pub(crate) const MAX_FOLDS: usize = 3;
 
 /// The iteration limit of a fold's refit: it starts at the full fit's optimum, which a fold's
 /// optimum lies near, so a few steps settle it; a flat direction (a parameter the data do
@@ -191,7 +191,7 @@ fn piece(record: &Record, first: usize, end: usize) -> Record {
 
 /// The scheme of a comparison of `records` and each law's held-out score (`None` when the
 /// records are too short to split).
-pub fn validate(
+pub(crate) fn validate(
     fits: &[FitResult],
     records: &[Record],
     opts: &FitOptions,

@@ -10,7 +10,7 @@ use crate::identify::values::result::{FitResult, Identifiability};
 use serde::Serialize;
 
 /// A held-out error within this share of the best is within its noise whatever the folds say.
-pub const VALIDATION_FLOOR: f64 = 0.01;
+pub(crate) const VALIDATION_FLOOR: f64 = 0.01;
 
 /// A law the verdict does not recommend, and why.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -22,7 +22,7 @@ pub struct SetAside {
 }
 
 /// What stands against recommending `fit` (`None` when nothing does).
-pub fn set_aside_reason(fit: &FitResult) -> Option<String> {
+pub(crate) fn set_aside_reason(fit: &FitResult) -> Option<String> {
     if !fit.converged {
         return Some(format!("its search did not converge ({})", fit.termination));
     }
@@ -102,7 +102,7 @@ fn velocity_resolution(fit: &FitResult) -> f64 {
 /// Whether `law`'s held-out error is within the folds' noise of `best`'s: the mean of their
 /// fold-wise differences is at most its standard error (the one-standard-error rule, on
 /// paired folds), or within [`VALIDATION_FLOOR`] of the best.
-pub fn within_noise(law: &LawValidation, best: &LawValidation) -> bool {
+pub(crate) fn within_noise(law: &LawValidation, best: &LawValidation) -> bool {
     let (Some(l), Some(b)) = (law.validation_rms, best.validation_rms) else {
         return false;
     };
@@ -124,7 +124,7 @@ pub fn within_noise(law: &LawValidation, best: &LawValidation) -> bool {
 
 /// Why the information criteria are shown only as information: the lag-one correlation of
 /// `best`'s residuals and the effective sample size it leaves.
-pub fn information_note(best: &FitResult) -> String {
+pub(crate) fn information_note(best: &FitResult) -> String {
     let residuals: Vec<Vec<f64>> = best
         .records
         .iter()

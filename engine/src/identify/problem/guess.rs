@@ -20,7 +20,7 @@ pub fn guess_hint(osc: &Oscillator, records: &[Record], energy: &EnergyOptions) 
 
 /// [`guess_hint`] with each record's friction level from `level` (of its index and itself),
 /// the start clipped to where `levels` lets it lie.
-pub fn guess_hint_with<B: Borrow<Record>>(
+pub(crate) fn guess_hint_with<B: Borrow<Record>>(
     osc: &Oscillator,
     records: &[B],
     levels: FrictionLevels,

@@ -30,7 +30,7 @@ use std::sync::{Arc, Mutex};
 /// Relative forward-difference step in internal coordinates. The ODE engine's default
 /// tolerances (rtol 1e-10) leave ~1e-10 relative noise in the residuals, so a step of 1e-6
 /// balances truncation against that noise (error ~ 1e-4 of the derivative).
-pub const FD_STEP: f64 = 1e-6;
+pub(crate) const FD_STEP: f64 = 1e-6;
 
 /// The residual function of a fit, generic over what produces the residuals.
 pub struct FitProblem<R: Residuals = SimulatedResponse> {

@@ -8,7 +8,7 @@ use crate::record::Record;
 
 /// A record whose largest speed is within this many noise levels of zero has no motion
 /// (Gaussian noise alone stays below 4.5 levels over a million samples).
-pub const MOTION_OVER_NOISE: f64 = 5.0;
+pub(crate) const MOTION_OVER_NOISE: f64 = 5.0;
 
 /// Whether `record` moves: its velocity (measured, or the differentiated displacement) must
 /// exceed zero and [`MOTION_OVER_NOISE`] times its noise level (from third differences).

@@ -50,7 +50,7 @@ impl Key {
 
 /// Recently integrated states, shared by the threads of a fit.
 #[derive(Debug, Default)]
-pub struct StateCache {
+pub(crate) struct StateCache {
     entries: Mutex<VecDeque<(Key, Arc<Vec<f64>>)>>,
 }
 
@@ -64,7 +64,7 @@ impl Clone for StateCache {
 impl StateCache {
     /// The states of `model` on record `record`: cached when a model with the same state
     /// parameters was integrated there, else from `integrate` (and kept).
-    pub fn states<E>(
+    pub(crate) fn states<E>(
         &self,
         record: usize,
         model: &dyn FrictionModel,

@@ -12,17 +12,17 @@ use crate::simulate::SimStats;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A trial simulation may take this many times the start point's steps per sample.
-pub const WORK_FACTOR: f64 = 8.0;
+pub(crate) const WORK_FACTOR: f64 = 8.0;
 
 /// Steps per sample every simulation may take whatever the baseline (the exact propagator's
 /// baseline is a few steps per record).
-pub const MIN_STEPS_PER_SAMPLE: f64 = 1.0;
+pub(crate) const MIN_STEPS_PER_SAMPLE: f64 = 1.0;
 
 /// Below this many integrator steps over all records at the start point, a problem's records
 /// and Jacobian columns are simulated on one thread: handing them to other threads costs
 /// more than it saves (the exact propagator takes a few steps per record; Dopri5 on a 2 s
 /// FMM record about 400).
-pub const PARALLEL_MIN_STEPS: f64 = 2000.0;
+pub(crate) const PARALLEL_MIN_STEPS: f64 = 2000.0;
 
 /// Baseline steps per sample, in millionths (0: not measured yet).
 const SCALE: f64 = 1e6;

@@ -28,16 +28,16 @@ use nalgebra::DVector;
 /// A residual RMS above this many noise floors (the residuals' own, from their first
 /// differences) sends the search further, and still above it after, makes the optimum
 /// suspect.
-pub const FURTHER_RATIO: f64 = 2.0;
+pub(crate) const FURTHER_RATIO: f64 = 2.0;
 
 /// Factors that spread the frequency's properties around the optimum (their frequency
 /// changes by half as much: a count of half-cycles over a record of a few dozen).
-pub const SPREAD: [f64; 6] = [0.99, 1.01, 0.98, 1.02, 0.96, 1.04];
+pub(crate) const SPREAD: [f64; 6] = [0.99, 1.01, 0.98, 1.02, 0.96, 1.04];
 
 /// The origin of the start whose frequency comes from the record's turning points.
-pub const FREQUENCY_ORIGIN: &str = "frequency from the turning points";
+pub(crate) const FREQUENCY_ORIGIN: &str = "frequency from the turning points";
 /// The origin of a start spread in the frequency's properties.
-pub const SPREAD_ORIGIN: &str = "spread in the oscillator's frequency";
+pub(crate) const SPREAD_ORIGIN: &str = "spread in the oscillator's frequency";
 
 /// Share of a record's samples at its end that must rest for the record to stick.
 const REST_SHARE: f64 = 0.05;
@@ -58,13 +58,13 @@ fn sets_frequency(p: &FreeParam) -> bool {
 }
 
 /// Whether the layout fits a property that sets the frequency.
-pub fn fits_frequency(layout: &Layout) -> bool {
+pub(crate) fn fits_frequency(layout: &Layout) -> bool {
     layout.params.iter().any(sets_frequency)
 }
 
 /// The residual RMS over the residuals' noise floor (their robust first-difference
 /// level); `None` when there is no floor to divide by.
-pub fn residual_ratio(r: &DVector<f64>) -> Option<f64> {
+pub(crate) fn residual_ratio(r: &DVector<f64>) -> Option<f64> {
     if r.is_empty() {
         return None;
     }
@@ -93,7 +93,7 @@ fn motion(record: &Record) -> Option<(Vec<f64>, f64)> {
 
 /// Whether the record's motion stops: its last [`REST_SHARE`] of samples (at least 20) all
 /// within the rest band while its peak is far beyond it.
-pub fn sticks(record: &Record) -> bool {
+pub(crate) fn sticks(record: &Record) -> bool {
     let Some((s, band)) = motion(record) else {
         return false;
     };
@@ -135,7 +135,7 @@ fn turning_times(s: &[f64], time: &[f64], band: f64) -> Vec<f64> {
 /// The half period of the record's motion from its turning points: the slope of their times
 /// on their half-cycle counts (each count the nearest multiple of the median spacing), by
 /// least squares; `None` with fewer than four turning points.
-pub fn half_period(record: &Record) -> Option<f64> {
+pub(crate) fn half_period(record: &Record) -> Option<f64> {
     let (s, band) = motion(record)?;
     let time = record.time();
     let time = if s.len() < time.len() {
@@ -212,7 +212,7 @@ fn with_frequency(layout: &Layout, point: &[f64], osc: &Oscillator, half: f64) -
 /// spring; the median over the records that give one), once with the optimum's other values
 /// and once with the layout's start's, then `best` with each frequency property spread by
 /// [`SPREAD`].
-pub fn further_points(
+pub(crate) fn further_points(
     layout: &Layout,
     best: &[f64],
     osc: &Oscillator,
@@ -253,7 +253,7 @@ pub fn further_points(
 /// Whether a velocity fit over `layout` on `records` whose optimum leaves the residuals
 /// `r` should search further: it fits the frequency, a record sticks, and the residual
 /// sits above [`FURTHER_RATIO`] noise floors.
-pub fn should_search_further(layout: &Layout, records: &[Record], r: &DVector<f64>) -> bool {
+pub(crate) fn should_search_further(layout: &Layout, records: &[Record], r: &DVector<f64>) -> bool {
     fits_frequency(layout)
         && records.iter().any(sticks)
         && residual_ratio(r).is_some_and(|q| q > FURTHER_RATIO)
@@ -262,7 +262,7 @@ pub fn should_search_further(layout: &Layout, records: &[Record], r: &DVector<f6
 /// The finding of a further search: how far above the noise floor the residual sat
 /// (`before`) and sits (`after`) after `starts` further starts; a warning when it still
 /// sits above [`FURTHER_RATIO`].
-pub fn suspect_finding(before: f64, after: f64, starts: usize) -> Finding {
+pub(crate) fn suspect_finding(before: f64, after: f64, starts: usize) -> Finding {
     if after > FURTHER_RATIO {
         Finding::new(
             Check::SuspectOptimum,
@@ -286,7 +286,7 @@ pub fn suspect_finding(before: f64, after: f64, starts: usize) -> Finding {
 
 /// Further starts run: the search's starts so far, their origins, and the finding when it
 /// went further.
-pub struct Searched {
+pub(crate) struct Searched {
     /// Every run, the further ones after the first.
     pub runs: MultiStart,
     /// Where each start came from.
@@ -311,7 +311,7 @@ fn best_residuals<R: Residuals>(
 /// The fit's runs, extended by the further starts of a velocity fit whose optimum sits far
 /// above the noise on records that stick ([`should_search_further`], [`further_points`]):
 /// the better optimum is kept, the further starts' outcomes follow the first ones'.
-pub fn search_further<R, F>(
+pub(crate) fn search_further<R, F>(
     plan: &StartPlan<'_, R>,
     make_problem: &F,
     reference: &FitProblem<R>,
@@ -378,7 +378,7 @@ where
 }
 
 /// Further starts continued past their screening.
-pub const FURTHER_PROMOTED: usize = 2;
+pub(crate) const FURTHER_PROMOTED: usize = 2;
 
 /// How the first starts and the further ones are numbered as one multi-start: the further
 /// ones after the first, except that the prefit's start stays the last (its finding looks

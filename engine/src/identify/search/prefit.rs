@@ -19,7 +19,7 @@ use crate::identify::values::target_options::{FitDomain, ForceTarget, TargetOpti
 use frictionid_models::FrictionModel;
 
 /// The prefit's optimum and what it cost.
-pub struct Prefit {
+pub(crate) struct Prefit {
     /// The fitted model.
     pub model: Box<dyn FrictionModel>,
     /// RMS of the model force against the energy-based force \[N\].
@@ -30,7 +30,7 @@ pub struct Prefit {
 
 impl Prefit {
     /// The prefit's optimum and cost out of its force-domain fit.
-    pub fn of(result: FitResult) -> Self {
+    pub(crate) fn of(result: FitResult) -> Self {
         Self {
             model: result.fitted_model,
             rms_force: result.rms_residual,
@@ -42,7 +42,7 @@ impl Prefit {
 /// The options of the prefit of `model`, when `opts` asks for it and the model has internal
 /// states (`None` otherwise): the force domain against the energy-based force, nothing but
 /// the model's parameters free, no uncertainty refits, no progress.
-pub fn prefit_options(model: &dyn FrictionModel, opts: &FitOptions) -> Option<FitOptions> {
+pub(crate) fn prefit_options(model: &dyn FrictionModel, opts: &FitOptions) -> Option<FitOptions> {
     if !opts.search.prefit || model.n_states() == 0 {
         return None;
     }
@@ -68,10 +68,10 @@ pub fn prefit_options(model: &dyn FrictionModel, opts: &FitOptions) -> Option<Fi
 }
 
 /// The origin a fit reports for the start the prefit gave.
-pub const PREFIT_ORIGIN: &str = "force-domain prefit";
+pub(crate) const PREFIT_ORIGIN: &str = "force-domain prefit";
 
 /// What the prefit gave the velocity fit `result`: its start (the last) and whether it won.
-pub fn prefit_finding(seed: &Result<Prefit, EngineError>, result: &FitResult) -> Finding {
+pub(crate) fn prefit_finding(seed: &Result<Prefit, EngineError>, result: &FitResult) -> Finding {
     let p = match seed {
         Ok(p) => p,
         Err(e) => {

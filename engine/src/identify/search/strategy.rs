@@ -29,21 +29,21 @@ use frictionid_models::{clone_model, Coulomb, FrictionModel, StartContext, Strib
 use std::sync::Arc;
 
 /// Latin-hypercube starts a `global` search adds.
-pub const GLOBAL_STARTS: usize = 12;
+pub(crate) const GLOBAL_STARTS: usize = 12;
 
 /// Half-width of the global box around the start, as a factor (log coordinates).
-pub const GLOBAL_SPAN: f64 = 100.0;
+pub(crate) const GLOBAL_SPAN: f64 = 100.0;
 
 /// Seed of the global search's Latin hypercube (runs are reproducible).
-pub const GLOBAL_SEED: u64 = 0x5eed_0014;
+pub(crate) const GLOBAL_SEED: u64 = 0x5eed_0014;
 
 /// Presliding displacements (multiples of the typical one) that map the last stage onto
 /// the target: the typical one and a stiffer contact.
-pub const STAGED_PRESLIDING: [f64; 2] = [1.0, 0.1];
+pub(crate) const STAGED_PRESLIDING: [f64; 2] = [1.0, 0.1];
 
 /// A starting point and where it came from.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Seeded {
+pub(crate) struct Seeded {
     /// Physical values of the free parameters.
     pub point: Vec<f64>,
     /// `data-driven guess`, `spread around the guess`, `staged from coulomb`, ...
@@ -51,7 +51,7 @@ pub struct Seeded {
 }
 
 /// What the starts of a fit need to know.
-pub struct StartPlan<'a, R: Residuals> {
+pub(crate) struct StartPlan<'a, R: Residuals> {
     /// The residuals of the fit (the stages use them too).
     pub residuals: &'a Arc<R>,
     /// The oscillator.
@@ -68,7 +68,7 @@ pub struct StartPlan<'a, R: Residuals> {
 
 /// Every start of a fit: the starts of `search` ([`plan_starts`]) and, last (where the
 /// prefit finding looks for it), the prefit's optimum when there is one.
-pub fn plan_fit_starts<R: Residuals + 'static>(
+pub(crate) fn plan_fit_starts<R: Residuals + 'static>(
     plan: &StartPlan<'_, R>,
     search: Search,
     n_starts: usize,
@@ -102,7 +102,7 @@ fn seeded_point(layout: &Layout, seeded: &dyn FrictionModel) -> Vec<f64> {
 /// Every starting point of `search`: staged ones first, then the local ones, then (global)
 /// the Latin hypercube; duplicates dropped; with the cost of the target's nested limit law
 /// when a stage fitted it.
-pub fn plan_starts<R: Residuals + 'static>(
+pub(crate) fn plan_starts<R: Residuals + 'static>(
     plan: &StartPlan<'_, R>,
     search: Search,
     n_local: usize,
@@ -148,7 +148,7 @@ pub fn plan_starts<R: Residuals + 'static>(
 }
 
 /// The starts of a fit and what the stages found.
-pub struct Planned {
+pub(crate) struct Planned {
     /// Every starting point, staged ones first.
     pub seeded: Vec<Seeded>,
     /// The cost of the stage that is the target's rigid limit (`InternalStates::rigid_limit`):
@@ -189,7 +189,7 @@ fn stages<R: Residuals + 'static>(plan: &StartPlan<'_, R>) -> Vec<SimplerFit> {
 
 /// The options of a stage: one start, one local run, the model's own parameters and
 /// bounds, the oscillator fixed, no uncertainty budget, no progress.
-pub fn stage_options(opts: &FitOptions) -> FitOptions {
+pub(crate) fn stage_options(opts: &FitOptions) -> FitOptions {
     FitOptions {
         params: opts.params.for_simpler_law(),
         search: opts.search.one_start(true),
@@ -214,7 +214,7 @@ fn stage_fit<R: Residuals + 'static>(
 }
 
 /// The records a simpler law is fitted to, with the fit's residuals and oscillator.
-pub struct FitTarget<'a, R: Residuals> {
+pub(crate) struct FitTarget<'a, R: Residuals> {
     /// The residuals of the fit.
     pub residuals: &'a Arc<R>,
     /// The oscillator.
@@ -224,7 +224,7 @@ pub struct FitTarget<'a, R: Residuals> {
 }
 
 /// A simpler law fitted to the records of a fit.
-pub struct SimplerFit {
+pub(crate) struct SimplerFit {
     /// The fitted law.
     pub model: Box<dyn FrictionModel>,
     /// Its cost (half the sum of squared residuals, as the fit's).
@@ -235,7 +235,7 @@ pub struct SimplerFit {
 
 /// Fits `law` with `opts` (local runs: one from its data-driven guess and one from each model
 /// of `also_from` mapped onto it by `start_from`, the best kept); `None` when it fails.
-pub fn fit_simpler<R: Residuals + 'static>(
+pub(crate) fn fit_simpler<R: Residuals + 'static>(
     on: &FitTarget<'_, R>,
     law: &(dyn FrictionModel + 'static),
     opts: &FitOptions,
@@ -336,7 +336,7 @@ fn mapped_point(
 }
 
 /// A model and the free parameters of a fit, onto which a fitted model is mapped.
-pub struct Onto<'a> {
+pub(crate) struct Onto<'a> {
     /// The model whose `start_from` maps.
     pub model: &'a (dyn FrictionModel + 'static),
     /// The free parameters (the layout).
@@ -352,7 +352,11 @@ impl Onto<'_> {
     /// take the mapped values (clipped to their bounds; a non-finite one, or one in `keep`,
     /// its base value), the others their base values. `None` when the model cannot start
     /// from `fitted`.
-    pub fn started_from(&self, fitted: &dyn FrictionModel, ctx: &StartContext) -> Option<Vec<f64>> {
+    pub(crate) fn started_from(
+        &self,
+        fitted: &dyn FrictionModel,
+        ctx: &StartContext,
+    ) -> Option<Vec<f64>> {
         let mut started = clone_model(self.model);
         if !started.staging().is_some_and(|s| s.start_from(fitted, ctx)) {
             return None;
@@ -395,7 +399,7 @@ impl SplitMix64 {
 
 /// `n` points of a Latin hypercube in [0, 1)^d: each coordinate has exactly one point in
 /// each of its `n` strata.
-pub fn latin_hypercube(n: usize, d: usize, seed: u64) -> Vec<Vec<f64>> {
+pub(crate) fn latin_hypercube(n: usize, d: usize, seed: u64) -> Vec<Vec<f64>> {
     let mut rng = SplitMix64(seed);
     let columns: Vec<Vec<f64>> = (0..d)
         .map(|_| {

@@ -187,7 +187,7 @@ impl FreeParam {
 /// Whether a model parameter named `name` in `unit` is a friction level: a coefficient
 /// (`mu`, `mu_c`, `mu_s`, ...) that the normal force turns into a force, so that a level at
 /// its bound may be a missing normal force. The one place of this rule.
-pub fn is_friction_level(name: &str, unit: &str) -> bool {
+pub(crate) fn is_friction_level(name: &str, unit: &str) -> bool {
     unit == "1" && (name == "mu" || name.starts_with("mu_"))
 }
 

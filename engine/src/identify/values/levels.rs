@@ -16,11 +16,11 @@ use crate::record::{NormalForce, Record};
 use frictionid_models::{clone_model, FrictionModel, ParamInfo};
 
 /// The normal force a fit without one multiplies its levels by \[N\].
-pub const UNIT_NORMAL_FORCE: f64 = 1.0;
+pub(crate) const UNIT_NORMAL_FORCE: f64 = 1.0;
 
 /// A level's upper bound without a normal force, in multiples of the largest |force| the fit
 /// compares: a friction force above every force that moves the axis cannot fit the records.
-pub const LEVEL_BOUND_FACTOR: f64 = 5.0;
+pub(crate) const LEVEL_BOUND_FACTOR: f64 = 5.0;
 
 /// How a fit reads the friction levels of its law.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

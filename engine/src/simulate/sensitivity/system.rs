@@ -20,7 +20,11 @@ impl<'a> DirectTerms<'a> {
     /// The terms of `params` for `dynamics` starting from `y0`; `None` where one of them has
     /// no derivative (a law without gradients, a states' rate without them, the normal force,
     /// a restoring-law property whose balance column is not its exact derivative).
-    pub fn new(dynamics: &Dynamics<'a>, params: &[SensitivityParam], y0: &[f64]) -> Option<Self> {
+    pub(super) fn new(
+        dynamics: &Dynamics<'a>,
+        params: &[SensitivityParam],
+        y0: &[f64],
+    ) -> Option<Self> {
         let n_model = dynamics.model.params().len();
         let mut gradients = None;
         for &p in params {
@@ -48,7 +52,7 @@ impl<'a> DirectTerms<'a> {
     }
 
     /// The parameters, in order.
-    pub fn params(&self) -> &[SensitivityParam] {
+    pub(super) fn params(&self) -> &[SensitivityParam] {
         &self.params
     }
 }
@@ -90,7 +94,7 @@ pub(super) struct Augmented<'a, 'b> {
 }
 
 impl<'a, 'b> Augmented<'a, 'b> {
-    pub fn new(dynamics: Dynamics<'a>, dir: f64, terms: &'b DirectTerms<'a>) -> Self {
+    pub(super) fn new(dynamics: Dynamics<'a>, dir: f64, terms: &'b DirectTerms<'a>) -> Self {
         Self {
             dynamics,
             dir,
@@ -100,7 +104,7 @@ impl<'a, 'b> Augmented<'a, 'b> {
     }
 
     /// The states' dimension n of y = [x, v, z...].
-    pub fn n(&self) -> usize {
+    pub(super) fn n(&self) -> usize {
         2 + self.dynamics.model.n_states()
     }
 
