@@ -7,7 +7,8 @@
 
 use crate::driven_axis::{identify_with, record};
 use crate::inverse_dynamics::{options, TRUTH};
-use frictionid_engine::identify::{fit, FitResult, Status};
+use crate::util::{false_alarms, unflagged};
+use frictionid_engine::identify::{fit, FitResult};
 use frictionid_engine::record::Channel;
 use frictionid_engine::synthetic::{add_coloured_noise, add_gaussian_noise};
 use frictionid_engine::Record;
@@ -17,16 +18,6 @@ use frictionid_models::{Coulomb, FrictionModel, ViscousCoulomb};
 const V_NOISE: f64 = 5e-3;
 /// The input noise of the inverse-dynamics records [N].
 const U_NOISE: f64 = 0.2;
-
-/// The findings of `result` at `status`, as "check: message".
-fn at(result: &FitResult, status: Status) -> Vec<String> {
-    result
-        .diagnostics
-        .iter()
-        .filter(|d| d.status == status)
-        .map(|d| format!("{:?}: {}", d.check, d.message))
-        .collect()
-}
 
 /// The velocity route's records: noise-free, or with white velocity noise.
 fn velocity_records(noise: f64) -> [Record; 2] {
@@ -84,45 +75,14 @@ fn correct_laws_on_driven_axes_raise_no_failed_diagnostic() {
         viscous: 15.0,
     };
     let outcomes = cases(&truth);
-    let mut alarms = 0;
-    for (label, result) in &outcomes {
-        let failed = at(result, Status::Fail);
-        eprintln!(
-            "{label}: {} failed, {} warned",
-            failed.len(),
-            at(result, Status::Warn).len()
-        );
-        if !failed.is_empty() {
-            alarms += 1;
-            eprintln!("  {}", failed.join("\n  "));
-        }
-    }
-    eprintln!(
-        "{alarms} false alarms in {} correct driven fits",
-        outcomes.len()
-    );
-    assert_eq!(alarms, 0);
+    let alarmed = false_alarms(&outcomes);
+    assert!(alarmed.is_empty(), "false alarms: {alarmed:?}");
 }
 
 /// Coulomb alone on the same records (the viscous term missing): every fit warns or fails.
 #[test]
 fn a_wrong_law_on_driven_axes_is_flagged() {
     let outcomes = cases(&Coulomb { mu: 4.0 });
-    let mut missed = Vec::new();
-    for (label, result) in &outcomes {
-        let flagged: Vec<String> = [Status::Warn, Status::Fail]
-            .into_iter()
-            .flat_map(|s| at(result, s))
-            .collect();
-        eprintln!("coulomb, {label}: {flagged:?}");
-        if flagged.is_empty() {
-            missed.push(label.clone());
-        }
-    }
-    eprintln!(
-        "{} of {} wrong driven fits flagged",
-        outcomes.len() - missed.len(),
-        outcomes.len()
-    );
+    let missed = unflagged(&outcomes);
     assert!(missed.is_empty(), "not flagged: {missed:?}");
 }

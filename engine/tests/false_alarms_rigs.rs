@@ -13,9 +13,9 @@
 //! resonant at 2 % of the rate): the true law (viscous_coulomb) raises no failed diagnostic;
 //! its wrong-law twin (Coulomb alone) on the same records warns or fails in every case.
 
-use crate::util::no_oscillator_force_options;
+use crate::util::{false_alarms, no_oscillator_force_options, unflagged};
 use frictionid_engine::axis::{Axis, Pendulum, Restoring};
-use frictionid_engine::identify::{fit, FitOptions, FitResult, OscillatorParam, Status};
+use frictionid_engine::identify::{fit, FitOptions, FitResult, OscillatorParam};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::{add_coloured_noise, add_gaussian_noise, uniform_times};
 use frictionid_engine::{Oscillator, Record};
@@ -286,62 +286,16 @@ fn cases(correct: bool) -> Vec<(String, FitResult)> {
         .collect()
 }
 
-/// The findings of `result` at `status`, as "check: message".
-fn at(result: &FitResult, status: Status) -> Vec<String> {
-    result
-        .diagnostics
-        .iter()
-        .filter(|d| d.status == status)
-        .map(|d| format!("{:?}: {}", d.check, d.message))
-        .collect()
-}
-
 #[test]
 fn correct_laws_on_pendulums_and_displacement_channels_raise_no_failed_diagnostic() {
     let outcomes = cases(true);
-    let mut alarms = 0;
-    for (label, result) in &outcomes {
-        let failed = at(result, Status::Fail);
-        let warned = at(result, Status::Warn);
-        eprintln!(
-            "{label}: rms {:.3e}, {} failed, {} warned",
-            result.rms_residual,
-            failed.len(),
-            warned.len()
-        );
-        for w in &warned {
-            eprintln!("  warn {w}");
-        }
-        if !failed.is_empty() {
-            alarms += 1;
-            eprintln!("  {}", failed.join("\n  "));
-        }
-    }
-    eprintln!("{alarms} false alarms in {} correct fits", outcomes.len());
-    assert_eq!(alarms, 0);
+    let alarmed = false_alarms(&outcomes);
+    assert!(alarmed.is_empty(), "false alarms: {alarmed:?}");
 }
 
 #[test]
 fn a_wrong_law_on_pendulums_and_displacement_channels_is_flagged() {
     let outcomes = cases(false);
-    let mut missed = Vec::new();
-    for (label, result) in &outcomes {
-        let flagged: Vec<String> = [Status::Warn, Status::Fail]
-            .into_iter()
-            .flat_map(|s| at(result, s))
-            .collect();
-        eprintln!(
-            "coulomb, {label}: rms {:.3e}, {flagged:?}",
-            result.rms_residual
-        );
-        if flagged.is_empty() {
-            missed.push(label.clone());
-        }
-    }
-    eprintln!(
-        "{} of {} wrong fits flagged",
-        outcomes.len() - missed.len(),
-        outcomes.len()
-    );
+    let missed = unflagged(&outcomes);
     assert!(missed.is_empty(), "not flagged: {missed:?}");
 }

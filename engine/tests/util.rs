@@ -4,7 +4,7 @@
 
 use frictionid_engine::axis::{NoRestoring, Restoring};
 use frictionid_engine::identify::{
-    fit, FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam, ParamOptions,
+    fit, FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam, ParamOptions, Status,
     TargetOptions,
 };
 use frictionid_engine::oscillator::{OscillatorProperty, PartialOscillator};
@@ -202,4 +202,64 @@ pub fn estimate(result: &FitResult, name: &str) -> (f64, f64) {
         .find(|p| p.name == name || p.name.starts_with(&format!("{name}[")))
         .unwrap_or_else(|| panic!("no parameter {name}"));
     (p.value, p.std_error.unwrap_or(f64::NAN))
+}
+
+/// The diagnostics of `result` with `status`, each as "check: message".
+pub(crate) fn findings_at(result: &FitResult, status: Status) -> Vec<String> {
+    result
+        .diagnostics
+        .iter()
+        .filter(|d| d.status == status)
+        .map(|d| format!("{:?}: {}", d.check, d.message))
+        .collect()
+}
+
+/// The labels of the correct fits among `outcomes` that fail a diagnostic (a false alarm),
+/// each fit's findings printed for the reader of a failing run.
+pub(crate) fn false_alarms(outcomes: &[(String, FitResult)]) -> Vec<String> {
+    let mut alarmed = Vec::new();
+    for (label, result) in outcomes {
+        let failed = findings_at(result, Status::Fail);
+        let warned = findings_at(result, Status::Warn);
+        eprintln!(
+            "{label}: rms {:.3e}, {} failed, {} warned",
+            result.rms_residual,
+            failed.len(),
+            warned.len()
+        );
+        for w in &warned {
+            eprintln!("  warn {w}");
+        }
+        if !failed.is_empty() {
+            alarmed.push(label.clone());
+            eprintln!("  {}", failed.join("\n  "));
+        }
+    }
+    eprintln!(
+        "{} false alarms in {} correct fits",
+        alarmed.len(),
+        outcomes.len()
+    );
+    alarmed
+}
+
+/// The labels of the wrong-law fits among `outcomes` that neither warn nor fail (a miss).
+pub(crate) fn unflagged(outcomes: &[(String, FitResult)]) -> Vec<String> {
+    let mut missed = Vec::new();
+    for (label, result) in outcomes {
+        let flagged: Vec<String> = [Status::Warn, Status::Fail]
+            .into_iter()
+            .flat_map(|s| findings_at(result, s))
+            .collect();
+        eprintln!("{label}: rms {:.3e}, {flagged:?}", result.rms_residual);
+        if flagged.is_empty() {
+            missed.push(label.clone());
+        }
+    }
+    eprintln!(
+        "{} of {} wrong fits flagged",
+        outcomes.len() - missed.len(),
+        outcomes.len()
+    );
+    missed
 }

@@ -69,6 +69,15 @@ impl StribeckLevels {
         })
     }
 
+    /// The Coulomb level and viscous term of a fitted `coulomb` or `viscous_coulomb`: the start
+    /// of a law that holds them with its extra terms at zero (`None` for any other law).
+    pub fn of_coulomb_law(model: &dyn FrictionModel) -> Option<(f64, f64)> {
+        if !matches!(model.name(), "coulomb" | "viscous_coulomb") {
+            return None;
+        }
+        Self::from_model(model).map(|levels| (levels.mu_c, levels.viscous))
+    }
+
     /// Writes the levels into a Stribeck-curve model's `[mu_c, mu_s, v_s, delta, viscous]`,
     /// keeping its own `v_s` and `delta` where the levels have none.
     pub(crate) fn write_into(&self, [mu_c, mu_s, v_s, delta, viscous]: [&mut f64; 5]) {

@@ -94,13 +94,10 @@ impl Staging for CoulombLoad {
     /// The load-free law's level and viscous term, no load dependence: exactly the fitted
     /// `coulomb` or `viscous_coulomb`.
     fn start_from(&mut self, fitted: &dyn FrictionModel, _ctx: &StartContext) -> bool {
-        if !matches!(fitted.name(), "coulomb" | "viscous_coulomb") {
-            return false;
-        }
-        let Some(levels) = StribeckLevels::from_model(fitted) else {
+        let Some((mu, viscous)) = StribeckLevels::of_coulomb_law(fitted) else {
             return false;
         };
-        (self.mu, self.mu_load, self.viscous) = (levels.mu_c, 0.0, levels.viscous);
+        (self.mu, self.mu_load, self.viscous) = (mu, 0.0, viscous);
         true
     }
 }
