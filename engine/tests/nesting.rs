@@ -5,9 +5,9 @@
 //! driver). Dahl holds Coulomb friction as its rigid limit, so its fit by inverse dynamics
 //! must end at least as low as Coulomb's, stay ranked, and recover the truth. On the
 //! viscous + Coulomb drive of the inverse-dynamics tests LuGre must end as low as
-//! viscous_coulomb. The `#[ignore]`d free-decay cases (records from the engine's simulator,
-//! as the recovery tests make them) check that compare's velocity route recommends the
-//! bristle law whose stiffness the records determine.
+//! viscous_coulomb. The free-decay cases (records from the fixed-step Runge-Kutta reference
+//! of `util::rk4_free_decay`, not from the engine's simulator) check that compare's velocity
+//! route recommends the bristle law whose stiffness the records determine.
 
 use crate::util::{inverse_dynamics_options, rel};
 use frictionid_engine::identify::{compare, Check, Status};
@@ -191,7 +191,7 @@ fn lugre_on_a_viscous_coulomb_drive_ends_at_least_as_low() {
 /// velocity route recommends lugre, which holds coulomb and stribeck, and the static laws
 /// warn or fail `goodness_of_fit`.
 #[test]
-#[ignore = "slow: a compare of velocity fits with a dynamic law (about 8 s)"]
+#[ignore = "slow: a compare of velocity fits with a dynamic law (about 2 s alone)"]
 fn a_lugre_free_decay_recommends_lugre() {
     use crate::util::lugre_truth;
     free_decay_recommends(&lugre_truth(), &["coulomb", "stribeck", "lugre"]);
@@ -200,7 +200,7 @@ fn a_lugre_free_decay_recommends_lugre() {
 /// The same for a Dahl truth (bristle stiffness 1e5 N/m, mu_c 0.22): compare recommends
 /// dahl, and coulomb, the law it holds, warns or fails `goodness_of_fit`.
 #[test]
-#[ignore = "slow: a compare of velocity fits with a dynamic law (about 8 s)"]
+#[ignore = "slow: a compare of velocity fits with a dynamic law (about 3 s alone)"]
 fn a_dahl_free_decay_recommends_dahl() {
     let truth = frictionid_models::Dahl {
         sigma0: 1e5,
@@ -210,14 +210,15 @@ fn a_dahl_free_decay_recommends_dahl() {
     free_decay_recommends(&truth, &["coulomb", "dahl"]);
 }
 
-/// Compares `laws` on the FMM free decays of `truth`: the truth's law (the last) is
-/// recommended and every other law warns or fails `goodness_of_fit`.
+/// Compares `laws` on the FMM free decays of `truth` made by the Runge-Kutta reference: the
+/// truth's law (the last) is recommended and every other law warns or fails
+/// `goodness_of_fit`.
 fn free_decay_recommends(truth: &dyn FrictionModel, laws: &[&str]) {
-    use crate::util::{records, NOISE};
+    use crate::util::{rk4_records, NOISE};
     use frictionid_engine::identify::FitOptions;
     use frictionid_engine::Oscillator;
     let osc = Oscillator::fmm();
-    let recs = records(&osc, truth, NOISE, 3);
+    let recs = rk4_records(&osc, truth, NOISE, 3);
     let models: Vec<Box<dyn FrictionModel>> = laws
         .iter()
         .map(|n| default_model(n).expect("a registered law"))
@@ -230,8 +231,10 @@ fn free_decay_recommends(truth: &dyn FrictionModel, laws: &[&str]) {
             .find(|d| d.check == Check::GoodnessOfFit)
             .map(|d| (d.status, d.value));
         eprintln!(
-            "{}: RMS {} m/s, goodness {goodness:?}",
-            f.model, f.rms_residual
+            "{}: RMS {} m/s, goodness {goodness:?}, sigma0 {:?}",
+            f.model,
+            f.rms_residual,
+            f.value("sigma0")
         );
     }
     let verdict = c.verdict.as_ref().expect("a verdict");
@@ -251,4 +254,53 @@ fn free_decay_recommends(truth: &dyn FrictionModel, laws: &[&str]) {
             goodness.message
         );
     }
+}
+
+/// The Runge-Kutta reference is converged far below the noise: halving its step changes no
+/// velocity sample of the LuGre and Dahl decays from the largest release by a hundredth of
+/// the records' noise; and it is the same motion as the engine's simulator makes (within a
+/// tenth of the noise), so both describe the truth the fits are judged against.
+#[test]
+fn the_reference_decays_are_converged_far_below_the_noise() {
+    use crate::util::{rk4_free_decay, NOISE, RK4_SUBSTEPS};
+    use frictionid_engine::synthetic::release_records;
+    use frictionid_engine::Oscillator;
+    let osc = Oscillator::fmm();
+    let dahl = frictionid_models::Dahl {
+        sigma0: 1e5,
+        mu_c: 0.22,
+        alpha: 1.0,
+    };
+    let lugre = crate::util::lugre_truth();
+    for truth in [&lugre as &dyn FrictionModel, &dahl] {
+        let x0 = 0.022;
+        let (_, v) = rk4_free_decay(&osc, truth, x0, (2.0, 1000.0, RK4_SUBSTEPS));
+        let (_, fine) = rk4_free_decay(&osc, truth, x0, (2.0, 1000.0, 2 * RK4_SUBSTEPS));
+        let engine = release_records(&osc, truth, &[x0], 2.0, 1000.0, 0.0, 0).expect("a decay");
+        let engine = engine[0].velocity();
+        let worst = |a: &[f64], b: &[f64]| {
+            a.iter()
+                .zip(b)
+                .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()))
+        };
+        let (step, simulators) = (worst(&v, &fine), worst(&v, engine));
+        eprintln!(
+            "{}: step error {step:.2e}, against the engine {simulators:.2e} m/s",
+            truth.name()
+        );
+        assert!(step < 0.01 * NOISE, "{step}");
+        assert!(simulators < 0.1 * NOISE, "{simulators}");
+    }
+    // A wrong truth is told apart: the Dahl decay with a 5 % lower level.
+    let wrong = frictionid_models::Dahl {
+        mu_c: 0.209,
+        ..dahl
+    };
+    let (_, v) = rk4_free_decay(&osc, &dahl, 0.022, (2.0, 1000.0, RK4_SUBSTEPS));
+    let (_, off) = rk4_free_decay(&osc, &wrong, 0.022, (2.0, 1000.0, RK4_SUBSTEPS));
+    let gap = v
+        .iter()
+        .zip(&off)
+        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(gap > 10.0 * NOISE, "{gap}");
 }
