@@ -9,6 +9,7 @@ mod beyond_speed;
 mod calibration;
 mod channels;
 mod compare_verdict;
+mod down_weighted;
 mod driven_axis;
 mod dynamic;
 mod false_alarms;

@@ -39,6 +39,6 @@ pub use values::{
     EnergyForce, Finding, FitDomain, FitOptions, FitResult, FitSeries, FittedParam, ForceBalance,
     ForceTarget, FrictionLevels, Hooks, Identifiability, NuisanceKind, NuisanceValues, OptionKeys,
     OscillatorParam, ParamOptions, Progress, ProgressFn, PropertyUncertainty, Rank, RecordFit,
-    ReplayPath, Search, SearchOptions, SlidingSamples, StartOutcome, Status, StdErrorComponents,
-    TargetOptions, TerminationReason, Verdict, DEFAULT_MAX_ITERATIONS,
+    ReplayPath, RobustWeights, Search, SearchOptions, SlidingSamples, StartOutcome, Status,
+    StdErrorComponents, TargetOptions, TerminationReason, Verdict, DEFAULT_MAX_ITERATIONS,
 };

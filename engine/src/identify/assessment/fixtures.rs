@@ -36,6 +36,7 @@ pub(crate) fn record_fit_of(
         samples: measured.len(),
         sliding: None,
         unreliable_target: None,
+        robust_weights: None,
         channel: channel.into(),
         rms_residual: 0.0,
         channels: Vec::new(),

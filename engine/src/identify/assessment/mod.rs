@@ -6,6 +6,7 @@
 //! oscillator's property uncertainties ([`property_refits`], handed the refit by the fit).
 
 pub(crate) mod diagnostics;
+mod down_weighted;
 pub(crate) mod energy_check;
 #[cfg(test)]
 mod fixtures;

@@ -2,6 +2,7 @@
 //! and fitted series and the energy-based force check along it.
 
 use super::diagnostics;
+use super::down_weighted::{down_weighted_finding, robust_weights};
 use super::energy_check::{
     energy_force_check, skip_ill_conditioned, FittedDamping, ForceReference,
 };
@@ -57,6 +58,12 @@ pub(crate) fn record_fits<R: Residuals>(
                 .as_ref()
                 .and_then(|u| unreliable_target_finding(&record.file, u)),
         );
+        out.findings.extend(
+            record
+                .robust_weights
+                .as_ref()
+                .and_then(|w| down_weighted_finding(&record.file, w)),
+        );
         out.records.push(record);
     }
     Ok(out)
@@ -93,6 +100,7 @@ fn record_fit<R: Residuals>(
     let balance = problem
         .residuals
         .force_balance(&problem.evaluation(world), case)?;
+    let weights = record_weights(problem, world, case, (&axes.time, first))?;
     let record = RecordFit {
         file: rec.name.clone(),
         x0: nuisance.x0_of(rec),
@@ -100,6 +108,7 @@ fn record_fit<R: Residuals>(
         samples: rec.len(),
         sliding: problem.residuals.sliding_samples(ri),
         unreliable_target: problem.residuals.unreliable_samples(ri),
+        robust_weights: weights,
         channel: problem.residuals.record_channel(ri).to_string(),
         rms_residual: (sum_sq / measured.len() as f64).sqrt(),
         channels,
@@ -114,6 +123,28 @@ fn record_fit<R: Residuals>(
         },
     };
     Ok((record, sum_sq, checked.finding))
+}
+
+/// The robust loss's weights of the record's first `first` residuals (its first channel), at
+/// `time`; `None` under least squares.
+fn record_weights<R: Residuals>(
+    problem: &FitProblem<R>,
+    world: &Realised,
+    case: RecordCase<'_>,
+    (time, first): (&[f64], usize),
+) -> Result<Option<crate::identify::values::RobustWeights>, EngineError> {
+    if problem.loss().is_linear() {
+        return Ok(None);
+    }
+    let r = problem
+        .residuals
+        .residuals(&problem.evaluation(world), case)?;
+    let r = &r[..first.min(r.len())];
+    Ok(robust_weights(
+        problem.loss(),
+        r,
+        &time[..first.min(time.len())],
+    ))
 }
 
 /// A record's energy-based force check: its figures, Eq. 7's force and the model's along the

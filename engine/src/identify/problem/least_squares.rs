@@ -117,6 +117,11 @@ impl<R: Residuals> FitProblem<R> {
         Self { loss, ..self }
     }
 
+    /// The loss the solver minimises.
+    pub fn loss(&self) -> RobustLoss {
+        self.loss
+    }
+
     /// `r` through the loss's transform.
     fn robust(&self, mut r: DVector<f64>) -> DVector<f64> {
         if !self.loss.is_linear() {

@@ -28,7 +28,8 @@ pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, Terminatio
 pub use param_options::ParamOptions;
 pub use result::{
     ChannelFit, Derived, EnergyForce, EnergySkip, FitResult, FitSeries, FittedParam, ForceBalance,
-    Identifiability, Rank, RecordFit, SampleAxes, SlidingSamples, UnreliableSamples, Verdict,
+    Identifiability, Rank, RecordFit, RobustWeights, SampleAxes, SlidingSamples, UnreliableSamples,
+    Verdict,
 };
 pub use search::{fits_directly, Search, SearchOptions, DEFAULT_MAX_ITERATIONS, PROMOTED_STARTS};
 pub use target_options::{check_min_speed, FitDomain, ForceTarget, ReplayPath, TargetOptions};

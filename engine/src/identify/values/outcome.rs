@@ -221,6 +221,9 @@ pub enum Check {
     PhysicalConsistency,
     /// Samples whose target is unreliable, left out of the fit.
     UnreliableTarget,
+    /// Samples a robust loss down-weighted at the optimum (spikes, a target the law cannot
+    /// follow there).
+    DownWeighted,
     /// The residual RMS against the records' noise floor: a law that follows the records
     /// leaves only their noise.
     GoodnessOfFit,

@@ -4,7 +4,7 @@ use super::uncertainty::StdErrorComponents;
 
 use super::outcome::{as_display, worst_status, Finding, StartOutcome, Status, TerminationReason};
 
-use super::search::Search;
+use super::search::{Loss, Search};
 use crate::axis::Axis;
 use crate::oscillator::Oscillator;
 use frictionid_models::FrictionModel;
@@ -59,6 +59,10 @@ pub struct RecordFit {
     /// acceleration differentiated one-sided at a run's end or across a reversal).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub unreliable_target: Option<UnreliableSamples>,
+    /// The weights a robust loss (`loss = "huber"` / `"soft_l1"`) gave the compared samples
+    /// at the optimum; `None` under least squares.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub robust_weights: Option<RobustWeights>,
     /// The quantity compared (`velocity`, `force`, `energy_based_force`).
     pub channel: String,
     /// RMS of fitted - measured, in the unit of the compared quantity (m/s for velocity).
@@ -87,6 +91,36 @@ pub struct UnreliableSamples {
     /// The time \[s\] of each sample left out (for plots).
     #[serde(skip)]
     pub times: Vec<f64>,
+}
+
+/// The weights a robust loss gave a record's compared samples (its first channel) at the
+/// optimum, and the samples it down-weighted: those whose weight is below
+/// [`RobustWeights::DOWN_WEIGHTED`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RobustWeights {
+    /// The loss (`huber`, `soft_l1`).
+    pub loss: Loss,
+    /// Samples down-weighted.
+    pub count: usize,
+    /// Samples compared.
+    pub of: usize,
+    /// The least weight of any sample.
+    pub least: f64,
+    /// The time ranges \[s\] of the samples down-weighted, \[first, last\] of each contiguous
+    /// run.
+    pub ranges: Vec<[f64; 2]>,
+    /// The weight of each compared sample, in the order of the record's series (for plots).
+    #[serde(skip)]
+    pub weights: Vec<f64>,
+    /// The time \[s\] of each sample down-weighted (for plots).
+    #[serde(skip)]
+    pub times: Vec<f64>,
+}
+
+impl RobustWeights {
+    /// A sample whose weight is below this is down-weighted (a Huber residual beyond twice
+    /// the loss's scale).
+    pub const DOWN_WEIGHTED: f64 = 0.5;
 }
 
 /// The samples of a force-domain record compared under `[fit.options] min_speed`: those

@@ -162,6 +162,12 @@ impl RobustLoss {
         }
     }
 
+    /// The weight rho'((r / C)^2) the loss gives residual `r` in iteratively reweighted least
+    /// squares: 1 within the scale, less beyond (Huber: C / |r|); 1 under least squares.
+    pub fn weight(&self, r: f64) -> f64 {
+        self.rho((r / self.scale).powi(2)).1
+    }
+
     /// The transformed residual C sgn(r) sqrt(rho((r / C)^2)) (NaN stays NaN).
     pub fn residual(&self, r: f64) -> f64 {
         if self.is_linear() {
