@@ -7,6 +7,7 @@ mod channels;
 mod cli;
 mod compare_report;
 mod defects;
+mod down_weighted_marks;
 mod driven_keys;
 mod excluded_marks;
 mod export;

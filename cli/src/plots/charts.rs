@@ -52,7 +52,8 @@ fn fit_and_measured<'a>(
 /// The measured and fitted response of one record over time, and their difference:
 /// `quantity` is the compared channel and its unit as shown (velocity in m/s, or
 /// displacement in m for interferometer records; a fit's units are on its axis already);
-/// `window` the time shown.
+/// `window` the time shown; the samples a robust loss down-weighted (`down_weighted`, their
+/// times) are marked at zero residual.
 pub fn response_fit(
     path: &Path,
     record: &str,
@@ -60,6 +61,7 @@ pub fn response_fit(
     time: &[f64],
     series: (&[f64], &[f64]),
     (model, window): (&str, Option<(f64, f64)>),
+    down_weighted: &[f64],
 ) -> Result<(), CliError> {
     let ((name, unit), (measured, fitted)) = (quantity, series);
     let residual: Vec<f64> = measured.iter().zip(fitted).map(|(m, f)| m - f).collect();
@@ -77,6 +79,14 @@ pub fn response_fit(
                 .color(super::REFERENCE_GREY),
         )
         .with_reference("", 0.0);
+    let residual_panel = with_sample_marks(
+        residual_panel,
+        SampleMarks {
+            excluded: &[],
+            down_weighted,
+        },
+        0.0,
+    );
     let title = format!("{record}: measured and fitted {name}");
     draw(
         path,
@@ -183,17 +193,45 @@ pub fn friction_force(
     draw(path, &fig)
 }
 
+/// The samples a fit's plots mark, by their times: those left out for an unreliable target
+/// and those a robust loss down-weighted.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SampleMarks<'a> {
+    /// Left out of the comparison (an unreliable target).
+    pub excluded: &'a [f64],
+    /// Given a weight below one half by a robust loss.
+    pub down_weighted: &'a [f64],
+}
+
+/// Labels of the marked samples in the legends.
+const EXCLUDED_LABEL: &str = "left out: unreliable target";
+const DOWN_WEIGHTED_LABEL: &str = "down-weighted by the robust loss";
+
+/// `panel` with `marks` at the level `y`: circles for the samples left out, triangles for
+/// those down-weighted.
+fn with_sample_marks<'a>(panel: Panel<'a>, marks: SampleMarks<'a>, y: f64) -> Panel<'a> {
+    panel
+        .with_marks(EXCLUDED_LABEL, marks.excluded, y)
+        .with_shaped_marks(
+            DOWN_WEIGHTED_LABEL,
+            super::MarkShape::Triangle,
+            marks.down_weighted,
+            y,
+        )
+}
+
 /// The force balance of an inverse-dynamics fit over time: in the upper panel the input u
 /// with the inertial force J a and the restoring force R(q); in the lower panel the friction
 /// force the balance leaves (u - J a - c v - R(q) - offset) and the fitted law's. Lines break
-/// across the samples left out (at rest); the samples left out for an unreliable target
-/// (`excluded`, their times) are marked at zero friction force. Units are shown on `axis`.
+/// across the samples left out (at rest); the samples left out for an unreliable target and
+/// those a robust loss down-weighted (`marks`) are marked at zero friction force. Units are
+/// shown on `axis`.
 pub fn force_balance(
     path: &Path,
     title: &str,
     time: &[f64],
     balance: &ForceBalance,
-    excluded: &[f64],
+    marks: SampleMarks<'_>,
     model: &str,
     axis: Axis,
 ) -> Result<(), CliError> {
@@ -211,14 +249,17 @@ pub fn force_balance(
         .with(Series::solid("input u", time, &input).color(super::MEASURED))
         .with(Series::solid("inertia J a", time, &inertia).width(1))
         .with(Series::dashed("restoring R(q)", time, &restoring).width(1));
-    let friction = fit_and_measured(
-        Panel::new("friction force", "N"),
-        time,
-        ("from the balance", &from_balance),
-        &fitted,
-        model,
-    )
-    .with_marks("left out: unreliable target", excluded, 0.0);
+    let friction = with_sample_marks(
+        fit_and_measured(
+            Panel::new("friction force", "N"),
+            time,
+            ("from the balance", &from_balance),
+            &fitted,
+            model,
+        ),
+        marks,
+        0.0,
+    );
     draw(
         path,
         &Figure::over_time(title, vec![forces, friction]).on(axis),

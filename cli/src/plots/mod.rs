@@ -13,7 +13,7 @@ mod trends;
 
 pub use charts::{
     force_against_motion, force_balance, friction_force, input_force, named_channels, over_time,
-    response_fit, steady_state_curves, MotionAxis, Quantity, View,
+    response_fit, steady_state_curves, MotionAxis, Quantity, SampleMarks, View,
 };
 pub use plan::{plan_plots, PLAN_PLOT};
 pub use trends::trend_plots;
@@ -74,6 +74,9 @@ pub const MARKED: RGBColor = RGBColor(230, 0, 120);
 
 /// Radius of a marked sample's circle [px].
 pub const MARK_RADIUS: i32 = 3;
+
+/// The colour of samples a robust loss down-weighted (an orange apart from [`MARKED`]).
+pub const DOWN_WEIGHTED: RGBColor = RGBColor(230, 120, 0);
 
 /// The laws that get the strongest colours, in this order; other registered laws follow in
 /// their registry order.
@@ -181,12 +184,24 @@ pub struct RefLine {
     pub y: f64,
 }
 
-/// Samples marked on a panel at one level, each by a small filled circle (e.g. the samples a
+/// How marked samples are drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MarkShape {
+    /// A small filled circle in [`MARKED`] (samples a fit left out of its comparison).
+    #[default]
+    Circle,
+    /// A small filled triangle in [`DOWN_WEIGHTED`] (samples a robust loss down-weighted).
+    Triangle,
+}
+
+/// Samples marked on a panel at one level, each by a small filled shape (e.g. the samples a
 /// fit left out of its comparison).
 #[derive(Debug, Clone)]
 pub struct Marks<'a> {
     /// Legend label.
     pub label: String,
+    /// How each is drawn.
+    pub shape: MarkShape,
     /// Abscissa of each marked sample.
     pub x: &'a [f64],
     /// The level they are marked at on the panel's y axis.
@@ -227,10 +242,23 @@ impl<'a> Panel<'a> {
     }
 
     /// Marks the samples at abscissae `x` at the level `y` (nothing when `x` is empty).
-    pub fn with_marks(mut self, label: impl Into<String>, x: &'a [f64], y: f64) -> Self {
+    pub fn with_marks(self, label: impl Into<String>, x: &'a [f64], y: f64) -> Self {
+        self.with_shaped_marks(label, MarkShape::Circle, x, y)
+    }
+
+    /// Marks the samples at abscissae `x` at the level `y`, each drawn as `shape` (nothing
+    /// when `x` is empty).
+    pub fn with_shaped_marks(
+        mut self,
+        label: impl Into<String>,
+        shape: MarkShape,
+        x: &'a [f64],
+        y: f64,
+    ) -> Self {
         if !x.is_empty() {
             self.marks.push(Marks {
                 label: label.into(),
+                shape,
                 x,
                 y,
             });

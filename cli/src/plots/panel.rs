@@ -1,6 +1,9 @@
 //! Drawing one panel of a figure: axes, lines, reference levels and the legend.
 
-use super::{symlog_inverse, Figure, Panel, XTicks, MARKED, MARK_RADIUS, PALETTE, REFERENCE_GREY};
+use super::{
+    symlog_inverse, Figure, MarkShape, Panel, XTicks, DOWN_WEIGHTED, MARKED, MARK_RADIUS, PALETTE,
+    REFERENCE_GREY,
+};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -257,7 +260,7 @@ fn entries(panel: &Panel<'_>) -> Vec<Entry> {
         });
     let marks = panel.marks.iter().map(|m| Entry {
         label: m.label.clone(),
-        style: MARKED.stroke_width(2),
+        style: mark_color(m.shape).stroke_width(2),
         dashed: false,
     });
     lines.chain(levels).chain(marks).collect()
@@ -409,7 +412,15 @@ pub(super) fn draw_panel(
     Ok(())
 }
 
-/// The panel's marked samples within the x range shown, one filled circle each, over the
+/// The colour of marks drawn as `shape`.
+fn mark_color(shape: MarkShape) -> RGBColor {
+    match shape {
+        MarkShape::Circle => MARKED,
+        MarkShape::Triangle => DOWN_WEIGHTED,
+    }
+}
+
+/// The panel's marked samples within the x range shown, one filled shape each, over the
 /// lines.
 fn draw_marks<'a, 'b: 'a>(
     chart: &mut Chart<'a, 'b>,
@@ -420,8 +431,16 @@ fn draw_marks<'a, 'b: 'a>(
         let shown =
             m.x.iter()
                 .filter(|x| x.is_finite() && (x_range.0..=x_range.1).contains(*x))
-                .map(|&x| Circle::new((x, m.y), MARK_RADIUS, MARKED.filled()));
-        chart.draw_series(shown).map_err(|e| e.to_string())?;
+                .copied();
+        let style = mark_color(m.shape).filled();
+        match m.shape {
+            MarkShape::Circle => {
+                chart.draw_series(shown.map(|x| Circle::new((x, m.y), MARK_RADIUS, style)))
+            }
+            MarkShape::Triangle => chart
+                .draw_series(shown.map(|x| TriangleMarker::new((x, m.y), MARK_RADIUS + 1, style))),
+        }
+        .map_err(|e| e.to_string())?;
     }
     Ok(())
 }

@@ -212,6 +212,7 @@ pub fn fit_record_plots(
             &r.axes.time,
             (&r.series.measured, &r.series.fitted),
             (&fit.model, record_window(r)),
+            down_weighted(r),
         )?;
         files.push(vf);
         if !r.series.energy_based_force.is_empty() {
@@ -221,6 +222,11 @@ pub fn fit_record_plots(
         }
     }
     Ok(files)
+}
+
+/// The times of the samples of `r` a robust loss down-weighted (none under least squares).
+fn down_weighted(r: &RecordFit) -> &[f64] {
+    r.robust_weights.as_ref().map_or(&[][..], |w| &w.times)
 }
 
 /// A gap (NaN) in `values` wherever the time step exceeds 1.5 times the smallest one, so a
@@ -276,7 +282,10 @@ fn force_record_plots(
             &format!("{}: force balance", r.file),
             &r.axes.time,
             balance,
-            r.unreliable_target.as_ref().map_or(&[][..], |u| &u.times),
+            super::SampleMarks {
+                excluded: r.unreliable_target.as_ref().map_or(&[][..], |u| &u.times),
+                down_weighted: down_weighted(r),
+            },
             &fit.model,
             fit.oscillator.axis,
         )?;
