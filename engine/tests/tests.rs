@@ -35,5 +35,6 @@ mod robust_targets;
 mod simulate;
 mod slow_runs;
 mod standard_errors;
+mod torsion_decay;
 mod units;
 mod util;

@@ -339,3 +339,72 @@ pub fn rk4_records(
         })
         .collect()
 }
+
+/// The free decay of a linear oscillator (inertia `inertia`, stiffness `stiffness`, viscous
+/// damping `damping`) with Coulomb friction of level `coulomb` whose static level equals it,
+/// released from rest at `x0`, in closed form: between two stops the motion is a damped
+/// oscillation about the offset centre -coulomb d / stiffness (d the direction of motion),
+/// each half-cycle lasting pi / omega_d; at a turning point where the spring's force is
+/// within `coulomb` the oscillator sticks for good. An event-locating reference independent
+/// of the engine's driver and its closed-form stepper.
+#[derive(Debug, Clone, Copy)]
+pub struct CoulombDecay {
+    /// Mass or inertia.
+    pub inertia: f64,
+    /// Linear stiffness.
+    pub stiffness: f64,
+    /// Viscous damping (the oscillator's and the law's viscous term together).
+    pub damping: f64,
+    /// Coulomb level.
+    pub coulomb: f64,
+    /// Release displacement.
+    pub x0: f64,
+}
+
+impl CoulombDecay {
+    /// The undamped and damped angular frequencies and the damping ratio.
+    fn frequencies(&self) -> (f64, f64, f64) {
+        let omega = (self.stiffness / self.inertia).sqrt();
+        let zeta = self.damping / (2.0 * (self.stiffness * self.inertia).sqrt());
+        (omega, omega * (1.0 - zeta * zeta).sqrt(), zeta)
+    }
+
+    /// Each slip phase's start time, release displacement and direction, and the time the
+    /// oscillator sticks.
+    pub fn slips(&self) -> (Vec<(f64, f64, f64)>, f64) {
+        let (omega, omega_d, zeta) = self.frequencies();
+        let half = PI / omega_d;
+        let (mut q, mut t) = (self.x0, 0.0);
+        let mut out = Vec::new();
+        while self.stiffness * q.abs() > self.coulomb {
+            let d = -q.signum();
+            out.push((t, q, d));
+            let centre = -self.coulomb * d / self.stiffness;
+            q = centre - (q - centre) * (-zeta * omega * half).exp();
+            t += half;
+        }
+        (out, t)
+    }
+
+    /// The velocity at each of `times`.
+    pub fn velocity(&self, times: &[f64]) -> Vec<f64> {
+        let (omega, omega_d, zeta) = self.frequencies();
+        let (slips, stuck_at) = self.slips();
+        times
+            .iter()
+            .map(|&t| {
+                let slip = slips.iter().rev().find(|s| s.0 <= t);
+                match slip {
+                    Some(&(start, q0, d)) if t < stuck_at => {
+                        let u0 = q0 + self.coulomb * d / self.stiffness;
+                        let tau = t - start;
+                        -u0 * omega * omega / omega_d
+                            * (-zeta * omega * tau).exp()
+                            * (omega_d * tau).sin()
+                    }
+                    _ => 0.0,
+                }
+            })
+            .collect()
+    }
+}
