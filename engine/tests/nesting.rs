@@ -198,7 +198,7 @@ fn a_lugre_free_decay_recommends_lugre() {
 }
 
 /// The same for a Dahl truth (bristle stiffness 1e5 N/m, mu_c 0.22): compare recommends
-/// dahl, and coulomb, the law it holds, warns or fails `goodness_of_fit`.
+/// dahl, and coulomb, the law it holds, and stribeck warn or fail `goodness_of_fit`.
 #[test]
 #[ignore = "slow: a compare of velocity fits with a dynamic law (about 3 s alone)"]
 fn a_dahl_free_decay_recommends_dahl() {
@@ -207,7 +207,7 @@ fn a_dahl_free_decay_recommends_dahl() {
         mu_c: 0.22,
         alpha: 1.0,
     };
-    free_decay_recommends(&truth, &["coulomb", "dahl"]);
+    free_decay_recommends(&truth, &["coulomb", "stribeck", "dahl"]);
 }
 
 /// Compares `laws` on the FMM free decays of `truth` made by the Runge-Kutta reference: the
