@@ -200,7 +200,7 @@ fn a_lugre_free_decay_recommends_lugre() {
 /// The same for a Dahl truth (bristle stiffness 1e5 N/m, mu_c 0.22): compare recommends
 /// dahl, and coulomb, the law it holds, and stribeck warn or fail `goodness_of_fit`.
 #[test]
-#[ignore = "slow: a compare of velocity fits with a dynamic law (about 3 s alone)"]
+#[ignore = "slow: a compare of velocity fits with a dynamic law (about 5 s alone)"]
 fn a_dahl_free_decay_recommends_dahl() {
     let truth = frictionid_models::Dahl {
         sigma0: 1e5,
