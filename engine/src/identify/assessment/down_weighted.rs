@@ -66,17 +66,14 @@ pub(crate) fn down_weighted_finding(record: &str, w: &RobustWeights) -> Option<F
         0 => String::new(),
         n => format!(" and {n} more"),
     };
-    let loss = serde_json::to_value(w.loss)
-        .ok()
-        .and_then(|v| v.as_str().map(str::to_string))
-        .unwrap_or_default();
     Some(Finding::new(
         Check::DownWeighted,
         Status::Pass,
         Some(100.0 * share),
         format!(
-            "record `{record}`: the {loss} loss gave {} of {} compared samples ({:.2} %) a \
+            "record `{record}`: the {} loss gave {} of {} compared samples ({:.2} %) a \
              weight below {} (least {:.3}): residuals beyond about twice its scale, in {} ranges: {}{more}",
+            w.loss.name(),
             w.count,
             w.of,
             100.0 * share,

@@ -60,6 +60,17 @@ pub enum Loss {
     SoftL1,
 }
 
+impl Loss {
+    /// Config name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Linear => "linear",
+            Self::Huber => "huber",
+            Self::SoftL1 => "soft_l1",
+        }
+    }
+}
+
 /// The loss's default scale in units of the record's noise level: Huber's constant of 95 %
 /// efficiency under Gaussian noise.
 pub const DEFAULT_F_SCALE: f64 = 1.345;
