@@ -3,6 +3,7 @@
 
 mod beyond_speed;
 mod campaign;
+mod campaign_channels;
 mod channels;
 mod cli;
 mod compare_report;
