@@ -315,3 +315,58 @@ fn a_velocity_fit_names_the_condition_a_record_cannot_give() {
         .to_string();
     assert!(e.contains("`a`") && e.contains("domain = \"force\""), "{e}");
 }
+
+/// The stick test reads the level at the channel's value of the moment: the FMM rig held at
+/// 5 mm by `coulomb_load` while its load falls linearly from 20 N to 0 over a second breaks
+/// away exactly when mu N + mu_load |load(t)| has fallen to the spring's k x0, and stays
+/// put until then.
+#[test]
+fn a_mass_held_by_a_falling_load_breaks_away_when_its_level_meets_the_spring() {
+    use frictionid_engine::simulate::{
+        simulate_driven, ChannelSeries, EventKind, Initial, RunInputs, SampleGrid, SimOptions,
+    };
+    let osc = Oscillator::fmm();
+    let (mu, mu_load, x0) = (0.2, 0.5, 0.005);
+    let law = CoulombLoad {
+        mu,
+        mu_load,
+        viscous: 0.0,
+    };
+    let channels = ChannelSeries::new("falling")
+        .with_channel("load", vec![0.0, 1.0], vec![20.0, 0.0])
+        .expect("a channel");
+    let times = sample_times(0.5, 1000.0);
+    let motion = simulate_driven(RunInputs {
+        osc: &osc,
+        model: &law,
+        init: &Initial::at_rest(x0),
+        input: None,
+        channels: Some(&channels),
+        grid: SampleGrid {
+            t_end: 0.5,
+            sample_times: &times,
+        },
+        opts: &SimOptions::default(),
+    })
+    .expect("a simulation");
+    // mu N + mu_load 20 (1 - t) = k x0.
+    let t_b = 1.0 - (osc.stiffness * x0 - mu * osc.normal_force) / (mu_load * 20.0);
+    let kinds: Vec<EventKind> = motion.events.iter().map(|e| e.kind).collect();
+    assert_eq!(
+        kinds[..2],
+        [EventKind::Stick, EventKind::Breakaway],
+        "{kinds:?}"
+    );
+    let found = motion.events[1].time;
+    eprintln!("breakaway at {found} s (closed form {t_b} s)");
+    assert!((found - t_b).abs() < 1e-9, "{found} against {t_b}");
+    for (t, x) in times.iter().zip(&motion.x) {
+        if *t < t_b {
+            assert_eq!(*x, x0, "t = {t}");
+        }
+    }
+    assert!(
+        motion.x.last().is_some_and(|&x| x < x0),
+        "the spring pulls it back"
+    );
+}

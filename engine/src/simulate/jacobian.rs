@@ -142,6 +142,36 @@ mod tests {
         jac
     }
 
+    /// A law that reads x: dF/dx joins the spring's -k/m in the Jacobian.
+    #[test]
+    fn a_position_ripple_s_slope_in_x_is_in_the_jacobian() {
+        use super::super::conditions::BoundConditions;
+        let ripple = frictionid_models::PositionRipple {
+            mu: 0.2,
+            ripple: 0.05,
+            period: 0.01,
+            phase: 0.3,
+            viscous: 2.0,
+        };
+        let bound = BoundConditions::bind(&ripple, None, None)
+            .expect("x is given")
+            .expect("the law reads x");
+        let d = Dynamics::new(&crate::Oscillator::fmm(), &ripple)
+            .expect("a switched law")
+            .reading(Some(&bound));
+        for (x, v, dir) in [(0.01, 0.05, 1.0), (-0.003, -0.02, -1.0)] {
+            let y = [x, v];
+            let mut jac = [f64::NAN; 4];
+            d.jacobian(0.0, &y, dir, &mut jac);
+            let num = numeric_jacobian(&d, &y, dir);
+            let spring = -crate::Oscillator::fmm().stiffness / crate::Oscillator::fmm().mass;
+            assert!((jac[2] - spring).abs() > 1e-3, "the ripple has a slope in x");
+            for (a, b) in jac.iter().zip(&num) {
+                assert!((a - b).abs() <= 1e-5 * (1.0 + b.abs()), "{a} vs {b}");
+            }
+        }
+    }
+
     #[test]
     fn the_jacobian_matches_finite_differences_of_the_rhs_for_every_built_in_model() {
         for name in names() {
