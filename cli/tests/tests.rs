@@ -20,5 +20,6 @@ mod init;
 mod outputs;
 mod plan;
 mod rotary;
+mod simulate_channels;
 mod simulate_input;
 mod units;

@@ -165,7 +165,10 @@ mod tests {
             d.jacobian(0.0, &y, dir, &mut jac);
             let num = numeric_jacobian(&d, &y, dir);
             let spring = -crate::Oscillator::fmm().stiffness / crate::Oscillator::fmm().mass;
-            assert!((jac[2] - spring).abs() > 1e-3, "the ripple has a slope in x");
+            assert!(
+                (jac[2] - spring).abs() > 1e-3,
+                "the ripple has a slope in x"
+            );
             for (a, b) in jac.iter().zip(&num) {
                 assert!((a - b).abs() <= 1e-5 * (1.0 + b.abs()), "{a} vs {b}");
             }
