@@ -3,6 +3,7 @@
 
 mod beyond_speed;
 mod campaign;
+mod campaign_channels;
 mod channels;
 mod cli;
 mod compare_report;
@@ -20,5 +21,6 @@ mod init;
 mod outputs;
 mod plan;
 mod rotary;
+mod simulate_channels;
 mod simulate_input;
 mod units;

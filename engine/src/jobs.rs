@@ -12,15 +12,18 @@ use crate::energy::{
 };
 use crate::error::EngineError;
 use crate::identify::{
-    compare, fit, require_mechanics, require_no_conditions, require_oscillator, Check, Finding,
-    FitResult, PropertyUncertainty, Status,
+    compare, fit, require_mechanics, require_oscillator, Check, Finding, FitResult,
+    PropertyUncertainty, Status,
 };
 use crate::oscillator::Oscillator;
 use crate::record::{channel_list, Channel, ConditionSource, NormalForce, Record};
 use crate::report::{
     CompareReport, EnergyRecord, EnergyReport, FitReport, GroupReport, InputSeries, SimulateReport,
 };
-use crate::simulate::{simulate_driven, Initial, Input, RunInputs, SampleGrid, Trajectory};
+use crate::simulate::{
+    require_motion_conditions, simulate_driven, ChannelSeries, Initial, Input, RunInputs,
+    SampleGrid, Trajectory,
+};
 use crate::spec::{Hooks, SimulationSpec, Spec, SpecError};
 use crate::synthetic::{add_gaussian_noise, uniform_times};
 use frictionid_models::{Coulomb, FrictionModel};
@@ -121,7 +124,6 @@ pub fn simulate_job(spec: &Spec, input: Option<&Record>) -> Result<SimulateRepor
     let model = &spec.require_model("simulate")?.model;
     require_oscillator(&spec.unknown_oscillator, spec.oscillator.axis, "simulate")
         .map_err(JobError::Fit)?;
-    require_no_conditions(model.as_ref()).map_err(JobError::Fit)?;
     let sim: &SimulationSpec = spec.require_simulation("simulate")?;
     let times = uniform_times(sim.duration, sim.sample_rate);
     let init = Initial {
@@ -130,13 +132,23 @@ pub fn simulate_job(spec: &Spec, input: Option<&Record>) -> Result<SimulateRepor
         z0: sim.z0.clone(),
     };
     let osc = &spec.oscillator;
-    let driving = input.map(driving_input).transpose()?;
+    let channels = input
+        .map(|record| ChannelSeries::of_record(record, model.as_ref(), record_start(record)))
+        .transpose()
+        .map_err(JobError::Simulation)?
+        .flatten();
+    // A record that only carries the channels a law reads (a temperature beside a free
+    // vibration) drives nothing.
+    let drives =
+        |record: &&Record| record.channel(Channel::InputForce).is_some() || channels.is_none();
+    let driving = input.filter(drives).map(driving_input).transpose()?;
     let started = Instant::now();
     let traj = simulate_driven(RunInputs {
         osc,
         model: model.as_ref(),
         init: &init,
         input: driving.as_ref().map(|d| &d.input),
+        channels: channels.as_ref(),
         grid: SampleGrid {
             t_end: sim.duration,
             sample_times: &times,
@@ -158,6 +170,11 @@ pub fn simulate_job(spec: &Spec, input: Option<&Record>) -> Result<SimulateRepor
     report.noisy_velocity = noisy_velocity;
     report.input = driving.map(|d| d.series);
     Ok(report)
+}
+
+/// The first sample time of `record`: t = 0 of a simulation it drives.
+fn record_start(record: &Record) -> f64 {
+    record.time().first().copied().unwrap_or(0.0)
 }
 
 /// The input of a simulation and the series it was read from.
@@ -182,7 +199,7 @@ fn driving_input(record: &Record) -> Result<Driving, JobError> {
             channel_list(&record.channels())
         )));
     };
-    let t0 = record.time().first().copied().unwrap_or(0.0);
+    let t0 = record_start(record);
     let time: Vec<f64> = record.time().iter().map(|t| t - t0).collect();
     let input = Input::new(time.clone(), u.to_vec()).map_err(|e| err(e.to_string()))?;
     Ok(Driving {
@@ -591,7 +608,7 @@ pub fn plan_job(
         )
         .into());
     }
-    require_no_conditions(model.as_ref()).map_err(JobError::Fit)?;
+    require_motion_conditions(model.as_ref()).map_err(JobError::Fit)?;
     let options = spec.fit_options(&[], &Hooks::default());
     let request = PlanRequest {
         assumed: Assumed {

@@ -397,6 +397,7 @@ fn velocity_only_variant_matches_the_full_trajectory() {
             model: model.as_ref(),
             init: &Initial::at_rest(0.022),
             input: None,
+            channels: None,
             grid: SampleGrid {
                 t_end: 2.0,
                 sample_times: &times,
@@ -423,6 +424,7 @@ fn a_watched_run_stops_when_its_watch_says_so() {
         model: model.as_ref(),
         init: &init,
         input: None,
+        channels: None,
         grid: SampleGrid {
             t_end: 2.0,
             sample_times: &times,
@@ -941,32 +943,48 @@ fn every_model_gives_the_same_trajectory_with_each_integrator() {
     }
 }
 
-/// A law that reads the position or a channel cannot be simulated (the simulation would give
-/// it x = 0 and no load): every such registered law is refused with a message that names
-/// the force domain, and every other law runs.
+/// A simulation gives a law the conditions it can: x from the motion, a named channel from
+/// the series it is handed. Every registered law that reads only x (or nothing) runs; every
+/// other is refused with a message naming what it lacks, and runs once that is given.
 #[test]
-fn the_simulator_refuses_exactly_the_laws_that_read_conditions() {
-    let runnable = simulable_names();
+fn the_simulator_runs_a_law_whose_conditions_it_is_given_and_names_what_it_lacks() {
+    use frictionid_engine::simulate::{simulate_driven, ChannelSeries};
+    use frictionid_models::Condition;
     let times = uniform_times(0.1, 1000.0);
+    let channels = ChannelSeries::new("bench")
+        .with_channel("load", vec![0.0, 0.1], vec![2.0, 3.0])
+        .unwrap();
+    let run = |model: &dyn FrictionModel, channels: Option<&ChannelSeries>| {
+        simulate_driven(RunInputs {
+            osc: &Oscillator::fmm(),
+            model,
+            init: &Initial::new(0.022, 0.0),
+            input: None,
+            channels,
+            grid: SampleGrid {
+                t_end: 0.1,
+                sample_times: &times,
+            },
+            opts: &SimOptions::default(),
+        })
+    };
+    let mut needing_channels = 0;
     for name in names() {
         let model = default_model(&name).unwrap();
-        let run = simulate(
-            &Oscillator::fmm(),
-            model.as_ref(),
-            &Initial::new(0.022, 0.0),
-            0.1,
-            &times,
-            &SimOptions::default(),
-        );
-        if runnable.contains(&name) {
-            assert!(run.is_ok(), "{name}: {:?}", run.err());
-        } else {
-            let message = run.err().map(|e| e.to_string()).unwrap_or_default();
-            assert!(message.contains("domain = \"force\""), "{name}: {message}");
+        let wanted = model.conditions();
+        let bare = run(model.as_ref(), None);
+        if wanted.iter().all(|c| *c == Condition::Displacement) {
+            assert!(bare.is_ok(), "{name}: {:?}", bare.err());
+            continue;
         }
+        needing_channels += 1;
+        let message = bare.err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(
+            wanted.iter().any(|c| message.contains(&format!("`{c}`"))),
+            "{name}: {message}"
+        );
+        let given = run(model.as_ref(), Some(&channels));
+        assert!(given.is_ok(), "{name}: {:?}", given.err());
     }
-    assert!(
-        runnable.len() < names().len(),
-        "some registered law reads conditions"
-    );
+    assert!(needing_channels > 0, "some registered law reads a channel");
 }

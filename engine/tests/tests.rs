@@ -8,6 +8,7 @@ mod asymmetric_levels;
 mod beyond_speed;
 mod calibration;
 mod channels;
+mod channels_in_motion;
 mod compare_verdict;
 mod down_weighted;
 mod driven_axis;

@@ -184,6 +184,7 @@ pub fn driven_from_rest(
         model,
         init: &Initial::at_rest(0.0),
         input: Some(&input),
+        channels: None,
         grid: SampleGrid {
             t_end: *t.last().expect("samples"),
             sample_times: t,

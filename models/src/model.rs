@@ -271,6 +271,26 @@ pub trait SwitchedLaw: FrictionModel {
     fn affine_slip(&self, _direction: f64, _normal: f64) -> Option<(f64, f64)> {
         None
     }
+
+    /// [`static_limit`](Self::static_limit) at the values `at` of the law's
+    /// [`conditions`](FrictionModel::conditions) (a simulation's displacement, input force
+    /// and interpolated channels). Default: the limit without them (right for a law that
+    /// reads none).
+    fn static_limit_in(&self, normal: f64, _at: &[f64]) -> Option<f64> {
+        self.static_limit(normal)
+    }
+
+    /// [`static_offset`](Self::static_offset) at the values `at` of the law's conditions.
+    /// Default: the offset without them.
+    fn static_offset_in(&self, normal: f64, _at: &[f64]) -> f64 {
+        self.static_offset(normal)
+    }
+
+    /// [`slip_force`](Self::slip_force) at the values `at` of the law's conditions. Default:
+    /// the slip force without them.
+    fn slip_force_in(&self, v: f64, direction: f64, normal: f64, _at: &[f64]) -> f64 {
+        self.slip_force(v, direction, normal)
+    }
 }
 
 /// The exact step of a law's states over an [`Interval`] of constant velocity v and normal

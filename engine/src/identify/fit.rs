@@ -15,9 +15,7 @@
 use super::assessment::identifiability;
 use super::assessment::property_refits::add_property_uncertainty;
 use super::assessment::summary::{summarise, FinishContext};
-use super::problem::{
-    check_force_domain, check_moves, require_mechanics, require_no_conditions, ForceAlongMotion,
-};
+use super::problem::{check_force_domain, check_moves, require_mechanics, ForceAlongMotion};
 use super::problem::{
     simulated_levels, FitProblem, ProblemParts, Realised, Residuals, SimulatedResponse,
 };
@@ -34,6 +32,7 @@ use super::values::{
 use crate::error::EngineError;
 use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::Record;
+use crate::simulate::require_simulable_conditions;
 use frictionid_models::FrictionModel;
 use nalgebra::DVector;
 use std::sync::Arc;
@@ -59,7 +58,7 @@ pub fn fit(
     if target.domain == FitDomain::Force {
         return fit_force(osc, model, records, opts);
     }
-    require_no_conditions(model)?;
+    require_simulable_conditions(model, records)?;
     let clock = Instant::now();
     let (residuals, simulated) = simulated_response(osc, records, opts)?;
     let seed = prefit_options(model, opts)
@@ -220,7 +219,7 @@ pub(crate) fn lean_fit(
         let start = producer.starting_oscillator(osc, &opts.params.oscillator);
         return lean_with(Arc::new(producer), &start, model, records, opts);
     }
-    require_no_conditions(model)?;
+    require_simulable_conditions(model, records)?;
     let (residuals, simulated) = simulated_response(osc, records, opts)?;
     lean_with(residuals, &simulated, model, records, opts)
 }

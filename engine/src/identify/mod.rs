@@ -29,9 +29,7 @@ pub use compare::{
     compare, Comparison, ComparisonVerdict, FailedFit, LawValidation, SetAside, ValidationScheme,
 };
 pub use fit::{fit, fit_force, fit_with};
-pub use problem::{
-    guess_hint, require_mechanics, require_no_conditions, require_oscillator, ForceAlongMotion,
-};
+pub use problem::{guess_hint, require_mechanics, require_oscillator, ForceAlongMotion};
 pub use problem::{Evaluation, Residuals, Segment, SimulatedResponse};
 pub use search::LevenbergMarquardt;
 pub use values::{

@@ -207,6 +207,7 @@ impl Experiment {
             model,
             init: &init,
             input: input.as_ref(),
+            channels: None,
             grid: SampleGrid {
                 t_end,
                 sample_times: &times,

@@ -112,7 +112,7 @@ fn spectral_radius(dynamics: &Dynamics<'_>, speed: f64, z: &[f64]) -> f64 {
     y.extend_from_slice(z);
     let n = y.len();
     let mut jac = vec![0.0; n * n];
-    dynamics.jacobian(&y, 1.0, &mut jac);
+    dynamics.jacobian(0.0, &y, 1.0, &mut jac);
     if jac.iter().any(|j| !j.is_finite()) {
         return f64::INFINITY;
     }

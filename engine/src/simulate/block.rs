@@ -44,13 +44,14 @@ impl BlockBuffer {
         };
         let affine = dynamics
             .switching
+            .filter(|_| dynamics.conditions.is_none())
             .and_then(|law| law.affine_slip(dir, dynamics.normal));
         let rows = times.iter().zip(&self.x[..n]).zip(&self.v[..n]);
         let out = self.a[..n].iter_mut().zip(&mut self.friction[..n]);
         for (((&t, &x), &v), (a, f)) in rows.zip(out) {
             *f = match affine {
                 Some((offset, slope)) => offset + slope * v,
-                None => dynamics.force(v, &[], dir),
+                None => dynamics.force(t, x, v, &[], dir),
             };
             *a = dynamics.accel(t, x, v, *f);
         }

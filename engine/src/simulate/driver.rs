@@ -29,8 +29,8 @@ impl OdeSystem for Segment<'_> {
         self.dynamics.rhs(t, y, dy, self.dir);
     }
 
-    fn jacobian(&self, _t: f64, y: &[f64], jac: &mut [f64]) {
-        self.dynamics.jacobian(y, self.dir, jac);
+    fn jacobian(&self, t: f64, y: &[f64], jac: &mut [f64]) {
+        self.dynamics.jacobian(t, y, self.dir, jac);
     }
 
     fn affine_motion(&self) -> Option<AffineMotion> {
@@ -182,11 +182,19 @@ impl<R: Recorder> Driver<'_, R> {
     /// nine steps in ten under a multisine sampled at 1 kHz and left errors of 1e-7 m/s that
     /// changed erratically with the parameters), else `t_end`.
     fn stop_after(&self, t: f64, t_end: f64) -> f64 {
+        self.next_knot(t).map_or(t_end, |knot| knot.min(t_end))
+    }
+
+    /// The next knot after `t` of the input or of a channel the law reads (the same kink
+    /// in a condition's slope), if any.
+    fn next_knot(&self, t: f64) -> Option<f64> {
         let gap = KNOT_GAP * (1.0 + t.abs());
-        self.dynamics
-            .input
-            .and_then(|u| u.next_knot(t, gap))
-            .map_or(t_end, |knot| knot.min(t_end))
+        let input = self.dynamics.input.and_then(|u| u.next_knot(t, gap));
+        let channels = self.dynamics.conditions.and_then(|c| c.next_knot(t, gap));
+        match (input, channels) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
     }
 
     /// The time of the zero of the event function inside the last step.
@@ -246,7 +254,7 @@ impl<R: Recorder> Driver<'_, R> {
     fn write_moving(&mut self, t: f64, y: &[f64], dir: f64) {
         if let [x, v, z @ ..] = y {
             let (a, f) = if self.rec.wants_forces() {
-                let f = self.dynamics.force(*v, z, dir);
+                let f = self.dynamics.force(t, *x, *v, z, dir);
                 (self.dynamics.accel(t, *x, *v, f), f)
             } else {
                 (f64::NAN, f64::NAN)
@@ -359,6 +367,12 @@ impl<R: Recorder> Driver<'_, R> {
     /// the piecewise-linear input. `None` in free vibration, for laws without a static limit
     /// and when the stick lasts to the end.
     fn breakaway(&self, t: f64, x: f64, t_end: f64) -> Option<(f64, f64)> {
+        if !matches!(self.dynamics.law, Law::Switched { .. }) {
+            return None;
+        }
+        if self.dynamics.conditions.is_some() {
+            return self.breakaway_under_conditions(t, x, t_end);
+        }
         let input = self.dynamics.input?;
         let Law::Switched { limit, offset } = self.dynamics.law else {
             return None;
@@ -372,6 +386,43 @@ impl<R: Recorder> Driver<'_, R> {
             return None;
         }
         Some((t_b, sgn(self.dynamics.held_force(t_b, x) - offset)))
+    }
+
+    /// [`Driver::breakaway`] of a law whose stick band moves with its conditions (a load, a
+    /// temperature): the held force and the band are linear in time between the knots of
+    /// the input and of the channels (up to the law's own curvature in them), so the first
+    /// knot outside the band brackets the breakaway, located there by the Illinois method.
+    /// Also in free vibration, where a shrinking band lets the mass go.
+    fn breakaway_under_conditions(&self, t: f64, x: f64, t_end: f64) -> Option<(f64, f64)> {
+        let dynamics = &self.dynamics;
+        let excess = |s: f64| {
+            let (limit, offset) = dynamics.stick_band(s, x)?;
+            Some((dynamics.held_force(s, x) - offset).abs() - limit)
+        };
+        let mut t0 = t;
+        while t0 < t_end {
+            let t1 = self.next_knot(t0).map_or(t_end, |k| k.min(t_end));
+            let g1 = excess(t1)?;
+            if g1 > 0.0 {
+                let g0 = excess(t0)?;
+                let g = |s: f64| excess(s).map(|e| -e);
+                let t_b = if g0 > 0.0 {
+                    t0
+                } else {
+                    illinois(g, t0, -g0, t1, -g1, EVENT_TOL)?
+                };
+                if t_b <= t {
+                    return None;
+                }
+                let (_, offset) = dynamics.stick_band(t_b, x)?;
+                return Some((t_b, sgn(dynamics.held_force(t_b, x) - offset)));
+            }
+            if t1 <= t0 {
+                return None;
+            }
+            t0 = t1;
+        }
+        None
     }
 }
 

@@ -1,6 +1,7 @@
 //! The equation of motion J q'' + c q' + R(q) + F_f = u(t) - F_0 of an oscillator with its
 //! friction law: the right-hand side, the modes of a switched law and the start of a segment.
 
+use super::conditions::{BoundConditions, ConditionValues};
 use super::{AffineMotion, ClosedForm, Input};
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
@@ -36,6 +37,8 @@ pub(crate) struct Dynamics<'a> {
     pub law: Law<'a>,
     /// The measured input (`None`: free vibration).
     pub input: Option<&'a Input>,
+    /// Where the law's conditions come from (`None`: it reads none).
+    pub conditions: Option<&'a BoundConditions<'a>>,
 }
 
 /// What happens at a state with (possibly) zero velocity.
@@ -57,6 +60,7 @@ impl<'a> Dynamics<'a> {
             switching: model.switching(),
             law: classify_law(model, osc.normal_force)?,
             input: None,
+            conditions: None,
         })
     }
 
@@ -64,26 +68,63 @@ impl<'a> Dynamics<'a> {
     pub(crate) fn driven_by(self, input: Option<&'a Input>) -> Self {
         Self { input, ..self }
     }
+
+    /// The same equation of motion with the law's conditions read from `conditions`.
+    pub(crate) fn reading(self, conditions: Option<&'a BoundConditions<'a>>) -> Self {
+        Self { conditions, ..self }
+    }
 }
 
 impl Dynamics<'_> {
-    /// The friction force in slip direction `dir` (static laws) or from the states (dynamic).
+    /// The values of the law's conditions at time `t` and displacement `x` (`None` for a
+    /// law that reads none).
     #[inline]
-    pub(crate) fn force(&self, v: f64, z: &[f64], dir: f64) -> f64 {
+    fn conditions_at(&self, t: f64, x: f64) -> Option<ConditionValues> {
+        self.conditions.map(|c| c.values(t, x))
+    }
+
+    /// The friction force at time `t` and displacement `x` in slip direction `dir` (static
+    /// laws) or from the states (dynamic).
+    #[inline]
+    pub(crate) fn force(&self, t: f64, x: f64, v: f64, z: &[f64], dir: f64) -> f64 {
         match self.law {
-            Law::Dynamic { .. } => self.model.force(v, z, self.normal),
-            _ => self.slip_force(v, dir),
+            Law::Dynamic { .. } => match self.conditions_at(t, x) {
+                Some(at) => self.model.force_in(v, z, self.normal, at.as_slice()),
+                None => self.model.force(v, z, self.normal),
+            },
+            _ => self.slip_force(t, x, v, dir),
         }
     }
 
-    /// The force of a static law slipping in direction `dir` (its force at `v` when it is
-    /// not a switched law).
+    /// The force of a static law at time `t` and displacement `x` slipping in direction
+    /// `dir` (its force at `v` when it is not a switched law).
     #[inline]
-    pub(crate) fn slip_force(&self, v: f64, dir: f64) -> f64 {
-        match self.switching {
-            Some(law) => law.slip_force(v, dir, self.normal),
-            None => self.model.force(v, &[], self.normal),
+    pub(crate) fn slip_force(&self, t: f64, x: f64, v: f64, dir: f64) -> f64 {
+        match (self.switching, self.conditions_at(t, x)) {
+            (Some(law), None) => law.slip_force(v, dir, self.normal),
+            (Some(law), Some(at)) => law.slip_force_in(v, dir, self.normal, at.as_slice()),
+            (None, None) => self.model.force(v, &[], self.normal),
+            (None, Some(at)) => self.model.force_in(v, &[], self.normal, at.as_slice()),
         }
+    }
+
+    /// The stick band of a switched law at time `t` and displacement `x`: its static limit
+    /// and the band's offset, read at the conditions there for a law that reads some (a
+    /// limit that is not finite holds nothing).
+    #[inline]
+    pub(crate) fn stick_band(&self, t: f64, x: f64) -> Option<(f64, f64)> {
+        let Law::Switched { limit, offset } = self.law else {
+            return None;
+        };
+        let (Some(law), Some(at)) = (self.switching, self.conditions_at(t, x)) else {
+            return Some((limit, offset));
+        };
+        let at = at.as_slice();
+        let limit = law
+            .static_limit_in(self.normal, at)
+            .filter(|l| l.is_finite())
+            .unwrap_or(-1.0);
+        Some((limit, law.static_offset_in(self.normal, at)))
     }
 
     /// The restoring force R(x) ([`Oscillator::restoring_force`]).
@@ -134,11 +175,15 @@ impl Dynamics<'_> {
         let ([x, v, z @ ..], [dx, dv, dz @ ..]) = (y, dy) else {
             return;
         };
-        let f = match self.law {
-            Law::Dynamic { states, .. } => {
+        let f = match (self.law, self.conditions) {
+            (Law::Dynamic { states, .. }, None) => {
                 states.state_derivative_and_force(*v, z, self.normal, dz)
             }
-            _ => self.slip_force(*v, dir),
+            (Law::Dynamic { states, .. }, Some(_)) => {
+                states.state_derivative(*v, z, self.normal, dz);
+                self.force(t, *x, *v, z, dir)
+            }
+            _ => self.slip_force(t, *x, *v, dir),
         };
         *dx = *v;
         *dv = self.accel(t, *x, *v, f);
@@ -147,7 +192,10 @@ impl Dynamics<'_> {
     /// The segment's linear equation when the law is affine in v in direction `dir`, on a
     /// linear spring in free vibration.
     pub(crate) fn affine_motion(&self, dir: f64) -> Option<AffineMotion> {
-        if matches!(self.law, Law::Dynamic { .. }) || self.driven() || !self.osc.has_linear_spring()
+        if matches!(self.law, Law::Dynamic { .. })
+            || self.driven()
+            || !self.osc.has_linear_spring()
+            || self.conditions.is_some()
         {
             return None;
         }
@@ -175,22 +223,23 @@ impl Dynamics<'_> {
         if v != 0.0 {
             return Start::Slip(sgn(v));
         }
-        match self.law {
-            Law::Switched { limit, offset } => {
-                let held = self.held_force(t, x);
-                if (held - offset).abs() <= limit {
-                    return Start::Rest;
-                }
-                let dir = sgn(held - offset);
-                let a = self.accel(t, x, 0.0, self.slip_force(0.0, dir));
-                if dir * a > 0.0 {
-                    Start::Slip(dir)
-                } else {
-                    Start::Rest
-                }
+        if let Some((limit, offset)) = self.stick_band(t, x) {
+            let held = self.held_force(t, x);
+            if (held - offset).abs() <= limit {
+                return Start::Rest;
             }
+            let dir = sgn(held - offset);
+            let a = self.accel(t, x, 0.0, self.slip_force(t, x, 0.0, dir));
+            return if dir * a > 0.0 {
+                Start::Slip(dir)
+            } else {
+                Start::Rest
+            };
+        }
+        match self.law {
+            Law::Switched { .. } => Start::Rest,
             Law::Smooth | Law::Dynamic { .. } => {
-                let a = self.accel(t, x, 0.0, self.force(0.0, z, 0.0));
+                let a = self.accel(t, x, 0.0, self.force(t, x, 0.0, z, 0.0));
                 if a == 0.0 || !a.is_finite() {
                     Start::Rest
                 } else {

@@ -24,6 +24,7 @@ pub fn simulate(
         model,
         init,
         input: None,
+        channels: None,
         grid: SampleGrid {
             t_end,
             sample_times,

@@ -11,7 +11,8 @@
 //! dh/dz is the model's `state_jacobian`, dF/dv and dF/dz its `force_gradient` and dh/dv its
 //! `state_velocity_derivative` (analytic for the built-in dynamic models, finite differences
 //! by default), all three from one call of its `linearisation`. For static laws only the
-//! 2 x 2 mechanics remain, with d(slip_force)/dv taken by finite differences.
+//! 2 x 2 mechanics remain, with d(slip_force)/dv taken by finite differences. A law that
+//! reads the displacement (a position ripple) adds dF/dx to -k/m, by finite differences too.
 
 use super::{Dynamics, Law};
 use frictionid_models::linearisation::velocity_step;
@@ -21,7 +22,7 @@ impl Dynamics<'_> {
     /// Writes the Jacobian of [`Dynamics::rhs`] at `y` in slip direction `dir`, row-major,
     /// into `jac` (len(y)^2 entries). Allocates nothing beyond what the model's derivative
     /// methods do, up to [`STACK_STATES`] internal states.
-    pub(crate) fn jacobian(&self, y: &[f64], dir: f64, jac: &mut [f64]) {
+    pub(crate) fn jacobian(&self, t: f64, y: &[f64], dir: f64, jac: &mut [f64]) {
         let n = y.len();
         let ([x, v, z @ ..], true) = (y, jac.len() == n * n) else {
             return;
@@ -35,21 +36,33 @@ impl Dynamics<'_> {
         };
         let df_dv = match self.law {
             Law::Dynamic { derivatives, .. } => self.state_blocks(&derivatives, v, z, jac),
-            _ => self.slip_slope(v, dir),
+            _ => self.slip_slope(t, *x, v, dir),
         };
         if let Some(row0) = jac.get_mut(..n) {
             row0.fill(0.0);
             row0[1] = 1.0;
         }
-        jac[n] = -self.restoring_stiffness(*x) / self.osc.mass;
+        let df_dx = self.position_slope(t, *x, v, z, dir);
+        jac[n] = -(self.restoring_stiffness(*x) + df_dx) / self.osc.mass;
         jac[n + 1] = -(self.osc.damping + df_dv) / self.osc.mass;
     }
 
     /// d(slip_force)/dv of a static law in direction `dir`.
-    fn slip_slope(&self, v: f64, dir: f64) -> f64 {
+    fn slip_slope(&self, t: f64, x: f64, v: f64, dir: f64) -> f64 {
         let (width, hi, lo) = velocity_step(v);
-        let force = |u: f64| self.slip_force(u, dir);
+        let force = |u: f64| self.slip_force(t, x, u, dir);
         (force(hi) - force(lo)) / width
+    }
+
+    /// dF/dx at fixed v and states, by central differences: 0 unless the law reads the
+    /// displacement.
+    fn position_slope(&self, t: f64, x: f64, v: f64, z: &[f64], dir: f64) -> f64 {
+        if !self.conditions.is_some_and(|c| c.reads_displacement()) {
+            return 0.0;
+        }
+        let h = 1e-6 * x.abs().max(1e-6);
+        let force = |s: f64| self.force(t, s, v, z, dir);
+        (force(x + h) - force(x - h)) / (2.0 * h)
     }
 
     /// Fills rows 1 (dF/dz, scaled by -1/m) and 2.. (dh/dv, dh/dz) of a dynamic model; rows
@@ -129,6 +142,39 @@ mod tests {
         jac
     }
 
+    /// A law that reads x: dF/dx joins the spring's -k/m in the Jacobian.
+    #[test]
+    fn a_position_ripple_s_slope_in_x_is_in_the_jacobian() {
+        use super::super::conditions::BoundConditions;
+        let ripple = frictionid_models::PositionRipple {
+            mu: 0.2,
+            ripple: 0.05,
+            period: 0.01,
+            phase: 0.3,
+            viscous: 2.0,
+        };
+        let bound = BoundConditions::bind(&ripple, None, None)
+            .expect("x is given")
+            .expect("the law reads x");
+        let d = Dynamics::new(&crate::Oscillator::fmm(), &ripple)
+            .expect("a switched law")
+            .reading(Some(&bound));
+        for (x, v, dir) in [(0.01, 0.05, 1.0), (-0.003, -0.02, -1.0)] {
+            let y = [x, v];
+            let mut jac = [f64::NAN; 4];
+            d.jacobian(0.0, &y, dir, &mut jac);
+            let num = numeric_jacobian(&d, &y, dir);
+            let spring = -crate::Oscillator::fmm().stiffness / crate::Oscillator::fmm().mass;
+            assert!(
+                (jac[2] - spring).abs() > 1e-3,
+                "the ripple has a slope in x"
+            );
+            for (a, b) in jac.iter().zip(&num) {
+                assert!((a - b).abs() <= 1e-5 * (1.0 + b.abs()), "{a} vs {b}");
+            }
+        }
+    }
+
     #[test]
     fn the_jacobian_matches_finite_differences_of_the_rhs_for_every_built_in_model() {
         for name in names() {
@@ -148,7 +194,7 @@ mod tests {
                 );
                 let n = y.len();
                 let mut jac = vec![f64::NAN; n * n];
-                d.jacobian(&y, dir, &mut jac);
+                d.jacobian(0.0, &y, dir, &mut jac);
                 let num = numeric_jacobian(&d, &y, dir);
                 for (k, (a, b)) in jac.iter().zip(&num).enumerate() {
                     let scale = 1.0 + b.abs().max(a.abs());

@@ -44,6 +44,7 @@
 mod auto;
 mod block;
 mod closed_form;
+mod conditions;
 mod dopri;
 mod driver;
 mod dynamics;
@@ -62,6 +63,10 @@ mod stepper;
 mod values;
 
 pub use closed_form::ClosedForm;
+pub use conditions::{
+    require_motion_conditions, require_simulable_conditions, ChannelSeries,
+    MAX_SIMULATED_CONDITIONS,
+};
 pub use dopri::Dopri5;
 pub use entry::{
     simulate, simulate_driven, simulate_velocity, simulate_velocity_watched, VelocityRun,
@@ -70,7 +75,7 @@ pub use euler::Euler;
 pub use input::Input;
 pub use mechanical::MechanicalEnergy;
 pub use rodas::Rodas4;
-pub use run::{require_no_conditions, REST_SWING_ATOLS, RODAS_ATOL_SCALE, RODAS_TOL_SCALE};
+pub use run::{REST_SWING_ATOLS, RODAS_ATOL_SCALE, RODAS_TOL_SCALE};
 pub use sensitivity::{
     simulate_sensitivities, SampledSeries, Sensitivities, SensitivityParam, SENSITIVITY_STIFF_RATIO,
 };

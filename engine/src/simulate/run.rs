@@ -3,6 +3,7 @@
 
 use super::auto::resolve_method;
 use super::block::BlockBuffer;
+use super::conditions::BoundConditions;
 use super::driver::Driver;
 use super::dynamics::Dynamics;
 use super::recorders::{Recorder, RunOutput};
@@ -41,6 +42,7 @@ pub(crate) fn run<R: Recorder>(
         model,
         init,
         input,
+        channels,
         grid: SampleGrid {
             t_end,
             sample_times,
@@ -49,11 +51,13 @@ pub(crate) fn run<R: Recorder>(
     } = inputs;
     osc.validate()?;
     model.check()?;
-    require_no_conditions(model)?;
+    let conditions = BoundConditions::bind(model, input, channels)?;
     let y0 = initial_state(model, init)?;
     check_times(t_end, sample_times)?;
     check_options(opts)?;
-    let dynamics = Dynamics::new(osc, model)?.driven_by(input);
+    let dynamics = Dynamics::new(osc, model)?
+        .driven_by(input)
+        .reading(conditions.as_ref());
     let mut driver = Driver {
         dynamics,
         samples: sample_times,
@@ -133,23 +137,6 @@ fn component_tolerance_scales(model: &dyn FrictionModel, dim: usize) -> Vec<f64>
     }
     scales.resize(dim, 1.0);
     scales
-}
-
-/// A simulation does not hand a law its conditions: a law that reads any (x, a, u, a named channel) is fitted along the measured
-/// motion, where every condition has its samples.
-pub fn require_no_conditions(model: &dyn FrictionModel) -> Result<(), EngineError> {
-    let conditions = model.conditions();
-    if conditions.is_empty() {
-        return Ok(());
-    }
-    let names: Vec<String> = conditions.iter().map(|c| format!("`{c}`")).collect();
-    Err(EngineError::InvalidInput(format!(
-        "model `{}` reads {} besides the speed: fit it along the measured motion with \
-         [fit.options] domain = \"force\" (a measured force or force_target = \
-         \"inverse_dynamics\"); a velocity-domain simulation does not give it these",
-        model.name(),
-        names.join(", ")
-    )))
 }
 
 fn initial_state(model: &dyn FrictionModel, init: &Initial) -> Result<Vec<f64>, EngineError> {

@@ -2,7 +2,7 @@
 //! the rest and statistics of a run, and the sampled [`Trajectory`].
 
 use super::mechanical::MechanicalEnergy;
-use super::Input;
+use super::{ChannelSeries, Input};
 use crate::oscillator::Oscillator;
 use frictionid_models::FrictionModel;
 use serde::{Deserialize, Serialize};
@@ -222,6 +222,9 @@ pub struct RunInputs<'a> {
     pub init: &'a Initial,
     /// The measured input u(t) driving the axis (`None`: free vibration).
     pub input: Option<&'a Input>,
+    /// The named channels a law that reads some takes its values from (a load, a
+    /// temperature), linear in time between their samples (`None`: no channels).
+    pub channels: Option<&'a ChannelSeries>,
     /// The end time and the sample times.
     pub grid: SampleGrid<'a>,
     /// The integrator and its tolerances and limits.

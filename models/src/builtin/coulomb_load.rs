@@ -23,7 +23,7 @@
 
 use crate::conditions::{condition_value, Condition};
 use crate::hints::GuessHint;
-use crate::model::{sgn, FrictionModel, ParamGradients, Staging};
+use crate::model::{sgn, FrictionModel, ParamGradients, Staging, SwitchedLaw};
 use crate::start::{StartContext, StribeckLevels};
 
 /// The named channel the law reads.
@@ -41,7 +41,12 @@ crate::declare_params! {
 impl CoulombLoad {
     /// The force at load `load`.
     fn force_at(&self, v: f64, normal: f64, load: f64) -> f64 {
-        (self.mu * normal + self.mu_load * load.abs()) * sgn(v) + self.viscous * v
+        self.level(normal, load) * sgn(v) + self.viscous * v
+    }
+
+    /// The Coulomb level at load `load`: mu N + mu_load |load|.
+    fn level(&self, normal: f64, load: f64) -> f64 {
+        self.mu * normal + self.mu_load * load.abs()
     }
 }
 
@@ -61,7 +66,7 @@ impl FrictionModel for CoulombLoad {
     fn force_in(&self, v: f64, _z: &[f64], normal: f64, at: &[f64]) -> f64 {
         self.force_at(v, normal, condition_value(at, 0))
     }
-    crate::law_groups!(staging, param_gradients);
+    crate::law_groups!(switching, staging, param_gradients);
 }
 
 impl ParamGradients for CoulombLoad {
@@ -82,6 +87,23 @@ impl ParamGradients for CoulombLoad {
         for (o, d) in out.iter_mut().zip([normal * sgn(v), load * sgn(v), v]) {
             *o = d;
         }
+    }
+}
+
+/// A simulation sticks the joint while the force it holds is within the level at the current
+/// load, and slips at that level in the slip direction.
+impl SwitchedLaw for CoulombLoad {
+    fn static_limit(&self, normal: f64) -> Option<f64> {
+        self.static_limit_in(normal, &[])
+    }
+    fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
+        self.slip_force_in(v, direction, normal, &[])
+    }
+    fn static_limit_in(&self, normal: f64, at: &[f64]) -> Option<f64> {
+        Some(self.level(normal, condition_value(at, 0)))
+    }
+    fn slip_force_in(&self, v: f64, direction: f64, normal: f64, at: &[f64]) -> f64 {
+        direction * self.level(normal, condition_value(at, 0)) + self.viscous * v
     }
 }
 

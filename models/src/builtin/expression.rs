@@ -152,8 +152,13 @@ impl Expression {
 
     /// The force at v -> 0+ in the switched form (sign(v) = +1).
     fn breakaway(&self, normal: f64) -> Option<f64> {
+        self.breakaway_in(normal, &[])
+    }
+
+    /// [`Expression::breakaway`] at the values `at` of the formula's conditions.
+    fn breakaway_in(&self, normal: f64, at: &[f64]) -> Option<f64> {
         let f = self.switched.as_ref()?;
-        let f0 = self.eval(f, 0.0, normal, &[], Some(1.0));
+        let f0 = self.eval(f, 0.0, normal, at, Some(1.0));
         f0.is_finite().then_some(f0.abs())
     }
 }
@@ -443,9 +448,15 @@ impl SwitchedLaw for Expression {
         self.breakaway(normal)
     }
     fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
+        self.slip_force_in(v, direction, normal, &[])
+    }
+    fn static_limit_in(&self, normal: f64, at: &[f64]) -> Option<f64> {
+        self.breakaway_in(normal, at)
+    }
+    fn slip_force_in(&self, v: f64, direction: f64, normal: f64, at: &[f64]) -> f64 {
         match &self.switched {
-            Some(f) => self.eval(f, v, normal, &[], Some(direction)),
-            None => self.force(v, &[], normal),
+            Some(f) => self.eval(f, v, normal, at, Some(direction)),
+            None => self.force_in(v, &[], normal, at),
         }
     }
 }

@@ -25,7 +25,7 @@
 
 use crate::conditions::{condition_value, Condition};
 use crate::hints::GuessHint;
-use crate::model::{sgn, FrictionModel, ParamGradients, Staging};
+use crate::model::{sgn, FrictionModel, ParamGradients, Staging, SwitchedLaw};
 use crate::start::{StartContext, StribeckLevels};
 use std::f64::consts::PI;
 
@@ -49,7 +49,12 @@ impl PositionRipple {
 
     /// The force at displacement `x`.
     fn force_at(&self, v: f64, normal: f64, x: f64) -> f64 {
-        (self.mu + self.ripple * self.angle(x).sin()) * normal * sgn(v) + self.viscous * v
+        self.level(normal, x) * sgn(v) + self.viscous * v
+    }
+
+    /// The Coulomb level at displacement `x`: (mu + ripple sin(theta)) N.
+    fn level(&self, normal: f64, x: f64) -> f64 {
+        (self.mu + self.ripple * self.angle(x).sin()) * normal
     }
 }
 
@@ -69,7 +74,7 @@ impl FrictionModel for PositionRipple {
     fn force_in(&self, v: f64, _z: &[f64], normal: f64, at: &[f64]) -> f64 {
         self.force_at(v, normal, condition_value(at, 0))
     }
-    crate::law_groups!(staging, param_gradients);
+    crate::law_groups!(switching, staging, param_gradients);
     /// A ripple larger than the mean level makes the level negative at some positions: the
     /// friction would push along the motion there.
     fn validate(&self) -> Result<Vec<String>, crate::error::ModelError> {
@@ -108,6 +113,24 @@ impl ParamGradients for PositionRipple {
         for (o, d) in out.iter_mut().zip([s, s * sin, d_period, d_phase, v]) {
             *o = d;
         }
+    }
+}
+
+/// A simulation sticks the axis while the force it holds is within the level at the current
+/// position (never below 0: a ripple larger than the mean level holds nothing there), and
+/// slips at that level in the slip direction.
+impl SwitchedLaw for PositionRipple {
+    fn static_limit(&self, normal: f64) -> Option<f64> {
+        self.static_limit_in(normal, &[])
+    }
+    fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
+        self.slip_force_in(v, direction, normal, &[])
+    }
+    fn static_limit_in(&self, normal: f64, at: &[f64]) -> Option<f64> {
+        Some(self.level(normal, condition_value(at, 0)).max(0.0))
+    }
+    fn slip_force_in(&self, v: f64, direction: f64, normal: f64, at: &[f64]) -> f64 {
+        direction * self.level(normal, condition_value(at, 0)) + self.viscous * v
     }
 }
 

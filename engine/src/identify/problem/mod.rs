@@ -18,8 +18,7 @@ pub mod unit_check;
 
 pub use analysis_cache::AnalysisRequest;
 pub use force_along_motion::{
-    check_force_domain, require_mechanics, require_no_conditions, require_oscillator,
-    ForceAlongMotion,
+    check_force_domain, require_mechanics, require_oscillator, ForceAlongMotion,
 };
 pub use guess::guess_hint;
 pub use least_squares::{FitProblem, ProblemParts, Realised};

@@ -26,8 +26,8 @@ use crate::identify::values::nuisance::{NuisanceKind, NuisanceValues};
 use crate::oscillator::{Oscillator, OscillatorProperty};
 use crate::record::{channel_list, Channel, Record};
 use crate::simulate::{
-    simulate_driven, simulate_velocity_watched, Initial, Input, RunInputs, SampleGrid, SimOptions,
-    SimStats, VelocityRun,
+    simulate_driven, simulate_velocity_watched, ChannelSeries, Initial, Input, RunInputs,
+    SampleGrid, SimOptions, SimStats, VelocityRun,
 };
 use frictionid_models::GuessHint;
 use std::borrow::Cow;
@@ -295,6 +295,7 @@ fn simulated_from_release<T>(
     let init = initial(record, case.nuisance);
     let opts = within_allowance(at, index, record, clock.times.len());
     let input = clock.input(record)?;
+    let channels = ChannelSeries::of_record(record, at.model, clock.release)?;
     // A record's own constant normal force reaches its simulation; levels read as forces
     // beyond a coefficient's bound run scaled.
     let mut osc = record.oscillator_for(at.oscillator);
@@ -311,6 +312,7 @@ fn simulated_from_release<T>(
         model,
         init: &init,
         input: input.as_ref(),
+        channels: channels.as_ref(),
         grid: SampleGrid {
             t_end,
             sample_times: &clock.times,

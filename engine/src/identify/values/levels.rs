@@ -22,6 +22,11 @@ pub(crate) const UNIT_NORMAL_FORCE: f64 = 1.0;
 /// compares: a friction force above every force that moves the axis cannot fit the records.
 pub(crate) const LEVEL_BOUND_FACTOR: f64 = 5.0;
 
+/// Dimensionless `mu_*` parameters that are no level: `coulomb_load`'s growth of its level
+/// per unit of load (a ratio of forces, multiplied by |load|, not by N), which neither a
+/// report's unit nor a simulation's scaling of the levels touches.
+const NOT_LEVELS: [&str; 1] = ["mu_load"];
+
 /// How a fit reads the friction levels of its law.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum FrictionLevels {
@@ -69,9 +74,12 @@ impl FrictionLevels {
         }
     }
 
-    /// Whether `info` declares a friction level: dimensionless, named `mu` or `mu_*`.
+    /// Whether `info` declares a friction level: dimensionless, named `mu` or `mu_*`, except
+    /// the ratios of forces a law does not multiply by N ([`NOT_LEVELS`]).
     pub fn is_level(info: &ParamInfo) -> bool {
-        info.unit == "1" && (info.name == "mu" || info.name.starts_with("mu_"))
+        info.unit == "1"
+            && (info.name == "mu" || info.name.starts_with("mu_"))
+            && !NOT_LEVELS.contains(&info.name.as_str())
     }
 
     /// Whether the levels are forces.
@@ -213,6 +221,29 @@ mod tests {
         for v in [-0.5, -1e-3, 2e-3, 0.3] {
             assert_eq!(scaled.force(v, &[], normal), stribeck.force(v, &[], 1.0));
         }
+    }
+
+    /// A load law's growth per unit load is a ratio of forces: a 24 N level runs as 6 under
+    /// N = 4 while the ratio stays, the same force at every load.
+    #[test]
+    fn a_load_ratio_is_no_level() {
+        use frictionid_models::CoulombLoad;
+        let forces = FrictionLevels::Forces { largest: 30.0 };
+        let law = CoulombLoad {
+            mu: 24.0,
+            mu_load: 0.5,
+            viscous: 2.0,
+        };
+        let (scaled, normal) = forces.scaled_for_simulation(&law).expect("a scaled law");
+        assert_eq!((scaled.params(), normal), (vec![6.0, 0.5, 2.0], 4.0));
+        for load in [-20.0, 0.0, 3.0] {
+            assert_eq!(
+                scaled.force_in(0.1, &[], normal, &[load]),
+                law.force_in(0.1, &[], 1.0, &[load])
+            );
+        }
+        let ratio = law.param_info().into_iter().nth(1).expect("mu_load");
+        assert_eq!(forces.unit(&ratio, Axis::Linear), "1");
     }
 
     /// On a rotary axis a level read as a force is a torque in N m and a viscous coefficient

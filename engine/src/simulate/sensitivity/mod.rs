@@ -18,7 +18,7 @@
 //! smooth law's right-hand side is continuous there: no jump.
 //!
 //! # Where it applies
-//! Free vibration (no measured input), every parameter with its derivative available (a
+//! Free vibration (no measured input) of a law that reads no conditions, every parameter with its derivative available (a
 //! law with [`ParamGradients`], and states' rate gradients for a dynamic law; the normal
 //! force is never differentiated), not the Euler integrator (whose trajectory the
 //! sensitivities of the exact motion would not describe) and not a contact so stiff that
@@ -95,10 +95,17 @@ pub fn simulate_sensitivities(
         model,
         init,
         input,
+        channels,
         grid,
         opts,
     } = inputs;
-    if input.is_some() || matches!(opts.integrator, Integrator::Euler { .. }) {
+    // A law that reads conditions (x, a channel) is differentiated by difference quotients:
+    // its force's dependence on x and on the channels is not among the direct terms.
+    if input.is_some()
+        || channels.is_some()
+        || !model.conditions().is_empty()
+        || matches!(opts.integrator, Integrator::Euler { .. })
+    {
         return Ok(None);
     }
     osc.validate()?;

@@ -137,7 +137,7 @@ impl<'a, 'b> Augmented<'a, 'b> {
             }
         }
         let accel = || {
-            let f = self.dynamics.force(*v, z, self.dir);
+            let f = self.dynamics.force(t, *x, *v, z, self.dir);
             self.dynamics.accel(t, *x, *v, f)
         };
         for (j, p) in self.terms.params.iter().enumerate() {
@@ -166,7 +166,7 @@ impl OdeSystem for Augmented<'_, '_> {
         self.dynamics.rhs(t, state, d_state, self.dir);
         let mut scratch = self.scratch.borrow_mut();
         scratch.jac.resize(n * n, 0.0);
-        self.dynamics.jacobian(state, self.dir, &mut scratch.jac);
+        self.dynamics.jacobian(t, state, self.dir, &mut scratch.jac);
         self.direct_terms(t, state, &mut scratch);
         let Scratch { jac, direct, .. } = &*scratch;
         for ((s, ds), d) in sens

@@ -54,6 +54,7 @@ impl World {
             model: self.model.as_ref(),
             init: &init,
             input: None,
+            channels: None,
             grid: SampleGrid {
                 t_end: time.last().copied().unwrap_or(0.0),
                 sample_times: time,
@@ -247,6 +248,7 @@ fn laws_without_gradients_and_driven_or_euler_runs_give_none() {
             model,
             init: &init,
             input: None,
+            channels: None,
             grid: SampleGrid {
                 t_end: 0.2,
                 sample_times: &time,

@@ -35,7 +35,6 @@ mod checks;
 mod guards;
 mod track;
 
-pub use crate::simulate::require_no_conditions;
 pub use checks::check_force_domain;
 pub use guards::{require_mechanics, require_oscillator};
 use track::target_source;

@@ -145,6 +145,7 @@ impl SimulatedResponse {
                 model: at.model,
                 init: &init,
                 input: None,
+                channels: None,
                 grid: SampleGrid {
                     t_end,
                     sample_times: &clock.times,
