@@ -4,7 +4,10 @@
 //! simulation of `coulomb_load` under a multisine input with the run's own load torque as a
 //! named channel (velocity noise 1e-4 m/s), fitted in the velocity domain: every group
 //! recovers its level and coefficient within 1 %, and the trends recover the growth of the
-//! level with the temperature within 1 % and no trend of the coefficient.
+//! level with the temperature within 1 % and no trend of the coefficient. Each record also
+//! carries its measured temperature as a channel, swinging 2 K about the run's temperature in
+//! whole periods: the campaign takes its mean as the condition `temperature_mean`, equal to
+//! the manifest's value, and trends the level against it as against the manifest's column.
 
 use frictionid_cli::testing::{runs_ok, scratch_dir};
 use frictionid_engine::axis::{NoRestoring, Restoring};
@@ -81,9 +84,10 @@ fn run_csv(temperature: f64, seed: u64) -> String {
     .expect("a simulation");
     let mut v = motion.v;
     add_gaussian_noise(&mut v, 1e-4, seed);
-    let mut csv = String::from("time,velocity,u,load\n");
+    let mut csv = String::from("time,velocity,u,load,temp\n");
     for i in 0..time.len() {
-        let _ = writeln!(csv, "{},{},{},{}", time[i], v[i], u[i], load[i]);
+        let measured = temperature + 2.0 * (2.0 * PI * time[i]).sin();
+        let _ = writeln!(csv, "{},{},{},{},{measured}", time[i], v[i], u[i], load[i]);
     }
     csv
 }
@@ -101,7 +105,7 @@ fn campaign(dir: &Path) -> Value {
         &config,
         "[oscillator]\nmass = 2.0\ndamping = 0.0\nrestoring = { type = \"none\" }\n\
          [model]\ntype = \"coulomb_load\"\nmu = 1.5\nmu_load = 0.01\nviscous = 15.0\n\
-         [record_defaults]\ninput_force_column = \"u\"\nchannels = { load = \"load\" }\n\
+         [record_defaults]\ninput_force_column = \"u\"\nchannels = { load = \"load\", temperature = \"temp\" }\n\
          [campaign]\nmanifest = \"runs.csv\"\n",
     )
     .expect("config");
@@ -136,23 +140,23 @@ fn param(row: &Value, name: &str) -> (f64, f64) {
     )
 }
 
-fn temperature(row: &Value) -> f64 {
+fn condition(row: &Value, name: &str) -> f64 {
     row["conditions"]
         .as_array()
-        .and_then(|cs| cs.iter().find(|c| c[0] == "temperature"))
+        .and_then(|cs| cs.iter().find(|c| c[0] == name))
         .and_then(|c| c[1].as_f64())
-        .expect("a numeric temperature")
+        .unwrap_or_else(|| panic!("a numeric condition {name}"))
 }
 
-/// The linear trend of `parameter` against the temperature: (slope, its standard error).
-fn slope(report: &Value, parameter: &str) -> (f64, f64) {
+/// The linear trend of `parameter` against `condition`: (slope, its standard error).
+fn slope_against(report: &Value, parameter: &str, condition: &str) -> (f64, f64) {
     let trend = report["trends"]
         .as_array()
         .and_then(|ts| {
             ts.iter()
-                .find(|t| t["parameter"] == parameter && t["condition"] == "temperature")
+                .find(|t| t["parameter"] == parameter && t["condition"] == condition)
         })
-        .expect("a trend");
+        .unwrap_or_else(|| panic!("a trend of {parameter} against {condition}"));
     (
         trend["linear"]["b"].as_f64().expect("a slope"),
         trend["linear"]["b_std_error"].as_f64().expect("its error"),
@@ -166,7 +170,12 @@ fn a_campaign_of_a_load_reading_law_recovers_its_level_s_growth_with_the_tempera
     let rows = report["rows"].as_array().expect("rows");
     assert_eq!(rows.len(), TEMPERATURES.len());
     for row in rows {
-        let t = temperature(row);
+        let t = condition(row, "temperature");
+        let measured = condition(row, "temperature_mean");
+        assert!(
+            (measured - t).abs() < 1e-9,
+            "T = {t}: channel mean {measured}"
+        );
         let (mu, mu_se) = param(row, "mu");
         let (mu_load, load_se) = param(row, "mu_load");
         eprintln!(
@@ -181,12 +190,15 @@ fn a_campaign_of_a_load_reading_law_recovers_its_level_s_growth_with_the_tempera
         );
         assert!((mu_load / MU_LOAD - 1.0).abs() < 0.01, "T = {t}: {mu_load}");
     }
-    let (b, se) = slope(&report, "mu");
-    eprintln!("d Tc / d T = {b:.6} +- {se:.1e} (truth 0.04)");
     // Four points leave the line's own error estimate two degrees of freedom: the slope is
-    // held to 1 % of the truth, its standard error to a fortieth of it.
-    assert!((b / 0.04 - 1.0).abs() < 0.01 && se < 1e-3, "{b} +- {se}");
-    let (b, se) = slope(&report, "mu_load");
+    // held to 1 % of the truth, its standard error to a fortieth of it, against the manifest's
+    // temperature and against the mean of the measured one.
+    for against in ["temperature", "temperature_mean"] {
+        let (b, se) = slope_against(&report, "mu", against);
+        eprintln!("d Tc / d {against} = {b:.6} +- {se:.1e} (truth 0.04)");
+        assert!((b / 0.04 - 1.0).abs() < 0.01 && se < 1e-3, "{b} +- {se}");
+    }
+    let (b, se) = slope_against(&report, "mu_load", "temperature");
     eprintln!("d mu_load / d T = {b:.2e} +- {se:.1e} (truth 0)");
     // No trend: less than 0.5 % of the coefficient over the 30 K the campaign spans.
     assert!(b.abs() * 30.0 < 0.005 * MU_LOAD, "{b} +- {se}");

@@ -464,6 +464,7 @@ pub fn campaign_group_job(
         Ok(records) => records,
         Err(e) => return failed(e),
     };
+    let task = &task.with_channel_means(&records);
     let report = match models {
         Some(list) => {
             compare_job(spec, list, &records, hooks).map(|r| GroupReport::Compare(Box::new(r)))

@@ -37,3 +37,14 @@ impl CellValue {
         }
     }
 }
+
+/// The value of condition `name` in `conditions` (`None`: absent, or no single value).
+pub(crate) fn condition_value<'a>(
+    conditions: &'a [(String, Option<CellValue>)],
+    name: &str,
+) -> Option<&'a CellValue> {
+    conditions
+        .iter()
+        .find(|(n, _)| n == name)
+        .and_then(|(_, v)| v.as_ref())
+}

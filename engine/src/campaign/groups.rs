@@ -1,10 +1,11 @@
 //! From manifest rows to groups: rows with equal `group_by` values are fitted jointly, each
 //! group as one configuration listing its records.
 
-use super::cell::CellValue;
+use super::cell::{condition_value, CellValue};
 use super::manifest::{Manifest, FILE_COLUMN};
 use super::{CampaignError, CampaignSpec};
 use crate::data::{RecordSource, RecordUse};
+use crate::record::Record;
 use frictionid_models::suggest::did_you_mean;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -37,6 +38,52 @@ impl GroupTask {
             _ => None,
         }
     }
+
+    /// The task with each named channel that all of `records` carry added as a condition
+    /// `<name>_mean`, the channel's mean over the group's samples (a run's temperature or
+    /// load), so that a campaign trends the fitted parameters against what was measured. A
+    /// condition of that name from the manifest keeps its own value.
+    pub fn with_channel_means(&self, records: &[Record]) -> Self {
+        let mut task = self.clone();
+        for name in shared_channel_names(records) {
+            let key = format!("{name}_mean");
+            if task.conditions.iter().any(|(n, _)| *n == key) {
+                continue;
+            }
+            let mean = channel_mean(records, &name).map(CellValue::Number);
+            task.conditions.push((key, mean));
+        }
+        task
+    }
+
+    /// The value of condition `name`, when the group has one.
+    pub fn condition(&self, name: &str) -> Option<&CellValue> {
+        condition_value(&self.conditions, name)
+    }
+}
+
+/// The named channels every one of `records` carries, in the first record's order.
+fn shared_channel_names(records: &[Record]) -> Vec<String> {
+    let Some(first) = records.first() else {
+        return Vec::new();
+    };
+    first
+        .named_channels()
+        .into_iter()
+        .filter(|name| records.iter().all(|r| r.named_channel(name).is_some()))
+        .map(str::to_string)
+        .collect()
+}
+
+/// The mean of the finite samples of channel `name` over all of `records`.
+fn channel_mean(records: &[Record], name: &str) -> Option<f64> {
+    let (sum, count) = records
+        .iter()
+        .filter_map(|r| r.named_channel(name))
+        .flatten()
+        .filter(|x| x.is_finite())
+        .fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+    (count > 0).then(|| sum / count as f64)
 }
 
 /// The condition columns of `manifest`: every column that is not a `[[records]]` key, and

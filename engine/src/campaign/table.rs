@@ -1,5 +1,6 @@
 //! The results table of a campaign: one row per group and model, and its CSV form.
 
+use super::cell::condition_value;
 pub(crate) use super::cell::CellValue;
 use super::groups::GroupTask;
 use crate::identify::{FitResult, FittedParam, Verdict};
@@ -163,10 +164,7 @@ impl CampaignRow {
 
     /// The value of condition `name`.
     pub fn condition(&self, name: &str) -> Option<&CellValue> {
-        self.conditions
-            .iter()
-            .find(|(n, _)| n == name)
-            .and_then(|(_, v)| v.as_ref())
+        condition_value(&self.conditions, name)
     }
 }
 

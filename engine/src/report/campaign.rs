@@ -76,10 +76,7 @@ impl CampaignReport {
         results: &[GroupResult],
         wall_time_s: f64,
     ) -> Self {
-        let conditions: Vec<String> = results
-            .first()
-            .map(|g| g.task.conditions.iter().map(|(n, _)| n.clone()).collect())
-            .unwrap_or_default();
+        let conditions = condition_names(results);
         let rows: Vec<CampaignRow> = results.iter().flat_map(|g| g.rows.clone()).collect();
         let numeric_conditions = numeric_conditions(&conditions, results);
         let trends = campaign_trends(&rows, &numeric_conditions);
@@ -245,18 +242,29 @@ impl CampaignReport {
 }
 
 /// The conditions whose values are numbers in every group that has one.
+/// The conditions of the groups in order of first appearance: the manifest's columns, then
+/// the channel means of groups whose records carry named channels.
+fn condition_names(results: &[GroupResult]) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    for (name, _) in results.iter().flat_map(|g| &g.task.conditions) {
+        if !names.contains(name) {
+            names.push(name.clone());
+        }
+    }
+    names
+}
+
 fn numeric_conditions(conditions: &[String], results: &[GroupResult]) -> Vec<String> {
     conditions
         .iter()
-        .enumerate()
-        .filter(|&(i, _)| {
+        .filter(|&name| {
             let values: Vec<_> = results
                 .iter()
-                .filter_map(|g| g.task.conditions.get(i)?.1.as_ref())
+                .filter_map(|g| g.task.condition(name))
                 .collect();
             !values.is_empty() && values.iter().all(|v| v.number().is_some())
         })
-        .map(|(_, c)| c.clone())
+        .cloned()
         .collect()
 }
 
