@@ -475,6 +475,7 @@ fn add_rigid_limit(
         limit: sep.limit.clone(),
         chi2: sep.chi2,
         threshold: sep.threshold,
+        needed: sep.needed,
     };
     for name in &sep.stiffnesses {
         let Some(i) = plan.parameters.iter().position(|p| &p.name == name) else {

@@ -190,6 +190,8 @@ pub struct RigidEvidence {
     pub chi2: f64,
     /// chi^2_95 of the parameters it removes: the fit's test.
     pub threshold: f64,
+    /// The chi^2 at which a fit would reject the limit 9 times in 10.
+    pub needed: f64,
 }
 
 impl OutOfReach {
@@ -233,9 +235,9 @@ impl OutOfReach {
         if let Some(r) = &self.rigid_limit {
             text.push_str(&format!(
                 "; the recommended records would not tell it from a rigid contact: `{}` fits \
-                 them within chi2 = {:.3} where the fit's test needs {:.2}, so a fit could \
-                 bound it only from below",
-                r.limit, r.chi2, r.threshold
+                 them within chi2 = {:.3}, where a fit's test (at {:.2}) would reject it 9 \
+                 times in 10 only from {:.1}, so a fit could bound it only from below",
+                r.limit, r.chi2, r.threshold, r.needed
             ));
         }
         match &self.change {
