@@ -189,11 +189,23 @@ fn noisy_records(
     noise: f64,
     seed: u64,
 ) -> Vec<Record> {
+    noisy_records_with(&SimOptions::default(), osc, law, experiments, noise, seed)
+}
+
+/// [`noisy_records`] simulated with `sim`.
+fn noisy_records_with(
+    sim: &SimOptions,
+    osc: &Oscillator,
+    law: &dyn FrictionModel,
+    experiments: &[&Experiment],
+    noise: f64,
+    seed: u64,
+) -> Vec<Record> {
     experiments
         .iter()
         .enumerate()
         .map(|(i, e)| {
-            let mut rec = e.record(osc, law, &SimOptions::default(), noise).unwrap();
+            let mut rec = e.record(osc, law, sim, noise).unwrap();
             let mut v = rec.velocity().to_vec();
             add_gaussian_noise(&mut v, noise, seed * 7 + i as u64);
             rec.velocity_mut().copy_from_slice(&v);
@@ -288,56 +300,126 @@ fn stribeck_pair_prediction_matches_monte_carlo() {
     );
 }
 
-/// Stiff LuGre bristles (sigma0 1e7 N/m) released from the paper's three releases, 0.6 s at 1 kHz and at
-/// 20 kHz: the plan puts sigma0 out of reach exactly when the identifiability finding of a
-/// fit of noisy records does not call it determined. The fit holds sigma2, which is not free,
-/// at the value the plan assumes (LuGre's default 0.5 against the truth's 2 is another law:
-/// its fit ends 1.4 times the noise with sigma0 bounded only from below).
-#[test]
-#[ignore = "slow: LuGre fits at 20 kHz (about 10 s)"]
-fn lugre_sigma0_reach_agrees_with_the_fits_findings() {
-    use frictionid_engine::identify::Identifiability;
-    let osc = Oscillator::fmm();
-    let law = crate::util::stiff_lugre_truth();
-    let free = ["sigma0", "sigma1", "mu_c", "mu_s", "v_s"];
-    for rate in [1000.0, 20_000.0] {
-        let candidates: Vec<Experiment> = [0.010, 0.014, 0.022]
-            .iter()
-            .map(|&x0| Experiment::release(x0, 0.6, rate))
-            .collect();
-        let mut req = request(osc, &law, &free, candidates.clone(), 2e-4);
-        req.choose = 3;
-        let p = plan(&req).unwrap();
-        let planned_reach = !p.out_of_reach.iter().any(|o| o.parameter == "sigma0");
-        let set: Vec<&Experiment> = candidates.iter().collect();
-        let records = noisy_records(&osc, &law, &set, 2e-4, 77);
-        let opts = FitOptions {
-            params: ParamOptions {
-                free: Some(free.iter().map(|s| s.to_string()).collect()),
-                ..ParamOptions::default()
-            },
-            ..FitOptions::default()
-        };
-        // sigma2 is not free: the fit holds it at the value the plan assumes.
-        let start = frictionid_models::LuGre {
-            sigma2: law.sigma2,
-            ..frictionid_models::LuGre::default()
-        };
-        let r = fit(&osc, &start, &records, &opts).unwrap();
-        let sigma0 = r.param("sigma0").unwrap();
-        let found = sigma0.identifiability == Some(Identifiability::Determined);
-        eprintln!(
-            "{rate} Hz: plan relative std of sigma0 {:?}, out of reach {:?}; fit {:?} {:?}",
-            p.relative(&p.predicted_std, index_of(&p, "sigma0")),
-            p.out_of_reach
-                .iter()
-                .map(|o| &o.message)
-                .collect::<Vec<_>>(),
-            sigma0.identifiability,
-            sigma0.value
-        );
-        assert_eq!(planned_reach, found, "{rate} Hz");
+/// What the plan and a fit of noisy records say about LuGre's sigma0 at one sample rate.
+struct Sigma0Reach {
+    /// The plan's out-of-reach finding for sigma0, if any.
+    out: Option<frictionid_engine::plan::OutOfReach>,
+    /// The plan's predicted relative standard error of sigma0.
+    relative: Option<f64>,
+    /// The fit's identifiability finding for sigma0 and its value.
+    fitted: Option<frictionid_engine::identify::Identifiability>,
+    value: f64,
+}
+
+impl Sigma0Reach {
+    fn determined(&self) -> bool {
+        self.fitted == Some(frictionid_engine::identify::Identifiability::Determined)
     }
+}
+
+/// `law` on the FMM stage released from the paper's three releases, 0.6 s at `rate`, noise
+/// 2e-4 m/s: the plan for the five free parameters (sigma2 held, with the smallest changes
+/// looked for) and a fit of noisy records of the same experiments (simulated with `sim`,
+/// seed `seed`) from LuGre's defaults, sigma2 held at the value the plan assumes (LuGre's
+/// default 0.5 against the truth's 2 is another law: its fit ends 1.4 times the noise with
+/// sigma0 bounded only from below).
+fn sigma0_reach(
+    law: &frictionid_models::LuGre,
+    rate: f64,
+    sim: &SimOptions,
+    seed: u64,
+) -> Sigma0Reach {
+    let osc = Oscillator::fmm();
+    let free = ["sigma0", "sigma1", "mu_c", "mu_s", "v_s"];
+    let candidates: Vec<Experiment> = [0.010, 0.014, 0.022]
+        .iter()
+        .map(|&x0| Experiment::release(x0, 0.6, rate))
+        .collect();
+    let mut req = request(osc, law, &free, candidates.clone(), 2e-4);
+    req.choose = 3;
+    req.suggest = true;
+    let p = plan(&req).unwrap();
+    let set: Vec<&Experiment> = candidates.iter().collect();
+    let records = noisy_records_with(sim, &osc, law, &set, 2e-4, seed);
+    let opts = FitOptions {
+        params: ParamOptions {
+            free: Some(free.iter().map(|s| s.to_string()).collect()),
+            ..ParamOptions::default()
+        },
+        ..FitOptions::default()
+    };
+    let start = frictionid_models::LuGre {
+        sigma2: law.sigma2,
+        ..frictionid_models::LuGre::default()
+    };
+    let r = fit(&osc, &start, &records, &opts).unwrap();
+    let sigma0 = r.param("sigma0").unwrap();
+    let out = Sigma0Reach {
+        out: p
+            .out_of_reach
+            .iter()
+            .find(|o| o.parameter == "sigma0")
+            .cloned(),
+        relative: p.relative(&p.predicted_std, index_of(&p, "sigma0")),
+        fitted: sigma0.identifiability,
+        value: sigma0.value,
+    };
+    eprintln!(
+        "sigma0 {:e} at {rate} Hz: plan relative std {:?}, out of reach: {:?}; fit {:?} {:e}",
+        law.sigma0,
+        out.relative,
+        out.out.as_ref().map(|o| &o.message),
+        out.fitted,
+        out.value
+    );
+    out
+}
+
+/// LuGre's bristle stiffness at 1 kHz and 20 kHz: the plan puts sigma0 out of reach
+/// exactly when the identifiability finding of a fit of noisy records does not call it
+/// determined, both ways.
+///
+/// Bristles of 1e7 N/m (`stiff_lugre_truth`) are within reach at both rates (plan: 23 % and
+/// 5.2 %) and both fits determine them. Bristles of 1e10 N/m (`unresolved_lugre_truth`, ringing
+/// at 4.9 kHz) are out of reach at 1 kHz: the records would not tell them from a rigid
+/// contact (the Stribeck limit fits them within chi2 0.88, where the fit's test at 3.84
+/// would reject it 9 times in 10 only from 10.5) and the fit bounds sigma0 only from below;
+/// at 20 kHz (chi2 about 17) the plan puts them within reach and the fit determines them.
+/// The 1 kHz message names, among its changes, a sample rate that reaches sigma0 (20 kHz),
+/// no faster than the 20 kHz the second case confirms. Of eight noise seeds the fits agree
+/// at 1 kHz in seven (a lower bound) and at 20 kHz in eight (determined).
+#[test]
+#[ignore = "slow: LuGre fits at 20 kHz (about 15 s)"]
+fn lugre_sigma0_reach_agrees_with_the_fits_findings() {
+    use frictionid_engine::plan::Dimension;
+    use frictionid_engine::simulate::Integrator;
+    let stiff = crate::util::stiff_lugre_truth();
+    for rate in [1000.0, 20_000.0] {
+        let at = sigma0_reach(&stiff, rate, &SimOptions::default(), 77);
+        assert!(at.out.is_none(), "{rate} Hz: {:?}", at.out);
+        assert!(at.determined(), "{rate} Hz: {:?}", at.fitted);
+    }
+    let unresolved = crate::util::unresolved_lugre_truth();
+    let rodas = SimOptions {
+        integrator: Integrator::Rodas,
+        ..SimOptions::default()
+    };
+    let slow = sigma0_reach(&unresolved, 1000.0, &rodas, 100);
+    let fast = sigma0_reach(&unresolved, 20_000.0, &rodas, 100);
+    let out = slow.out.as_ref().expect("sigma0 out of reach at 1 kHz");
+    assert!(out.rigid_limit.is_some(), "{}", out.message);
+    assert!(!slow.determined(), "1 kHz: {:?}", slow.fitted);
+    assert!(fast.out.is_none(), "20 kHz: {:?}", fast.out);
+    assert!(fast.determined(), "20 kHz: {:?}", fast.fitted);
+    let named = out
+        .changes()
+        .find(|c| c.dimension == Dimension::SampleRate)
+        .expect("a sample rate named");
+    assert!(
+        named.to.iter().all(|&r| r > 1000.0 && r <= 20_000.0),
+        "{named:?}"
+    );
+    assert!(out.message.contains("sample rate 1000"), "{}", out.message);
 }
 
 /// A driven slide (2 kg, no spring, N 20 N) with the Stribeck truth under multisines of

@@ -91,6 +91,18 @@ pub fn stiff_lugre_truth() -> LuGre {
     }
 }
 
+/// LuGre bristles too stiff for a 1 kHz vibrometer on the FMM stage: sigma0 1e10 N/m (the
+/// bristle rings at sqrt(sigma0 / m) / 2 pi = 4.9 kHz, above 1 kHz's Nyquist frequency and
+/// below 20 kHz's; a presliding displacement of 0.26 nm), lightly damped (sigma1 13 000 N s/m,
+/// a damping ratio of 0.02), sigma2 2 N s/m and the levels of [`stiff_lugre_truth`].
+pub fn unresolved_lugre_truth() -> LuGre {
+    LuGre {
+        sigma0: 1e10,
+        sigma1: 13_000.0,
+        ..stiff_lugre_truth()
+    }
+}
+
 /// A Stribeck law with a pronounced dip and viscous drag: mu_c 0.20, mu_s 0.28, v_s 0.02 m/s,
 /// delta 2, viscous 3 N s/m.
 pub fn stribeck_truth() -> Stribeck {

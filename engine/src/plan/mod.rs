@@ -404,6 +404,7 @@ fn out_of_reach(
                     relative_std: plan.relative(&plan.predicted_std, i),
                     all_candidates: plan.relative(all_std, i),
                     change: None,
+                    alternatives: Vec::new(),
                     rigid_limit: None,
                     message: String::new(),
                 },
@@ -417,7 +418,7 @@ fn out_of_reach(
     Ok(found
         .into_iter()
         .map(|(_, mut o)| {
-            o.describe(reach);
+            o.describe(reach, request.suggest);
             o
         })
         .collect())
@@ -474,6 +475,7 @@ fn add_rigid_limit(
         limit: sep.limit.clone(),
         chi2: sep.chi2,
         threshold: sep.threshold,
+        needed: sep.needed,
     };
     for name in &sep.stiffnesses {
         let Some(i) = plan.parameters.iter().position(|p| &p.name == name) else {
@@ -488,6 +490,7 @@ fn add_rigid_limit(
                     relative_std: plan.relative(&plan.predicted_std, i),
                     all_candidates: None,
                     change: None,
+                    alternatives: Vec::new(),
                     rigid_limit: Some(evidence.clone()),
                     message: String::new(),
                 },
@@ -499,8 +502,9 @@ fn add_rigid_limit(
 }
 
 /// Walks the ladder of changes on the recommended records until each parameter in `found`
-/// has the smallest change that reaches it (or the ladder ends). A changed experiment that
-/// cannot be simulated is a rung skipped.
+/// has, along every dimension the records have, the smallest change that reaches it (or the
+/// ladder ends): the first found is the smallest overall, the others its alternatives. A
+/// changed experiment that cannot be simulated is a rung skipped.
 fn find_changes(
     request: &PlanRequest<'_>,
     plan: &Plan,
@@ -515,8 +519,8 @@ fn find_changes(
         .collect();
     let values: Vec<f64> = plan.parameters.iter().map(|p| p.value).collect();
     for &(dimension, factor) in &reach::LADDER {
-        if found.iter().all(|(_, o)| o.change.is_some()) {
-            return;
+        if found.iter().all(|(_, o)| o.has_change_along(dimension)) {
+            continue;
         }
         let changed: Option<Vec<Experiment>> = chosen
             .iter()
@@ -532,11 +536,17 @@ fn find_changes(
         let total = infos.iter().fold(base.clone(), |acc, i| acc + &i.matrix);
         let std = design::predicted_std(&total, &values);
         let mut rejects: Option<bool> = None;
-        for (i, o) in found.iter_mut().filter(|(_, o)| o.change.is_none()) {
+        for (i, o) in found
+            .iter_mut()
+            .filter(|(_, o)| !o.has_change_along(dimension))
+        {
             let Some(r) = relative_of(&std, &plan.parameters, *i) else {
                 continue;
             };
-            if r <= request.reach && o.rigid_limit.is_some() {
+            if r > request.reach {
+                continue;
+            }
+            if o.rigid_limit.is_some() {
                 let refs: Vec<&Experiment> = changed.iter().collect();
                 let sep = *rejects.get_or_insert_with(|| {
                     separation_of(request, plan, &refs).is_none_or(|s| s.rejects())
@@ -545,21 +555,19 @@ fn find_changes(
                     continue;
                 }
             }
-            if r <= request.reach {
-                o.change = Some(Change {
-                    dimension,
-                    factor,
-                    from: chosen
-                        .iter()
-                        .filter_map(|e| dimension.value(e, normal))
-                        .collect(),
-                    to: changed
-                        .iter()
-                        .filter_map(|e| dimension.value(e, normal))
-                        .collect(),
-                    relative_std: r,
-                });
-            }
+            o.add_change(Change {
+                dimension,
+                factor,
+                from: chosen
+                    .iter()
+                    .filter_map(|e| dimension.value(e, normal))
+                    .collect(),
+                to: changed
+                    .iter()
+                    .filter_map(|e| dimension.value(e, normal))
+                    .collect(),
+                relative_std: r,
+            });
         }
     }
 }

@@ -171,6 +171,9 @@ pub struct OutOfReach {
     pub all_candidates: Option<f64>,
     /// The smallest change among the ladder's that brings it within reach, if any.
     pub change: Option<Change>,
+    /// Along each other dimension, the smallest change that brings it within reach (smallest
+    /// first): what else would do, for a rig whose first choice cannot change.
+    pub alternatives: Vec<Change>,
     /// For a contact stiffness: the records' evidence against the rigid limit, when it is
     /// below the fit's threshold.
     pub rigid_limit: Option<RigidEvidence>,
@@ -187,11 +190,36 @@ pub struct RigidEvidence {
     pub chi2: f64,
     /// chi^2_95 of the parameters it removes: the fit's test.
     pub threshold: f64,
+    /// The chi^2 at which a fit would reject the limit 9 times in 10.
+    pub needed: f64,
 }
 
 impl OutOfReach {
-    /// The finding in words, for a reach of `reach` (relative).
-    pub fn describe(&mut self, reach: f64) {
+    /// The smallest changes found, one per dimension, smallest first.
+    pub fn changes(&self) -> impl Iterator<Item = &Change> {
+        self.change.iter().chain(&self.alternatives)
+    }
+
+    /// Whether a change along `dimension` has been found.
+    pub fn has_change_along(&self, dimension: Dimension) -> bool {
+        self.changes().any(|c| c.dimension == dimension)
+    }
+
+    /// Records `change` as the smallest along its dimension (the first found is the smallest
+    /// overall).
+    pub fn add_change(&mut self, change: Change) {
+        if self.has_change_along(change.dimension) {
+            return;
+        }
+        match self.change {
+            None => self.change = Some(change),
+            Some(_) => self.alternatives.push(change),
+        }
+    }
+
+    /// The finding in words, for a reach of `reach` (relative); `sought`: whether changes
+    /// were looked for.
+    pub fn describe(&mut self, reach: f64, sought: bool) {
         let pct = |r: Option<f64>| match r {
             Some(r) => percent(r),
             None => "unbounded (no information)".into(),
@@ -207,9 +235,9 @@ impl OutOfReach {
         if let Some(r) = &self.rigid_limit {
             text.push_str(&format!(
                 "; the recommended records would not tell it from a rigid contact: `{}` fits \
-                 them within chi2 = {:.3} where the fit's test needs {:.2}, so a fit could \
-                 bound it only from below",
-                r.limit, r.chi2, r.threshold
+                 them within chi2 = {:.3}, where a fit's test (at {:.2}) would reject it 9 \
+                 times in 10 only from {:.1}, so a fit could bound it only from below",
+                r.limit, r.chi2, r.threshold, r.needed
             ));
         }
         match &self.change {
@@ -218,10 +246,25 @@ impl OutOfReach {
                 c.words(unit_of(c.dimension)),
                 percent(c.relative_std)
             )),
-            None => text.push_str(
+            None if sought => text.push_str(
                 "; none of the changes tried (sample rate up to x50, release and normal force \
                  x0.25 to x4, record length up to x4, amplitude x0.5 to x4) reaches it",
             ),
+            None => {}
+        }
+        if !self.alternatives.is_empty() {
+            let others: Vec<String> = self
+                .alternatives
+                .iter()
+                .map(|c| {
+                    format!(
+                        "{} (predicted {})",
+                        c.words(unit_of(c.dimension)),
+                        percent(c.relative_std)
+                    )
+                })
+                .collect();
+            text.push_str(&format!("; or else {}", others.join("; or ")));
         }
         self.message = text;
     }
@@ -243,5 +286,65 @@ mod tests {
         let lighter = Dimension::NormalForce.scaled(&e, 0.5, 14.5).unwrap();
         assert_eq!(lighter.normal_force, Some(7.25));
         assert!(Dimension::Amplitude.scaled(&e, 2.0, 14.5).is_none());
+    }
+
+    fn change(dimension: Dimension, factor: f64, from: f64) -> Change {
+        Change {
+            dimension,
+            factor,
+            from: vec![from],
+            to: vec![from * factor],
+            relative_std: 0.2,
+        }
+    }
+
+    fn unreached() -> OutOfReach {
+        OutOfReach {
+            parameter: "sigma0".into(),
+            relative_std: Some(0.9),
+            all_candidates: Some(0.9),
+            change: None,
+            alternatives: Vec::new(),
+            rigid_limit: None,
+            message: String::new(),
+        }
+    }
+
+    /// The first change found is the smallest, one per dimension is kept, and the message
+    /// names each: a rig that cannot change its normal force reads the sample rate to take.
+    #[test]
+    fn the_smallest_change_along_each_dimension_is_named() {
+        let mut o = unreached();
+        o.add_change(change(Dimension::NormalForce, 2.0, 14.5));
+        o.add_change(change(Dimension::NormalForce, 4.0, 14.5));
+        o.add_change(change(Dimension::SampleRate, 10.0, 1000.0));
+        assert_eq!(o.change.as_ref().map(|c| c.factor), Some(2.0));
+        assert_eq!(o.alternatives.len(), 1);
+        o.describe(0.5, true);
+        assert!(
+            o.message.contains("normal force 14.5 N -> 29 N (x2)"),
+            "{}",
+            o.message
+        );
+        assert!(
+            o.message
+                .contains("or else sample rate 1000 Hz -> 10000 Hz (x10)"),
+            "{}",
+            o.message
+        );
+    }
+
+    /// Without a search for changes the message does not claim that none reaches it.
+    #[test]
+    fn no_search_no_claim_about_changes() {
+        let mut o = unreached();
+        o.describe(0.5, false);
+        assert!(!o.message.contains("none of the changes"), "{}", o.message);
+        o.describe(0.5, true);
+        assert!(
+            o.message.contains("none of the changes tried"),
+            "{}",
+            o.message
+        );
     }
 }
