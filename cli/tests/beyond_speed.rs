@@ -26,13 +26,8 @@ fn joint_csv(with_load: bool) -> String {
             .parse()
             .unwrap();
         let load = 30.0 * (2.0 * PI * 0.13 * t).sin() + 10.0 * (2.0 * PI * 0.41 * t + 1.0).sin();
-        let s = if v > 0.0 {
-            1.0
-        } else if v < 0.0 {
-            -1.0
-        } else {
-            0.0
-        };
+        // sgn(v), 0 at rest (std's signum gives +-1 at +-0).
+        let s = if v == 0.0 { 0.0 } else { f64::signum(v) };
         let f = (2.0 + 0.03 * f64::abs(load)) * s + 5.0 * v;
         csv.push_str(&format!("{t},{v},{f:.12}"));
         if with_load {
