@@ -3,7 +3,7 @@
 //! motion, plotted beside the record; and the one-line error of a record without it.
 
 use assert_cmd::Command;
-use frictionid_cli::testing::{runs_ok, scratch_dir};
+use frictionid_cli::testing::{fitted_value, runs_ok, scratch_dir};
 use std::f64::consts::PI;
 use std::path::Path;
 
@@ -56,15 +56,7 @@ fn a_gearbox_load_channel_is_read_fitted_and_plotted() {
         run(&dir, "channels = { load = \"Load torque\" }\n"),
         &dir.join("out"),
     );
-    let value = |name: &str| {
-        r["parameters"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|p| p["name"] == name)
-            .and_then(|p| p["value"].as_f64())
-            .unwrap()
-    };
+    let value = |name: &str| fitted_value(&r, name);
     for (name, truth) in [("mu", 2.0), ("mu_load", 0.03), ("viscous", 5.0)] {
         let got = value(name);
         assert!((got / truth - 1.0).abs() < 1e-3, "{name} = {got}");

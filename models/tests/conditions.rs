@@ -194,22 +194,3 @@ fn position_ripple_reads_the_displacement() {
         plain.force(0.2, &[], 3.0)
     );
 }
-
-#[test]
-fn documentation_tables_match_the_declarations() {
-    for (name, source) in [
-        (
-            "coulomb_load",
-            include_str!("../src/builtin/coulomb_load.rs"),
-        ),
-        (
-            "position_ripple",
-            include_str!("../src/builtin/position_ripple.rs"),
-        ),
-    ] {
-        let info = default_model(name).unwrap().param_info();
-        if let Some(table) = testing::doc_table_mismatch(source, &info) {
-            panic!("the documentation of `{name}` should contain\n{table}");
-        }
-    }
-}
