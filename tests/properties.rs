@@ -15,6 +15,17 @@ use frictionid_models::{default_model, Coulomb, FrictionModel, ViscousCoulomb};
 use proptest::prelude::*;
 use proptest::test_runner::{RngSeed, TestCaseError};
 
+/// The default fit options, the starts run on one thread.
+fn serial() -> FitOptions {
+    FitOptions {
+        hooks: Hooks {
+            parallel: false,
+            ..Hooks::default()
+        },
+        ..FitOptions::default()
+    }
+}
+
 /// FMM-like oscillators: the paper's stage is m = 10.4 kg, c = 0.275 N s/m, k = 1982 N/m,
 /// N = 14.5 N.
 fn oscillator() -> impl Strategy<Value = Oscillator> {
@@ -299,14 +310,7 @@ proptest! {
         let x0 = x0.max(6.0 * mu * osc.normal_force / osc.stiffness);
         let truth = Coulomb { mu };
         let recs = records(&osc, &truth, &[x0]);
-        let opts = FitOptions {
-            hooks: Hooks {
-                parallel: false,
-                ..Hooks::default()
-            },
-            ..FitOptions::default()
-        };
-        let r = fit(&osc, &Coulomb::default(), &recs, &opts).expect("fit");
+        let r = fit(&osc, &Coulomb::default(), &recs, &serial()).expect("fit");
         let got = r.value("mu").expect("mu is fitted");
         prop_assert!(rel(got, mu) < 1e-5, "mu {got} vs truth {mu} ({})", r.termination);
     }
@@ -321,14 +325,7 @@ proptest! {
         let x0 = 8.0 * mu * osc.normal_force / osc.stiffness + 0.005;
         let truth = ViscousCoulomb { mu, viscous };
         let recs = records(&osc, &truth, &[x0, 1.6 * x0]);
-        let opts = FitOptions {
-            hooks: Hooks {
-                parallel: false,
-                ..Hooks::default()
-            },
-            ..FitOptions::default()
-        };
-        let r = fit(&osc, &ViscousCoulomb::default(), &recs, &opts).expect("fit");
+        let r = fit(&osc, &ViscousCoulomb::default(), &recs, &serial()).expect("fit");
         let (m, b) = (r.value("mu").expect("mu"), r.value("viscous").expect("viscous"));
         prop_assert!(rel(m, mu) < 1e-4, "mu {m} vs truth {mu} ({})", r.termination);
         prop_assert!(rel(b, viscous) < 1e-3, "viscous {b} vs truth {viscous} ({})", r.termination);

@@ -51,6 +51,16 @@ pub fn read_report(out: &Path) -> serde_json::Value {
         .unwrap_or(serde_json::Value::Null)
 }
 
+/// The value of the fitted parameter `name` in a fit report (report.json), NaN when the
+/// report has no such parameter.
+pub fn fitted_value(report: &serde_json::Value, name: &str) -> f64 {
+    report["parameters"]
+        .as_array()
+        .and_then(|p| p.iter().find(|p| p["name"] == name))
+        .and_then(|p| p["value"].as_f64())
+        .unwrap_or(f64::NAN)
+}
+
 /// The report of a run that must succeed: checks that `output` (a finished run of a command
 /// that wrote its report into `out`) exited successfully, the failure message showing its
 /// stderr, and returns report.json with the run's stderr.

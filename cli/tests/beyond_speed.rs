@@ -3,7 +3,7 @@
 //! motion, plotted beside the record; and the one-line error of a record without it.
 
 use assert_cmd::Command;
-use frictionid_cli::testing::{runs_ok, scratch_dir};
+use frictionid_cli::testing::{fitted_value, runs_ok, scratch_dir};
 use std::f64::consts::PI;
 use std::path::Path;
 
@@ -26,13 +26,8 @@ fn joint_csv(with_load: bool) -> String {
             .parse()
             .unwrap();
         let load = 30.0 * (2.0 * PI * 0.13 * t).sin() + 10.0 * (2.0 * PI * 0.41 * t + 1.0).sin();
-        let s = if v > 0.0 {
-            1.0
-        } else if v < 0.0 {
-            -1.0
-        } else {
-            0.0
-        };
+        // sgn(v), 0 at rest (std's signum gives +-1 at +-0).
+        let s = if v == 0.0 { 0.0 } else { f64::signum(v) };
         let f = (2.0 + 0.03 * f64::abs(load)) * s + 5.0 * v;
         csv.push_str(&format!("{t},{v},{f:.12}"));
         if with_load {
@@ -61,15 +56,7 @@ fn a_gearbox_load_channel_is_read_fitted_and_plotted() {
         run(&dir, "channels = { load = \"Load torque\" }\n"),
         &dir.join("out"),
     );
-    let value = |name: &str| {
-        r["parameters"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|p| p["name"] == name)
-            .and_then(|p| p["value"].as_f64())
-            .unwrap()
-    };
+    let value = |name: &str| fitted_value(&r, name);
     for (name, truth) in [("mu", 2.0), ("mu_load", 0.03), ("viscous", 5.0)] {
         let got = value(name);
         assert!((got / truth - 1.0).abs() < 1e-3, "{name} = {got}");

@@ -4,7 +4,7 @@
 //! force (the levels are forces). Truth: m 2 kg, F_c 2 N, viscous 4 N s/m, against the closed
 //! form of m v' = u - F_c - b v between the input's steps.
 
-use frictionid_cli::testing::{runs_ok, scratch_dir};
+use frictionid_cli::testing::{fitted_value, runs_ok, scratch_dir};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use std::fmt::Write as _;
 use std::process::Command;
@@ -70,11 +70,7 @@ fn fit(tag: &str, oscillator: &str) -> (serde_json::Value, String) {
 }
 
 fn value(r: &serde_json::Value, name: &str) -> f64 {
-    r["parameters"]
-        .as_array()
-        .and_then(|p| p.iter().find(|p| p["name"] == name))
-        .and_then(|p| p["value"].as_f64())
-        .unwrap_or(f64::NAN)
+    fitted_value(r, name)
 }
 
 #[test]

@@ -3,8 +3,8 @@
 //! acceleration is differentiated across a reversal; its force-balance plot draws one
 //! marker per sample left out, as many as report.json's finding counts.
 
-use crate::units::{drive_config, drive_csv, frictionid};
-use frictionid_cli::testing::{run_ok, scratch_dir};
+use crate::units::{drive_config, drive_csv, run_quiet};
+use frictionid_cli::testing::scratch_dir;
 
 /// The fill of a marked sample's circle in the SVG (the plots' colour of marked samples).
 const MARK_FILL: &str = "#E60078";
@@ -26,12 +26,7 @@ fn the_force_balance_plot_marks_each_sample_left_out() {
     std::fs::write(dir.join("drive.csv"), drive_csv(&dir, 1.0)).unwrap();
     std::fs::write(dir.join("fit.toml"), drive_config("force", "mass = 10.0\n")).unwrap();
     let out = dir.join("fit");
-    run_ok(
-        frictionid()
-            .args(["fit", "--quiet", "--out"])
-            .arg(&out)
-            .arg(dir.join("fit.toml")),
-    );
+    run_quiet("fit", &dir.join("fit.toml"), &out);
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     let count = report["records"][0]["unreliable_target"]["count"]

@@ -13,6 +13,8 @@ fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
 }
 
+/// Runs `frictionid <args> --out <out> --json` and checks that it succeeds; its output and
+/// report.json.
 fn run_json(args: &[&str], out: &Path) -> (std::process::Output, serde_json::Value) {
     let o = frictionid()
         .args(args)
@@ -21,6 +23,7 @@ fn run_json(args: &[&str], out: &Path) -> (std::process::Output, serde_json::Val
         .arg("--json")
         .output()
         .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     (o, read_report(out))
 }
 
@@ -29,11 +32,10 @@ fn run_json(args: &[&str], out: &Path) -> (std::process::Output, serde_json::Val
 fn compare_fixture(tag: &str, models: &str) -> (std::path::PathBuf, serde_json::Value) {
     let out = scratch_dir("fc", tag);
     let cfg = fixtures_dir().join("fmm-compare.toml");
-    let (o, r) = run_json(
+    let (_, r) = run_json(
         &["compare", cfg.to_str().unwrap(), "--models", models],
         &out,
     );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     (out, r)
 }
 
@@ -45,7 +47,6 @@ fn fit_recovers_the_fixture_truth_and_writes_every_output() {
     let out = scratch_dir("fc", "fit");
     let cfg = fixtures_dir().join("fmm-fit.toml");
     let (o, r) = run_json(&["fit", cfg.to_str().unwrap()], &out);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let stdout: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(stdout, r, "--json prints report.json");
     assert_eq!(r["command"], "fit");
@@ -117,8 +118,7 @@ fn a_normal_force_uncertainty_in_the_config_reaches_every_fitted_parameter() {
     );
     let cfg = out.join("budget.toml");
     std::fs::write(&cfg, config).unwrap();
-    let (o, r) = run_json(&["fit", cfg.to_str().unwrap()], &out.join("out"));
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (_, r) = run_json(&["fit", cfg.to_str().unwrap()], &out.join("out"));
     let p = &r["parameters"][0];
     assert_eq!(p["name"], "mu");
     let c = &p["std_error_components"];
@@ -336,8 +336,7 @@ fn energy_without_a_model_takes_its_reference_from_a_coulomb_fit() {
     let cfg = dir.join("energy.toml");
     std::fs::write(&cfg, text).unwrap();
     let out = dir.join("out");
-    let (o, r) = run_json(&["energy", cfg.to_str().unwrap()], &out);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (_, r) = run_json(&["energy", cfg.to_str().unwrap()], &out);
     for rec in r["records"].as_array().unwrap() {
         let reference = rec["reference"].as_f64().unwrap();
         // The fitted mu N: the truth 3.48 N within 0.1 %.
@@ -372,8 +371,7 @@ fn energy_uses_measured_displacement_and_acceleration_columns() {
     );
     std::fs::write(dir.join("energy.toml"), cfg).unwrap();
     let out = dir.join("out");
-    let (o, r) = run_json(&["energy", dir.join("energy.toml").to_str().unwrap()], &out);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (_, r) = run_json(&["energy", dir.join("energy.toml").to_str().unwrap()], &out);
     let rec = &r["records"][0];
     assert_eq!(rec["sources"]["displacement"], "measured");
     assert_eq!(rec["sources"]["acceleration"], "measured");
@@ -403,8 +401,7 @@ fn expression_sign_law_fits_the_same_mu_as_coulomb() {
     for (name, text) in [("coulomb", &base), ("expression", &expr)] {
         let cfg = dir.join(format!("{name}.toml"));
         std::fs::write(&cfg, text).unwrap();
-        let (o, r) = run_json(&["fit", cfg.to_str().unwrap()], &dir.join(name));
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let (_, r) = run_json(&["fit", cfg.to_str().unwrap()], &dir.join(name));
         assert_eq!(r["model"], name);
         mus.push(r["parameters"][0]["value"].as_f64().unwrap());
     }
@@ -427,8 +424,7 @@ fn a_displacement_only_record_is_fitted_in_displacement() {
     );
     std::fs::write(dir.join("fit.toml"), cfg).unwrap();
     let out = dir.join("out");
-    let (o, r) = run_json(&["fit", dir.join("fit.toml").to_str().unwrap()], &out);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (_, r) = run_json(&["fit", dir.join("fit.toml").to_str().unwrap()], &out);
     let mu = r["parameters"][0]["value"].as_f64().unwrap();
     assert!((mu / TRUTH_MU - 1.0).abs() < 1e-6, "mu {mu}");
     assert_eq!(r["residual_unit"], "m", "{}", r["residual_unit"]);

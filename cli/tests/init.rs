@@ -7,7 +7,9 @@
 
 use assert_cmd::Command;
 use frictionid_cli::testing::Says::Contains;
-use frictionid_cli::testing::{assert_bad_inputs, read_report, runs_ok, scratch_dir, BadInput};
+use frictionid_cli::testing::{
+    assert_bad_inputs, fitted_value, read_report, runs_ok, scratch_dir, BadInput,
+};
 use frictionid_engine::synthetic::{add_gaussian_noise, release_records};
 use frictionid_engine::Oscillator;
 use frictionid_models::Stribeck;
@@ -74,18 +76,8 @@ fn vibrometer_file(dir: &Path) -> PathBuf {
     path
 }
 
-fn param(fit: &serde_json::Value, name: &str) -> f64 {
-    fit["parameters"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|p| p["name"] == name)
-        .and_then(|p| p["value"].as_f64())
-        .unwrap_or(f64::NAN)
-}
-
 fn assert_levels(fit: &serde_json::Value) {
-    let (mu_c, mu_s) = (param(fit, "mu_c"), param(fit, "mu_s"));
+    let (mu_c, mu_s) = (fitted_value(fit, "mu_c"), fitted_value(fit, "mu_s"));
     assert!((mu_c / MU_C - 1.0).abs() < 0.01, "mu_c {mu_c}");
     assert!((mu_s / MU_S - 1.0).abs() < 0.01, "mu_s {mu_s}");
 }
@@ -148,7 +140,7 @@ fn the_export_named_in_a_hand_written_config_fits() {
     assert_levels(&r);
     // The release found in the samples, then fitted: the instant to a twentieth of a sample.
     let found = r["records"][0]["release_time"].as_f64().unwrap();
-    let shift = param(&r, "shift[vib.txt]");
+    let shift = fitted_value(&r, "shift[vib.txt]");
     let fitted = found + shift;
     eprintln!("release found {found} s, fitted {fitted} s (truth {REST} s)");
     assert!(

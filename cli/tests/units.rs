@@ -4,13 +4,25 @@
 //! (exit 1), while their correct twins fit; a formula that is not finite on the data and
 //! `max_iterations = 0` are config errors. The records are made by `simulate`.
 
-use frictionid_cli::testing::{assert_bad_inputs, run_ok, scratch_dir, BadInput, Says};
+use frictionid_cli::testing::{
+    assert_bad_inputs, fitted_value, run_ok, scratch_dir, BadInput, Says,
+};
 use std::fmt::Write;
 use std::path::Path;
-use std::process::Command;
+use std::process::{Command, Output};
 
 pub(crate) fn frictionid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_frictionid"))
+}
+
+/// Runs `frictionid <command> --quiet --out <out> <config>` and checks that it succeeds.
+pub(crate) fn run_quiet(command: &str, config: &Path, out: &Path) -> Output {
+    run_ok(
+        frictionid()
+            .args([command, "--quiet", "--out"])
+            .arg(out)
+            .arg(config),
+    )
 }
 
 /// Runs `simulate` on `config` in `dir` and returns the rows of its trajectory.csv as
@@ -18,12 +30,7 @@ pub(crate) fn frictionid() -> Command {
 fn simulate(dir: &Path, config: &str) -> Vec<(f64, f64, f64)> {
     std::fs::write(dir.join("sim.toml"), config).unwrap();
     let out = dir.join("sim");
-    run_ok(
-        frictionid()
-            .args(["simulate", "--quiet", "--out"])
-            .arg(&out)
-            .arg(dir.join("sim.toml")),
-    );
+    run_quiet("simulate", &dir.join("sim.toml"), &out);
     let text = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
@@ -123,23 +130,12 @@ fn a_drive_in_millimetres_read_as_metres_is_refused_and_its_twin_fits() {
     std::fs::write(dir.join("drive.csv"), drive_csv(&dir, 1.0)).unwrap();
     std::fs::write(dir.join("fit.toml"), drive_config("force", "mass = 10.0\n")).unwrap();
     let out = dir.join("fit");
-    let o = run_ok(
-        frictionid()
-            .args(["fit", "--quiet", "--out"])
-            .arg(&out)
-            .arg(dir.join("fit.toml")),
-    );
+    let o = run_quiet("fit", &dir.join("fit.toml"), &out);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!stderr.contains("_scale"), "{stderr}");
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
-    let value = |name: &str| {
-        report["parameters"]
-            .as_array()
-            .and_then(|p| p.iter().find(|p| p["name"] == name))
-            .and_then(|p| p["value"].as_f64())
-            .unwrap_or(f64::NAN)
-    };
+    let value = |name: &str| fitted_value(&report, name);
     for (name, truth) in [("mass", 12.0), ("damping", 30.0), ("mu", 8.0)] {
         assert!(
             (value(name) / truth - 1.0).abs() < 0.01,
@@ -204,12 +200,7 @@ fn a_pendulum_in_degrees_is_refused_whether_or_not_its_gravity_moment_is_fitted(
         pendulum_config("\"damping\", \"gravity_moment\""),
     )
     .unwrap();
-    let o = run_ok(
-        frictionid()
-            .args(["fit", "--quiet", "--out"])
-            .arg(dir.join("fit"))
-            .arg(dir.join("fit.toml")),
-    );
+    let o = run_quiet("fit", &dir.join("fit.toml"), &dir.join("fit"));
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!stderr.contains("_scale"), "{stderr}");
     let _ = std::fs::remove_dir_all(&dir);

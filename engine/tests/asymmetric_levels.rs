@@ -9,8 +9,7 @@
 //! inverse-dynamics route (the balance u - M a against the law) recover both levels within
 //! 1 %; the symmetric law is worse.
 
-use crate::util::{multisine, sample_times, Tone};
-use frictionid_engine::axis::{NoRestoring, Restoring};
+use crate::util::{driven_slide, multisine, sample_times, Tone};
 use frictionid_engine::identify::{
     fit, FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam, ParamOptions,
     TargetOptions,
@@ -133,15 +132,9 @@ fn record(name: &str) -> Record {
         .with_channel(Channel::InputForce, u)
 }
 
+/// The slide the fits start from: the mass 1.5 (fitted; the truth is `MASS`), no spring.
 fn slide() -> Oscillator {
-    Oscillator {
-        mass: 1.5,
-        damping: 0.0,
-        stiffness: 1.0,
-        normal_force: 1.0,
-        restoring: Restoring::None(NoRestoring),
-        ..Oscillator::fmm()
-    }
+    driven_slide(1.5, 0.0)
 }
 
 fn options(domain: FitDomain) -> FitOptions {
@@ -164,16 +157,24 @@ fn options(domain: FitDomain) -> FitOptions {
     }
 }
 
-fn fit_both(domain: FitDomain, records: &[Record]) -> (FitResult, FitResult) {
+/// The direction-dependent law of levels `mu_pos` and `mu_neg`, and the symmetric law of
+/// their mean level, both with the viscous term `viscous`.
+fn level_pair(
+    mu_pos: f64,
+    mu_neg: f64,
+    viscous: f64,
+) -> (ViscousCoulombAsymmetric, ViscousCoulomb) {
     let asymmetric = ViscousCoulombAsymmetric {
-        mu_pos: 4.0,
-        mu_neg: 4.0,
-        viscous: 15.0,
+        mu_pos,
+        mu_neg,
+        viscous,
     };
-    let symmetric = ViscousCoulomb {
-        mu: 4.0,
-        viscous: 15.0,
-    };
+    let mu = 0.5 * (mu_pos + mu_neg);
+    (asymmetric, ViscousCoulomb { mu, viscous })
+}
+
+fn fit_both(domain: FitDomain, records: &[Record]) -> (FitResult, FitResult) {
+    let (asymmetric, symmetric) = level_pair(4.0, 4.0, 15.0);
     let opts = options(domain);
     (
         fit(&slide(), &asymmetric, records, &opts).expect("a fit"),
@@ -229,15 +230,7 @@ fn compare_recommends_direction_dependent_levels_only_where_the_records_have_the
     let names = ["coulomb", "viscous_coulomb", "viscous_coulomb_asymmetric"];
     let models: Vec<Box<dyn FrictionModel>> =
         names.iter().map(|n| default_model(n).unwrap()).collect();
-    let asymmetric = ViscousCoulombAsymmetric {
-        mu_pos: 0.26,
-        mu_neg: 0.18,
-        viscous: 0.5,
-    };
-    let symmetric = ViscousCoulomb {
-        mu: 0.22,
-        viscous: 0.5,
-    };
+    let (asymmetric, symmetric) = level_pair(0.26, 0.18, 0.5);
     for (truth, expected) in [
         (
             &asymmetric as &dyn FrictionModel,

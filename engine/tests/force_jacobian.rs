@@ -260,22 +260,19 @@ fn the_balance_columns_of_inverse_dynamics_are_the_residuals_derivatives() {
         normal_force: 1.0,
         ..Oscillator::fmm()
     };
-    let coulomb = ["mu", "viscous"];
-    check(
-        &ViscousCoulomb::default(),
-        vec![driven_record()],
-        osc,
-        &inverse_options(&coulomb),
-        &[],
-    );
-    let dahl = ["sigma0", "mu_c"];
-    check(
-        &Dahl::default(),
-        vec![driven_record()],
-        osc,
-        &inverse_options(&dahl),
-        &[],
-    );
+    let laws: [(&(dyn FrictionModel + 'static), [&str; 2]); 2] = [
+        (&ViscousCoulomb::default(), ["mu", "viscous"]),
+        (&Dahl::default(), ["sigma0", "mu_c"]),
+    ];
+    for (law, free) in laws {
+        check(
+            law,
+            vec![driven_record()],
+            osc,
+            &inverse_options(&free),
+            &[],
+        );
+    }
 }
 
 /// The columns the producer gives directly are all but GMS's sharpness (which has no closed-form

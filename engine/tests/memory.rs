@@ -14,11 +14,11 @@
 mod util;
 
 use frictionid_engine::exact::coulomb_free_vibration;
-use frictionid_engine::identify::{fit, FitOptions};
+use frictionid_engine::identify::{fit, FitOptions, FitResult};
 
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::testing::DamperStroke;
-use frictionid_engine::{Oscillator, Record};
+use frictionid_engine::{EngineError, Oscillator, Record};
 use frictionid_models::{Coulomb, Dahl};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -101,6 +101,31 @@ fn long_coulomb_record(samples: usize) -> Record {
     Record::new("long", time, v, 0.14)
 }
 
+/// The memory a fit of `samples` samples may hold at its peak over the baseline.
+struct Budget {
+    /// The fit, as the failure names it.
+    what: &'static str,
+    samples: usize,
+    bytes_per_sample: usize,
+}
+
+impl Budget {
+    /// Runs `run` under the allocation counter, checks that its peak keeps to the budget, and
+    /// returns its fit.
+    fn fit(&self, run: impl FnOnce() -> Result<FitResult, EngineError>) -> FitResult {
+        let (result, peak) = peak_over_baseline(run);
+        let result = result.expect("the fit");
+        let (what, samples, budget) = (self.what, self.samples, self.bytes_per_sample);
+        let per_sample = peak / samples;
+        assert!(
+            per_sample <= budget,
+            "{what} of {samples} samples held {peak} bytes at its peak: {per_sample} per sample \
+             (at most {budget})"
+        );
+        result
+    }
+}
+
 #[test]
 fn a_velocity_fit_holds_a_bounded_number_of_bytes_per_sample() {
     let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
@@ -108,17 +133,15 @@ fn a_velocity_fit_holds_a_bounded_number_of_bytes_per_sample() {
     let record = [long_coulomb_record(samples)];
     let opts = FitOptions::default();
     let osc = Oscillator::fmm();
-    let (result, peak) = peak_over_baseline(|| fit(&osc, &Coulomb::default(), &record, &opts));
-    let result = result.expect("the fit");
+    let budget = Budget {
+        what: "a velocity fit",
+        samples,
+        bytes_per_sample: VELOCITY_BYTES_PER_SAMPLE,
+    };
+    let result = budget.fit(|| fit(&osc, &Coulomb::default(), &record, &opts));
     // The fit itself is right: mu within 1 % of the truth.
     let mu = result.fitted_model.params()[0];
     assert!((mu / 0.24 - 1.0).abs() < 0.01, "mu = {mu}");
-    let per_sample = peak / samples;
-    assert!(
-        per_sample <= VELOCITY_BYTES_PER_SAMPLE,
-        "a velocity fit of {samples} samples held {peak} bytes at its peak: {per_sample} per \
-         sample (at most {VELOCITY_BYTES_PER_SAMPLE})"
-    );
 }
 
 /// A friction damper's stroke: 2 mm at 3 Hz, `samples` at 1 kHz, Dahl's force (alpha 1,
@@ -145,14 +168,12 @@ fn a_force_domain_fit_holds_a_bounded_number_of_bytes_per_sample() {
     opts.params.free = util::free(&["sigma0", "mu_c"]);
     // One thread: the starts in flight at once would depend on the machine's cores.
     let opts = util::serial(opts);
-    let (result, peak) = peak_over_baseline(|| fit(&osc, &Dahl::default(), &record, &opts));
-    let result = result.expect("the fit");
+    let budget = Budget {
+        what: "a force-domain fit",
+        samples,
+        bytes_per_sample: FORCE_BYTES_PER_SAMPLE,
+    };
+    let result = budget.fit(|| fit(&osc, &Dahl::default(), &record, &opts));
     let level = result.fitted_model.params()[1];
     assert!((level / 60.0 - 1.0).abs() < 0.01, "level = {level}");
-    let per_sample = peak / samples;
-    assert!(
-        per_sample <= FORCE_BYTES_PER_SAMPLE,
-        "a force-domain fit of {samples} samples held {peak} bytes at its peak: {per_sample} \
-         per sample (at most {FORCE_BYTES_PER_SAMPLE})"
-    );
 }

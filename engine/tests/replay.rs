@@ -10,6 +10,7 @@
 //! (extrapolated, so that a load crossing zero within a step costs no accuracy) within 1e-6 of
 //! each parameter's largest derivative.
 
+use crate::util::{assert_derivative_matches, central_difference};
 use frictionid_engine::energy::{
     force_derivatives_along, model_force_with_normal, replay_interval, states_along, MeasuredMotion,
 };
@@ -150,18 +151,6 @@ fn force_at(model: &(dyn FrictionModel + 'static), m: &Motion, j: usize, value: 
     model_force_with_normal(moved.as_ref(), &m.time, &m.v, &m.normal).expect("a replay")
 }
 
-/// dF/dp_j at every sample by central differences with steps h and h/2, extrapolated.
-fn differenced(model: &(dyn FrictionModel + 'static), m: &Motion, j: usize) -> Vec<f64> {
-    let p = model.params()[j];
-    let h = 1e-6 * if p == 0.0 { 1.0 } else { p.abs() };
-    let central = |h: f64| -> Vec<f64> {
-        let (a, b) = (force_at(model, m, j, p + h), force_at(model, m, j, p - h));
-        a.iter().zip(&b).map(|(a, b)| (a - b) / (2.0 * h)).collect()
-    };
-    let (wide, narrow) = (central(h), central(0.5 * h));
-    wide.iter().zip(&narrow).map(|(w, n)| 2.0 * n - w).collect()
-}
-
 #[test]
 fn replayed_force_derivatives_match_central_differences() {
     let m = motion();
@@ -180,16 +169,10 @@ fn replayed_force_derivatives_match_central_differences() {
                 );
                 continue;
             }
-            let expected = differenced(model.as_ref(), &m, j);
-            let largest = expected.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-            let worst = (0..SAMPLES)
-                .map(|k| (d.at(k, j) - expected[k]).abs())
-                .fold(0.0f64, f64::max);
-            assert!(
-                worst <= 1e-6 * largest,
-                "{} dF/d{name}: worst difference {worst:e}, largest derivative {largest:e}",
-                model.name()
-            );
+            let p = model.params()[j];
+            let expected = central_difference(p, |value| force_at(model.as_ref(), &m, j, value));
+            let what = format!("{} dF/d{name}", model.name());
+            assert_derivative_matches(|k| d.at(k, j), &expected, 1e-6, &what);
         }
     }
 }

@@ -8,7 +8,10 @@
 //! the true velocity with 3 mm/s of noise, an eighth of the peak speed, so that near every
 //! reversal the velocity's sign flips back and forth where the displacement's does not.
 
-use crate::util::{estimate, free, no_oscillator_force_options, rel, serial};
+use crate::util::{
+    assert_derivative_matches, central_difference, estimate, free, no_oscillator_force_options,
+    rel, serial,
+};
 use frictionid_engine::energy::{
     force_derivatives_along_path, states_along, states_along_path, MeasuredMotion,
 };
@@ -36,6 +39,25 @@ fn stroke() -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let x = time.iter().map(|t| AMPLITUDE * (w * t).sin()).collect();
     let v = time.iter().map(|t| AMPLITUDE * w * (w * t).cos()).collect();
     (time, x, v)
+}
+
+/// The stroke's time, true displacement and velocity with its noise.
+fn stroke_with_noisy_velocity() -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let (time, x, mut v) = stroke();
+    add_gaussian_noise(&mut v, VELOCITY_NOISE, 12);
+    (time, x, v)
+}
+
+/// A normal force of 1 N throughout.
+static UNIT_NORMAL: NormalForce = NormalForce::Constant(1.0);
+
+/// The motion of `time` and `v` under a normal force of 1 N.
+fn unit_normal_motion<'a>(time: &'a [f64], v: &'a [f64]) -> MeasuredMotion<'a> {
+    MeasuredMotion {
+        time,
+        v,
+        normal: &UNIT_NORMAL,
+    }
 }
 
 /// The stroke as measured: the displacement and velocity with their noise, and Dahl's force
@@ -67,15 +89,8 @@ fn dahl_fit(record: &Record, path: ReplayPath) -> (f64, f64) {
 
 #[test]
 fn the_replay_along_the_displacement_is_dahls_closed_form() {
-    let (time, x, v) = stroke();
-    let mut noisy_v = v;
-    add_gaussian_noise(&mut noisy_v, VELOCITY_NOISE, 12);
-    let normal = NormalForce::Constant(1.0);
-    let motion = MeasuredMotion {
-        time: &time,
-        v: &noisy_v,
-        normal: &normal,
-    };
+    let (time, x, noisy_v) = stroke_with_noisy_velocity();
+    let motion = unit_normal_motion(&time, &noisy_v);
     let dahl = Dahl {
         sigma0: SIGMA0,
         mu_c: LEVEL,
@@ -157,15 +172,8 @@ fn force_along_path(model: &dyn FrictionModel, motion: MeasuredMotion<'_>, x: &[
 
 #[test]
 fn sensitivities_along_the_displacement_match_central_differences() {
-    let (time, x, v) = stroke();
-    let mut noisy_v = v;
-    add_gaussian_noise(&mut noisy_v, VELOCITY_NOISE, 12);
-    let normal = NormalForce::Constant(1.0);
-    let motion = MeasuredMotion {
-        time: &time,
-        v: &noisy_v,
-        normal: &normal,
-    };
+    let (time, x, noisy_v) = stroke_with_noisy_velocity();
+    let motion = unit_normal_motion(&time, &noisy_v);
     let laws: [Box<dyn FrictionModel>; 3] = [
         Box::new(Dahl {
             sigma0: SIGMA0,
@@ -187,7 +195,6 @@ fn sensitivities_along_the_displacement_match_central_differences() {
             .expect("exact steps and a parameter gradient");
         let base = model.params();
         for (j, &p) in base.iter().enumerate().filter(|&(j, _)| d.given[j]) {
-            let h = 1e-6 * if p == 0.0 { 1.0 } else { p.abs() };
             let at = |value: f64| {
                 let mut moved = frictionid_models::clone_model(model.as_ref());
                 let mut params = base.clone();
@@ -195,26 +202,9 @@ fn sensitivities_along_the_displacement_match_central_differences() {
                 moved.set_params(&params).expect("valid parameters");
                 force_along_path(moved.as_ref(), motion, &x)
             };
-            // Central differences with steps h and h/2, extrapolated (a load crossing zero
-            // within a step costs no accuracy).
-            let central = |h: f64| -> Vec<f64> {
-                let (up, down) = (at(p + h), at(p - h));
-                up.iter()
-                    .zip(&down)
-                    .map(|(a, b)| (a - b) / (2.0 * h))
-                    .collect()
-            };
-            let (wide, narrow) = (central(h), central(0.5 * h));
-            let expected: Vec<f64> = wide.iter().zip(&narrow).map(|(w, n)| 2.0 * n - w).collect();
-            let largest = expected.iter().fold(0.0f64, |a, e| a.max(e.abs()));
-            let worst = (0..SAMPLES)
-                .map(|k| (d.at(k, j) - expected[k]).abs())
-                .fold(0.0f64, f64::max);
-            assert!(
-                worst <= 1e-5 * largest,
-                "{} parameter {j}: worst difference {worst:e}, largest derivative {largest:e}",
-                model.name()
-            );
+            let expected = central_difference(p, at);
+            let what = format!("{} parameter {j}", model.name());
+            assert_derivative_matches(|k| d.at(k, j), &expected, 1e-5, &what);
         }
     }
 }

@@ -12,7 +12,7 @@ use frictionid_engine::identify::values::search::Loss;
 use frictionid_engine::identify::{compare, fit, Check, FitOptions, FitResult, Status};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
-use frictionid_engine::{Oscillator, Record};
+use frictionid_engine::{EngineError, Oscillator, Record};
 use frictionid_models::{default_model, FrictionModel, ViscousCoulomb};
 
 const MASS: f64 = 12.0;
@@ -47,6 +47,15 @@ fn drive_record(seconds: f64, unit: f64, seed: u64) -> Record {
     Record::from_time_base("drive.csv", TimeBase::new(t).unwrap())
         .with_channel(Channel::Displacement, x)
         .with_channel(Channel::InputForce, u)
+}
+
+/// The law of the drive (viscous and Coulomb friction) fitted to `record`.
+fn fit_drive(
+    osc: &Oscillator,
+    record: Record,
+    opts: &FitOptions,
+) -> Result<FitResult, EngineError> {
+    fit(osc, &ViscousCoulomb::default(), &[record], opts)
 }
 
 /// `seconds` of the drive with its exact position and input.
@@ -150,22 +159,10 @@ fn the_target_does_not_depend_on_the_unit_of_the_position() {
     // Off the velocity's resolution (1 mm/s at 2 kHz), which a rescaled sample may cross by
     // its last bit.
     opts.energy.velocity_threshold = 1.5e-3;
-    let metres = fit(
-        &osc,
-        &ViscousCoulomb::default(),
-        &[drive_record(9.5, 1.0, 7)],
-        &opts,
-    )
-    .unwrap();
+    let metres = fit_drive(&osc, drive_record(9.5, 1.0, 7), &opts).unwrap();
     let mut mm_opts = opts.clone();
     mm_opts.energy.velocity_threshold *= 1000.0;
-    let millimetres = fit(
-        &osc,
-        &ViscousCoulomb::default(),
-        &[drive_record(9.5, 1e-3, 7)],
-        &mm_opts,
-    )
-    .unwrap();
+    let millimetres = fit_drive(&osc, drive_record(9.5, 1e-3, 7), &mm_opts).unwrap();
     let same = |a: f64, b: f64| (a / b - 1.0).abs() < 1e-6;
     assert_eq!(
         metres.records[0].series.measured.len(),
@@ -193,7 +190,7 @@ fn the_target_does_not_depend_on_the_unit_of_the_position() {
 fn a_clean_record_is_fitted_as_before() {
     let (osc, opts) = options();
     let record = drive_record_exact(9.5);
-    let r = fit(&osc, &ViscousCoulomb::default(), &[record], &opts).unwrap();
+    let r = fit_drive(&osc, record, &opts).unwrap();
     for (name, truth) in [
         ("mass", MASS),
         ("viscous", VISCOUS),
@@ -234,13 +231,7 @@ fn a_robust_loss_leaves_a_clean_fit_where_least_squares_puts_it() {
     let run = |loss: Loss| {
         let mut o = opts.clone();
         o.search.loss = loss;
-        fit(
-            &osc,
-            &ViscousCoulomb::default(),
-            std::slice::from_ref(&record),
-            &o,
-        )
-        .unwrap()
+        fit_drive(&osc, record.clone(), &o).unwrap()
     };
     let linear = run(Loss::Linear);
     for loss in [Loss::Huber, Loss::SoftL1] {
@@ -270,13 +261,7 @@ fn a_robust_loss_leaves_a_clean_fit_where_least_squares_puts_it() {
 fn a_robust_loss_fits_the_drive_case() {
     let (osc, mut opts) = options();
     opts.search.loss = Loss::Huber;
-    let r = fit(
-        &osc,
-        &ViscousCoulomb::default(),
-        &[drive_record(9.5, 1.0, 7)],
-        &opts,
-    )
-    .unwrap();
+    let r = fit_drive(&osc, drive_record(9.5, 1.0, 7), &opts).unwrap();
     for (name, truth) in [("mass", MASS), ("viscous", VISCOUS), ("mu", COULOMB)] {
         let v = value(&r, name);
         assert!(
@@ -292,13 +277,8 @@ fn a_robust_loss_fits_the_drive_case() {
 fn a_loss_scale_that_is_not_positive_is_refused() {
     let (osc, mut opts) = options();
     opts.search.f_scale = Some(-1.0);
-    let e = fit(
-        &osc,
-        &ViscousCoulomb::default(),
-        &[drive_record(1.0, 1.0, 7)],
-        &opts,
-    )
-    .unwrap_err()
-    .to_string();
+    let e = fit_drive(&osc, drive_record(1.0, 1.0, 7), &opts)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("f_scale must be a number > 0"), "{e}");
 }

@@ -31,6 +31,39 @@ pub fn sample_times(duration: f64, rate: f64) -> Vec<f64> {
     (0..n).map(|i| i as f64 / rate).collect()
 }
 
+/// d(series)/dp at every sample by central differences with steps h and h/2 (h = 1e-6 of |p|,
+/// 1e-6 at p = 0), extrapolated: `series(value)` is the series with the parameter at `value`.
+pub fn central_difference(p: f64, series: impl Fn(f64) -> Vec<f64>) -> Vec<f64> {
+    let h = 1e-6 * if p == 0.0 { 1.0 } else { p.abs() };
+    let central = |h: f64| -> Vec<f64> {
+        let (up, down) = (series(p + h), series(p - h));
+        up.iter()
+            .zip(&down)
+            .map(|(a, b)| (a - b) / (2.0 * h))
+            .collect()
+    };
+    let (wide, narrow) = (central(h), central(0.5 * h));
+    wide.iter().zip(&narrow).map(|(w, n)| 2.0 * n - w).collect()
+}
+
+/// `derivative(k)` is within `rtol` of the largest |expected| of `expected[k]` at every sample;
+/// `what` names the derivative in the failure.
+pub fn assert_derivative_matches(
+    derivative: impl Fn(usize) -> f64,
+    expected: &[f64],
+    rtol: f64,
+    what: &str,
+) {
+    let largest = expected.iter().fold(0.0f64, |a, e| a.max(e.abs()));
+    let worst = (0..expected.len())
+        .map(|k| (derivative(k) - expected[k]).abs())
+        .fold(0.0f64, f64::max);
+    assert!(
+        worst <= rtol * largest,
+        "{what}: worst difference {worst:e}, largest derivative {largest:e}"
+    );
+}
+
 /// |a - b| / |b|: the relative error of `a` against the truth `b`.
 pub fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs()

@@ -107,7 +107,7 @@ fn the_harness_finds_broken_laws() {
 /// The parameter tables in the module docs are the ones rendered from the declarations.
 #[test]
 fn documentation_tables_match_the_declarations() {
-    let sources: [(&str, &str); 7] = [
+    let sources: [(&str, &str); 11] = [
         ("coulomb", include_str!("../src/builtin/coulomb.rs")),
         (
             "viscous_coulomb",
@@ -118,6 +118,22 @@ fn documentation_tables_match_the_declarations() {
         ("lugre", include_str!("../src/builtin/lugre.rs")),
         ("makkar", include_str!("../src/builtin/makkar.rs")),
         ("gms", include_str!("../src/builtin/gms.rs")),
+        (
+            "coulomb_asymmetric",
+            include_str!("../src/builtin/coulomb_asymmetric.rs"),
+        ),
+        (
+            "viscous_coulomb_asymmetric",
+            include_str!("../src/builtin/viscous_coulomb_asymmetric.rs"),
+        ),
+        (
+            "coulomb_load",
+            include_str!("../src/builtin/coulomb_load.rs"),
+        ),
+        (
+            "position_ripple",
+            include_str!("../src/builtin/position_ripple.rs"),
+        ),
     ];
     for (name, source) in sources {
         let info = if name == "gms" {

@@ -708,22 +708,37 @@ mod tests {
         );
     }
 
+    /// The rows `row(0)` to `row(count - 1)`, one a line.
+    fn table(count: usize, row: impl Fn(usize) -> String) -> String {
+        (0..count).map(|i| row(i) + "\n").collect()
+    }
+
+    /// A fresh directory `frictionid-<name>-<pid>` under the system's temporary directory
+    /// holding `files` (name, contents).
+    fn scratch(name: &str, files: &[(&str, String)]) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("frictionid-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (file, contents) in files {
+            std::fs::write(dir.join(file), contents).unwrap();
+        }
+        dir
+    }
+
     /// x0 is the entry's, else the first sample of the displacement channel (its column named,
     /// or found under its default name), else unknown: an error for a simulated record once
     /// read, a stand-in 0 for a force-domain fit on a measured force.
     #[test]
     fn x0_comes_from_the_entry_the_displacement_or_nowhere() {
-        let dir = std::env::temp_dir().join(format!("frictionid-x0-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let rows: String = (0..12)
-            .map(|i| format!("{},{},{}\n", i as f64 * 1e-3, 0.5 - i as f64 * 1e-3, i))
-            .collect();
-        std::fs::write(dir.join("r.csv"), format!("time,x,velocity\n{rows}")).unwrap();
-        std::fs::write(
-            dir.join("d.csv"),
-            format!("time,displacement,velocity\n{rows}"),
-        )
-        .unwrap();
+        let rows = table(12, |i| {
+            format!("{},{},{}", i as f64 * 1e-3, 0.5 - i as f64 * 1e-3, i)
+        });
+        let dir = scratch(
+            "x0",
+            &[
+                ("r.csv", format!("time,x,velocity\n{rows}")),
+                ("d.csv", format!("time,displacement,velocity\n{rows}")),
+            ],
+        );
         let with_x = source("file = \"r.csv\"\ndisplacement_column = \"x\"").unwrap();
         let r = with_x.resolve(1, &dir).unwrap().load().unwrap();
         assert_eq!((r.x0, r.x0_source), (0.5, X0Source::FirstDisplacement));
@@ -761,16 +776,11 @@ mod tests {
     /// release with the motion; a wrong table is one line naming the entry and the name.
     #[test]
     fn named_channels_are_read_scaled_and_cut_at_the_release() {
-        let dir = std::env::temp_dir().join(format!("frictionid-named-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let rows: String = (0..14)
-            .map(|i| format!("{},{},{},{}\n", i as f64 * 1e-3, i, 20 + i, 2 * i))
-            .collect();
-        std::fs::write(
-            dir.join("r.csv"),
-            format!("time,velocity,T [degC],Load torque [mN m]\n{rows}"),
-        )
-        .unwrap();
+        let rows = table(14, |i| {
+            format!("{},{},{},{}", i as f64 * 1e-3, i, 20 + i, 2 * i)
+        });
+        let header = "time,velocity,T [degC],Load torque [mN m]";
+        let dir = scratch("named", &[("r.csv", format!("{header}\n{rows}"))]);
         let s = source(
             "file = \"r.csv\"\nx0 = 0.0\nrelease = 0.0035\nchannels = { \"temperature\": \"T [degC]\", \"load\": \"Load torque\", \"temperature_scale\": 2.0 }",
         )
@@ -817,12 +827,8 @@ mod tests {
 
     #[test]
     fn load_reads_the_file_and_sets_the_release_state() {
-        let dir = std::env::temp_dir().join(format!("frictionid-source-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let rows: String = (0..12)
-            .map(|i| format!("{},{}\n", i as f64 * 1e-3, i))
-            .collect();
-        std::fs::write(dir.join("r.csv"), format!("time,v\n{rows}")).unwrap();
+        let rows = table(12, |i| format!("{},{}", i as f64 * 1e-3, i));
+        let dir = scratch("source", &[("r.csv", format!("time,v\n{rows}"))]);
         let s = source(
             "file = \"r.csv\"\nx0 = 0.02\nv0 = 0.1\nvelocity_column = \"v\"\nvelocity_scale = 1e-3",
         )

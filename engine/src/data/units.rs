@@ -75,6 +75,9 @@ pub fn unit_of(name: &str) -> Option<Unit> {
     split_unit(name).1.and_then(parse_unit)
 }
 
+/// Unit names and their factors to SI.
+type Spellings = &'static [(&'static str, f64)];
+
 /// Length prefixes: the unit text's prefix and its factor.
 const LENGTHS: [(&str, f64); 7] = [
     ("m", 1.0),
@@ -120,26 +123,31 @@ pub fn parse_unit(text: &str) -> Option<Unit> {
         "rpm" | "1/min" => return unit(Quantity::AngularVelocity, 2.0 * PI / 60.0),
         _ => {}
     }
-    for (name, factor) in LENGTHS {
-        if lower == name {
-            return unit(Quantity::Length, factor);
-        }
-        if lower == format!("{name}/s") {
-            return unit(Quantity::Velocity, factor);
-        }
-        if lower == format!("{name}/s^2") {
-            return unit(Quantity::Acceleration, factor);
-        }
-    }
-    for (name, factor) in ANGLES {
-        if lower == name {
-            return unit(Quantity::Angle, factor);
-        }
-        if lower == format!("{name}/s") {
-            return unit(Quantity::AngularVelocity, factor);
-        }
-        if lower == format!("{name}/s^2") {
-            return unit(Quantity::AngularAcceleration, factor);
+    let families: [(Spellings, [Quantity; 3]); 2] = [
+        (
+            &LENGTHS,
+            [Quantity::Length, Quantity::Velocity, Quantity::Acceleration],
+        ),
+        (
+            &ANGLES,
+            [
+                Quantity::Angle,
+                Quantity::AngularVelocity,
+                Quantity::AngularAcceleration,
+            ],
+        ),
+    ];
+    for (units, [position, velocity, acceleration]) in families {
+        for &(name, factor) in units {
+            for (spelled, quantity) in [
+                (name.to_string(), position),
+                (format!("{name}/s"), velocity),
+                (format!("{name}/s^2"), acceleration),
+            ] {
+                if lower == spelled {
+                    return unit(quantity, factor);
+                }
+            }
         }
     }
     None

@@ -603,7 +603,7 @@ pub fn force_residuals(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use frictionid_models::{Dahl, Gms, LuGre};
+    use crate::energy::numerical_replay::checks::{assert_states_agree, laws_with_states};
     use std::f64::consts::PI;
 
     /// A 3 s stroke at 1 kHz: its displacement, and a velocity channel whose noise (a
@@ -666,31 +666,13 @@ mod tests {
         }
         .along(&x)
         .expect("a valid displacement");
-        let laws: [Box<dyn FrictionModel>; 3] = [
-            Box::new(Dahl::default()),
-            Box::new(LuGre::default()),
-            Box::new(Gms::default()),
-        ];
-        for model in laws {
+        for model in laws_with_states() {
             let law = model.states().expect("a law with states");
             let exact = states_along_checked(model.as_ref(), motion).expect("exact steps");
             let numerical =
                 numerical_replay(law, &time, |i| motion.interval(i)).expect("a numerical replay");
-            let ns = law.n_states();
-            for j in 0..ns {
-                let state = |z: &[f64]| z.iter().skip(j).step_by(ns).copied().collect::<Vec<_>>();
-                let (a, b) = (state(&exact), state(&numerical));
-                let scale = a.iter().fold(0.0f64, |m, z| m.max(z.abs()));
-                let worst = a
-                    .iter()
-                    .zip(&b)
-                    .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
-                assert!(
-                    worst <= 1e-6 * scale + 1e-12 * time.len() as f64,
-                    "{} state {j}: {worst:e} of {scale:e}",
-                    model.name()
-                );
-            }
+            let allowance = 1e-12 * time.len() as f64;
+            assert_states_agree(model.as_ref(), &exact, &numerical, allowance);
         }
     }
 }

@@ -223,12 +223,58 @@ fn run<S: Stepper>(
     Ok((stepper.counts().attempts() - start) as f64)
 }
 
+/// What the replays' tests share: the laws with states they run, and the comparison of two
+/// replays' states.
+#[cfg(test)]
+pub(crate) mod checks {
+    use frictionid_models::{Dahl, FrictionModel, Gms, LuGre};
+
+    /// Dahl, LuGre and GMS at their defaults.
+    pub(crate) fn laws_with_states() -> [Box<dyn FrictionModel>; 3] {
+        [
+            Box::new(Dahl::default()),
+            Box::new(LuGre::default()),
+            Box::new(Gms::default()),
+        ]
+    }
+
+    /// Each of `model`'s states in `numerical` (interleaved, one row per sample) is within
+    /// `1e-6` of the state's largest value in `exact`, plus `allowance`.
+    pub(crate) fn assert_states_agree(
+        model: &dyn FrictionModel,
+        exact: &[f64],
+        numerical: &[f64],
+        allowance: f64,
+    ) {
+        let ns = model.states().map_or(0, |law| law.n_states());
+        for j in 0..ns {
+            let scale = exact
+                .iter()
+                .skip(j)
+                .step_by(ns)
+                .fold(0.0f64, |a, z| a.max(z.abs()));
+            let worst = exact
+                .iter()
+                .zip(numerical)
+                .skip(j)
+                .step_by(ns)
+                .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+            assert!(
+                worst <= 1e-6 * scale + allowance,
+                "{} state {j}: {worst:e} of {scale:e}",
+                model.name()
+            );
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::checks::{assert_states_agree, laws_with_states};
     use super::*;
     use crate::energy::model_force::{replay_interval, states_along, MeasuredMotion};
     use crate::record::NormalForce;
-    use frictionid_models::{Dahl, FrictionModel, Gms, LuGre};
+    use frictionid_models::{FrictionModel, Gms};
     use std::f64::consts::PI;
 
     /// A motion of `seconds` at 1 kHz: v(t) from `velocity`, N swinging around 14.5 N.
@@ -254,12 +300,7 @@ mod tests {
         let (time, v, normal) = motion(4.0, |t| {
             0.15 * (2.0 * PI * 1.1 * t).sin() * (2.0 * PI * 0.2 * t).cos() + 2e-3
         });
-        let laws: [Box<dyn FrictionModel>; 3] = [
-            Box::new(Dahl::default()),
-            Box::new(LuGre::default()),
-            Box::new(Gms::default()),
-        ];
-        for model in laws {
+        for model in laws_with_states() {
             let law = model.states().expect("a law with states");
             let exact = states_along(
                 model.as_ref(),
@@ -273,26 +314,8 @@ mod tests {
             let numerical =
                 numerical_replay(law, &time, |i| replay_interval(&time, &v, &normal, i))
                     .expect("a numerical replay");
-            let ns = law.n_states();
-            for j in 0..ns {
-                let scale = exact
-                    .iter()
-                    .skip(j)
-                    .step_by(ns)
-                    .fold(0.0f64, |a, z| a.max(z.abs()));
-                let worst = exact
-                    .iter()
-                    .zip(&numerical)
-                    .skip(j)
-                    .step_by(ns)
-                    .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
-                let bound = 1e-6 * scale + ATOL * (time.len() - 1) as f64;
-                assert!(
-                    worst <= bound,
-                    "{} state {j}: {worst:e} of {scale:e}",
-                    model.name()
-                );
-            }
+            let allowance = ATOL * (time.len() - 1) as f64;
+            assert_states_agree(model.as_ref(), &exact, &numerical, allowance);
         }
     }
 

@@ -14,11 +14,11 @@ struct C {
 }
 
 impl Syntax for C {
-    fn param(&self, index: usize) -> String {
-        self.constants[index].clone()
-    }
     fn state(&self, index: usize) -> String {
         format!("s->z[{index}]")
+    }
+    fn constants(&self) -> &[String] {
+        &self.constants
     }
     fn call(&self, f: Func, args: &[String]) -> String {
         let name = match f {
@@ -30,21 +30,12 @@ impl Syntax for C {
     fn select(&self, c: &str, then: &str, otherwise: &str) -> String {
         format!("({c} ? {then} : {otherwise})")
     }
-    fn logic(&self) -> [&'static str; 3] {
-        ["&&", "||", "!"]
-    }
     fn bind(&self, name: &str, value: &str, mutable: bool) -> String {
         let qualifier = if mutable { "" } else { "const " };
         format!("{qualifier}double {name} = {value};")
     }
-    fn end(&self) -> &'static str {
-        ";"
-    }
     fn comment(&self, text: &str) -> String {
         format!("/* {text} */")
-    }
-    fn braces(&self) -> bool {
-        true
     }
     fn repeat_head(&self, count: &str) -> String {
         format!("for (long k = 0; k < (long)({count}); ++k) {{")

@@ -4,30 +4,46 @@
 use super::code::{Cond, Expr, Func, Stmt};
 use super::description::literal;
 
-/// How a target spells the pieces of the export language.
+/// How a target spells the pieces of the export language. The provided methods spell the C
+/// family's way (braces, `;`, `&&`, states in `self.z`); a target overrides what it spells
+/// otherwise.
 pub(super) trait Syntax {
-    /// Constant `index`.
-    fn param(&self, index: usize) -> String;
-    /// State `index` (read or written).
-    fn state(&self, index: usize) -> String;
+    /// The constants' names, in parameter order.
+    fn constants(&self) -> &[String];
     /// A call of `f`.
     fn call(&self, f: Func, args: &[String]) -> String;
     /// `then` if `c` else `otherwise`.
     fn select(&self, c: &str, then: &str, otherwise: &str) -> String;
-    /// The words for and, or, not.
-    fn logic(&self) -> [&'static str; 3];
     /// A new local; `mutable` where it is assigned later.
     fn bind(&self, name: &str, value: &str, mutable: bool) -> String;
-    /// A statement's end (`;` or nothing).
-    fn end(&self) -> &'static str;
     /// A comment line.
     fn comment(&self, text: &str) -> String;
-    /// Blocks by braces (C, Rust) rather than by indentation (Python).
-    fn braces(&self) -> bool;
-    /// The head of an `if`.
-    fn if_head(&self, c: &str) -> String;
     /// The head of a loop run `count` times.
     fn repeat_head(&self, count: &str) -> String;
+    /// Constant `index`.
+    fn param(&self, index: usize) -> String {
+        self.constants()[index].clone()
+    }
+    /// State `index` (read or written).
+    fn state(&self, index: usize) -> String {
+        format!("self.z[{index}]")
+    }
+    /// The words for and, or, not.
+    fn logic(&self) -> [&'static str; 3] {
+        ["&&", "||", "!"]
+    }
+    /// A statement's end (`;` or nothing).
+    fn end(&self) -> &'static str {
+        ";"
+    }
+    /// Blocks by braces (C, Rust) rather than by indentation (Python).
+    fn braces(&self) -> bool {
+        true
+    }
+    /// The head of an `if`.
+    fn if_head(&self, c: &str) -> String {
+        format!("if {c} {{")
+    }
 }
 
 /// An expression, fully parenthesised.

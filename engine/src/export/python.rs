@@ -12,11 +12,8 @@ struct Python {
 }
 
 impl Syntax for Python {
-    fn param(&self, index: usize) -> String {
-        self.constants[index].clone()
-    }
-    fn state(&self, index: usize) -> String {
-        format!("self.z[{index}]")
+    fn constants(&self) -> &[String] {
+        &self.constants
     }
     fn call(&self, f: Func, args: &[String]) -> String {
         let name = match f {

@@ -13,11 +13,8 @@ struct Rust {
 }
 
 impl Syntax for Rust {
-    fn param(&self, index: usize) -> String {
-        self.constants[index].clone()
-    }
-    fn state(&self, index: usize) -> String {
-        format!("self.z[{index}]")
+    fn constants(&self) -> &[String] {
+        &self.constants
     }
     fn call(&self, f: Func, args: &[String]) -> String {
         let name = match f {
@@ -35,21 +32,12 @@ impl Syntax for Rust {
             bare(otherwise)
         )
     }
-    fn logic(&self) -> [&'static str; 3] {
-        ["&&", "||", "!"]
-    }
     fn bind(&self, name: &str, value: &str, mutable: bool) -> String {
         let m = if mutable { "mut " } else { "" };
         format!("let {m}{name}: f64 = {value};")
     }
-    fn end(&self) -> &'static str {
-        ";"
-    }
     fn comment(&self, text: &str) -> String {
         format!("// {text}")
-    }
-    fn braces(&self) -> bool {
-        true
     }
     fn repeat_head(&self, count: &str) -> String {
         if count.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
@@ -57,9 +45,6 @@ impl Syntax for Rust {
         } else {
             format!("for _ in 0..(({count}) as u64) {{")
         }
-    }
-    fn if_head(&self, c: &str) -> String {
-        format!("if {c} {{")
     }
 }
 

@@ -321,22 +321,37 @@ impl Record {
 
     /// The record from sample `first` on: the same channels, release state and weight.
     pub fn starting_at(&self, first: usize) -> Self {
-        let tail = |v: &Vec<f64>| v.get(first..).unwrap_or_default().to_vec();
+        Self {
+            run_in: self.run_in.saturating_sub(first),
+            ..self.cut_to(self.time.tail(first), |v| {
+                v.get(first..).unwrap_or_default().to_vec()
+            })
+        }
+    }
+
+    /// The record's first `len` samples: the same channels, release state and weight.
+    pub fn ending_at(&self, len: usize) -> Self {
+        self.cut_to(self.time.head(len), |v| v[..len.min(v.len())].to_vec())
+    }
+
+    /// The record on the time base `time`, every sampled series (channels, named channels, a
+    /// sampled normal force) cut by `cut`, its derived facts cleared.
+    fn cut_to(&self, time: TimeBase, cut: impl Fn(&[f64]) -> Vec<f64>) -> Self {
         Self {
             name: self.name.clone(),
-            time: self.time.tail(first),
+            time,
             channels: self
                 .channels
                 .iter()
-                .map(|(&c, v)| (c, Arc::new(tail(v))))
+                .map(|(&c, v)| (c, Arc::new(cut(v))))
                 .collect(),
             named: self
                 .named
                 .iter()
-                .map(|(c, v)| (c.clone(), Arc::new(tail(v))))
+                .map(|(c, v)| (c.clone(), Arc::new(cut(v))))
                 .collect(),
             normal_force: self.normal_force.as_ref().map(|n| match n {
-                NormalForce::Sampled(v) => NormalForce::Sampled(tail(v)),
+                NormalForce::Sampled(v) => NormalForce::Sampled(cut(v)),
                 constant => constant.clone(),
             }),
             noise: self.noise.clone(),
@@ -346,32 +361,8 @@ impl Record {
             weight: self.weight,
             release_time: self.release_time,
             release_found: self.release_found,
-            run_in: self.run_in.saturating_sub(first),
+            run_in: self.run_in,
             derived: SampleFacts::default(),
-        }
-    }
-
-    /// The record's first `len` samples: the same channels, release state and weight.
-    pub fn ending_at(&self, len: usize) -> Self {
-        let head = |v: &Vec<f64>| v[..len.min(v.len())].to_vec();
-        Self {
-            time: self.time.head(len),
-            channels: self
-                .channels
-                .iter()
-                .map(|(&c, v)| (c, Arc::new(head(v))))
-                .collect(),
-            named: self
-                .named
-                .iter()
-                .map(|(c, v)| (c.clone(), Arc::new(head(v))))
-                .collect(),
-            normal_force: self.normal_force.as_ref().map(|n| match n {
-                NormalForce::Sampled(v) => NormalForce::Sampled(head(v)),
-                constant => constant.clone(),
-            }),
-            derived: SampleFacts::default(),
-            ..self.clone()
         }
     }
 

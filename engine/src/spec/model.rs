@@ -134,28 +134,24 @@ mod tests {
     #[test]
     fn a_formula_dividing_by_zero_on_the_data_names_the_key_and_the_place() {
         let osc = Oscillator::fmm();
-        let rest = spec(serde_json::json!({
-            "type": "expression", "force": "mu * N * v / abs(v)", "params": {"mu": 0.2}
-        }));
-        let e = rest
-            .check_finite_on(&record(), &osc)
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.starts_with("[model] force = `mu * N * v / abs(v)`: the force is NaN at rest"),
-            "{e}"
-        );
-        let pole = spec(serde_json::json!({
-            "type": "expression", "force": "mu * N / (v - 0.5)", "params": {"mu": 0.2}
-        }));
-        let e = pole
-            .check_finite_on(&record(), &osc)
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("the force is inf on record `run.csv` at v = 5e-1 (t = 0.5 s)"),
-            "{e}"
-        );
+        for (force, says) in [
+            (
+                "mu * N * v / abs(v)",
+                "[model] force = `mu * N * v / abs(v)`: the force is NaN at rest",
+            ),
+            (
+                "mu * N / (v - 0.5)",
+                "[model] force = `mu * N / (v - 0.5)`: the force is inf on record `run.csv` at v = \
+                 5e-1 (t = 0.5 s)",
+            ),
+        ] {
+            let table = serde_json::json!({"type": "expression", "force": force, "params": {"mu": 0.2}});
+            let e = spec(table)
+                .check_finite_on(&record(), &osc)
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with(says), "{force}: {e}");
+        }
         for fine in [
             serde_json::json!({"type": "expression"}),
             serde_json::json!({"type": "expression", "force": "mu * N * sign(v)", "params": {"mu": 0.2}}),

@@ -86,19 +86,9 @@ fn models_lists_the_plugin_model_and_every_builtin() {
     for p in plugin.param_info() {
         assert!(text.contains(&p.description), "{}: {text}", p.name);
     }
-    for builtin in [
-        "coulomb",
-        "viscous_coulomb",
-        "stribeck",
-        "dahl",
-        "lugre",
-        "gms",
-        "makkar",
-        "expression",
-        "none",
-    ] {
+    for builtin in frictionid_models::names() {
         assert!(
-            text.lines().any(|l| l.starts_with(builtin)),
+            text.lines().any(|l| l.starts_with(builtin.as_str())),
             "{builtin} missing: {text}"
         );
     }

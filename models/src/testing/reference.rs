@@ -8,35 +8,24 @@
 use crate::interval::Interval;
 use crate::model::InternalStates;
 
-/// The Dormand-Prince 5(4) tableau: the stage coefficients a_ij (row i: stage i + 1).
-const A: [[f64; 6]; 6] = [
-    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
-    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
-    [
-        19372.0 / 6561.0,
-        -25360.0 / 2187.0,
-        64448.0 / 6561.0,
-        -212.0 / 729.0,
-        0.0,
-        0.0,
-    ],
-    [
-        9017.0 / 3168.0,
-        -355.0 / 33.0,
-        46732.0 / 5247.0,
-        49.0 / 176.0,
-        -5103.0 / 18656.0,
-        0.0,
-    ],
-    [
-        35.0 / 384.0,
-        0.0,
-        500.0 / 1113.0,
-        125.0 / 192.0,
-        -2187.0 / 6784.0,
-        11.0 / 84.0,
-    ],
+/// The Dormand-Prince 5(4) tableau (Hairer, Norsett & Wanner, Table II.5.2): row i holds
+/// stage i + 1's coefficients a_ij as whole numerators over the row's least common
+/// denominator, the last row the fifth-order weights b. The oracle states the tableau in this
+/// form of its own so that it shares no transcription with the engine's solver it checks;
+/// each quotient is the correctly rounded a_ij.
+const ROWS: [(f64, &[f64]); 6] = [
+    (5.0, &[1.0]),
+    (40.0, &[3.0, 9.0]),
+    (45.0, &[44.0, -168.0, 160.0]),
+    (6561.0, &[19372.0, -76080.0, 64448.0, -1908.0]),
+    (
+        167904.0,
+        &[477901.0, -1806240.0, 1495424.0, 46746.0, -45927.0],
+    ),
+    (
+        142464.0,
+        &[12985.0, 0.0, 64000.0, 92750.0, -45927.0, 18656.0],
+    ),
 ];
 
 /// Most steps of one interval before the integration gives up.
@@ -97,8 +86,14 @@ fn dp5_step(
     rhs(z, &mut stages[0]);
     for s in 1..7 {
         let (done, todo) = stages.split_at_mut(s);
+        let (denominator, numerators) = ROWS[s - 1];
         for (j, o) in out.iter_mut().enumerate() {
-            *o = z[j] + h * (0..s).map(|i| A[s - 1][i] * done[i][j]).sum::<f64>();
+            let slope: f64 = numerators
+                .iter()
+                .zip(done.iter())
+                .map(|(a, k)| a / denominator * k[j])
+                .sum();
+            *o = z[j] + h * slope;
         }
         if s < 6 {
             rhs(out, &mut todo[0]);

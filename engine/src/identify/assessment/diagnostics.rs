@@ -15,6 +15,7 @@
 //!   non-convergence.
 
 use super::identifiability::PROFILE_DELTA;
+use super::stats::autocorrelation;
 use crate::axis::Axis;
 use crate::energy::cumulative_trapezoid;
 use crate::identify::values::layout::{is_friction_level, FreeParam, ParamKind};
@@ -120,24 +121,6 @@ fn energy_skips(ef: &EnergyForce, axis: Axis) -> Vec<String> {
 /// which the residuals are smoother than measurement noise: a model error (or low-pass
 /// filtered data), reported as such instead of corrected for.
 pub(crate) const SMOOTH_RESIDUALS: f64 = 0.98;
-
-/// Lag-`lag` autocorrelation of the residual segments (pairs within a segment only).
-fn autocorrelation<S: AsRef<[f64]>>(segments: &[S], lag: usize) -> f64 {
-    let (mut num, mut den) = (0.0, 0.0);
-    for s in segments.iter().map(AsRef::as_ref) {
-        den += s.iter().map(|r| r * r).sum::<f64>();
-        num += s
-            .iter()
-            .zip(s.iter().skip(lag))
-            .map(|(a, b)| a * b)
-            .sum::<f64>();
-    }
-    if den > 0.0 {
-        num / den
-    } else {
-        0.0
-    }
-}
 
 /// The lag-1 correlation phi of the noise in the residuals, assuming AR(1) noise, from the
 /// residuals' first differences (for AR(1), their lag-1 autocorrelation is -(1 - phi) / 2).

@@ -285,18 +285,30 @@ impl Ar2 {
 /// The lag-`lag` autocorrelation of `values` cut into `segments` (pairs within a segment,
 /// about zero: scores at a least-squares optimum sum to zero), 0 for a zero series.
 pub fn pooled_autocorrelation(values: &[f64], segments: &[usize], lag: usize) -> f64 {
-    let (mut num, mut den) = (0.0, 0.0);
     let mut start = 0;
-    for &len in segments {
-        let end = (start + len).min(values.len());
-        let s = &values[start.min(end)..end];
+    let slices: Vec<&[f64]> = segments
+        .iter()
+        .map(|&len| {
+            let end = (start + len).min(values.len());
+            let s = &values[start.min(end)..end];
+            start = end;
+            s
+        })
+        .collect();
+    autocorrelation(&slices, lag)
+}
+
+/// Lag-`lag` autocorrelation of the segments pooled (pairs within a segment only, about
+/// zero), 0 for zero segments.
+pub(crate) fn autocorrelation<S: AsRef<[f64]>>(segments: &[S], lag: usize) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for s in segments.iter().map(AsRef::as_ref) {
         den += s.iter().map(|x| x * x).sum::<f64>();
         num += s
             .iter()
             .zip(s.iter().skip(lag))
             .map(|(a, b)| a * b)
             .sum::<f64>();
-        start = end;
     }
     if den > 0.0 {
         num / den
