@@ -400,7 +400,8 @@ fn relax_near(m: f64, y0: f64, sigma: f64, with_m: bool) -> Relaxed {
     }
     let from = Load { y: y0, w: y0.ln() };
     let rate0 = rate(m, d0);
-    // F(x) = x / m + R(y1) - R(y0) - sigma in the advance x = u1 - u0, and F'(x).
+    // F(x) = x / m + R(y1) - R(y0) - sigma in the advance x = u1 - u0, and F'(x) =
+    // delta / ((1 + delta)^m - 1), delta = y1 - 1 = d0 e^(-x).
     let residual = |advance: f64| -> (f64, f64) {
         let (to, delta, span) = end_of(y0, from.w, advance);
         let (regular, _) = regular_change(m, from, to, span, false);
