@@ -297,6 +297,13 @@ fn overload_integrand(m: f64, x: f64, with_m: bool) -> (f64, f64) {
 /// at +-2 pi i / m.
 fn overload_travel(m: f64, wa: f64, wb: f64, with_m: bool) -> (f64, f64) {
     let longest = PANEL_REACH / m.max(1.0);
+    // The integrand falls as e^((1 - m) x): beyond 40 / (m - 1) past `wa` the rest is below
+    // e^-40 of what came before.
+    let wb = if m > 1.0 {
+        wb.min(wa + 40.0 / (m - 1.0))
+    } else {
+        wb
+    };
     let (mut sum, mut d_sum) = (0.0, 0.0);
     let mut lo = wa;
     while lo < wb {
