@@ -409,9 +409,19 @@ fn relax_near(m: f64, y0: f64, sigma: f64, with_m: bool) -> Relaxed {
     let rate0 = rate(m, d0);
     // F(x) = x / m + R(y1) - R(y0) - sigma in the advance x = u1 - u0, and F'(x) =
     // delta / ((1 + delta)^m - 1), delta = y1 - 1 = d0 e^(-x).
+    // Below the series' limit R(y0) (and R at the limit) once for every iteration.
+    let wq = SERIES_LIMIT.ln() / m;
+    let series_start = (from.w <= wq).then(|| {
+        let at_start = series(m, y0, false).0;
+        (at_start, series(m, wq.exp(), false).0 - at_start)
+    });
     let residual = |advance: f64| -> (f64, f64) {
         let (to, delta, span) = end_of(y0, from.w, advance);
-        let (regular, _) = regular_change(m, from, to, span, false);
+        let regular = match series_start {
+            None => panels(m, from.w, span, false).0,
+            Some((at_start, _)) if to.w <= wq => series(m, to.y, false).0 - at_start,
+            Some((_, to_limit)) => to_limit + panels(m, wq, to.w - wq, false).0,
+        };
         let value = advance / m + regular - sigma;
         (value, delta / (m * to.w).exp_m1())
     };
