@@ -301,9 +301,10 @@ fn gms_force_fit(c: &mut Criterion) {
     let record = [record];
     let mut group = c.benchmark_group("gms");
     group.sample_size(10);
-    group.bench_function("force-domain fit, 20 000 samples of the drive record", |b| {
-        b.iter(|| fit(&osc, black_box(model.as_ref()), &record, &opts).expect("fit"))
-    });
+    group.bench_function(
+        "force-domain fit, 20 000 samples of the drive record",
+        |b| b.iter(|| fit(&osc, black_box(model.as_ref()), &record, &opts).expect("fit")),
+    );
     group.finish();
 }
 
