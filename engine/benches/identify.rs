@@ -4,7 +4,7 @@
 //! and 22 mm, 2 s at 1 kHz, 0.2 mm/s noise). And the inverse-dynamics fit of a driven axis
 //! (25 000 samples; `benches/scipy_inverse_dynamics.py` is SciPy's counterpart), and five
 //! models compared in the force domain along a driven axis's measured motion and friction
-//! force (25 000 samples).
+//! force (25 000 samples), and GMS fitted along 20 000 of those samples.
 
 /// mimalloc, as the `frictionid` binary and the Python module use (glibc's malloc returned
 /// and refaulted the fits' buffers, a sixth of a Coulomb fit's time).
@@ -283,12 +283,38 @@ fn drive_compare(c: &mut Criterion) {
     group.finish();
 }
 
+/// GMS (three elements, its sharpness free) fitted in the force domain to the first 20 000
+/// samples of the driven axis's measured LuGre friction force: every element stepped exactly
+/// at whatever sharpness the fit reaches, every Jacobian column from the replay's
+/// sensitivities.
+fn gms_force_fit(c: &mut Criterion) {
+    let (osc, opts) = no_oscillator_force_options();
+    let full = drive_friction_record();
+    let keep = 20_000;
+    let time = full.time()[..keep].to_vec();
+    let mut record = Record::from_time_base("drive", TimeBase::new(time).expect("time"));
+    for channel in [Channel::Velocity, Channel::Force] {
+        let values = full.channel(channel).expect("a channel")[..keep].to_vec();
+        record = record.with_channel(channel, values);
+    }
+    let model = default_model("gms").expect("gms");
+    let record = [record];
+    let mut group = c.benchmark_group("gms");
+    group.sample_size(10);
+    group.bench_function(
+        "force-domain fit, 20 000 samples of the drive record",
+        |b| b.iter(|| fit(&osc, black_box(model.as_ref()), &record, &opts).expect("fit")),
+    );
+    group.finish();
+}
+
 criterion_group!(
     benches,
     coulomb_and_compare,
     lugre,
     force_route,
     inverse_dynamics,
-    drive_compare
+    drive_compare,
+    gms_force_fit
 );
 criterion_main!(benches);

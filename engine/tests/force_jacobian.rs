@@ -275,8 +275,9 @@ fn the_balance_columns_of_inverse_dynamics_are_the_residuals_derivatives() {
     }
 }
 
-/// The columns the producer gives directly are all but GMS's sharpness (which has no closed-form
-/// sensitivity) and a restoring law's own parameters.
+/// The columns the producer gives directly are every law parameter, GMS's sharpness included
+/// (its steps are exact at any sharpness), and the offsets, not a restoring law's own
+/// parameters.
 #[test]
 fn the_producer_gives_every_column_it_has_in_closed_form() {
     let gms = ["k_1", "w_1", "mu_c", "sharpness"];
@@ -307,7 +308,14 @@ fn the_producer_gives_every_column_it_has_in_closed_form() {
             .collect();
         assert_eq!(
             given,
-            ["k_1", "w_1", "mu_c", "force_offset[a]", "force_offset[b]"],
+            [
+                "k_1",
+                "w_1",
+                "mu_c",
+                "sharpness",
+                "force_offset[a]",
+                "force_offset[b]"
+            ],
             "record {index}"
         );
     }

@@ -78,8 +78,10 @@
 //!
 //! Exact steps (`Propagator`, in `gms_steps.rs`): at constant velocity each element's law is
 //! separable in the distance travelled, with closed forms for sharpness 1 (exponential) and 2
-//! (tanh), the stick branch of an unloaded element included; the engine integrates other
-//! sharpnesses.
+//! (tanh), the stick branch of an unloaded element included; at any other sharpness the
+//! element's load solves travel = Phi(y1) - Phi(y0), Phi the integral of 1 / (1 - y^m), by
+//! Newton's method (`gms_relaxation.rs`). The sensitivities of every parameter, the sharpness
+//! included, come with the step.
 //!
 //! Energy: the elements store sum_i k_i z_i^2 / 2 and dissipate
 //! k_i z_i (v - dz_i/dt) = |v| w_i s max(0, sgn(v) rho_i)^(m+1) >= 0 each, so with

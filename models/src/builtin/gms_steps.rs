@@ -10,19 +10,21 @@
 //! it crosses 0 within the step and loads from there on. Loading it relaxes towards y = 1:
 //! 1 - y = (1 - y0) exp(-sigma) for m = 1, and for m = 2 y = tanh(atanh(y0) + sigma), written
 //! y = (y0 + tanh sigma) / (1 + y0 tanh sigma) so that it holds for an overloaded element
-//! (y0 > 1, where s(v) fell: it is coth(acoth(y0) + sigma)) as well. Other sharpnesses have no
-//! such closed form: the engine integrates them. A frozen element (w s = 0) stays.
+//! (y0 > 1, where s(v) fell: it is coth(acoth(y0) + sigma)) as well. Every other sharpness
+//! solves sigma = Phi(y1) - Phi(y0), Phi the integral of 1 / (1 - y^m), by Newton's method
+//! (`gms_relaxation.rs`). A frozen element (w s = 0) stays.
 //!
 //! Sensitivities: the load and the travel scale with rho = k / (w s), so a parameter moves an
 //! element's step through d ln(rho)/dp (1/k, -1/w, -(ds/dp)/s for the Stribeck parameters):
 //! dy0/dp = y0 d ln(rho)/dp + sgn(v) rho dz0/dp, dsigma/dp = sigma d ln(rho)/dp, and
 //! dz1/dp = sgn(v) (dy1/dp - y1 d ln(rho)/dp) / rho with dy1 = (dy1/dy0) dy0 + (dy1/dsigma)
-//! dsigma. The sharpness has none (its derivative of the step is no closed form): those
-//! entries are NaN and `exact_sensitivities` says so.
+//! dsigma, plus for the sharpness its direct dy1/dm (the implicit function theorem on
+//! Phi(y1) - Phi(y0) = sigma, `gms_relaxation.rs`).
 
 use super::gms::{Gms, GmsElement};
+use super::gms_relaxation::{relax, sharpness_slope_of_loads};
 use crate::interval::Interval;
-use crate::model::{sgn, FrictionModel, ParamGradients, Propagator};
+use crate::model::{sgn, ParamGradients, Propagator};
 
 /// An element's exact step in its load y over the travel sigma.
 struct LoadStep {
@@ -32,6 +34,8 @@ struct LoadStep {
     gain: f64,
     /// dy1/dsigma (the rate 1 - max(0, y1)^m).
     slope: f64,
+    /// dy1/dm (0 unless asked for).
+    sharpness: f64,
     /// The element stuck throughout (dz = v dt, whatever its parameters).
     stuck: bool,
 }
@@ -66,6 +70,7 @@ fn loaded_step(two: bool, y0: f64, sigma: f64) -> LoadStep {
             change,
             gain: rate / (den * den),
             slope: unloaded * (2.0 - unloaded),
+            sharpness: 0.0,
             stuck: false,
         }
     } else {
@@ -74,32 +79,64 @@ fn loaded_step(two: bool, y0: f64, sigma: f64) -> LoadStep {
             change: -(1.0 - y0) * (-sigma).exp_m1(),
             gain: kept,
             slope: (1.0 - y0) * kept,
+            sharpness: 0.0,
             stuck: false,
         }
     }
 }
 
-/// The exact step of an element's load from `y0` over the travel `sigma` >= 0 (m = 2 when
-/// `two`, else m = 1).
-fn load_step(two: bool, y0: f64, sigma: f64) -> LoadStep {
+/// The step of a loaded element (y0 >= 0) over the travel `sigma` at sharpness `m`: the
+/// closed forms at m = 1 and 2, else the Newton solve; with dy1/dm when `with_m`.
+fn loading_step(m: f64, y0: f64, sigma: f64, with_m: bool) -> LoadStep {
+    if m == 1.0 || m == 2.0 {
+        let mut step = if y0 > 0.0 {
+            loaded_step(m == 2.0, y0, sigma)
+        } else {
+            let (y1, rate) = loaded_from_zero(m == 2.0, sigma);
+            LoadStep {
+                change: y1,
+                gain: rate,
+                slope: rate,
+                sharpness: 0.0,
+                stuck: false,
+            }
+        };
+        if with_m {
+            step.sharpness = sharpness_slope_of_loads(m, y0, step.change);
+        }
+        return step;
+    }
+    let relaxed = relax(m, y0, sigma, with_m);
+    LoadStep {
+        change: relaxed.change,
+        gain: relaxed.gain,
+        slope: relaxed.slope,
+        sharpness: relaxed.sharpness,
+        stuck: false,
+    }
+}
+
+/// The exact step of an element's load from `y0` over the travel `sigma` >= 0 at sharpness
+/// `m`, with dy1/dm when `with_m`.
+fn load_step(m: f64, y0: f64, sigma: f64, with_m: bool) -> LoadStep {
     if y0 > 0.0 {
-        return loaded_step(two, y0, sigma);
+        return loading_step(m, y0, sigma, with_m);
     }
     if y0 + sigma <= 0.0 {
         return LoadStep {
             change: sigma,
             gain: 1.0,
             slope: 1.0,
+            sharpness: 0.0,
             stuck: true,
         };
     }
     // Stuck until the load crosses 0, then loading over the rest of the travel.
-    let (y1, rate) = loaded_from_zero(two, y0 + sigma);
+    let from_zero = loading_step(m, 0.0, y0 + sigma, with_m);
     LoadStep {
-        change: y1 - y0,
-        gain: rate,
-        slope: rate,
-        stuck: false,
+        change: from_zero.change - y0,
+        gain: from_zero.slope,
+        ..from_zero
     }
 }
 
@@ -112,9 +149,9 @@ struct ElementFrame {
 }
 
 impl Gms {
-    /// Whether the element law has a closed form: sharpness 1 or 2.
-    fn has_closed_form(&self) -> bool {
-        self.sharpness == 1.0 || self.sharpness == 2.0
+    /// Whether the steps are exact: a finite, positive sharpness.
+    fn has_exact_steps(&self) -> bool {
+        self.sharpness.is_finite() && self.sharpness > 0.0
     }
 
     /// Steps the element `e` of deflection `z` over `interval` at the Stribeck level `s`;
@@ -125,6 +162,7 @@ impl Gms {
         interval: Interval,
         s: f64,
         z: &mut f64,
+        with_m: bool,
     ) -> Option<ElementFrame> {
         let limit = e.weight * s;
         if limit.is_nan() || limit <= 0.0 || interval.v == 0.0 || interval.dt <= 0.0 {
@@ -134,7 +172,7 @@ impl Gms {
         let rho = e.stiffness / limit;
         let y0 = u * rho * *z;
         let sigma = rho * interval.travel();
-        let step = load_step(self.sharpness == 2.0, y0, sigma);
+        let step = load_step(self.sharpness, y0, sigma, with_m);
         *z += if step.stuck {
             interval.v * interval.dt
         } else {
@@ -182,13 +220,13 @@ impl Gms {
 
 impl Propagator for Gms {
     fn propagates_exactly(&self) -> bool {
-        self.has_closed_form()
+        self.has_exact_steps()
     }
 
     fn propagate(&self, interval: Interval, z: &mut [f64]) {
         let s = self.s(interval.v, interval.normal);
         for (e, zi) in self.elements.iter().zip(z.iter_mut()) {
-            self.step_element(e, interval, s, zi);
+            self.step_element(e, interval, s, zi, false);
         }
     }
 
@@ -202,8 +240,7 @@ impl Propagator for Gms {
             let Some(row) = sens.get_mut(i * np..(i + 1) * np) else {
                 return;
             };
-            row[sharpness] = f64::NAN;
-            let Some(frame) = self.step_element(e, interval, s, zi) else {
+            let Some(frame) = self.step_element(e, interval, s, zi, true) else {
                 continue;
             };
             if frame.step.stuck {
@@ -211,21 +248,17 @@ impl Propagator for Gms {
             }
             let y1 = frame.y0 + frame.step.change;
             for (j, sj) in row.iter_mut().enumerate() {
-                if j == sharpness {
-                    continue;
-                }
                 let g = self.log_rho_slope(i, j, s, &s_slopes);
                 let dy0 = frame.y0 * g + u * frame.rho * *sj;
-                let dy1 = frame.step.gain * dy0 + frame.step.slope * frame.sigma * g;
+                let direct = if j == sharpness {
+                    frame.step.sharpness
+                } else {
+                    frame.step.slope * frame.sigma * g
+                };
+                let dy1 = frame.step.gain * dy0 + direct;
                 *sj = u * (dy1 - y1 * g) / frame.rho;
             }
         }
-    }
-
-    /// Every parameter but the sharpness.
-    fn exact_sensitivities(&self) -> Vec<bool> {
-        let sharpness = 3 * self.elements.len() + 4;
-        (0..self.params().len()).map(|j| j != sharpness).collect()
     }
 }
 

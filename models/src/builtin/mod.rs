@@ -6,6 +6,7 @@ mod coulomb_load;
 mod dahl;
 mod expression;
 mod gms;
+mod gms_relaxation;
 mod gms_steps;
 mod lugre;
 mod makkar;
