@@ -305,3 +305,50 @@ fn inverse_dynamics_without_input_or_motion_or_mass_says_what_to_give() {
     );
     assert!(!e.contains('\n'), "{e}");
 }
+
+/// A Coulomb level above the dimensionless bound of 10 with no normal force given (12 N, read
+/// as a force): held-out validation scores the laws at the levels their training fits found,
+/// so the true law's held-out error stays near its own residual (0.2 N of noise on u), and
+/// `compare` recommends it over plain Coulomb friction. Scored as coefficients, the 12 N level
+/// would be cut to 10 N and every law's held-out error would be the clipped level's misfit.
+#[test]
+fn held_out_validation_keeps_levels_read_as_forces_above_ten() {
+    use frictionid_engine::identify::compare;
+    use frictionid_models::{default_model, FrictionModel};
+    const NOISE: f64 = 0.2;
+    let axis = Axis {
+        coulomb: 12.0,
+        ..TRUTH
+    };
+    let mut record = axis.record(4000);
+    if let Some(u) = record.channel_mut(Channel::InputForce) {
+        add_gaussian_noise(u, NOISE, 5);
+    }
+    let record = record.with_noise(Channel::InputForce, NOISE);
+    let (osc, opts) = inverse_dynamics_options();
+    let models: Vec<Box<dyn FrictionModel>> = ["coulomb", "viscous_coulomb"]
+        .iter()
+        .map(|n| default_model(n).expect("a registered law"))
+        .collect();
+    let c = compare(&osc, &models, &[record], &serial(opts)).expect("a comparison");
+    let fitted = c
+        .ranking
+        .iter()
+        .find(|f| f.model == "viscous_coulomb")
+        .expect("ranked");
+    let held = c
+        .validation
+        .iter()
+        .find(|v| v.model == "viscous_coulomb")
+        .and_then(|v| v.validation_rms)
+        .expect("a held-out score");
+    let (mu, _) = estimate(fitted, "mu");
+    eprintln!(
+        "mu {mu} N, RMS {} N, held-out {held} N",
+        fitted.rms_residual
+    );
+    assert!((mu / 12.0 - 1.0).abs() < 0.01, "mu {mu}");
+    assert!(held < 1.5 * fitted.rms_residual, "held-out {held} N");
+    let recommended = c.verdict.as_ref().and_then(|v| v.recommended.as_deref());
+    assert_eq!(recommended, Some("viscous_coulomb"));
+}

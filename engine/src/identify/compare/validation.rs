@@ -20,8 +20,10 @@ use super::super::assessment::property_refits::refit_options;
 use super::super::fit::lean_fit;
 use crate::error::EngineError;
 use crate::identify::values::fit_options::FitOptions;
+use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::result::FitResult;
 use crate::identify::values::target_options::FitDomain;
+use crate::oscillator::OscillatorProperty;
 use crate::record::Record;
 use frictionid_models::{clone_model, FrictionModel};
 use serde::Serialize;
@@ -286,7 +288,8 @@ fn held_out(
         }
     }
     let world = &trained.world;
-    let model = within_bounds(world.model.as_ref())?;
+    let levels_are_forces = FrictionLevels::read_as_forces(&opts.target.unknown_oscillator, &test);
+    let model = within_bounds(world.model.as_ref(), levels_are_forces)?;
     let evaluated = lean_fit(&world.oscillator, model.as_ref(), &test, &eval)?;
     Ok(evaluated
         .records
@@ -300,6 +303,7 @@ fn held_out(
 /// check refuses).
 fn within_bounds(
     model: &(dyn FrictionModel + 'static),
+    levels_are_forces: bool,
 ) -> Result<Box<dyn FrictionModel>, EngineError> {
     let mut m = clone_model(model);
     let values: Vec<f64> = m
@@ -307,10 +311,14 @@ fn within_bounds(
         .iter()
         .zip(m.param_info())
         .map(|(&v, p)| {
-            if p.lower <= p.upper {
-                v.clamp(p.lower, p.upper)
-            } else {
+            if p.lower > p.upper {
                 v
+            } else if levels_are_forces && FrictionLevels::is_level(&p) {
+                // A level read as a force is bounded by the data, not by the coefficient's
+                // bound of 10: a 20 N Coulomb level stays 20 N.
+                v.max(p.lower)
+            } else {
+                v.clamp(p.lower, p.upper)
             }
         })
         .collect();
@@ -319,13 +327,18 @@ fn within_bounds(
 }
 
 /// The options that evaluate a fitted law: no model parameter or oscillator property free
-/// (the record's own nuisance parameters are still fitted), nothing guessed.
+/// (the record's own nuisance parameters are still fitted), nothing guessed. The properties
+/// the training fit found are the trained oscillator's; a normal force the configuration did
+/// not give stays unknown, so the levels are read as the forces the training fit found, not
+/// as coefficients bounded by 10.
 fn evaluation_options(refit: &FitOptions) -> FitOptions {
     let mut o = refit.clone();
     o.params.free = Some(Vec::new());
     o.params.oscillator = Vec::new();
     o.params.guess = false;
-    o.target.unknown_oscillator = Vec::new();
+    o.target
+        .unknown_oscillator
+        .retain(|p| *p == OscillatorProperty::NormalForce);
     o
 }
 

@@ -30,6 +30,8 @@ pub struct Layout {
     pub params: Vec<FreeParam>,
     /// Their starting physical values.
     pub start: Vec<f64>,
+    /// Whether the law's levels are coefficients or forces (bounded by the data).
+    pub levels: FrictionLevels,
 }
 
 impl Layout {
@@ -72,7 +74,12 @@ impl Layout {
             }
         }
         checked.set_params(&values)?;
-        checked.check()?;
+        // A fixed level read as a force (a 20 N Coulomb level without a normal force) is
+        // checked as the coefficient a simulation scales it to, not against the bound of 10.
+        match self.levels.scaled_for_simulation(checked.as_ref()) {
+            Some((scaled, _)) => scaled.check(),
+            None => checked.check(),
+        }?;
         Ok(())
     }
 }
@@ -95,13 +102,14 @@ pub fn build_layout<R: Residuals + ?Sized>(
     if let Some(k) = opts.keep_initial.iter().find(|k| !names.contains(k)) {
         return Err(unknown_name("initial value", k, &names));
     }
+    let levels = residuals.friction_levels();
     let mut layout = Layout {
         start_model: starting_model(model, opts, &free, || residuals.hint(osc, records, energy))?,
         params: Vec::new(),
         start: Vec::new(),
+        levels,
     };
     let values = layout.start_model.params();
-    let levels = residuals.friction_levels();
     for &i in &free {
         let (param, x) = model_param(&info[i], i, values[i], opts, (levels, osc.axis))?;
         layout.push(param, x);
