@@ -186,6 +186,33 @@ fn lugre_on_a_viscous_coulomb_drive_ends_at_least_as_low() {
     assert!(rms("lugre") <= rms("viscous_coulomb") * (1.0 + 1e-3));
 }
 
+/// The same drive, whose configuration gives no normal force (the levels are forces): Dahl
+/// does not hold the smoothed Coulomb law `expression` (mu N tanh(v / eps)), whose fitted
+/// eps stands in for the viscous term, so Dahl is ranked on its own cost, not set aside as a
+/// failed search. Compared under the oscillator's N = 0, every steady state vanished and any
+/// law seemed to hold any other.
+#[test]
+fn without_a_normal_force_nesting_compares_the_levels_as_forces() {
+    let record = crate::inverse_dynamics::TRUTH
+        .record(4000)
+        .with_noise(Channel::InputForce, NOISE);
+    let (osc, opts) = inverse_dynamics_options();
+    assert_eq!(
+        osc.normal_force, 0.0,
+        "the test needs an oscillator without N"
+    );
+    let models: Vec<Box<dyn FrictionModel>> = ["expression", "dahl"]
+        .iter()
+        .map(|n| default_model(n).expect("a registered law"))
+        .collect();
+    let c = compare(&osc, &models, &[record], &opts).expect("a comparison");
+    for f in &c.ranking {
+        eprintln!("{}: RMS {} N", f.model, f.rms_residual);
+    }
+    assert!(c.failed.is_empty(), "{:?}", c.failed);
+    assert!(c.ranking.iter().any(|f| f.model == "dahl"));
+}
+
 /// The FMM stage's free decays (the paper's three releases, 2 s at 1 kHz, 2e-4 m/s of noise)
 /// of a LuGre truth whose bristle stiffness (1e5 N/m) the records determine: compare's
 /// velocity route recommends lugre, which holds coulomb and stribeck, and the static laws

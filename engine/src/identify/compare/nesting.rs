@@ -10,6 +10,7 @@
 use super::super::assessment::property_refits::refit_options;
 use super::super::fit::fit;
 use crate::identify::values::fit_options::FitOptions;
+use crate::identify::values::levels::UNIT_NORMAL_FORCE;
 use crate::identify::values::result::FitResult;
 use crate::oscillator::Oscillator;
 use crate::record::Record;
@@ -166,7 +167,7 @@ fn holds(fit: &FitResult, sub: &dyn FrictionModel, osc: &Oscillator, speed: f64)
     let Some(started) = started_from(fit.fitted_model.as_ref(), sub, &ctx) else {
         return false;
     };
-    let n = osc.normal_force;
+    let n = nesting_normal_force(fit, osc);
     let speeds: Vec<f64> = STEADY_SPEEDS
         .iter()
         .flat_map(|s| [s * speed, -s * speed])
@@ -174,10 +175,22 @@ fn holds(fit: &FitResult, sub: &dyn FrictionModel, osc: &Oscillator, speed: f64)
     let scale = speeds
         .iter()
         .fold(0.0_f64, |m, &v| m.max(sub.steady_state(v, n).abs()));
-    speeds.iter().all(|&v| {
-        let gap = (started.steady_state(v, n) - sub.steady_state(v, n)).abs();
-        gap <= STEADY_TOLERANCE * scale
-    })
+    // A held law with no force at any of these speeds tells nothing about the holder.
+    scale > 0.0
+        && speeds.iter().all(|&v| {
+            let gap = (started.steady_state(v, n) - sub.steady_state(v, n)).abs();
+            gap <= STEADY_TOLERANCE * scale
+        })
+}
+
+/// The normal force the steady states are compared under: the fit's or the oscillator's,
+/// else (no normal force given: the levels are forces) [`UNIT_NORMAL_FORCE`]. Under N = 0
+/// every law's force vanishes and any law would seem to hold any other.
+fn nesting_normal_force(fit: &FitResult, osc: &Oscillator) -> f64 {
+    [fit.oscillator.normal_force, osc.normal_force]
+        .into_iter()
+        .find(|n| n.is_finite() && *n > 0.0)
+        .unwrap_or(UNIT_NORMAL_FORCE)
 }
 
 /// `model` started at `sub`'s optimum in `ctx` (`None` when it cannot be).
