@@ -9,7 +9,7 @@
 //! inverse-dynamics route (the balance u - M a against the law) recover both levels within
 //! 1 %; the symmetric law is worse.
 
-use crate::util::{driven_slide, multisine, sample_times, Tone};
+use crate::util::{driven_slide, linear_between_samples, multisine, sample_times, Tone};
 use frictionid_engine::identify::{
     fit, FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam, ParamOptions,
     TargetOptions,
@@ -38,9 +38,7 @@ fn input(t: f64) -> f64 {
 
 /// The samples' input, linear between them (as the engine reads it).
 fn input_at(u: &[f64], t: f64) -> f64 {
-    let i = ((t * RATE).floor() as usize).min(u.len() - 2);
-    let w = t * RATE - i as f64;
-    u[i] + w * (u[i + 1] - u[i])
+    linear_between_samples(u, RATE, t)
 }
 
 /// The friction force sliding in `d`.

@@ -21,7 +21,7 @@
 //! well off it, and viscous_coulomb, which cannot follow the condition, at least five times
 //! the residual.
 
-use crate::util::{multisine, sample_times, Tone};
+use crate::util::{linear_between_samples, multisine, sample_times, Tone};
 use frictionid_engine::axis::{NoRestoring, Restoring};
 use frictionid_engine::identify::{fit, FitOptions, FitResult, ParamOptions};
 use frictionid_engine::record::{Channel, TimeBase};
@@ -49,9 +49,7 @@ fn input(t: f64) -> f64 {
 
 /// The samples `s`, linear between them (as the engine reads an input and a channel).
 fn linear(s: &[f64], t: f64) -> f64 {
-    let i = ((t * RATE).floor() as usize).min(s.len() - 2);
-    let w = t * RATE - i as f64;
-    s[i] + w * (s[i + 1] - s[i])
+    linear_between_samples(s, RATE, t)
 }
 
 /// The truth's level L(t, x) >= 0 [N].

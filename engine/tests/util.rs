@@ -454,3 +454,11 @@ impl CoulombDecay {
             .collect()
     }
 }
+
+/// The samples `s` taken at `rate` from t = 0, linear between them (as the engine reads an
+/// input and a channel), the last interval extended beyond the end.
+pub fn linear_between_samples(s: &[f64], rate: f64, t: f64) -> f64 {
+    let i = ((t * rate).floor() as usize).min(s.len() - 2);
+    let w = t * rate - i as f64;
+    s[i] + w * (s[i + 1] - s[i])
+}

@@ -71,15 +71,7 @@ impl ConditionSource {
         let reason = match condition {
             Condition::Channel(name) => {
                 let named: Vec<&str> = self.named.keys().map(String::as_str).collect();
-                format!(
-                    "the law reads channel `{name}`, which the record does not have (its named \
-                     channels: {}); name its column in the record's `channels`",
-                    if named.is_empty() {
-                        "none".to_string()
-                    } else {
-                        named.join(", ")
-                    }
-                )
+                missing_channel_reason(name, &named)
             }
             Condition::InputForce => "the law reads the input force `u`, which the record does \
                                       not have; name its column with `input_force_column`"
@@ -91,6 +83,19 @@ impl ConditionSource {
             reason,
         }
     }
+}
+
+/// Why a law cannot read channel `name` from a record whose named channels are `named`.
+pub(crate) fn missing_channel_reason(name: &str, named: &[&str]) -> String {
+    format!(
+        "the law reads channel `{name}`, which the record does not have (its named channels: \
+         {}); name its column in the record's `channels`",
+        if named.is_empty() {
+            "none".to_string()
+        } else {
+            named.join(", ")
+        }
+    )
 }
 
 /// The columns of one law's conditions along a record, in the law's order.

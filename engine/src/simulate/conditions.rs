@@ -10,6 +10,7 @@
 
 use super::Input;
 use crate::error::EngineError;
+use crate::record::conditions::missing_channel_reason;
 use crate::record::Record;
 use frictionid_models::{Condition, FrictionModel};
 use std::collections::BTreeMap;
@@ -99,15 +100,7 @@ impl ChannelSeries {
 fn missing_channel(record: &str, name: &str, named: &[&str]) -> EngineError {
     EngineError::Record {
         record: record.to_string(),
-        reason: format!(
-            "the law reads channel `{name}`, which the record does not have (its named \
-             channels: {}); name its column in the record's `channels`",
-            if named.is_empty() {
-                "none".to_string()
-            } else {
-                named.join(", ")
-            }
-        ),
+        reason: missing_channel_reason(name, named),
     }
 }
 
