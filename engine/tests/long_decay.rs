@@ -143,10 +143,7 @@ fn report(r: &FitResult) -> (f64, f64) {
 
 /// The status of the suspect-optimum finding, if the search went further.
 fn suspect(r: &FitResult) -> Option<Status> {
-    r.diagnostics
-        .iter()
-        .find(|f| f.check == Check::SuspectOptimum)
-        .map(|f| f.status)
+    crate::util::finding(r, Check::SuspectOptimum).map(|f| f.status)
 }
 
 /// Started 4 % stiff, the fit reaches the truth: the Coulomb torque within 2 %, the residual

@@ -10,7 +10,7 @@
 //! route recommends the bristle law whose stiffness the records determine.
 
 use crate::util::{inverse_dynamics_options, rel};
-use frictionid_engine::identify::{compare, Check, Status};
+use frictionid_engine::identify::{compare, Check};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::Record;
@@ -138,16 +138,7 @@ fn dahl_on_a_dahl_drive_ends_below_the_coulomb_it_holds() {
         .iter()
         .find(|f| f.model == "coulomb")
         .expect("ranked");
-    let goodness = coulomb
-        .diagnostics
-        .iter()
-        .find(|d| d.check == Check::GoodnessOfFit)
-        .expect("a goodness-of-fit finding");
-    assert!(
-        matches!(goodness.status, Status::Warn | Status::Fail),
-        "{}",
-        goodness.message
-    );
+    crate::util::assert_flagged(coulomb, Check::GoodnessOfFit);
 }
 
 /// The viscous + Coulomb drive of the inverse-dynamics tests (its own event-locating
@@ -270,17 +261,7 @@ fn free_decay_recommends(truth: &dyn FrictionModel, laws: &[&str]) {
     let law = truth.name();
     assert_eq!(verdict.recommended.as_deref(), Some(law));
     for f in c.ranking.iter().filter(|f| f.model != law) {
-        let goodness = f
-            .diagnostics
-            .iter()
-            .find(|d| d.check == Check::GoodnessOfFit)
-            .expect("a goodness-of-fit finding");
-        assert!(
-            matches!(goodness.status, Status::Warn | Status::Fail),
-            "{}: {}",
-            f.model,
-            goodness.message
-        );
+        crate::util::assert_flagged(f, Check::GoodnessOfFit);
     }
 }
 

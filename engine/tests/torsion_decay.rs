@@ -93,10 +93,7 @@ fn report(label: &str, r: &FitResult) -> (f64, f64) {
 
 /// The status of the suspect-optimum finding, if the search went further.
 fn suspect(r: &FitResult) -> Option<Status> {
-    r.diagnostics
-        .iter()
-        .find(|f| f.check == Check::SuspectOptimum)
-        .map(|f| f.status)
+    crate::util::finding(r, Check::SuspectOptimum).map(|f| f.status)
 }
 
 /// The record is the case described: the pendulum rings about 15 s and rests the rest.

@@ -4,8 +4,8 @@
 
 use frictionid_engine::axis::{NoRestoring, Restoring};
 use frictionid_engine::identify::{
-    fit, FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam, ParamOptions, Status,
-    TargetOptions,
+    fit, Check, Finding, FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam,
+    ParamOptions, Status, TargetOptions,
 };
 use frictionid_engine::oscillator::{OscillatorProperty, PartialOscillator};
 use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid, Trajectory};
@@ -248,6 +248,23 @@ pub fn estimate(result: &FitResult, name: &str) -> (f64, f64) {
         .find(|p| p.name == name || p.name.starts_with(&format!("{name}[")))
         .unwrap_or_else(|| panic!("no parameter {name}"));
     (p.value, p.std_error.unwrap_or(f64::NAN))
+}
+
+/// The finding of `check` in `result`, if the fit made one.
+pub(crate) fn finding(result: &FitResult, check: Check) -> Option<&Finding> {
+    result.diagnostics.iter().find(|d| d.check == check)
+}
+
+/// Asserts that `result` warns or fails `check`.
+pub(crate) fn assert_flagged(result: &FitResult, check: Check) {
+    let f =
+        finding(result, check).unwrap_or_else(|| panic!("{}: no {check:?} finding", result.model));
+    assert!(
+        matches!(f.status, Status::Warn | Status::Fail),
+        "{}: {}",
+        result.model,
+        f.message
+    );
 }
 
 /// The diagnostics of `result` with `status`, each as "check: message".
