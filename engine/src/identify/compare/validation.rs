@@ -365,3 +365,22 @@ fn scored(residuals: &[f64], time: &[f64], from: Option<f64>) -> (f64, usize) {
         .filter(|e| e.is_finite())
         .fold((0.0, 0), |(s, n), e| (s + e, n + 1))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identify::values::search::SearchOptions;
+
+    #[test]
+    fn a_fold_refits_locally_unless_a_search_is_asked_for() {
+        let mut opts = FitOptions::default();
+        assert_eq!(fold_strategy(&opts), Search::Local);
+        for asked in [Search::Staged, Search::Global, Search::Local] {
+            opts.search = SearchOptions {
+                strategy: Some(asked),
+                ..SearchOptions::default()
+            };
+            assert_eq!(fold_strategy(&opts), asked);
+        }
+    }
+}
