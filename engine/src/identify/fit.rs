@@ -22,7 +22,7 @@ use super::problem::{
 use super::search::further::{search_further, Searched};
 use super::search::prefit::{prefit_finding, prefit_options, Prefit};
 use super::search::starts::{run_starts, start_count, MultiStart, StartRun};
-use super::search::strategy::{plan_fit_starts, Planned, StartPlan};
+use super::search::strategy::{plan_fit_starts, Planned, SimplerFit, StartPlan};
 use super::search::{build_layout, Layout};
 use super::values::search::check_f_scale;
 use super::values::{
@@ -137,7 +137,12 @@ fn fit_seeded<R: Residuals + 'static>(
     let clock = Instant::now();
     let seed_model = seed.and_then(|s| s.as_ref().ok()).map(|p| p.model.as_ref());
     let (layout, found) = laid_out_optimum(&residuals, osc, model, records, opts, seed_model)?;
-    let (runs, standings) = identifiability::settle(&found.reference, found.runs, opts)?;
+    let (runs, standings) = identifiability::settle(
+        &found.reference,
+        found.runs,
+        opts,
+        found.limit_stage.as_ref(),
+    )?;
     let context = FinishContext {
         params: &opts.params,
         energy: &opts.energy,
@@ -270,6 +275,8 @@ struct Found<R: Residuals> {
     search: Search,
     /// What the further starts of a record that sticks found, when they ran.
     further: Option<Finding>,
+    /// The staged search's fit of the model's rigid-limit law, when it ran one.
+    limit_stage: Option<SimplerFit>,
 }
 
 /// Searches for the optimum over `plan`'s layout: the number of starts and the strategy
@@ -302,14 +309,19 @@ fn search_optimum<R: Residuals + 'static>(
     };
     let reference = make_problem();
     let search = Search::resolve(opts.search.strategy, plan.model, n_model_free, simulated);
-    let (mut runs, origins, further) = if layout.params.is_empty() {
+    let (mut runs, origins, further, limit_stage) = if layout.params.is_empty() {
         (
             evaluate_as_is(&reference)?,
             vec!["as given".to_string()],
             None,
+            None,
         )
     } else {
-        let Planned { seeded, reachable } = plan_fit_starts(plan, search, n_starts, seed);
+        let Planned {
+            seeded,
+            reachable,
+            limit_stage,
+        } = plan_fit_starts(plan, search, n_starts, seed);
         let points: Vec<Vec<f64>> = seeded.iter().map(|s| layout.projected(&s.point)).collect();
         let runs = run_starts(
             make_problem,
@@ -326,7 +338,7 @@ fn search_optimum<R: Residuals + 'static>(
             origins,
             finding,
         } = search_further(plan, &make_problem, &reference, runs, origins);
-        (runs, origins, finding)
+        (runs, origins, finding, limit_stage)
     };
     if let Some((jac, r)) = runs.best.linearisation.take() {
         reference.adopt_linearisation(&runs.best.u, jac, r);
@@ -337,6 +349,7 @@ fn search_optimum<R: Residuals + 'static>(
         origins,
         search,
         further,
+        limit_stage,
     })
 }
 

@@ -108,11 +108,11 @@ pub(crate) fn plan_starts<R: Residuals + 'static>(
     n_local: usize,
 ) -> Planned {
     let mut out = Vec::new();
-    let mut reachable = None;
+    let mut limit_stage = None;
     if search != Search::Local {
-        let fitted = stages(plan);
+        let mut fitted = stages(plan);
         out.extend(staged_points(plan, &fitted));
-        reachable = nested_limit_cost(plan.model, &fitted);
+        limit_stage = nested_limit(plan.model, &mut fitted);
     }
     let local = fit_starting_points(
         &plan.layout.params,
@@ -143,7 +143,8 @@ pub(crate) fn plan_starts<R: Residuals + 'static>(
     }
     Planned {
         seeded: unique,
-        reachable,
+        reachable: limit_stage.as_ref().map(|f| f.cost),
+        limit_stage,
     }
 }
 
@@ -155,15 +156,16 @@ pub(crate) struct Planned {
     /// the target reaches it as its stiffness grows, so a screened start left far above it
     /// is abandoned.
     pub reachable: Option<f64>,
+    /// That stage's fit, which starts the fit of the rigid limit in the assessment (in place
+    /// of the guess it was itself fitted from).
+    pub limit_stage: Option<SimplerFit>,
 }
 
-/// The cost of the fitted stage that is `model`'s rigid-limit law, if any.
-fn nested_limit_cost(model: &dyn FrictionModel, fitted: &[SimplerFit]) -> Option<f64> {
+/// The fitted stage that is `model`'s rigid-limit law, if any (taken out of `fitted`).
+fn nested_limit(model: &dyn FrictionModel, fitted: &mut Vec<SimplerFit>) -> Option<SimplerFit> {
     let law = model.states()?.rigid_limit()?.law;
-    fitted
-        .iter()
-        .find(|f| f.model.name() == law.name())
-        .map(|f| f.cost)
+    let at = fitted.iter().position(|f| f.model.name() == law.name())?;
+    Some(fitted.swap_remove(at))
 }
 
 /// Whether a model has Stribeck levels (a static and a Coulomb level and a Stribeck
@@ -210,7 +212,7 @@ fn stage_fit<R: Residuals + 'static>(
         osc: plan.osc,
         records: &plan.records.into(),
     };
-    fit_simpler(&on, stage, &stage_options(plan.opts), &[])
+    fit_simpler(&on, stage, &stage_options(plan.opts), &[], None)
 }
 
 /// The records a simpler law is fitted to, with the fit's residuals and oscillator.
@@ -231,15 +233,33 @@ pub(crate) struct SimplerFit {
     pub cost: f64,
     /// Its free parameters (the model's and the others alike).
     pub free: usize,
+    /// Their names, in the layout's order.
+    pub free_names: Vec<String>,
+}
+
+impl SimplerFit {
+    /// Whether this is a fit of `law` over the free parameters `layout` lays out.
+    fn fits_the_same(&self, law: &dyn FrictionModel, layout: &Layout) -> bool {
+        self.model.name() == law.name()
+            && self.free_names.len() == layout.params.len()
+            && self
+                .free_names
+                .iter()
+                .zip(&layout.params)
+                .all(|(n, f)| *n == f.name)
+    }
 }
 
 /// Fits `law` with `opts` (local runs: one from its data-driven guess and one from each model
-/// of `also_from` mapped onto it by `start_from`, the best kept); `None` when it fails.
+/// of `also_from` mapped onto it by `start_from`, the best kept); `None` when it fails. An
+/// earlier fit of the same law over the same free parameters (`fitted`, e.g. a stage of the
+/// staged search, itself one run from the guess) starts at its optimum in place of the guess.
 pub(crate) fn fit_simpler<R: Residuals + 'static>(
     on: &FitTarget<'_, R>,
     law: &(dyn FrictionModel + 'static),
     opts: &FitOptions,
     also_from: &[(&dyn FrictionModel, StartContext)],
+    fitted: Option<&SimplerFit>,
 ) -> Option<SimplerFit> {
     let layout = build_layout(
         on.osc,
@@ -267,10 +287,14 @@ pub(crate) fn fit_simpler<R: Residuals + 'static>(
         )
         .with_loss(opts.search.robust_loss())
     };
-    let mut points = vec![layout.start.clone()];
-    for (fitted, ctx) in also_from {
+    let first = match fitted.filter(|f| f.fits_the_same(law, &layout)) {
+        Some(f) => layout.projected(&seeded_point(&layout, f.model.as_ref())),
+        None => layout.start.clone(),
+    };
+    let mut points = vec![first];
+    for (from, ctx) in also_from {
         points.extend(
-            mapped_point(&layout, *fitted, ctx, &opts.params).filter(|p| !points.contains(p)),
+            mapped_point(&layout, *from, ctx, &opts.params).filter(|p| !points.contains(p)),
         );
     }
     let reference = make();
@@ -282,6 +306,7 @@ pub(crate) fn fit_simpler<R: Residuals + 'static>(
         model,
         cost: runs.best.cost,
         free: layout.params.len(),
+        free_names: layout.params.iter().map(|f| f.name.clone()).collect(),
     })
 }
 
@@ -467,6 +492,50 @@ fn global_points(layout: &Layout, n: usize, seed: u64) -> Vec<Seeded> {
 mod tests {
     use super::*;
     use frictionid_models::LuGre;
+
+    /// A layout of `names`, all free model parameters of Stribeck's law.
+    fn stribeck_layout(names: &[&str]) -> Layout {
+        let params = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| {
+                FreeParam::linear((*n).into(), "", ParamKind::Model(i), (0.0, 10.0), 0.1, 1.0)
+            })
+            .collect::<Vec<_>>();
+        Layout {
+            start_model: Box::new(Stribeck::default()),
+            start: vec![0.1; params.len()],
+            params,
+            levels: Default::default(),
+        }
+    }
+
+    fn stage(model: Box<dyn FrictionModel>, names: &[&str]) -> SimplerFit {
+        SimplerFit {
+            model,
+            cost: 1.0,
+            free: names.len(),
+            free_names: names.iter().map(|n| n.to_string()).collect(),
+        }
+    }
+
+    #[test]
+    fn a_stage_starts_the_limit_fit_only_for_the_same_law_and_free_parameters() {
+        let names = ["mu_c", "mu_s", "v_s", "viscous"];
+        let layout = stribeck_layout(&names);
+        let same = stage(Box::new(Stribeck::default()), &names);
+        assert!(same.fits_the_same(&Stribeck::default(), &layout));
+        // Another law, fewer or other free parameters: the limit starts from its guess.
+        let coulomb = stage(Box::new(Coulomb::default()), &names);
+        assert!(!coulomb.fits_the_same(&Stribeck::default(), &layout));
+        let fewer = stage(Box::new(Stribeck::default()), &names[..3]);
+        assert!(!fewer.fits_the_same(&Stribeck::default(), &layout));
+        let other = stage(
+            Box::new(Stribeck::default()),
+            &["mu_c", "mu_s", "v_s", "delta"],
+        );
+        assert!(!other.fits_the_same(&Stribeck::default(), &layout));
+    }
 
     #[test]
     fn a_latin_hypercube_fills_every_stratum_once() {

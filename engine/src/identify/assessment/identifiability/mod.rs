@@ -40,7 +40,8 @@ pub use profiles::{
     PROFILE_RESOLUTION, PROFILE_STEPS,
 };
 pub use rigid_limit::LIMIT_APPROACH_DECADES;
-pub use settle::{settle, PROFILE_RESTARTS};
+pub(crate) use settle::settle;
+pub use settle::PROFILE_RESTARTS;
 pub use shared::{shared_columns, shared_findings, with_shared, SharedColumn, SHARED_CORRELATION};
 
 use crate::identify::values::result::Identifiability;

@@ -6,7 +6,7 @@ use crate::identify::assessment::stats::chi_square_95;
 use crate::identify::problem::least_squares::FitProblem;
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::StartRun;
-use crate::identify::search::strategy::{fit_simpler, stage_options, FitTarget, Onto};
+use crate::identify::search::strategy::{fit_simpler, stage_options, FitTarget, Onto, SimplerFit};
 use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::ParamKind;
 use crate::identify::values::result::Identifiability;
@@ -162,13 +162,15 @@ impl Limit {
     }
 }
 
-/// The model's rigid limit fitted to the records (from its own guess and from the fit's best
-/// mapped onto it), when the model declares one and a stiffness of it is free; `None`
-/// otherwise or when the limit cannot be fitted.
+/// The model's rigid limit fitted to the records (from its own guess, or from `stage` when
+/// the staged search fitted the same law from it, and from the fit's best mapped onto it),
+/// when the model declares one and a stiffness of it is free; `None` otherwise or when the
+/// limit cannot be fitted.
 pub(super) fn rigid_limit<R: Residuals + 'static>(
     reference: &FitProblem<R>,
     best: &StartRun,
     opts: &FitOptions,
+    stage: Option<&SimplerFit>,
 ) -> Option<Limit> {
     let declared = reference.model.states()?.rigid_limit()?;
     let slots_of = |indices: &[usize]| -> Vec<usize> {
@@ -196,6 +198,7 @@ pub(super) fn rigid_limit<R: Residuals + 'static>(
         declared.law.as_ref(),
         &limit_opts,
         &[(fitted.as_ref(), ctx)],
+        stage,
     )?;
     Some(Limit {
         slots,

@@ -10,6 +10,7 @@ use crate::error::EngineError;
 use crate::identify::problem::least_squares::FitProblem;
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::{run_start, MultiStart, RunSlot, StartRun};
+use crate::identify::search::strategy::SimplerFit;
 use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::outcome::TerminationReason;
 use nalgebra::DVector;
@@ -22,17 +23,19 @@ pub const PROFILE_RESTARTS: usize = 2;
 /// unbounded ones, and returns the runs with one standing per free parameter. A profile
 /// point whose cost lies a [`PROFILE_DELTA`](super::PROFILE_DELTA) rise below the best (the
 /// fit stopped in a local minimum or on a plateau the profile stepped off) restarts the
-/// solver there, and the profiles are taken again at the better optimum.
-pub fn settle<R: Residuals + 'static>(
+/// solver there, and the profiles are taken again at the better optimum. `limit_stage`: the
+/// model's rigid-limit law as the staged search fitted it, which starts the limit's fit.
+pub(crate) fn settle<R: Residuals + 'static>(
     reference: &FitProblem<R>,
     mut runs: MultiStart,
     opts: &FitOptions,
+    limit_stage: Option<&SimplerFit>,
 ) -> Result<(MultiStart, Vec<Standing>), EngineError> {
     let quiet = FitOptions {
         hooks: opts.hooks.quiet(),
         ..opts.clone()
     };
-    let limit = rigid_limit(reference, &runs.best, &quiet);
+    let limit = rigid_limit(reference, &runs.best, &quiet, limit_stage);
     let mut restarts = PROFILE_RESTARTS;
     loop {
         match profile_all(reference, &runs.best, &quiet, limit.as_ref(), restarts > 0)? {
