@@ -1,5 +1,7 @@
 //! A loading GMS element's exact step at any sharpness m, with its sensitivities (used by
-//! `gms_steps.rs`, which keeps the closed forms of m = 1 and 2).
+//! `gms_steps.rs`, which keeps the closed forms of m = 1 and 2). The regular part R below
+//! comes from the table of `gms_table.rs` at the step's sharpness where it holds the loads,
+//! else from the series and panels of `gms_quadrature.rs`.
 //!
 //! A loading element's load y >= 0 obeys dy/dsigma = 1 - y^m in its dimensionless travel
 //! sigma, separable: sigma = Phi(y1) - Phi(y0) with Phi(y) = integral dr / (1 - r^m) on the
@@ -27,31 +29,11 @@
 //! dy1/dm = -(1 - y1^m) (dPhi/dm(y1) - dPhi/dm(y0)), dPhi/dm = -u / m^2 + dR/dm, with dR/dm
 //! from the same series and panels differentiated in m.
 
-/// Gauss-Legendre nodes and weights on [-1, 1], 4 points (the positive halves).
-const GAUSS_4: [(f64, f64); 2] = [
-    (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-    (0.861_136_311_594_052_6, 0.347_854_845_137_453_8),
-];
-/// Gauss-Legendre nodes and weights on [-1, 1], 8 points (the positive halves).
-const GAUSS_8: [(f64, f64); 4] = [
-    (0.183_434_642_495_649_8, 0.362_683_783_378_362),
-    (0.525_532_409_916_329, 0.313_706_645_877_887_3),
-    (0.796_666_477_413_626_7, 0.222_381_034_453_374_5),
-    (0.960_289_856_497_536_3, 0.101_228_536_290_376_3),
-];
-/// Longest panel, as (its length in w) x max(m, 1): 8 points then integrate to rounding (the
-/// integrand's poles lie 2 pi / max(m, 1) off the real axis).
-const PANEL_REACH: f64 = 1.5;
-/// Panels up to this reach take 4 points.
-const SHORT_REACH: f64 = 0.5;
-/// The series of R serves loads with y^m up to this value.
-const SERIES_LIMIT: f64 = 0.25;
-/// Most series terms (y^m <= 1/4: 30 reach rounding).
-const SERIES_TERMS: usize = 60;
+use super::gms_quadrature::{panels, series, GAUSS_8, PANEL_REACH, SERIES_LIMIT};
+use super::gms_table::{RegularTable, FAR_LEVEL};
+
 /// The largest u = -ln|1 - y| the Newton iterates take: e^(-u) still a normal number.
 const U_MAX: f64 = 600.0;
-/// Loads with y^m above this level step by [`relax_far`].
-const FAR_LEVEL: f64 = 2.0;
 /// Most Newton iterations (two or three are the rule).
 const NEWTON_ITERATIONS: usize = 60;
 
@@ -66,126 +48,6 @@ pub(super) struct Relaxed {
     pub slope: f64,
     /// dy1/dm (0 unless asked for).
     pub sharpness: f64,
-}
-
-/// 1/(1 - e^(-t)) - 1/t and its derivative in t (Bernoulli series near t = 0).
-fn bernoulli_part(t: f64) -> (f64, f64) {
-    if t.abs() < 0.2 {
-        let t2 = t * t;
-        let value =
-            0.5 + t * (1.0 / 12.0 + t2 * (-1.0 / 720.0 + t2 * (1.0 / 30_240.0 - t2 / 1_209_600.0)));
-        let slope = 1.0 / 12.0 + t2 * (-1.0 / 240.0 + t2 * (1.0 / 6_048.0 - t2 / 172_800.0));
-        (value, slope)
-    } else {
-        let half = (0.5 * t).sinh();
-        (
-            1.0 / -(-t).exp_m1() - 1.0 / t,
-            1.0 / (t * t) - 0.25 / (half * half),
-        )
-    }
-}
-
-/// 1/a - 1/eps for eps = 1 - r and a = -ln r (Gregory series near r = 1).
-fn gregory_part(eps: f64, a: f64) -> f64 {
-    if eps.abs() < 1e-2 {
-        let tail = 3.0 / 160.0 + eps * (863.0 / 60_480.0 + eps * 275.0 / 24_192.0);
-        -0.5 - eps * (1.0 / 12.0 + eps * (1.0 / 24.0 + eps * (19.0 / 720.0 + eps * tail)))
-    } else {
-        1.0 / a - 1.0 / eps
-    }
-}
-
-/// Below this |w| = |ln r| the integrand comes from the series (the direct form's two terms,
-/// each near 1 / (m |w|), would cancel).
-const NEAR_ONE: f64 = 0.2;
-
-/// h_m(e^w) e^w and its derivative in m (0 unless `with_m`).
-fn integrand(m: f64, w: f64, with_m: bool) -> (f64, f64) {
-    let r = w.exp();
-    let (h, dh) = if w.abs() > NEAR_ONE {
-        // h = 1 / (m (r - 1)) - 1 / (r^m - 1), dh/dm = w r^m / (r^m - 1)^2 - 1 / (m^2 (r - 1)).
-        let (em, e1) = ((m * w).exp_m1(), w.exp_m1());
-        let h = 1.0 / (m * e1) - 1.0 / em;
-        let dh = if with_m {
-            w / (em * -(-m * w).exp_m1()) - 1.0 / (m * m * e1)
-        } else {
-            0.0
-        };
-        (h, dh)
-    } else {
-        // h = (1/(1 - e^(-t)) - 1/t) + (1/a - 1/eps) / m with a = -w, t = m a, eps = 1 - r.
-        let a = -w;
-        let (b, db) = bernoulli_part(m * a);
-        let g = gregory_part(-w.exp_m1(), a);
-        let dh = if with_m { a * db - g / (m * m) } else { 0.0 };
-        (b + g / m, dh)
-    };
-    (h * r, dh * r)
-}
-
-/// One Gauss-Legendre panel from `lo` over `width` in w.
-fn panel(m: f64, lo: f64, width: f64, short: bool, with_m: bool) -> (f64, f64) {
-    let half = 0.5 * width;
-    let mid = lo + half;
-    let nodes: &[(f64, f64)] = if short { &GAUSS_4 } else { &GAUSS_8 };
-    let (mut sum, mut d_sum) = (0.0, 0.0);
-    for &(x, weight) in nodes {
-        for w in [mid - half * x, mid + half * x] {
-            let (f, df) = integrand(m, w, with_m);
-            sum += weight * f;
-            d_sum += weight * df;
-        }
-    }
-    (half * sum, half * d_sum)
-}
-
-/// The integral of h_m from r = e^`wa` to e^(`wa` + `span`) (and its derivative in m), by
-/// panels short enough for the integrand's poles.
-fn panels(m: f64, wa: f64, span: f64, with_m: bool) -> (f64, f64) {
-    let reach = span.abs() * m.max(1.0);
-    if reach == 0.0 {
-        return (0.0, 0.0);
-    }
-    if !reach.is_finite() {
-        return (f64::NAN, f64::NAN);
-    }
-    let count = (reach / PANEL_REACH).ceil().max(1.0);
-    let width = span / count;
-    let short = reach / count <= SHORT_REACH;
-    let (mut sum, mut d_sum) = (0.0, 0.0);
-    let mut done = 0.0;
-    while done < count {
-        let (f, df) = panel(m, wa + width * done, width, short, with_m);
-        sum += f;
-        d_sum += df;
-        done += 1.0;
-    }
-    (sum, d_sum)
-}
-
-/// R(y) = Phi(y) + ln(1 - y) / m and dR/dm by the series, for 0 <= y with y^m <= 1/4.
-fn series(m: f64, y: f64, with_m: bool) -> (f64, f64) {
-    if y <= 0.0 {
-        return (0.0, 0.0);
-    }
-    let ln_y = y.ln();
-    let x = (m * ln_y).exp();
-    let (mut sum, mut d_sum, mut power, mut k) = (0.0, 0.0, 1.0, 0.0);
-    for _ in 0..SERIES_TERMS {
-        let den = m * k + 1.0;
-        let term = power / den;
-        sum += term;
-        if with_m {
-            d_sum += term * k * (ln_y - 1.0 / den);
-        }
-        if term <= 1e-17 * sum {
-            break;
-        }
-        power *= x;
-        k += 1.0;
-    }
-    let log_rest = (-y).ln_1p();
-    (y * sum + log_rest / m, y * d_sum - log_rest / (m * m))
 }
 
 /// A load y >= 0 and its logarithm w = ln y.
@@ -244,17 +106,42 @@ fn end_of(y0: f64, w0: f64, advance: f64) -> (Load, f64, f64) {
 
 /// dy1/dm of a step from `from` to `to` that moved u = -ln|1 - y| by `advance` over the
 /// span w1 - w0, the rate at its end `rate1` = 1 - y1^m.
-fn sharpness_slope(m: f64, from: Load, to: Load, span: f64, advance: f64, rate1: f64) -> f64 {
+/// dR/dm from the table where it holds both loads, else from the series and panels.
+fn sharpness_slope(step: &Step, from: Load, to: Load, span: f64, rate1: f64) -> f64 {
     if rate1 == 0.0 {
         return 0.0;
     }
-    let (_, d_regular) = regular_change(m, from, to, span, true);
-    -rate1 * (-advance / (m * m) + d_regular)
+    let m = step.m;
+    let d_regular = match step.table_for(from, to) {
+        Some(t) => t.regular(to.y, to.w, true).1 - t.regular(from.y, from.w, true).1,
+        None => regular_change(m, from, to, span, true).1,
+    };
+    -rate1 * (-step.advance / (m * m) + d_regular)
+}
+
+/// A step's sharpness, the table of R at it (if any) and the advance in u it made.
+struct Step<'a> {
+    m: f64,
+    table: Option<&'a RegularTable>,
+    advance: f64,
+}
+
+impl Step<'_> {
+    /// The table, where it is the step's sharpness's and holds both loads.
+    fn table_for(&self, from: Load, to: Load) -> Option<&RegularTable> {
+        self.table
+            .filter(|t| t.sharpness() == self.m && t.holds(from.w) && t.holds(to.w))
+    }
 }
 
 /// dy1/dm of a step of the load from `y0` >= 0 by `change` (staying on its side of 1), from
-/// the loads alone (the closed forms' steps).
-pub(super) fn sharpness_slope_of_loads(m: f64, y0: f64, change: f64) -> f64 {
+/// the loads alone (the closed forms' steps), with R's slope from `table` where it holds them.
+pub(super) fn sharpness_slope_of_loads(
+    m: f64,
+    y0: f64,
+    change: f64,
+    table: Option<&RegularTable>,
+) -> f64 {
     let d0 = y0 - 1.0;
     let delta1 = d0 + change;
     let rate1 = rate(m, delta1);
@@ -274,7 +161,8 @@ pub(super) fn sharpness_slope_of_loads(m: f64, y0: f64, change: f64) -> f64 {
         y: y1,
         w: delta1.ln_1p(),
     };
-    sharpness_slope(m, from, to, span, advance, rate1)
+    let step = Step { m, table, advance };
+    sharpness_slope(&step, from, to, span, rate1)
 }
 
 /// r / (r^m - 1) at r = e^x (x > 0), the travel per unit of ln y of an overloaded element,
@@ -324,13 +212,20 @@ fn overload_travel(m: f64, wa: f64, wb: f64, with_m: bool) -> (f64, f64) {
 /// The step of an element overloaded past y^m = 2 (`w0` = ln y0 > ln 2 / m): solved in
 /// ln y, where the travel is a well-conditioned integral, down to y^m = 2 at most; from there
 /// on (when the travel goes on) by [`relax_near`].
-fn relax_far(m: f64, y0: f64, w0: f64, sigma: f64, with_m: bool) -> Relaxed {
+fn relax_far(
+    m: f64,
+    y0: f64,
+    w0: f64,
+    sigma: f64,
+    with_m: bool,
+    table: Option<&RegularTable>,
+) -> Relaxed {
     let w_far = FAR_LEVEL.ln() / m;
     let rate0 = -(m * w0).exp_m1();
     let (to_far, d_to_far) = overload_travel(m, w_far, w0, with_m);
     if sigma >= to_far {
         let y_far = w_far.exp();
-        let near = relax_near(m, y_far, sigma - to_far, with_m);
+        let near = relax_near(m, y_far, sigma - to_far, with_m, table);
         return Relaxed {
             change: (y_far - y0) + near.change,
             gain: near.slope / rate0,
@@ -384,18 +279,25 @@ fn relax_far(m: f64, y0: f64, w0: f64, sigma: f64, with_m: bool) -> Relaxed {
 }
 
 /// The exact step of a loading element's load from `y0` >= 0 over the travel `sigma` >= 0 at
-/// sharpness `m` > 0, with dy1/dm when `with_m`.
-pub(super) fn relax(m: f64, y0: f64, sigma: f64, with_m: bool) -> Relaxed {
+/// sharpness `m` > 0, with dy1/dm when `with_m`; R from `table` (the table at `m`) where it
+/// holds the loads, else from the series and panels.
+pub(super) fn relax(
+    m: f64,
+    y0: f64,
+    sigma: f64,
+    with_m: bool,
+    table: Option<&RegularTable>,
+) -> Relaxed {
     let w0 = y0.ln();
     if m * w0 > FAR_LEVEL.ln() && sigma > 0.0 {
-        return relax_far(m, y0, w0, sigma, with_m);
+        return relax_far(m, y0, w0, sigma, with_m, table);
     }
-    relax_near(m, y0, sigma, with_m)
+    relax_near(m, y0, sigma, with_m, table)
 }
 
 /// [`relax`] in u = -ln|1 - y|, for loads below y^m = 2 (above it the equation in u loses
 /// the precision of a short step to the cancellation of its two terms).
-fn relax_near(m: f64, y0: f64, sigma: f64, with_m: bool) -> Relaxed {
+fn relax_near(m: f64, y0: f64, sigma: f64, with_m: bool, table: Option<&RegularTable>) -> Relaxed {
     let d0 = y0 - 1.0;
     if sigma == 0.0 || d0 == 0.0 {
         return Relaxed {
@@ -409,18 +311,28 @@ fn relax_near(m: f64, y0: f64, sigma: f64, with_m: bool) -> Relaxed {
     let rate0 = rate(m, d0);
     // F(x) = x / m + R(y1) - R(y0) - sigma in the advance x = u1 - u0, and F'(x) =
     // delta / ((1 + delta)^m - 1), delta = y1 - 1 = d0 e^(-x).
+    // The iterates stay between y0 and 1: the table (if any) holds them all when it holds y0.
+    let start = Step {
+        m,
+        table,
+        advance: 0.0,
+    };
+    let tabled = start
+        .table_for(from, from)
+        .map(|t| (t, t.regular(y0, from.w, false).0));
     // Below the series' limit R(y0) (and R at the limit) once for every iteration.
     let wq = SERIES_LIMIT.ln() / m;
-    let series_start = (from.w <= wq).then(|| {
+    let series_start = (tabled.is_none() && from.w <= wq).then(|| {
         let at_start = series(m, y0, false).0;
         (at_start, series(m, wq.exp(), false).0 - at_start)
     });
     let residual = |advance: f64| -> (f64, f64) {
         let (to, delta, span) = end_of(y0, from.w, advance);
-        let regular = match series_start {
-            None => panels(m, from.w, span, false).0,
-            Some((at_start, _)) if to.w <= wq => series(m, to.y, false).0 - at_start,
-            Some((_, to_limit)) => to_limit + panels(m, wq, to.w - wq, false).0,
+        let regular = match (tabled, series_start) {
+            (Some((t, at_start)), _) => t.regular(to.y, to.w, false).0 - at_start,
+            (None, None) => panels(m, from.w, span, false).0,
+            (None, Some((at_start, _))) if to.w <= wq => series(m, to.y, false).0 - at_start,
+            (None, Some((_, to_limit))) => to_limit + panels(m, wq, to.w - wq, false).0,
         };
         let value = advance / m + regular - sigma;
         (value, delta / (m * to.w).exp_m1())
@@ -447,7 +359,8 @@ fn relax_near(m: f64, y0: f64, sigma: f64, with_m: bool) -> Relaxed {
     let (to, delta1, span) = end_of(y0, from.w, advance);
     let rate1 = rate(m, delta1);
     let sharpness = if with_m {
-        sharpness_slope(m, from, to, span, advance, rate1)
+        let step = Step { m, table, advance };
+        sharpness_slope(&step, from, to, span, rate1)
     } else {
         0.0
     };
@@ -478,23 +391,81 @@ mod tests {
         y
     }
 
+    /// Loads and travels of the tabled-step checks: from 0, below 1, near 1, overloaded near
+    /// and far (y^m > 2 at the larger sharpnesses), short and long travels.
+    const TABLED_CASES: [(f64, f64); 12] = [
+        (0.0, 1e-7),
+        (0.0, 0.05),
+        (0.0, 3.0),
+        (0.3, 1e-9),
+        (0.3, 0.4),
+        (0.97, 0.02),
+        (0.999_999, 5.0),
+        (1.000_001, 0.3),
+        (1.02, 1e-6),
+        (1.5, 0.1),
+        (1.2, 4.0),
+        (8.0, 0.01),
+    ];
+
+    fn close(got: f64, want: f64, tolerance: f64) -> bool {
+        (got - want).abs() <= tolerance * want.abs().max(1.0)
+    }
+
     #[test]
-    fn the_quadrature_rules_integrate_polynomials_exactly() {
-        for (nodes, degree) in [(&GAUSS_4[..], 7), (&GAUSS_8[..], 15)] {
-            for p in 0..=degree {
-                let sum: f64 = nodes
-                    .iter()
-                    .map(|&(x, w)| w * (x.powi(p) + (-x).powi(p)))
-                    .sum();
-                let exact = if p % 2 == 0 {
-                    2.0 / (p as f64 + 1.0)
-                } else {
-                    0.0
-                };
+    fn tabled_steps_match_the_quadrature_steps_and_the_closed_forms() {
+        for m in [1.0, 1.3, 2.0, 2.7, 6.0, 20.0] {
+            let table = RegularTable::new(m).expect("a table");
+            for (y0, sigma) in TABLED_CASES {
+                let case = format!("m = {m}, y0 = {y0}, sigma = {sigma}");
+                let exact = relax(m, y0, sigma, true, None);
+                let tabled = relax(m, y0, sigma, true, Some(&table));
+                let y1 = y0 + tabled.change;
                 assert!(
-                    (sum - exact).abs() < 1e-15,
-                    "{} points, x^{p}: {sum}",
-                    2 * nodes.len()
+                    close(y1, y0 + exact.change, 1e-14),
+                    "{case}: {tabled:?} {exact:?}"
+                );
+                assert!(
+                    close(tabled.gain, exact.gain, 1e-12),
+                    "{case}: {tabled:?} {exact:?}"
+                );
+                assert!(
+                    close(tabled.slope, exact.slope, 1e-12),
+                    "{case}: {tabled:?} {exact:?}"
+                );
+                let (got, want) = (tabled.sharpness, exact.sharpness);
+                assert!(close(got, want, 1e-11), "{case}: {tabled:?} {exact:?}");
+                // The closed forms: 1 - y = (1 - y0) e^-sigma at m = 1, y = (y0 + tanh sigma)
+                // / (1 + y0 tanh sigma) at m = 2.
+                let closed = match m {
+                    1.0 => Some(1.0 + (y0 - 1.0) * (-sigma).exp()),
+                    2.0 => Some((y0 + sigma.tanh()) / (1.0 + y0 * sigma.tanh())),
+                    _ => None,
+                };
+                if let Some(closed) = closed {
+                    assert!(close(y1, closed, 1e-14), "{case}: {y1} against {closed}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn tabled_slopes_in_the_sharpness_match_central_differences() {
+        for m in [1.0, 1.3, 2.0, 2.7, 6.0] {
+            let table = RegularTable::new(m).expect("a table");
+            let h = 1e-5 * m;
+            let end = |m: f64, y0: f64, sigma: f64| {
+                let table = RegularTable::new(m).expect("a table");
+                y0 + relax(m, y0, sigma, false, Some(&table)).change
+            };
+            for (y0, sigma) in TABLED_CASES {
+                let slope = relax(m, y0, sigma, true, Some(&table)).sharpness;
+                let difference = (end(m + h, y0, sigma) - end(m - h, y0, sigma)) / (2.0 * h);
+                // The difference's own rounding: the loads' to 1e-16 over 2 h.
+                let floor = 1e-16 / h;
+                assert!(
+                    (slope - difference).abs() <= 1e-6 * slope.abs() + floor,
+                    "m = {m}, y0 = {y0}, sigma = {sigma}: {slope} against {difference}"
                 );
             }
         }
@@ -516,7 +487,7 @@ mod tests {
                 if m * y0.powf(m - 1.0) * sigma / steps as f64 > 0.1 {
                     continue; // too stiff for the explicit reference
                 }
-                let step = relax(m, y0, sigma, false);
+                let step = relax(m, y0, sigma, false, None);
                 let reference = rk4(m, y0, sigma, steps);
                 let y1 = y0 + step.change;
                 assert!(

@@ -23,8 +23,10 @@
 
 use super::gms::{Gms, GmsElement};
 use super::gms_relaxation::{relax, sharpness_slope_of_loads};
+use super::gms_table::{table_for, RegularTable};
 use crate::interval::Interval;
 use crate::model::{sgn, ParamGradients, Propagator};
+use std::rc::Rc;
 
 /// An element's exact step in its load y over the travel sigma.
 struct LoadStep {
@@ -86,8 +88,15 @@ fn loaded_step(two: bool, y0: f64, sigma: f64) -> LoadStep {
 }
 
 /// The step of a loaded element (y0 >= 0) over the travel `sigma` at sharpness `m`: the
-/// closed forms at m = 1 and 2, else the Newton solve; with dy1/dm when `with_m`.
-fn loading_step(m: f64, y0: f64, sigma: f64, with_m: bool) -> LoadStep {
+/// closed forms at m = 1 and 2, else the Newton solve; with dy1/dm when `with_m` (R from
+/// `table`, the table at `m`, where it holds the loads).
+fn loading_step(
+    m: f64,
+    y0: f64,
+    sigma: f64,
+    with_m: bool,
+    table: Option<&RegularTable>,
+) -> LoadStep {
     if m == 1.0 || m == 2.0 {
         let mut step = if y0 > 0.0 {
             loaded_step(m == 2.0, y0, sigma)
@@ -102,11 +111,11 @@ fn loading_step(m: f64, y0: f64, sigma: f64, with_m: bool) -> LoadStep {
             }
         };
         if with_m {
-            step.sharpness = sharpness_slope_of_loads(m, y0, step.change);
+            step.sharpness = sharpness_slope_of_loads(m, y0, step.change, table);
         }
         return step;
     }
-    let relaxed = relax(m, y0, sigma, with_m);
+    let relaxed = relax(m, y0, sigma, with_m, table);
     LoadStep {
         change: relaxed.change,
         gain: relaxed.gain,
@@ -117,10 +126,10 @@ fn loading_step(m: f64, y0: f64, sigma: f64, with_m: bool) -> LoadStep {
 }
 
 /// The exact step of an element's load from `y0` over the travel `sigma` >= 0 at sharpness
-/// `m`, with dy1/dm when `with_m`.
-fn load_step(m: f64, y0: f64, sigma: f64, with_m: bool) -> LoadStep {
+/// `m`, with dy1/dm when `with_m` (R from `table` where it holds the loads).
+fn load_step(m: f64, y0: f64, sigma: f64, with_m: bool, table: Option<&RegularTable>) -> LoadStep {
     if y0 > 0.0 {
-        return loading_step(m, y0, sigma, with_m);
+        return loading_step(m, y0, sigma, with_m, table);
     }
     if y0 + sigma <= 0.0 {
         return LoadStep {
@@ -132,7 +141,7 @@ fn load_step(m: f64, y0: f64, sigma: f64, with_m: bool) -> LoadStep {
         };
     }
     // Stuck until the load crosses 0, then loading over the rest of the travel.
-    let from_zero = loading_step(m, 0.0, y0 + sigma, with_m);
+    let from_zero = loading_step(m, 0.0, y0 + sigma, with_m, table);
     LoadStep {
         change: from_zero.change - y0,
         gain: from_zero.slope,
@@ -154,8 +163,17 @@ impl Gms {
         self.sharpness.is_finite() && self.sharpness > 0.0
     }
 
-    /// Steps the element `e` of deflection `z` over `interval` at the Stribeck level `s`;
-    /// `None` where it stays (frozen, or no motion).
+    /// The table of the element law's regular part at this sharpness, where a step needs it:
+    /// every sharpness without a closed form, and the closed forms' slopes in m.
+    fn relaxation_table(&self, with_m: bool) -> Option<Rc<RegularTable>> {
+        let m = self.sharpness;
+        (with_m || (m != 1.0 && m != 2.0))
+            .then(|| table_for(m))
+            .flatten()
+    }
+
+    /// Steps the element `e` of deflection `z` over `interval` at the Stribeck level `s`
+    /// (R from `table` where it holds the loads); `None` where it stays (frozen, or no motion).
     fn step_element(
         &self,
         e: &GmsElement,
@@ -163,6 +181,7 @@ impl Gms {
         s: f64,
         z: &mut f64,
         with_m: bool,
+        table: Option<&RegularTable>,
     ) -> Option<ElementFrame> {
         let limit = e.weight * s;
         if limit.is_nan() || limit <= 0.0 || interval.v == 0.0 || interval.dt <= 0.0 {
@@ -172,7 +191,7 @@ impl Gms {
         let rho = e.stiffness / limit;
         let y0 = u * rho * *z;
         let sigma = rho * interval.travel();
-        let step = load_step(self.sharpness, y0, sigma, with_m);
+        let step = load_step(self.sharpness, y0, sigma, with_m, table);
         *z += if step.stuck {
             interval.v * interval.dt
         } else {
@@ -225,8 +244,9 @@ impl Propagator for Gms {
 
     fn propagate(&self, interval: Interval, z: &mut [f64]) {
         let s = self.s(interval.v, interval.normal);
+        let table = self.relaxation_table(false);
         for (e, zi) in self.elements.iter().zip(z.iter_mut()) {
-            self.step_element(e, interval, s, zi, false);
+            self.step_element(e, interval, s, zi, false, table.as_deref());
         }
     }
 
@@ -236,11 +256,12 @@ impl Propagator for Gms {
         let np = 3 * self.elements.len() + 6;
         let sharpness = 3 * self.elements.len() + 4;
         let u = sgn(interval.v);
+        let table = self.relaxation_table(true);
         for (i, (e, zi)) in self.elements.iter().zip(z.iter_mut()).enumerate() {
             let Some(row) = sens.get_mut(i * np..(i + 1) * np) else {
                 return;
             };
-            let Some(frame) = self.step_element(e, interval, s, zi, true) else {
+            let Some(frame) = self.step_element(e, interval, s, zi, true, table.as_deref()) else {
                 continue;
             };
             if frame.step.stuck {
@@ -275,7 +296,12 @@ impl ParamGradients for Gms {
         for (i, e) in self.elements.iter().enumerate() {
             let zi = z.get(i).copied().unwrap_or(0.0);
             let rate = self.z_dot(e, v, zi, s);
-            let (d_load, d_m) = self.rate_slopes(e, v, zi, s);
+            // The rate's slopes act through the damping only.
+            let (d_load, d_m) = if e.damping == 0.0 {
+                (0.0, 0.0)
+            } else {
+                self.rate_slopes(e, v, zi, s)
+            };
             let (d_k, d_w) = if d_load == 0.0 || e.damping == 0.0 {
                 (0.0, 0.0)
             } else {
@@ -312,7 +338,11 @@ impl Gms {
     fn rate_slopes(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> (f64, f64) {
         match Gms::element_load(e, v, z, s) {
             Some((_, load)) if load > 0.0 => {
-                let p = load.powf(self.sharpness);
+                let p = if self.sharpness == 1.0 {
+                    load
+                } else {
+                    load.powf(self.sharpness)
+                };
                 (-v * self.sharpness * p, -v * p * load.ln())
             }
             _ => (0.0, 0.0),

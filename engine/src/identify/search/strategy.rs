@@ -20,6 +20,7 @@ use crate::identify::problem::least_squares::{FitProblem, ProblemParts};
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::{FreeParam, ParamKind};
+use crate::identify::values::levels::{FrictionLevels, UNIT_NORMAL_FORCE};
 use crate::identify::values::param_options::ParamOptions;
 use crate::identify::values::search::Search;
 use crate::oscillator::Oscillator;
@@ -40,6 +41,13 @@ pub(crate) const GLOBAL_SEED: u64 = 0x5eed_0014;
 /// Presliding displacements (multiples of the typical one) that map the last stage onto
 /// the target: the typical one and a stiffer contact.
 pub(crate) const STAGED_PRESLIDING: [f64; 2] = [1.0, 0.1];
+
+/// The presliding displacement (a multiple of the typical one) of the compliant start a law
+/// with several elements (several stiffnesses, as GMS) takes after [`STAGED_PRESLIDING`]'s:
+/// elements stiff enough to saturate within a sample leave the force all but independent of
+/// their stiffnesses (the rigid limit's plateau, where the search cannot soften them), while
+/// from the compliant side it stiffens them.
+pub(crate) const COMPLIANT_PRESLIDING: f64 = 10.0;
 
 /// A starting point and where it came from.
 #[derive(Debug, Clone, PartialEq)]
@@ -311,26 +319,34 @@ pub(crate) fn fit_simpler<R: Residuals + 'static>(
 }
 
 /// The staged starting points: each stage mapped onto the target (the last, most refined
-/// stage at every presliding scale of [`STAGED_PRESLIDING`]).
+/// stage at every presliding scale of [`STAGED_PRESLIDING`], and a law with several elements
+/// at [`COMPLIANT_PRESLIDING`] too).
 fn staged_points<R: Residuals + 'static>(
     plan: &StartPlan<'_, R>,
     fitted: &[SimplerFit],
 ) -> Vec<Seeded> {
     let base = StartContext::new(plan.osc.normal_force, plan.osc.mass);
+    let at = |scale: f64| StartContext {
+        presliding_displacement: scale * TYPICAL_PRESLIDING_DISPLACEMENT,
+        ..base
+    };
+    let mut last: Vec<StartContext> = STAGED_PRESLIDING.iter().map(|&s| at(s)).collect();
+    if has_several_elements(plan.model) {
+        last.push(StartContext {
+            normal_force: fitted_normal_force(plan),
+            ..at(COMPLIANT_PRESLIDING)
+        });
+    }
     let mut out = Vec::new();
     for (k, stage) in fitted.iter().enumerate().rev() {
-        let scales: &[f64] = if k + 1 == fitted.len() {
-            &STAGED_PRESLIDING
+        let contexts = if k + 1 == fitted.len() {
+            &last[..]
         } else {
-            &STAGED_PRESLIDING[..1]
+            &last[..1]
         };
-        for &s in scales {
-            let ctx = StartContext {
-                presliding_displacement: s * TYPICAL_PRESLIDING_DISPLACEMENT,
-                ..base
-            };
+        for ctx in contexts {
             if let Some(point) =
-                mapped_point(plan.layout, stage.model.as_ref(), &ctx, &plan.opts.params)
+                mapped_point(plan.layout, stage.model.as_ref(), ctx, &plan.opts.params)
             {
                 out.push(Seeded {
                     point,
@@ -340,6 +356,25 @@ fn staged_points<R: Residuals + 'static>(
         }
     }
     out
+}
+
+/// Whether `model` has several elements (several stiffnesses that run to its rigid limit).
+fn has_several_elements(model: &dyn FrictionModel) -> bool {
+    model
+        .states()
+        .and_then(|s| s.rigid_limit())
+        .is_some_and(|limit| limit.stiffnesses.len() > 1)
+}
+
+/// The normal force the records' levels are fitted under: [`UNIT_NORMAL_FORCE`] when they are
+/// read as forces (no normal force given), else the oscillator's.
+fn fitted_normal_force<R: Residuals>(plan: &StartPlan<'_, R>) -> f64 {
+    let unknown = &plan.opts.target.unknown_oscillator;
+    if FrictionLevels::read_as_forces(unknown, plan.records) {
+        UNIT_NORMAL_FORCE
+    } else {
+        plan.osc.normal_force
+    }
 }
 
 /// The target started from a fitted simpler model (`start_from`), as a point of the layout:
@@ -572,6 +607,21 @@ mod tests {
             Search::resolve(None, &viscous_coulomb, 2, false),
             Search::Local
         );
+    }
+
+    #[test]
+    fn only_laws_with_several_elements_start_compliant_too() {
+        let gms = frictionid_models::Gms::default();
+        let one_element = frictionid_models::Gms::with_elements(1);
+        assert!(has_several_elements(&gms));
+        for law in [
+            &one_element as &dyn FrictionModel,
+            &LuGre::default(),
+            &frictionid_models::Dahl::default(),
+            &Stribeck::default(),
+        ] {
+            assert!(!has_several_elements(law), "{}", law.name());
+        }
     }
 
     #[test]
