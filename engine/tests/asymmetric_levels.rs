@@ -14,7 +14,6 @@ use frictionid_engine::identify::{
     fit, FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam, ParamOptions,
     TargetOptions,
 };
-use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::testing::driven_slide;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{ViscousCoulomb, ViscousCoulombAsymmetric};
@@ -42,21 +41,11 @@ fn level(_t: f64, _x: f64, d: f64) -> f64 {
 
 /// The reference record from rest at x = 0: time, displacement, velocity and input.
 fn record(name: &str) -> Record {
-    let time = sample_times(DURATION, RATE);
-    let u: Vec<f64> = time.iter().map(|&t| input(t)).collect();
-    let slide = SlideReference {
-        mass: MASS,
-        viscous: VISCOUS,
-        u: &u,
-        rate: RATE,
-        level: &level,
-        step: 1e-5,
-    };
-    let (xs, vs) = slide.motion_from_rest(&time);
-    Record::from_time_base(name, TimeBase::new(time).expect("a time base"))
-        .with_channel(Channel::Displacement, xs)
-        .with_channel(Channel::Velocity, vs)
-        .with_channel(Channel::InputForce, u)
+    let u: Vec<f64> = sample_times(DURATION, RATE)
+        .iter()
+        .map(|&t| input(t))
+        .collect();
+    SlideReference::new(MASS, VISCOUS, (&u, RATE), &level).record(name)
 }
 
 /// The slide the fits start from: the mass 1.5 (fitted; the truth is `MASS`), no spring.

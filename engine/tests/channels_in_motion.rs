@@ -35,8 +35,6 @@ const MASS: f64 = 2.0;
 const VISCOUS: f64 = 20.0;
 const RATE: f64 = 500.0;
 const DURATION: f64 = 2.0;
-/// The reference's step [s].
-const H: f64 = 1e-5;
 
 /// The input [N] at time `t`: four sines.
 fn input(t: f64) -> f64 {
@@ -50,21 +48,11 @@ fn linear(s: &[f64], t: f64) -> f64 {
 
 /// The reference record of `level` from rest at x = 0, with its input and named channels.
 fn record(name: &str, level: SlideLevel<'_>, named: &[(&str, Vec<f64>)]) -> Record {
-    let time = sample_times(DURATION, RATE);
-    let u: Vec<f64> = time.iter().map(|&t| input(t)).collect();
-    let slide = SlideReference {
-        mass: MASS,
-        viscous: VISCOUS,
-        u: &u,
-        rate: RATE,
-        level,
-        step: H,
-    };
-    let (xs, vs) = slide.motion_from_rest(&time);
-    let record = Record::from_time_base(name, TimeBase::new(time).expect("a time base"))
-        .with_channel(Channel::Displacement, xs)
-        .with_channel(Channel::Velocity, vs)
-        .with_channel(Channel::InputForce, u);
+    let u: Vec<f64> = sample_times(DURATION, RATE)
+        .iter()
+        .map(|&t| input(t))
+        .collect();
+    let record = SlideReference::new(MASS, VISCOUS, (&u, RATE), level).record(name);
     named.iter().fold(record, |r, (n, values)| {
         r.with_named_channel(*n, values.clone())
     })

@@ -7,6 +7,7 @@ use frictionid_engine::identify::{
     ParamOptions, Status, TargetOptions,
 };
 use frictionid_engine::oscillator::{OscillatorProperty, PartialOscillator};
+use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid, Trajectory};
 use frictionid_engine::synthetic::release_records;
 use frictionid_engine::{Initial, Oscillator, Record, SimOptions};
@@ -494,21 +495,50 @@ pub type SlideLevel<'a> = &'a dyn Fn(f64, f64, f64) -> f64;
 
 /// An independent reference for a driven slide without a spring,
 /// M a + c v + d L(t, x, d) = u(t) while sliding in d, stuck while -L(t, x, -1) <= u <=
-/// L(t, x, +1): classical Runge-Kutta (`step`, never across a sample time), the reversals
+/// L(t, x, +1): classical Runge-Kutta (1e-5 s, never across a sample time), the reversals
 /// located by bisection on the step and the stick's end bisected.
 pub struct SlideReference<'a> {
     /// The mass M \[kg\] and the viscous coefficient c \[N s/m\].
-    pub mass: f64,
-    pub viscous: f64,
+    mass: f64,
+    viscous: f64,
     /// The input's samples \[N\] at `rate` \[Hz\] from t = 0, linear between them.
-    pub u: &'a [f64],
-    pub rate: f64,
-    pub level: SlideLevel<'a>,
-    /// The Runge-Kutta step \[s\].
-    pub step: f64,
+    u: &'a [f64],
+    rate: f64,
+    level: SlideLevel<'a>,
 }
 
-impl SlideReference<'_> {
+impl<'a> SlideReference<'a> {
+    /// The Runge-Kutta step \[s\].
+    const STEP: f64 = 1e-5;
+
+    /// The slide of mass `mass` and viscous coefficient `viscous` under the input samples
+    /// `u` taken at `rate` from t = 0, with the level `level`.
+    pub fn new(
+        mass: f64,
+        viscous: f64,
+        (u, rate): (&'a [f64], f64),
+        level: SlideLevel<'a>,
+    ) -> Self {
+        Self {
+            mass,
+            viscous,
+            u,
+            rate,
+            level,
+        }
+    }
+
+    /// The record `name` of the motion from rest at the input's sample times: displacement,
+    /// velocity and the input.
+    pub fn record(&self, name: &str) -> Record {
+        let time: Vec<f64> = (0..self.u.len()).map(|i| i as f64 / self.rate).collect();
+        let (xs, vs) = self.motion_from_rest(&time);
+        Record::from_time_base(name, TimeBase::new(time).expect("a time base"))
+            .with_channel(Channel::Displacement, xs)
+            .with_channel(Channel::Velocity, vs)
+            .with_channel(Channel::InputForce, self.u.to_vec())
+    }
+
     /// The direction a slide stuck at x breaks away in at time t, or 0 while it holds.
     pub fn breakaway(&self, t: f64, x: f64) -> f64 {
         let u = linear_between_samples(self.u, self.rate, t);
@@ -549,7 +579,7 @@ impl SlideReference<'_> {
     fn advance(&self, state: (f64, f64, f64, f64), until: f64) -> (f64, f64, f64, f64) {
         let (mut t, mut x, mut v, mut d) = state;
         while t < until {
-            let h = self.step.min(until - t);
+            let h = Self::STEP.min(until - t);
             if d == 0.0 {
                 if self.breakaway(t + h, x) == 0.0 {
                     t += h;
