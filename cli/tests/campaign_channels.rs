@@ -10,11 +10,11 @@
 //! the manifest's value, and trends the level against it as against the manifest's column.
 
 use frictionid_cli::testing::{runs_ok, scratch_dir};
-use frictionid_engine::axis::{NoRestoring, Restoring};
 use frictionid_engine::simulate::{
     simulate_driven, ChannelSeries, Initial, Input, RunInputs, SampleGrid, SimOptions,
 };
 use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
+use frictionid_engine::testing::driven_slide;
 use frictionid_engine::Oscillator;
 use frictionid_models::CoulombLoad;
 use serde_json::Value;
@@ -34,14 +34,7 @@ fn level(t: f64) -> f64 {
 }
 
 fn slide() -> Oscillator {
-    Oscillator {
-        mass: MASS,
-        damping: 0.0,
-        stiffness: 1.0,
-        normal_force: 1.0,
-        restoring: Restoring::None(NoRestoring),
-        ..Oscillator::fmm()
-    }
+    driven_slide(MASS, 0.0)
 }
 
 /// The run at `temperature`: time, velocity (noisy, seed `seed`), input and load as CSV.

@@ -3,8 +3,8 @@
 //! dynamics with `loss = "huber"`. Its force-balance plot draws one triangle per sample
 //! report.json counts as down-weighted, the spikes among them, with a legend entry.
 
-use crate::units::{drive_config, drive_csv, frictionid};
-use frictionid_cli::testing::{run_ok, scratch_dir};
+use crate::units::{drive_config, drive_csv, filled, force_balance_svg, run_quiet};
+use frictionid_cli::testing::scratch_dir;
 use frictionid_engine::synthetic::add_gaussian_noise;
 use std::fmt::Write;
 
@@ -15,13 +15,7 @@ const SPIKE_EVERY: usize = 151;
 
 /// Filled polygons in `svg` in the down-weighted samples' colour.
 fn triangles(svg: &str) -> usize {
-    svg.split("<polygon")
-        .skip(1)
-        .filter(|c| {
-            let element = c.split('>').next().unwrap_or_default();
-            element.to_ascii_uppercase().contains(MARK_FILL)
-        })
-        .count()
+    filled(svg, "polygon", MARK_FILL)
 }
 
 /// The drive's rows with noise and spikes on the input, and the spikes' times.
@@ -54,12 +48,7 @@ fn the_force_balance_plot_marks_each_sample_the_loss_down_weighted() {
         .replace("[fit.options]\n", "[fit.options]\nloss = \"huber\"\n");
     std::fs::write(dir.join("fit.toml"), config).unwrap();
     let out = dir.join("fit");
-    run_ok(
-        frictionid()
-            .args(["fit", "--quiet", "--out"])
-            .arg(&out)
-            .arg(dir.join("fit.toml")),
-    );
+    run_quiet("fit", &dir.join("fit.toml"), &out);
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     let weights = &report["records"][0]["robust_weights"];
@@ -67,12 +56,7 @@ fn the_force_balance_plot_marks_each_sample_the_loss_down_weighted() {
         .as_u64()
         .unwrap_or_else(|| panic!("no robust weights: {}", report["records"][0]));
     let ranges: Vec<[f64; 2]> = serde_json::from_value(weights["ranges"].clone()).unwrap();
-    let plot = std::fs::read_dir(&out)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .find(|p| p.to_string_lossy().ends_with("_force_balance.svg"))
-        .expect("a force-balance plot");
-    let svg = std::fs::read_to_string(&plot).unwrap();
+    let svg = force_balance_svg(&out);
     eprintln!(
         "{count} samples down-weighted, {} marked, {} spikes",
         triangles(&svg),

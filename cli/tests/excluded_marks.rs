@@ -3,7 +3,7 @@
 //! acceleration is differentiated across a reversal; its force-balance plot draws one
 //! marker per sample left out, as many as report.json's finding counts.
 
-use crate::units::{drive_config, drive_csv, run_quiet};
+use crate::units::{drive_config, drive_csv, filled, force_balance_svg, run_quiet};
 use frictionid_cli::testing::scratch_dir;
 
 /// The fill of a marked sample's circle in the SVG (the plots' colour of marked samples).
@@ -11,13 +11,7 @@ const MARK_FILL: &str = "#E60078";
 
 /// Filled circles in `svg` in the marked samples' colour.
 fn marks(svg: &str) -> usize {
-    svg.split("<circle")
-        .skip(1)
-        .filter(|c| {
-            let element = c.split('>').next().unwrap_or_default();
-            element.to_ascii_uppercase().contains(MARK_FILL)
-        })
-        .count()
+    filled(svg, "circle", MARK_FILL)
 }
 
 #[test]
@@ -32,12 +26,7 @@ fn the_force_balance_plot_marks_each_sample_left_out() {
     let count = report["records"][0]["unreliable_target"]["count"]
         .as_u64()
         .unwrap_or_else(|| panic!("no samples left out: {}", report["records"][0]));
-    let plot = std::fs::read_dir(&out)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .find(|p| p.to_string_lossy().ends_with("_force_balance.svg"))
-        .expect("a force-balance plot");
-    let svg = std::fs::read_to_string(&plot).unwrap();
+    let svg = force_balance_svg(&out);
     eprintln!("{count} samples left out, {} marked", marks(&svg));
     assert!(count > 0);
     assert_eq!(marks(&svg) as u64, count);

@@ -82,6 +82,27 @@ pub(crate) fn drive_csv(dir: &Path, unit: f64) -> String {
     csv
 }
 
+/// The force-balance plot a fit wrote into `out`, as SVG text.
+pub(crate) fn force_balance_svg(out: &Path) -> String {
+    let plot = std::fs::read_dir(out)
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .find(|p| p.to_string_lossy().ends_with("_force_balance.svg"))
+        .expect("a force-balance plot");
+    std::fs::read_to_string(&plot).unwrap()
+}
+
+/// The `element`s (`"circle"`, `"polygon"`) in `svg` filled with the colour `fill`.
+pub(crate) fn filled(svg: &str, element: &str, fill: &str) -> usize {
+    svg.split(&format!("<{element}"))
+        .skip(1)
+        .filter(|c| {
+            let element = c.split('>').next().unwrap_or_default();
+            element.to_ascii_uppercase().contains(fill)
+        })
+        .count()
+}
+
 /// The drive fitted with its mass (start 10 kg), damping and offset free, by inverse
 /// dynamics or by its velocity.
 pub(crate) fn drive_config(domain: &str, mass_line: &str) -> String {

@@ -6,6 +6,7 @@
 //! And the records the integration tests share: Dahl's force along a stroke in closed form,
 //! runs at constant velocity, and the real tribometer record where the developers keep it.
 
+use crate::axis::{NoRestoring, Restoring};
 use crate::oscillator::Oscillator;
 use crate::record::{Channel, Record, TimeBase};
 use crate::simulate::{simulate, Initial, Integrator, SimOptions};
@@ -124,6 +125,20 @@ impl DamperStroke {
         Record::from_time_base("stroke", base)
             .with_channel(Channel::Displacement, x)
             .with_channel(Channel::Force, force)
+    }
+}
+
+/// A slide of mass `mass` with no spring, unit stiffness and normal force (friction levels in
+/// N) and an input offset of `offset` N: the driven axis of the inverse-dynamics tests.
+pub fn driven_slide(mass: f64, offset: f64) -> Oscillator {
+    Oscillator {
+        mass,
+        damping: 0.0,
+        stiffness: 1.0,
+        normal_force: 1.0,
+        restoring: Restoring::None(NoRestoring),
+        input_offset: offset,
+        ..Oscillator::fmm()
     }
 }
 

@@ -9,12 +9,12 @@
 //! inverse-dynamics route (the balance u - M a against the law) recover both levels within
 //! 1 %; the symmetric law is worse.
 
-use crate::util::{driven_slide, linear_between_samples, multisine, sample_times, Tone};
+use crate::util::{four_tones, multisine, sample_times, SlideReference};
 use frictionid_engine::identify::{
     fit, FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam, ParamOptions,
     TargetOptions,
 };
-use frictionid_engine::record::{Channel, TimeBase};
+use frictionid_engine::testing::driven_slide;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{ViscousCoulomb, ViscousCoulombAsymmetric};
 
@@ -27,107 +27,25 @@ const DURATION: f64 = 4.0;
 
 /// The input [N] at the sample times: four sines.
 fn input(t: f64) -> f64 {
-    const TONES: [Tone; 4] = [
-        (12.0, 0.7, 0.0),
-        (8.0, 1.9, 1.0),
-        (5.0, 3.3, 2.0),
-        (3.0, 5.1, 0.5),
-    ];
-    multisine(&TONES, t)
+    multisine(&four_tones(0.7, 0.0), t)
 }
 
-/// The samples' input, linear between them (as the engine reads it).
-fn input_at(u: &[f64], t: f64) -> f64 {
-    linear_between_samples(u, RATE, t)
-}
-
-/// The friction force sliding in `d`.
-fn level(d: f64) -> f64 {
+/// The Coulomb level sliding in `d`.
+fn level(_t: f64, _x: f64, d: f64) -> f64 {
     if d > 0.0 {
         LEVEL_POS
     } else {
-        -LEVEL_NEG
+        LEVEL_NEG
     }
-}
-
-/// The direction a stuck slide breaks away in under input `u`, or 0 while it holds.
-fn breakaway(u: f64) -> f64 {
-    if u > LEVEL_POS {
-        1.0
-    } else if u < -LEVEL_NEG {
-        -1.0
-    } else {
-        0.0
-    }
-}
-
-/// One RK4 step of (x, v) sliding in `d` from `t`.
-fn rk4(u: &[f64], t: f64, (x, v): (f64, f64), d: f64, h: f64) -> (f64, f64) {
-    let acc = |t: f64, v: f64| (input_at(u, t) - VISCOUS * v - level(d)) / MASS;
-    let (k1x, k1v) = (v, acc(t, v));
-    let (k2x, k2v) = (v + 0.5 * h * k1v, acc(t + 0.5 * h, v + 0.5 * h * k1v));
-    let (k3x, k3v) = (v + 0.5 * h * k2v, acc(t + 0.5 * h, v + 0.5 * h * k2v));
-    let (k4x, k4v) = (v + h * k3v, acc(t + h, v + h * k3v));
-    (
-        x + h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x),
-        v + h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v),
-    )
 }
 
 /// The reference record from rest at x = 0: time, displacement, velocity and input.
 fn record(name: &str) -> Record {
-    const H: f64 = 1e-5;
-    let time = sample_times(DURATION, RATE);
-    let n = time.len();
-    let u: Vec<f64> = time.iter().map(|&t| input(t)).collect();
-    let (mut t, mut x, mut v, mut d) = (0.0, 0.0, 0.0, breakaway(u[0]));
-    let (mut xs, mut vs) = (Vec::with_capacity(n), Vec::with_capacity(n));
-    for &t_sample in &time {
-        while t < t_sample {
-            let h = H.min(t_sample - t);
-            if d == 0.0 {
-                if breakaway(input_at(&u, t + h)) == 0.0 {
-                    t += h;
-                    continue;
-                }
-                let (mut lo, mut hi) = (t, t + h);
-                for _ in 0..80 {
-                    let mid = 0.5 * (lo + hi);
-                    if breakaway(input_at(&u, mid)) == 0.0 {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                t = hi;
-                d = breakaway(input_at(&u, t));
-                continue;
-            }
-            let (x1, v1) = rk4(&u, t, (x, v), d, h);
-            if d * v1 > 0.0 {
-                (t, x, v) = (t + h, x1, v1);
-                continue;
-            }
-            let (mut lo, mut hi) = (0.0, h);
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if d * rk4(&u, t, (x, v), d, mid).1 > 0.0 {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            x = rk4(&u, t, (x, v), d, hi).0;
-            (t, v) = (t + hi, 0.0);
-            d = breakaway(input_at(&u, t));
-        }
-        xs.push(x);
-        vs.push(v);
-    }
-    Record::from_time_base(name, TimeBase::new(time).expect("a time base"))
-        .with_channel(Channel::Displacement, xs)
-        .with_channel(Channel::Velocity, vs)
-        .with_channel(Channel::InputForce, u)
+    let u: Vec<f64> = sample_times(DURATION, RATE)
+        .iter()
+        .map(|&t| input(t))
+        .collect();
+    SlideReference::new(MASS, VISCOUS, (&u, RATE), &level).record(name)
 }
 
 /// The slide the fits start from: the mass 1.5 (fitted; the truth is `MASS`), no spring.

@@ -18,7 +18,9 @@ use frictionid_engine::identify::{compare, fit, FitOptions};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::{add_gaussian_noise, uniform_times};
 use frictionid_engine::{Oscillator, Record};
-use frictionid_models::{build_json, CoulombLoad, FrictionModel, PositionRipple, ViscousCoulomb};
+use frictionid_models::{
+    build_json, sgn, CoulombLoad, FrictionModel, PositionRipple, ViscousCoulomb,
+};
 use std::f64::consts::PI;
 
 /// Sample rate of the records [Hz].
@@ -56,16 +58,6 @@ fn stroke(
     named.iter().fold(record, |r, (n, values)| {
         r.with_named_channel(*n, values.clone())
     })
-}
-
-fn sgn(v: f64) -> f64 {
-    if v > 0.0 {
-        1.0
-    } else if v < 0.0 {
-        -1.0
-    } else {
-        0.0
-    }
 }
 
 /// A parameter's truth and how close the noise-free fit must come: relative, or absolute

@@ -21,10 +21,12 @@
 //! well off it, and viscous_coulomb, which cannot follow the condition, at least five times
 //! the residual.
 
-use crate::util::{linear_between_samples, multisine, sample_times, Tone};
-use frictionid_engine::axis::{NoRestoring, Restoring};
+use crate::util::{
+    four_tones, linear_between_samples, multisine, sample_times, SlideLevel, SlideReference,
+};
 use frictionid_engine::identify::{fit, FitOptions, FitResult, ParamOptions};
 use frictionid_engine::record::{Channel, TimeBase};
+use frictionid_engine::testing::driven_slide;
 use frictionid_engine::{Oscillator, Record};
 use frictionid_models::{CoulombLoad, FrictionModel, PositionRipple, ViscousCoulomb};
 use std::f64::consts::PI;
@@ -33,18 +35,10 @@ const MASS: f64 = 2.0;
 const VISCOUS: f64 = 20.0;
 const RATE: f64 = 500.0;
 const DURATION: f64 = 2.0;
-/// The reference's step [s].
-const H: f64 = 1e-5;
 
 /// The input [N] at time `t`: four sines.
 fn input(t: f64) -> f64 {
-    const TONES: [Tone; 4] = [
-        (12.0, 0.9, 0.0),
-        (8.0, 1.9, 1.0),
-        (5.0, 3.3, 2.0),
-        (3.0, 5.1, 0.5),
-    ];
-    multisine(&TONES, t)
+    multisine(&four_tones(0.9, 0.0), t)
 }
 
 /// The samples `s`, linear between them (as the engine reads an input and a channel).
@@ -52,110 +46,13 @@ fn linear(s: &[f64], t: f64) -> f64 {
     linear_between_samples(s, RATE, t)
 }
 
-/// The truth's level L(t, x) >= 0 [N].
-type Level<'a> = &'a dyn Fn(f64, f64) -> f64;
-
-/// The reference slide: its input samples and friction level.
-struct Slide<'a> {
-    u: &'a [f64],
-    level: Level<'a>,
-}
-
-impl Slide<'_> {
-    /// The direction a slide stuck at x breaks away in at time t, or 0 while it holds.
-    fn breakaway(&self, t: f64, x: f64) -> f64 {
-        let (u, level) = (linear(self.u, t), (self.level)(t, x));
-        if u > level {
-            1.0
-        } else if u < -level {
-            -1.0
-        } else {
-            0.0
-        }
-    }
-
-    /// One RK4 step of (x, v) sliding in `d` from `t`.
-    fn rk4(&self, t: f64, (x, v): (f64, f64), d: f64, h: f64) -> (f64, f64) {
-        let acc = |t: f64, x: f64, v: f64| {
-            (linear(self.u, t) - VISCOUS * v - d * (self.level)(t, x)) / MASS
-        };
-        let (k1x, k1v) = (v, acc(t, x, v));
-        let (k2x, k2v) = (
-            v + 0.5 * h * k1v,
-            acc(t + 0.5 * h, x + 0.5 * h * k1x, v + 0.5 * h * k1v),
-        );
-        let (k3x, k3v) = (
-            v + 0.5 * h * k2v,
-            acc(t + 0.5 * h, x + 0.5 * h * k2x, v + 0.5 * h * k2v),
-        );
-        let (k4x, k4v) = (v + h * k3v, acc(t + h, x + h * k3x, v + h * k3v));
-        (
-            x + h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x),
-            v + h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v),
-        )
-    }
-
-    /// From (t, x, v, d) to `until`: slipping, reversing or stuck.
-    fn advance(&self, state: (f64, f64, f64, f64), until: f64) -> (f64, f64, f64, f64) {
-        let (mut t, mut x, mut v, mut d) = state;
-        while t < until {
-            let h = H.min(until - t);
-            if d == 0.0 {
-                if self.breakaway(t + h, x) == 0.0 {
-                    t += h;
-                    continue;
-                }
-                let (mut lo, mut hi) = (t, t + h);
-                for _ in 0..80 {
-                    let mid = 0.5 * (lo + hi);
-                    if self.breakaway(mid, x) == 0.0 {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                t = hi;
-                d = self.breakaway(t, x);
-                continue;
-            }
-            let (x1, v1) = self.rk4(t, (x, v), d, h);
-            if d * v1 > 0.0 {
-                (t, x, v) = (t + h, x1, v1);
-                continue;
-            }
-            let (mut lo, mut hi) = (0.0, h);
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if d * self.rk4(t, (x, v), d, mid).1 > 0.0 {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            x = self.rk4(t, (x, v), d, hi).0;
-            (t, v) = (t + hi, 0.0);
-            d = self.breakaway(t, x);
-        }
-        (t, x, v, d)
-    }
-}
-
 /// The reference record of `level` from rest at x = 0, with its input and named channels.
-fn record(name: &str, level: Level<'_>, named: &[(&str, Vec<f64>)]) -> Record {
-    let time = sample_times(DURATION, RATE);
-    let u: Vec<f64> = time.iter().map(|&t| input(t)).collect();
-    let slide = Slide { u: &u, level };
-    let mut state = (0.0, 0.0, 0.0, slide.breakaway(0.0, 0.0));
-    let (mut xs, mut vs) = (Vec::new(), Vec::new());
-    for &t_sample in &time {
-        state = slide.advance(state, t_sample);
-        xs.push(state.1);
-        vs.push(state.2);
-    }
-    let record = Record::from_time_base(name, TimeBase::new(time).expect("a time base"))
-        .with_channel(Channel::Displacement, xs)
-        .with_channel(Channel::Velocity, vs)
-        .with_channel(Channel::InputForce, u);
+fn record(name: &str, level: SlideLevel<'_>, named: &[(&str, Vec<f64>)]) -> Record {
+    let u: Vec<f64> = sample_times(DURATION, RATE)
+        .iter()
+        .map(|&t| input(t))
+        .collect();
+    let record = SlideReference::new(MASS, VISCOUS, (&u, RATE), level).record(name);
     named.iter().fold(record, |r, (n, values)| {
         r.with_named_channel(*n, values.clone())
     })
@@ -163,14 +60,7 @@ fn record(name: &str, level: Level<'_>, named: &[(&str, Vec<f64>)]) -> Record {
 
 /// The slide as the fit knows it: its mass given, no spring, levels in N.
 fn slide() -> Oscillator {
-    Oscillator {
-        mass: MASS,
-        damping: 0.0,
-        stiffness: 1.0,
-        normal_force: 1.0,
-        restoring: Restoring::None(NoRestoring),
-        ..Oscillator::fmm()
-    }
+    driven_slide(MASS, 0.0)
 }
 
 /// The velocity route with the law's parameters alone, from the given start.
@@ -227,7 +117,7 @@ fn accept(
 #[test]
 fn position_ripple_is_recovered_from_the_simulated_motion() {
     let (fc, fr, p, phase) = (3.0, 0.6, 0.02, 1.0);
-    let level = |_t: f64, x: f64| fc + fr * (2.0 * PI * x / p + phase).sin();
+    let level = |_t: f64, x: f64, _d: f64| fc + fr * (2.0 * PI * x / p + phase).sin();
     let records = [record("guide.csv", &level, &[])];
     let travel = records[0]
         .channel(Channel::Displacement)
@@ -267,7 +157,7 @@ fn coulomb_load_is_recovered_from_the_simulated_motion() {
         .iter()
         .map(|&t| load_at(t))
         .collect();
-    let level = |t: f64, _x: f64| tc + mu_l * linear(&load, t).abs();
+    let level = |t: f64, _x: f64, _d: f64| tc + mu_l * linear(&load, t).abs();
     let records = [record("joint.csv", &level, &[("load", load.clone())])];
     let start = CoulombLoad {
         mu: 1.5,

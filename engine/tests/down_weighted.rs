@@ -6,12 +6,13 @@
 //! others); least squares keeps no weights.
 
 use crate::util::{
-    driven_from_rest, driven_slide, inverse_dynamics_options, multisine, sample_times, serial, Tone,
+    driven_from_rest, inverse_dynamics_options, multisine, sample_times, serial, Tone,
 };
 use frictionid_engine::identify::values::search::Loss;
 use frictionid_engine::identify::{fit, Check, FitResult, RobustWeights, Status};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
+use frictionid_engine::testing::driven_slide;
 use frictionid_engine::Record;
 use frictionid_models::ViscousCoulomb;
 

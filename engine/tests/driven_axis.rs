@@ -5,9 +5,10 @@
 //! bisection on the piecewise-linear input. The velocity route (simulate the axis under the
 //! measured input, compare velocities) recovers M, Fv, Fc and the offset F0.
 
-use crate::util::{driven_slide, sample_times, Tone};
+use crate::util::{four_tones, sample_times};
 use frictionid_engine::identify::{fit, FitOptions, FitResult, OscillatorParam, ParamOptions};
 use frictionid_engine::record::Channel;
+use frictionid_engine::testing::driven_slide;
 use frictionid_engine::Record;
 use frictionid_models::ViscousCoulomb;
 use rand::rngs::StdRng;
@@ -24,12 +25,7 @@ const DURATION: f64 = 4.0;
 /// The input: four sines [N] sampled at `RATE`.
 fn multisine(phase: f64) -> (Vec<f64>, Vec<f64>) {
     let t = sample_times(DURATION, RATE);
-    let parts: [Tone; 4] = [
-        (12.0, 0.7, phase),
-        (8.0, 1.9, 1.0 + phase),
-        (5.0, 3.3, 2.0 + phase),
-        (3.0, 5.1, 0.5 + phase),
-    ];
+    let parts = four_tones(0.7, phase);
     let u = t
         .iter()
         .map(|&t| crate::util::multisine(&parts, t))

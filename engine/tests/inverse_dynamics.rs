@@ -9,7 +9,7 @@
 //! within 0.5 % noise-free, and within three standard errors with noise on u. Also the
 //! errors a user meets: no input channel, no motion channel, no mass.
 
-use crate::util::{estimate, inverse_dynamics_options, multisine, serial, Tone};
+use crate::util::{estimate, five_tones, inverse_dynamics_options, multisine, serial};
 use frictionid_engine::identify::{fit, FitOptions, FitResult, ParamOptions};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
@@ -33,14 +33,7 @@ pub(crate) const TRUTH: Axis = Axis {
 
 /// The multisine input u(t) \[N\]: five tones from 0.3 to 3.4 Hz.
 fn input(t: f64) -> f64 {
-    const TONES: [Tone; 5] = [
-        (12.0, 0.3, 0.0),
-        (8.0, 0.7, 1.1),
-        (6.0, 1.3, 2.3),
-        (4.0, 2.1, 0.4),
-        (3.0, 3.4, 4.0),
-    ];
-    multisine(&TONES, t)
+    multisine(&five_tones(1.0), t)
 }
 
 impl Axis {

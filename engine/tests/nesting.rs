@@ -10,7 +10,7 @@
 //! route recommends the bristle law whose stiffness the records determine.
 
 use crate::util::{inverse_dynamics_options, rel};
-use frictionid_engine::identify::{compare, Check};
+use frictionid_engine::identify::{compare, Check, Comparison, FitResult};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::Record;
@@ -115,29 +115,15 @@ fn dahl_on_a_dahl_drive_ends_below_the_coulomb_it_holds() {
         c.verdict.as_ref().map(|v| &v.message)
     );
     assert!(c.failed.is_empty(), "{:?}", c.failed);
-    let rms = |name: &str| {
-        c.ranking
-            .iter()
-            .find(|f| f.model == name)
-            .map(|f| f.rms_residual)
-            .expect("ranked")
-    };
+    let rms = |name: &str| ranked(&c, name).rms_residual;
     assert!(rms("dahl") <= rms("coulomb"));
-    let dahl = c
-        .ranking
-        .iter()
-        .find(|f| f.model == "dahl")
-        .expect("ranked");
+    let dahl = ranked(&c, "dahl");
     let (sigma0, mu_c) = (dahl.value("sigma0").unwrap(), dahl.value("mu_c").unwrap());
     assert!(rel(sigma0, SIGMA0) < 0.1, "sigma0 {sigma0}");
     assert!(rel(mu_c, COULOMB) < 0.02, "mu_c {mu_c}");
     let verdict = c.verdict.as_ref().expect("a verdict");
     assert_eq!(verdict.recommended.as_deref(), Some("dahl"));
-    let coulomb = c
-        .ranking
-        .iter()
-        .find(|f| f.model == "coulomb")
-        .expect("ranked");
+    let coulomb = ranked(&c, "coulomb");
     crate::util::assert_flagged(coulomb, Check::GoodnessOfFit);
 }
 
@@ -157,13 +143,7 @@ fn lugre_on_a_viscous_coulomb_drive_ends_at_least_as_low() {
     }
     let record = record.with_noise(Channel::InputForce, NOISE);
     let c = drive_compare_with_every_law_ranked(record, &["viscous_coulomb", "dahl", "lugre"]);
-    let rms = |name: &str| {
-        c.ranking
-            .iter()
-            .find(|f| f.model == name)
-            .map(|f| f.rms_residual)
-            .expect("ranked")
-    };
+    let rms = |name: &str| ranked(&c, name).rms_residual;
     assert!(rms("lugre") <= rms("viscous_coulomb") * (1.0 + 1e-3));
 }
 
@@ -186,12 +166,14 @@ fn without_a_normal_force_nesting_compares_the_levels_as_forces() {
     assert!(c.ranking.iter().any(|f| f.model == "dahl"));
 }
 
+/// The fit of `law` among the ranked laws of `c`.
+fn ranked<'a>(c: &'a Comparison, law: &str) -> &'a FitResult {
+    c.ranking.iter().find(|f| f.model == law).expect("ranked")
+}
+
 /// `laws` compared by inverse dynamics on the drive `record` (mass and offset fitted, no
 /// normal force): no law fails, every one is ranked.
-fn drive_compare_with_every_law_ranked(
-    record: frictionid_engine::Record,
-    laws: &[&str],
-) -> frictionid_engine::identify::Comparison {
+fn drive_compare_with_every_law_ranked(record: Record, laws: &[&str]) -> Comparison {
     let (osc, opts) = inverse_dynamics_options();
     let models: Vec<Box<dyn FrictionModel>> = laws
         .iter()

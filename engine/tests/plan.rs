@@ -181,19 +181,9 @@ fn spreads(
     estimates.iter().map(|e| std_dev(e)).collect()
 }
 
-/// Noisy free-decay records of `experiments` under `law` (seed `seed`, one per record).
+/// Noisy free-decay records of `experiments` under `law` simulated with `sim` (seed `seed`,
+/// one per record).
 fn noisy_records(
-    osc: &Oscillator,
-    law: &dyn FrictionModel,
-    experiments: &[&Experiment],
-    noise: f64,
-    seed: u64,
-) -> Vec<Record> {
-    noisy_records_with(&SimOptions::default(), osc, law, experiments, noise, seed)
-}
-
-/// [`noisy_records`] simulated with `sim`.
-fn noisy_records_with(
     sim: &SimOptions,
     osc: &Oscillator,
     law: &dyn FrictionModel,
@@ -264,7 +254,8 @@ fn stribeck_pair_prediction_matches_monte_carlo() {
             &osc,
             &law,
             &free,
-            (0..100).map(|k| noisy_records(&osc, &law, set, 2e-4, seed + k)),
+            (0..100)
+                .map(|k| noisy_records(&SimOptions::default(), &osc, &law, set, 2e-4, seed + k)),
         )
     };
     let rec_mc = mc(&chosen, 1000);
@@ -340,7 +331,7 @@ fn sigma0_reach(
     req.suggest = true;
     let p = plan(&req).unwrap();
     let set: Vec<&Experiment> = candidates.iter().collect();
-    let records = noisy_records_with(sim, &osc, law, &set, 2e-4, seed);
+    let records = noisy_records(sim, &osc, law, &set, 2e-4, seed);
     let opts = FitOptions {
         params: ParamOptions {
             free: Some(free.iter().map(|s| s.to_string()).collect()),
@@ -464,7 +455,16 @@ fn driven_band_recommended_has_the_smallest_vs_spread() {
                 &osc,
                 &law,
                 &free,
-                (0..150).map(|k| noisy_records(&osc, &law, &[e], 2e-4, 900 + 1000 * i as u64 + k)),
+                (0..150).map(|k| {
+                    noisy_records(
+                        &SimOptions::default(),
+                        &osc,
+                        &law,
+                        &[e],
+                        2e-4,
+                        900 + 1000 * i as u64 + k,
+                    )
+                }),
             )[2]
         })
         .collect();

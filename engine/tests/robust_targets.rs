@@ -5,13 +5,14 @@
 //! reversal a few samples' accelerations are wrong by tens of m/s^2.
 
 use crate::util::{
-    driven_from_rest, driven_slide, estimate, inverse_dynamics_options, multisine, sample_times,
-    serial, Tone,
+    driven_from_rest, estimate, five_tones, inverse_dynamics_options, multisine, sample_times,
+    serial,
 };
 use frictionid_engine::identify::values::search::Loss;
 use frictionid_engine::identify::{compare, fit, Check, FitOptions, FitResult, Status};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
+use frictionid_engine::testing::driven_slide;
 use frictionid_engine::{EngineError, Oscillator, Record};
 use frictionid_models::{default_model, FrictionModel, ViscousCoulomb};
 
@@ -25,14 +26,7 @@ const FORCE_NOISE: f64 = 0.2;
 
 /// The multisine input u(t) \[N\]: five tones from 0.3 to 3.4 Hz.
 fn input(t: f64) -> f64 {
-    const TONES: [Tone; 5] = [
-        (30.0, 0.3, 0.0),
-        (20.0, 0.7, 1.1),
-        (15.0, 1.3, 2.3),
-        (10.0, 2.1, 0.4),
-        (7.5, 3.4, 4.0),
-    ];
-    multisine(&TONES, t)
+    multisine(&five_tones(2.5), t)
 }
 
 /// `seconds` of the drive at [`RATE`]: time, position quantised to [`QUANTUM`] and written

@@ -2,12 +2,12 @@
 //! identifier's recovery tests.
 #![allow(dead_code)]
 
-use frictionid_engine::axis::{NoRestoring, Restoring};
 use frictionid_engine::identify::{
     fit, Check, Finding, FitDomain, FitOptions, FitResult, ForceTarget, OscillatorParam,
     ParamOptions, Status, TargetOptions,
 };
 use frictionid_engine::oscillator::{OscillatorProperty, PartialOscillator};
+use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid, Trajectory};
 use frictionid_engine::synthetic::release_records;
 use frictionid_engine::{Initial, Oscillator, Record, SimOptions};
@@ -23,6 +23,29 @@ pub fn multisine(tones: &[Tone], t: f64) -> f64 {
         .iter()
         .map(|&(a, f, phase)| a * (2.0 * PI * f * t + phase).sin())
         .sum()
+}
+
+/// Four tones of 12, 8, 5 and 3 N at `first`, 1.9, 3.3 and 5.1 Hz, their phases (0, 1, 2 and
+/// 0.5 rad) shifted by `shift` rad: the input of the driven-slide tests.
+pub fn four_tones(first: f64, shift: f64) -> [Tone; 4] {
+    [
+        (12.0, first, shift),
+        (8.0, 1.9, 1.0 + shift),
+        (5.0, 3.3, 2.0 + shift),
+        (3.0, 5.1, 0.5 + shift),
+    ]
+}
+
+/// Five tones from 0.3 to 3.4 Hz of 12, 8, 6, 4 and 3 N times `gain`: the input of the
+/// inverse-dynamics drives.
+pub fn five_tones(gain: f64) -> [Tone; 5] {
+    [
+        (12.0 * gain, 0.3, 0.0),
+        (8.0 * gain, 0.7, 1.1),
+        (6.0 * gain, 1.3, 2.3),
+        (4.0 * gain, 2.1, 0.4),
+        (3.0 * gain, 3.4, 4.0),
+    ]
 }
 
 /// The sample times of `duration` seconds at `rate` Hz from 0, both ends included.
@@ -199,20 +222,6 @@ pub fn serial(mut opts: FitOptions) -> FitOptions {
 /// `names` as the free-parameter list of [`ParamOptions::free`](frictionid_engine::identify::ParamOptions).
 pub fn free(names: &[&str]) -> Option<Vec<String>> {
     Some(names.iter().map(|s| s.to_string()).collect())
-}
-
-/// A slide of mass `mass` with no spring, unit stiffness and normal force (friction levels in
-/// N) and an input offset of `offset` N: the driven axis of the inverse-dynamics tests.
-pub fn driven_slide(mass: f64, offset: f64) -> Oscillator {
-    Oscillator {
-        mass,
-        damping: 0.0,
-        stiffness: 1.0,
-        normal_force: 1.0,
-        restoring: Restoring::None(NoRestoring),
-        input_offset: offset,
-        ..Oscillator::fmm()
-    }
 }
 
 /// The motion of `osc` with friction `model` from rest at t = 0 under the input `u` sampled at
@@ -478,4 +487,150 @@ pub fn linear_between_samples(s: &[f64], rate: f64, t: f64) -> f64 {
     let i = ((t * rate).floor() as usize).min(s.len() - 2);
     let w = t * rate - i as f64;
     s[i] + w * (s[i + 1] - s[i])
+}
+
+/// The Coulomb level L(t, x, d) >= 0 \[N\] of a [`SlideReference`] at time t and position x,
+/// sliding or breaking away in the direction d (+1 or -1).
+pub type SlideLevel<'a> = &'a dyn Fn(f64, f64, f64) -> f64;
+
+/// An independent reference for a driven slide without a spring,
+/// M a + c v + d L(t, x, d) = u(t) while sliding in d, stuck while -L(t, x, -1) <= u <=
+/// L(t, x, +1): classical Runge-Kutta (1e-5 s, never across a sample time), the reversals
+/// located by bisection on the step and the stick's end bisected.
+pub struct SlideReference<'a> {
+    /// The mass M \[kg\] and the viscous coefficient c \[N s/m\].
+    mass: f64,
+    viscous: f64,
+    /// The input's samples \[N\] at `rate` \[Hz\] from t = 0, linear between them.
+    u: &'a [f64],
+    rate: f64,
+    level: SlideLevel<'a>,
+}
+
+impl<'a> SlideReference<'a> {
+    /// The Runge-Kutta step \[s\].
+    const STEP: f64 = 1e-5;
+
+    /// The slide of mass `mass` and viscous coefficient `viscous` under the input samples
+    /// `u` taken at `rate` from t = 0, with the level `level`.
+    pub fn new(
+        mass: f64,
+        viscous: f64,
+        (u, rate): (&'a [f64], f64),
+        level: SlideLevel<'a>,
+    ) -> Self {
+        Self {
+            mass,
+            viscous,
+            u,
+            rate,
+            level,
+        }
+    }
+
+    /// The record `name` of the motion from rest at the input's sample times: displacement,
+    /// velocity and the input.
+    pub fn record(&self, name: &str) -> Record {
+        let time: Vec<f64> = (0..self.u.len()).map(|i| i as f64 / self.rate).collect();
+        let (xs, vs) = self.motion_from_rest(&time);
+        Record::from_time_base(name, TimeBase::new(time).expect("a time base"))
+            .with_channel(Channel::Displacement, xs)
+            .with_channel(Channel::Velocity, vs)
+            .with_channel(Channel::InputForce, self.u.to_vec())
+    }
+
+    /// The direction a slide stuck at x breaks away in at time t, or 0 while it holds.
+    pub fn breakaway(&self, t: f64, x: f64) -> f64 {
+        let u = linear_between_samples(self.u, self.rate, t);
+        if u > (self.level)(t, x, 1.0) {
+            1.0
+        } else if u < -(self.level)(t, x, -1.0) {
+            -1.0
+        } else {
+            0.0
+        }
+    }
+
+    /// One RK4 step of (x, v) sliding in `d` from `t`.
+    fn rk4(&self, t: f64, (x, v): (f64, f64), d: f64, h: f64) -> (f64, f64) {
+        let acc = |t: f64, x: f64, v: f64| {
+            (linear_between_samples(self.u, self.rate, t)
+                - self.viscous * v
+                - d * (self.level)(t, x, d))
+                / self.mass
+        };
+        let (k1x, k1v) = (v, acc(t, x, v));
+        let (k2x, k2v) = (
+            v + 0.5 * h * k1v,
+            acc(t + 0.5 * h, x + 0.5 * h * k1x, v + 0.5 * h * k1v),
+        );
+        let (k3x, k3v) = (
+            v + 0.5 * h * k2v,
+            acc(t + 0.5 * h, x + 0.5 * h * k2x, v + 0.5 * h * k2v),
+        );
+        let (k4x, k4v) = (v + h * k3v, acc(t + h, x + h * k3x, v + h * k3v));
+        (
+            x + h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x),
+            v + h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v),
+        )
+    }
+
+    /// From (t, x, v, d) to `until`: slipping, reversing or stuck.
+    fn advance(&self, state: (f64, f64, f64, f64), until: f64) -> (f64, f64, f64, f64) {
+        let (mut t, mut x, mut v, mut d) = state;
+        while t < until {
+            let h = Self::STEP.min(until - t);
+            if d == 0.0 {
+                if self.breakaway(t + h, x) == 0.0 {
+                    t += h;
+                    continue;
+                }
+                let (mut lo, mut hi) = (t, t + h);
+                for _ in 0..80 {
+                    let mid = 0.5 * (lo + hi);
+                    if self.breakaway(mid, x) == 0.0 {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                t = hi;
+                d = self.breakaway(t, x);
+                continue;
+            }
+            let (x1, v1) = self.rk4(t, (x, v), d, h);
+            if d * v1 > 0.0 {
+                (t, x, v) = (t + h, x1, v1);
+                continue;
+            }
+            let (mut lo, mut hi) = (0.0, h);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if d * self.rk4(t, (x, v), d, mid).1 > 0.0 {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            x = self.rk4(t, (x, v), d, hi).0;
+            (t, v) = (t + hi, 0.0);
+            d = self.breakaway(t, x);
+        }
+        (t, x, v, d)
+    }
+
+    /// The displacement and velocity from rest at x = 0 and t = 0, sampled at `time`.
+    pub fn motion_from_rest(&self, time: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let mut state = (0.0, 0.0, 0.0, self.breakaway(0.0, 0.0));
+        let (mut xs, mut vs) = (
+            Vec::with_capacity(time.len()),
+            Vec::with_capacity(time.len()),
+        );
+        for &t_sample in time {
+            state = self.advance(state, t_sample);
+            xs.push(state.1);
+            vs.push(state.2);
+        }
+        (xs, vs)
+    }
 }

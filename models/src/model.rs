@@ -417,6 +417,31 @@ macro_rules! law_groups {
     };
 }
 
+/// Writes, for a law that reads conditions, the methods without them as their `_in` twins at
+/// no condition values (`&[]`: every condition at 0): `switching` gives `static_limit` and
+/// `slip_force` inside its `impl SwitchedLaw` block, `param_gradients` gives
+/// `force_param_gradient` inside its `impl ParamGradients` block.
+///
+/// ```ignore
+/// frictionid_models::at_no_conditions!(switching);
+/// ```
+#[macro_export]
+macro_rules! at_no_conditions {
+    (switching) => {
+        fn static_limit(&self, normal: f64) -> ::core::option::Option<f64> {
+            self.static_limit_in(normal, &[])
+        }
+        fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
+            self.slip_force_in(v, direction, normal, &[])
+        }
+    };
+    (param_gradients) => {
+        fn force_param_gradient(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) {
+            self.force_param_gradient_in(v, z, normal, &[], out);
+        }
+    };
+}
+
 /// The rigid-contact limit of a model with a presliding stiffness (see
 /// [`InternalStates::rigid_limit`]). On records that do not resolve presliding (Coulomb-like
 /// data), the cost falls towards the limit law's as the stiffness grows, so the stiffness has

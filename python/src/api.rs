@@ -191,12 +191,21 @@ pub fn fit<'py>(
     records: &Bound<'py, PyAny>,
     fit: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<WithTexts<'py>> {
-    let spec = spec_from(oscillator, Some(inputs::model(model)?), fit, None)?;
+    let spec = model_spec(oscillator, model, fit)?;
     let records = inputs::records(records)?;
     let report = run_job(py, move |hooks| {
         fit_job(&spec, &records, &hooks).map_err(job_error)
     })?;
     fit_output(py, &report)
+}
+
+/// The spec of `fit` and `plan`: the oscillator, the model dict and the fit's options.
+fn model_spec(
+    oscillator: &Bound<'_, PyAny>,
+    model: &Bound<'_, PyAny>,
+    fit: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Spec> {
+    spec_from(oscillator, Some(inputs::model(model)?), fit, None)
 }
 
 /// The models to compare: names (registered models with their defaults) or model dicts.
@@ -285,7 +294,7 @@ pub fn plan<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     use frictionid_engine::jobs::{plan_job, PlanInputs};
     use frictionid_engine::spec::PlanSpec;
-    let spec = spec_from(oscillator, Some(inputs::model(model)?), fit, None)?;
+    let spec = model_spec(oscillator, model, fit)?;
     let plan_spec: PlanSpec = serde_json::from_value(to_json(plan, "plan")?)
         .map_err(|e| value_error(format!("plan: {e}")))?;
     let files = plan_spec.candidates.iter().any(|c| c.input.is_some())

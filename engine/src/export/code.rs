@@ -4,6 +4,8 @@
 //! kept as the engine evaluates it (operands in the same order, parenthesised by the tree), so
 //! the emitted code rounds as the engine does up to the math library.
 
+use frictionid_models::formula::Func as FormulaFunc;
+
 /// A function an expression calls; the emitters name it in their language.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Func {
@@ -11,58 +13,41 @@ pub enum Func {
     Sgn,
     /// exp(-x), 0 for x > 745.2 (the engine's `decay`; a helper in every emitted file).
     Decay,
-    Abs,
-    Exp,
     Expm1,
-    Ln,
     Ln1p,
-    Log10,
-    Sqrt,
-    Sin,
-    Cos,
-    Tan,
-    Asin,
-    Acos,
-    Atan,
-    Sinh,
-    Cosh,
-    Tanh,
     /// The least whole number >= x.
     Ceil,
     /// x^y.
     Pow,
-    Min,
-    Max,
-    Atan2,
+    /// A function of the formula language (abs, exp, ln, the trigonometric and hyperbolic
+    /// functions, min, max, atan2), built by [`Func::of_formula`]: its `sign` is [`Func::Sgn`].
+    Math(FormulaFunc),
 }
 
 impl Func {
-    /// The C99 `math.h` name (`Sgn` and `Decay` are the file's helpers).
+    /// The function a formula's call of `f` prints as.
+    pub fn of_formula(f: FormulaFunc) -> Func {
+        match f {
+            FormulaFunc::Sign => Func::Sgn,
+            f => Func::Math(f),
+        }
+    }
+
+    /// The C99 `math.h` name (`Sgn` and `Decay` are the file's helpers): a formula function's
+    /// own name but for abs, ln, min and max.
     pub fn c_name(self) -> &'static str {
         match self {
-            Func::Sgn => "sgn",
+            Func::Sgn | Func::Math(FormulaFunc::Sign) => "sgn",
             Func::Decay => "decay",
-            Func::Abs => "fabs",
-            Func::Exp => "exp",
             Func::Expm1 => "expm1",
-            Func::Ln => "log",
             Func::Ln1p => "log1p",
-            Func::Log10 => "log10",
-            Func::Sqrt => "sqrt",
-            Func::Sin => "sin",
-            Func::Cos => "cos",
-            Func::Tan => "tan",
-            Func::Asin => "asin",
-            Func::Acos => "acos",
-            Func::Atan => "atan",
-            Func::Sinh => "sinh",
-            Func::Cosh => "cosh",
-            Func::Tanh => "tanh",
             Func::Ceil => "ceil",
             Func::Pow => "pow",
-            Func::Min => "fmin",
-            Func::Max => "fmax",
-            Func::Atan2 => "atan2",
+            Func::Math(FormulaFunc::Abs) => "fabs",
+            Func::Math(FormulaFunc::Ln) => "log",
+            Func::Math(FormulaFunc::Min) => "fmin",
+            Func::Math(FormulaFunc::Max) => "fmax",
+            Func::Math(f) => f.exmex_name(),
         }
     }
 }

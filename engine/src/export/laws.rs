@@ -85,7 +85,7 @@ fn sgn(e: Expr) -> Expr {
 }
 
 fn abs(e: Expr) -> Expr {
-    call(Func::Abs, e)
+    call(Func::Math(FormulaFunc::Abs), e)
 }
 
 /// mu N sgn(v).
@@ -134,8 +134,9 @@ fn stribeck(ps: &Params) -> Result<LawCode, ExportError> {
 
 /// g1 (tanh(g2 v) - tanh(g3 v)) + g4 tanh(g5 v) + g6 v.
 fn makkar(ps: &Params) -> Result<LawCode, ExportError> {
-    let tanh =
-        |g: &str| -> Result<Expr, ExportError> { Ok(call(Func::Tanh, mul(ps.p(g)?, Expr::V))) };
+    let tanh = |g: &str| -> Result<Expr, ExportError> {
+        Ok(call(Func::Math(FormulaFunc::Tanh), mul(ps.p(g)?, Expr::V)))
+    };
     Ok(static_law(add(
         add(
             mul(ps.p("g1")?, sub(tanh("g2")?, tanh("g3")?)),
@@ -174,36 +175,12 @@ fn translate(ps: &Params, node: &Node) -> Result<Expr, ExportError> {
             }
         }
         Node::Call(f, args) => Expr::Call(
-            function(*f),
+            Func::of_formula(*f),
             args.iter()
                 .map(|a| translate(ps, a))
                 .collect::<Result<_, _>>()?,
         ),
     })
-}
-
-/// The export function of a formula function.
-fn function(f: FormulaFunc) -> Func {
-    match f {
-        FormulaFunc::Sign => Func::Sgn,
-        FormulaFunc::Abs => Func::Abs,
-        FormulaFunc::Exp => Func::Exp,
-        FormulaFunc::Ln => Func::Ln,
-        FormulaFunc::Log10 => Func::Log10,
-        FormulaFunc::Sqrt => Func::Sqrt,
-        FormulaFunc::Sin => Func::Sin,
-        FormulaFunc::Cos => Func::Cos,
-        FormulaFunc::Tan => Func::Tan,
-        FormulaFunc::Asin => Func::Asin,
-        FormulaFunc::Acos => Func::Acos,
-        FormulaFunc::Atan => Func::Atan,
-        FormulaFunc::Sinh => Func::Sinh,
-        FormulaFunc::Cosh => Func::Cosh,
-        FormulaFunc::Tanh => Func::Tanh,
-        FormulaFunc::Min => Func::Min,
-        FormulaFunc::Max => Func::Max,
-        FormulaFunc::Atan2 => Func::Atan2,
-    }
 }
 
 /// `update` returns at once where nothing moves: `no_load` (no sliding force), v = 0 or
@@ -254,8 +231,11 @@ fn dahl(ps: &Params) -> Result<LawCode, ExportError> {
         let w = mul(
             mul(delta.clone(), local("kappa")),
             call(
-                Func::Exp,
-                mul(neg(delta.clone()), call(Func::Ln, abs(local("r0")))),
+                Func::Math(FormulaFunc::Exp),
+                mul(
+                    neg(delta.clone()),
+                    call(Func::Math(FormulaFunc::Ln), abs(local("r0"))),
+                ),
             ),
         );
         let relaxed = mul(
@@ -393,7 +373,10 @@ fn gms_s(ps: &Params) -> Result<Vec<Stmt>, ExportError> {
 fn gms_tanh(x: Expr) -> Expr {
     div(
         neg(call(Func::Expm1, mul(num(-2.0), x.clone()))),
-        add(num(1.0), call(Func::Exp, mul(num(-2.0), x))),
+        add(
+            num(1.0),
+            call(Func::Math(FormulaFunc::Exp), mul(num(-2.0), x)),
+        ),
     )
 }
 
@@ -481,7 +464,14 @@ const MAX_SUBSTEPS: f64 = 10000.0;
 
 /// dy/dsigma = 1 - max(0, y)^m at `y`.
 fn load_rate(y: Expr, m: Expr) -> Expr {
-    sub(num(1.0), call2(Func::Pow, call2(Func::Max, y, num(0.0)), m))
+    sub(
+        num(1.0),
+        call2(
+            Func::Pow,
+            call2(Func::Math(FormulaFunc::Max), y, num(0.0)),
+            m,
+        ),
+    )
 }
 
 /// The step of element `i` at a sharpness without closed form: stuck while unloaded (exact),
@@ -501,7 +491,7 @@ fn gms_element_substeps(i: usize, k: Expr, w: Expr, m: Expr) -> Vec<Stmt> {
         m.clone(),
         call2(
             Func::Pow,
-            call2(Func::Max, local("y0"), num(1.0)),
+            call2(Func::Math(FormulaFunc::Max), local("y0"), num(1.0)),
             sub(m.clone(), num(1.0)),
         ),
     );
@@ -525,11 +515,14 @@ fn gms_element_substeps(i: usize, k: Expr, w: Expr, m: Expr) -> Vec<Stmt> {
         ),
     ];
     let loading = vec![
-        var("y", call2(Func::Max, local("y0"), num(0.0))),
+        var(
+            "y",
+            call2(Func::Math(FormulaFunc::Max), local("y0"), num(0.0)),
+        ),
         let_(
             "rest",
             call2(
-                Func::Min,
+                Func::Math(FormulaFunc::Min),
                 cond(
                     cmp(Cmp::Gt, local("y0"), num(0.0)),
                     local("sg"),
@@ -541,9 +534,9 @@ fn gms_element_substeps(i: usize, k: Expr, w: Expr, m: Expr) -> Vec<Stmt> {
         let_(
             "count",
             call2(
-                Func::Min,
+                Func::Math(FormulaFunc::Min),
                 call2(
-                    Func::Max,
+                    Func::Math(FormulaFunc::Max),
                     call(Func::Ceil, div(mul(local("rest"), stiffness), num(0.5))),
                     num(1.0),
                 ),

@@ -5,6 +5,7 @@ use super::code::Func;
 use super::description::{literal, LawDescription};
 use super::print::{body, Syntax};
 use super::ExportError;
+use frictionid_models::formula::Func as FormulaFunc;
 
 /// Python's spelling of the export language.
 struct Python {
@@ -19,9 +20,9 @@ impl Syntax for Python {
         let name = match f {
             Func::Sgn => "_sgn",
             Func::Decay => "_decay",
-            Func::Min => "min",
-            Func::Max => "max",
-            Func::Abs => "abs",
+            Func::Math(FormulaFunc::Min) => "min",
+            Func::Math(FormulaFunc::Max) => "max",
+            Func::Math(FormulaFunc::Abs) => "abs",
             Func::Pow => "math.pow",
             _ => return format!("math.{}({})", f.c_name(), args.join(", ")),
         };

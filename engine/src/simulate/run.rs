@@ -32,6 +32,13 @@ pub const RODAS_TOL_SCALE: f64 = 100.0;
 /// [`RODAS_TOL_SCALE`]); the rest threshold of the driver keeps the options' `atol`.
 pub const RODAS_ATOL_SCALE: f64 = 100.0;
 
+/// Checks a run's oscillator and friction law.
+pub(super) fn check_system(osc: &Oscillator, model: &dyn FrictionModel) -> Result<(), EngineError> {
+    osc.validate()?;
+    model.check()?;
+    Ok(())
+}
+
 /// Validates the inputs, builds the driver and runs it over the chosen stepper.
 pub(crate) fn run<R: Recorder>(
     inputs: RunInputs<'_>,
@@ -49,8 +56,7 @@ pub(crate) fn run<R: Recorder>(
         },
         opts,
     } = inputs;
-    osc.validate()?;
-    model.check()?;
+    check_system(osc, model)?;
     let conditions = BoundConditions::bind(model, input, channels)?;
     let y0 = initial_state(model, init)?;
     check_times(t_end, sample_times)?;

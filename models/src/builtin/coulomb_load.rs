@@ -70,10 +70,8 @@ impl FrictionModel for CoulombLoad {
 }
 
 impl ParamGradients for CoulombLoad {
-    /// Without load: dF/dmu = N sgn(v), dF/dmu_load = 0, dF/dviscous = v.
-    fn force_param_gradient(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) {
-        self.force_param_gradient_in(v, z, normal, &[], out);
-    }
+    // Without load: dF/dmu = N sgn(v), dF/dmu_load = 0, dF/dviscous = v.
+    crate::at_no_conditions!(param_gradients);
     /// dF/dmu = N sgn(v), dF/dmu_load = |load| sgn(v), dF/dviscous = v.
     fn force_param_gradient_in(
         &self,
@@ -93,12 +91,7 @@ impl ParamGradients for CoulombLoad {
 /// A simulation sticks the joint while the force it holds is within the level at the current
 /// load, and slips at that level in the slip direction.
 impl SwitchedLaw for CoulombLoad {
-    fn static_limit(&self, normal: f64) -> Option<f64> {
-        self.static_limit_in(normal, &[])
-    }
-    fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
-        self.slip_force_in(v, direction, normal, &[])
-    }
+    crate::at_no_conditions!(switching);
     fn static_limit_in(&self, normal: f64, at: &[f64]) -> Option<f64> {
         Some(self.level(normal, condition_value(at, 0)))
     }

@@ -150,12 +150,8 @@ impl Expression {
         })
     }
 
-    /// The force at v -> 0+ in the switched form (sign(v) = +1).
-    fn breakaway(&self, normal: f64) -> Option<f64> {
-        self.breakaway_in(normal, &[])
-    }
-
-    /// [`Expression::breakaway`] at the values `at` of the formula's conditions.
+    /// The force at v -> 0+ in the switched form (sign(v) = +1) at the values `at` of the
+    /// formula's conditions.
     fn breakaway_in(&self, normal: f64, at: &[f64]) -> Option<f64> {
         let f = self.switched.as_ref()?;
         let f0 = self.eval(f, 0.0, normal, at, Some(1.0));
@@ -444,12 +440,7 @@ impl FrictionModel for Expression {
 }
 
 impl SwitchedLaw for Expression {
-    fn static_limit(&self, normal: f64) -> Option<f64> {
-        self.breakaway(normal)
-    }
-    fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
-        self.slip_force_in(v, direction, normal, &[])
-    }
+    crate::at_no_conditions!(switching);
     fn static_limit_in(&self, normal: f64, at: &[f64]) -> Option<f64> {
         self.breakaway_in(normal, at)
     }

@@ -90,10 +90,8 @@ impl FrictionModel for PositionRipple {
 }
 
 impl ParamGradients for PositionRipple {
-    /// The gradient at x = 0.
-    fn force_param_gradient(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) {
-        self.force_param_gradient_in(v, z, normal, &[], out);
-    }
+    // The gradient at x = 0.
+    crate::at_no_conditions!(param_gradients);
     /// With s = N sgn(v) and theta the ripple's angle: dF/dmu = s, dF/dripple = s sin(theta),
     /// dF/dperiod = -ripple s cos(theta) 2 pi x / period^2, dF/dphase = ripple s cos(theta),
     /// dF/dviscous = v.
@@ -120,12 +118,7 @@ impl ParamGradients for PositionRipple {
 /// position (never below 0: a ripple larger than the mean level holds nothing there), and
 /// slips at that level in the slip direction.
 impl SwitchedLaw for PositionRipple {
-    fn static_limit(&self, normal: f64) -> Option<f64> {
-        self.static_limit_in(normal, &[])
-    }
-    fn slip_force(&self, v: f64, direction: f64, normal: f64) -> f64 {
-        self.slip_force_in(v, direction, normal, &[])
-    }
+    crate::at_no_conditions!(switching);
     fn static_limit_in(&self, normal: f64, at: &[f64]) -> Option<f64> {
         Some(self.level(normal, condition_value(at, 0)).max(0.0))
     }

@@ -236,13 +236,19 @@ pub trait Residuals: Send + Sync {
     /// The parts of record `index`'s measured series, in order: one per compared channel
     /// (default: one part, the whole series, unscaled).
     fn segments(&self, index: usize, record: &Record) -> Vec<Segment> {
-        vec![Segment {
+        vec![self.record_segment(index, record, None)]
+    }
+
+    /// Record `index`'s measured series as one segment, its residuals weighted by `noise`
+    /// where the producer knows it (scale 1 / noise) and by 1 otherwise.
+    fn record_segment(&self, index: usize, record: &Record, noise: Option<f64>) -> Segment {
+        Segment {
             channel: self.record_channel(index),
             unit: self.unit(),
             len: self.measured(index, record).len(),
-            noise: None,
-            scale: 1.0,
-        }]
+            noise,
+            scale: noise.map_or(1.0, |n| 1.0 / n),
+        }
     }
 
     /// Whether [`Residuals::jacobian_columns`] may give any column (default: `false`, and the

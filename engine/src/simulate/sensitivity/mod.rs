@@ -35,6 +35,7 @@ mod system;
 
 use super::auto::stiffness_ratio;
 use super::dynamics::{Dynamics, Law};
+use super::run::check_system;
 use super::values::{Integrator, RunInputs, SimStats};
 use crate::error::EngineError;
 use crate::oscillator::OscillatorProperty;
@@ -108,8 +109,7 @@ pub fn simulate_sensitivities(
     {
         return Ok(None);
     }
-    osc.validate()?;
-    model.check()?;
+    check_system(osc, model)?;
     let dynamics = Dynamics::new(osc, model)?;
     let mut y0 = vec![init.x0, init.v0];
     match &init.z0 {

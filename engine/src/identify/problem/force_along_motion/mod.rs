@@ -372,13 +372,7 @@ impl Residuals for ForceAlongMotion {
     /// as they should in a joint fit.
     fn segments(&self, index: usize, record: &Record) -> Vec<Segment> {
         let noise = self.tracks.get(index).map_or(1.0, |t| t.noise);
-        vec![Segment {
-            channel: self.record_channel(index),
-            unit: self.unit(),
-            len: self.measured(index, record).len(),
-            noise: Some(noise),
-            scale: 1.0 / noise,
-        }]
+        vec![self.record_segment(index, record, Some(noise))]
     }
 
     fn check_record(&self, record: &Record) -> Result<(), EngineError> {
