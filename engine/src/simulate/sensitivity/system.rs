@@ -174,18 +174,27 @@ impl OdeSystem for Augmented<'_, '_> {
             3 => sensitivity_rates::<3>(jac, sens, direct, d_sens),
             4 => sensitivity_rates::<4>(jac, sens, direct, d_sens),
             5 => sensitivity_rates::<5>(jac, sens, direct, d_sens),
-            _ => {
-                for ((s, ds), d) in sens
-                    .chunks_exact(n)
-                    .zip(d_sens.chunks_exact_mut(n))
-                    .zip(direct.chunks_exact(n))
-                {
-                    for (i, (o, &di)) in ds.iter_mut().zip(d).enumerate() {
-                        let row = &jac[i * n..(i + 1) * n];
-                        *o = di + row.iter().zip(s).map(|(a, b)| a * b).sum::<f64>();
-                    }
-                }
-            }
+            _ => general_sensitivity_rates(n, jac, sens, direct, d_sens),
+        }
+    }
+}
+
+/// s_j' = df/dp_j + J s_j for every parameter j, for states of any dimension `n`.
+fn general_sensitivity_rates(
+    n: usize,
+    jac: &[f64],
+    sens: &[f64],
+    direct: &[f64],
+    d_sens: &mut [f64],
+) {
+    for ((s, ds), d) in sens
+        .chunks_exact(n)
+        .zip(d_sens.chunks_exact_mut(n))
+        .zip(direct.chunks_exact(n))
+    {
+        for (i, (o, &di)) in ds.iter_mut().zip(d).enumerate() {
+            let row = &jac[i * n..(i + 1) * n];
+            *o = di + row.iter().zip(s).map(|(a, b)| a * b).sum::<f64>();
         }
     }
 }
@@ -220,21 +229,12 @@ fn sensitivity_rates<const N: usize>(
 
 #[cfg(test)]
 mod tests {
-    use super::sensitivity_rates;
+    use super::{general_sensitivity_rates, sensitivity_rates};
 
     /// The rates of every parameter's sensitivity as the general size computes them.
     fn general(n: usize, jac: &[f64], sens: &[f64], direct: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; sens.len()];
-        for ((s, ds), d) in sens
-            .chunks_exact(n)
-            .zip(out.chunks_exact_mut(n))
-            .zip(direct.chunks_exact(n))
-        {
-            for (i, (o, &di)) in ds.iter_mut().zip(d).enumerate() {
-                let row = &jac[i * n..(i + 1) * n];
-                *o = di + row.iter().zip(s).map(|(a, b)| a * b).sum::<f64>();
-            }
-        }
+        general_sensitivity_rates(n, jac, sens, direct, &mut out);
         out
     }
 
