@@ -71,38 +71,14 @@ impl Pace {
 /// step undamped, large enough to keep a nearly singular system solvable.
 pub const GAUSS_NEWTON_DAMPING: f64 = 1e-10;
 
-/// Nielsen's tau of the largest-diagonal damping start ([`DampingStart::LargestDiagonal`]).
-pub const LARGEST_DIAGONAL_TAU: f64 = 1e-3;
-
-/// The damping of the first iteration.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum DampingStart {
-    /// mu = tau: a pure number (the damping scales diag(JᵀJ)), so the path does not depend
-    /// on the residuals' unit.
-    Relative(f64),
-    /// mu = tau max diag(JᵀJ) (Nielsen's rule for undamped scaling): depends on the unit of
-    /// the residuals, small for velocity fits in m/s, about 1e4 for a force fit weighted by
-    /// 1/noise. The rugged landscapes of the dynamic models were tuned on it: measured on
-    /// the tribometer record, the GMS and Dahl optima move by up to 60 % in cost with any
-    /// pure-number start from 1e-5 to 1e3 (a lottery of local minima either way), so it
-    /// stays theirs until their search is robust to it.
-    LargestDiagonal(f64),
-}
-
-impl DampingStart {
-    /// The first iteration's mu for the Jacobian `j` at the start.
-    fn initial(self, j: &DMatrix<f64>) -> f64 {
-        match self {
-            Self::Relative(tau) => tau,
-            Self::LargestDiagonal(tau) => {
-                // (As JᵀJ's diagonal, to the bit: the dynamic fits' paths are sensitive.)
-                let a = j.transpose() * j;
-                let largest = a.diagonal().iter().cloned().fold(0.0, f64::max);
-                tau * largest.max(1e-300)
-            }
-        }
-    }
-}
+/// The damping of the first iteration, relative to diag(JᵀJ) (Marquardt's scaling): a pure
+/// number, so a fit's path does not depend on the unit of its residuals. Small, so the first
+/// step is nearly Gauss-Newton's; a rejected step doubles its way up from there at the cost of
+/// one residual evaluation each. Nielsen's absolute start (1e-3 times the largest diagonal of
+/// JᵀJ) made a force fit weighted by 1/noise start with a damping of about 1e5 relative: a
+/// Dahl fit to a damper stroke spent ten of its sixteen iterations taking the damping down,
+/// a factor of three per accepted step.
+pub const INITIAL_DAMPING: f64 = 1e-5;
 
 /// The residuals at the initial parameters are not finite: the run cannot start (its caller,
 /// which knows the problem, says where they stop being finite).
@@ -121,9 +97,9 @@ pub struct LevenbergMarquardt {
     pub xtol: f64,
     /// Stop when an accepted step reduces the cost by less than ftol relative.
     pub ftol: f64,
-    /// How the damping starts (the step solves (JᵀJ + mu diag(JᵀJ)) d = -Jᵀr, Marquardt's
-    /// scaling).
-    pub damping_start: DampingStart,
+    /// The damping of the first iteration (the step solves (JᵀJ + mu diag(JᵀJ)) d = -Jᵀr,
+    /// Marquardt's scaling).
+    pub initial_damping: f64,
     /// Stop when the cost fell by less than this fraction over the last `stall_window`
     /// accepted steps. For noisy data a relative change of 1e-6 is far below the statistical
     /// spread of the cost itself (about sqrt(2/n) relative for n residuals), so iterating on
@@ -166,7 +142,7 @@ impl LevenbergMarquardt {
             gtol: 1e-10,
             xtol: 1e-8,
             ftol: 1e-9,
-            damping_start: DampingStart::LargestDiagonal(LARGEST_DIAGONAL_TAU),
+            initial_damping: INITIAL_DAMPING,
             max_step: f64::INFINITY,
             relative_step: Vec::new(),
             stall_tol: 1e-6,
@@ -245,7 +221,7 @@ where
             return Err(NonFiniteStart.into());
         }
         let j = problem.jacobian(&p0)?;
-        self.mu = self.damping_start.initial(&j);
+        self.mu = self.initial_damping;
         self.nu = 2.0;
         self.residuals = r;
         self.jacobian = j;
@@ -563,8 +539,7 @@ mod tests {
         O: Operator<Param = DVector<f64>, Output = DVector<f64>>
             + Jacobian<Param = DVector<f64>, Jacobian = DMatrix<f64>>,
     {
-        let start = LevenbergMarquardt::new(DVector::zeros(0), DVector::zeros(0)).damping_start;
-        run_with(problem, p0, lo, hi, start)
+        run_with(problem, p0, lo, hi, INITIAL_DAMPING)
     }
 
     fn run_with<O>(
@@ -572,14 +547,14 @@ mod tests {
         p0: Vec<f64>,
         lo: Vec<f64>,
         hi: Vec<f64>,
-        damping_start: DampingStart,
+        initial_damping: f64,
     ) -> (LmState, TerminationReason)
     where
         O: Operator<Param = DVector<f64>, Output = DVector<f64>>
             + Jacobian<Param = DVector<f64>, Jacobian = DMatrix<f64>>,
     {
         let mut solver = LevenbergMarquardt::new(DVector::from_vec(lo), DVector::from_vec(hi));
-        solver.damping_start = damping_start;
+        solver.initial_damping = initial_damping;
         // Exact (zero-residual) problems: tolerances far below the defaults for noisy data.
         solver.xtol = 1e-13;
         solver.ftol = 1e-15;
@@ -722,8 +697,8 @@ mod tests {
     }
 
     /// A relative damping start is a pure number: the path does not depend on the residuals'
-    /// unit (with the largest-diagonal rule a force fit weighted by 1/noise starts with 1e4
-    /// times the damping of the same fit in other units).
+    /// unit (with Nielsen's largest-diagonal rule a force fit weighted by 1/noise would start
+    /// with 1e4 times the damping of the same fit in other units).
     #[test]
     fn the_path_does_not_depend_on_the_unit_of_the_residuals() {
         let inf = f64::INFINITY;
@@ -733,7 +708,7 @@ mod tests {
                 vec![-1.2, 1.0],
                 vec![-inf; 2],
                 vec![inf; 2],
-                DampingStart::Relative(1e-2),
+                1e-2,
             );
             let p = best(&s).unwrap().0;
             (s.get_iter(), p, reason)

@@ -1,10 +1,7 @@
 //! Multi-start strategy: where the starts begin, one Levenberg-Marquardt run per start, a short
 //! screening of every start and the continuation of the most promising one.
 
-use super::lm::{
-    termination_reason, DampingStart, LevenbergMarquardt, LmState, NonFiniteStart, Pace,
-    LARGEST_DIAGONAL_TAU,
-};
+use super::lm::{termination_reason, LevenbergMarquardt, LmState, NonFiniteStart, Pace};
 use crate::error::EngineError;
 use crate::identify::problem::least_squares::{FitProblem, Realised};
 use crate::identify::problem::residuals::{RecordCase, Residuals};
@@ -13,7 +10,6 @@ use crate::identify::values::layout::{FreeParam, ParamKind};
 use crate::identify::values::options::{Progress, ProgressFn};
 use crate::identify::values::outcome::{StartOutcome, TerminationReason};
 use crate::identify::values::param_options::ParamOptions;
-use crate::identify::values::search::fits_directly;
 use crate::identify::values::search::SearchOptions;
 use crate::record::Record;
 use argmin::core::observers::{Observe, ObserverMode};
@@ -22,24 +18,6 @@ use frictionid_models::FrictionModel;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
-
-/// The relative damping start of the fits that take one (see [`damping_start_for`]).
-pub const RELATIVE_DAMPING: f64 = 1e-5;
-
-/// How the solver's damping starts for `model` fitted with residuals that do (`simulated`)
-/// or do not simulate the response. Relative ([`RELATIVE_DAMPING`], a pure number) for
-/// velocity fits and for static laws along the measured motion: a Stribeck force fit
-/// converges in 4 iterations (17 with the largest-diagonal rule at its 1/noise weights),
-/// GMS fitted to the FMM fixture in 6.3 s (14.9 s). The largest-diagonal rule for a model
-/// with internal states fitted along the measured motion, whose rugged landscapes it was
-/// measured on (see [`DampingStart::LargestDiagonal`]).
-pub fn damping_start_for(model: &dyn FrictionModel, simulated: bool) -> DampingStart {
-    if simulated || fits_directly(model, simulated) {
-        DampingStart::Relative(RELATIVE_DAMPING)
-    } else {
-        DampingStart::LargestDiagonal(LARGEST_DIAGONAL_TAU)
-    }
-}
 
 /// Starts of a multi-start fit when more than two model parameters are free.
 pub const DEFAULT_STARTS: usize = 4;
@@ -208,10 +186,6 @@ fn solver_for<R: Residuals>(problem: &FitProblem<R>, search: &SearchOptions) -> 
     // cannot throw a trial point into a region where the simulation is stiff or degenerate.
     solver.max_step = 2.0;
     solver.relative_step = problem.layout.iter().map(|f| !f.log).collect();
-    solver.damping_start = damping_start_for(
-        problem.model.as_ref(),
-        problem.residuals.simulates_response(),
-    );
     if let Some(t) = search.tolerance {
         solver.ftol = t;
     }
@@ -706,24 +680,4 @@ fn pick_best(screened: Screened) -> Option<MultiStart> {
         starts_at_best,
         outcomes: outcomes.into_iter().map(|(_, o)| o).collect(),
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use frictionid_models::{Coulomb, LuGre, Stribeck};
-
-    #[test]
-    fn the_damping_starts_relative_except_for_dynamic_models_along_the_motion() {
-        let relative = DampingStart::Relative(RELATIVE_DAMPING);
-        for simulated in [true, false] {
-            assert_eq!(damping_start_for(&Coulomb::default(), simulated), relative);
-            assert_eq!(damping_start_for(&Stribeck::default(), simulated), relative);
-        }
-        assert_eq!(damping_start_for(&LuGre::default(), true), relative);
-        assert_eq!(
-            damping_start_for(&LuGre::default(), false),
-            DampingStart::LargestDiagonal(LARGEST_DIAGONAL_TAU)
-        );
-    }
 }
