@@ -12,6 +12,7 @@
 //! through [`Jacobian`]. A residual vector with a non-finite entry (e.g. a simulation that
 //! failed for the trial parameters) is treated as an infinitely bad trial and rejected.
 
+use super::normal_equations::NormalEquations;
 use crate::identify::values::outcome::TerminationReason;
 use argmin::core::{
     Error, IterState, Jacobian, Operator, Problem, Solver, State,
@@ -306,38 +307,6 @@ where
             Some(why) => TerminationStatus::Terminated(ArgminReason::SolverExit(why.to_string())),
             None => TerminationStatus::NotTerminated,
         }
-    }
-}
-
-/// The Gauss-Newton quantities at the current point: JᵀJ, the gradient Jᵀr and Marquardt's
-/// scaling diagonal.
-struct NormalEquations {
-    a: DMatrix<f64>,
-    g: DVector<f64>,
-    diag: Vec<f64>,
-}
-
-impl NormalEquations {
-    /// The decrease of the cost the linear model predicts for `step`.
-    fn predicted_reduction(&self, step: &DVector<f64>) -> f64 {
-        -(step.dot(&self.g)) - 0.5 * step.dot(&(&self.a * step))
-    }
-
-    fn new(j: &DMatrix<f64>, r: &DVector<f64>) -> Self {
-        // One free parameter (a Coulomb mu): two dot products, no transposed copy. Otherwise
-        // one transposed copy for both products, gemm's summation order kept: column dots
-        // (`tr_mul`) move the LuGre and Dahl fits onto slower paths (the five-model compare
-        // 2.0 -> 2.6-2.9 s on repeated measurement).
-        let (a, g) = if j.ncols() == 1 {
-            (j.tr_mul(j), j.tr_mul(r))
-        } else {
-            let jt = j.transpose();
-            (&jt * j, &jt * r)
-        };
-        let diag: Vec<f64> = (0..a.nrows())
-            .map(|i| a[(i, i)].max(1e-12 * (1.0 + a[(i, i)])))
-            .collect();
-        Self { a, g, diag }
     }
 }
 

@@ -1,5 +1,6 @@
 //! The search for the optimum, on the problem's floor: the free parameters the options ask
-//! for ([`free_params`]), the bounded Levenberg-Marquardt solver ([`lm`]), the multi-start
+//! for ([`free_params`]), the bounded Levenberg-Marquardt solver ([`lm`], its
+//! normal equations in `normal_equations`), the multi-start
 //! runs ([`starts`]), where the starts come from ([`strategy`]: local, staged from simpler
 //! laws, global), the further starts of a free decay that sticks ([`further`]) and the
 //! force-domain prefit's options and finding ([`prefit`]).
@@ -8,6 +9,7 @@
 pub(crate) mod free_params;
 pub(crate) mod further;
 pub mod lm;
+mod normal_equations;
 pub(crate) mod prefit;
 pub mod starts;
 pub(crate) mod strategy;
