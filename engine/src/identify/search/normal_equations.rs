@@ -25,10 +25,10 @@ pub(super) struct NormalEquations {
 impl NormalEquations {
     /// The normal equations of the Jacobian `j` and residuals `r`.
     pub(super) fn new(j: &DMatrix<f64>, r: &DVector<f64>) -> Self {
-        let (a, g) = match j.ncols() {
-            // One free parameter (a Coulomb mu): two dot products.
-            1 => (j.tr_mul(j), j.tr_mul(r)),
-            p if p <= GEMV_SIZE || j.nrows() <= GEMV_SIZE => row_order_products(j, r),
+        let (a, g) = match (j.nrows(), j.ncols()) {
+            // One free parameter (a Coulomb mu): two dot products; no residuals: zeros.
+            (0, _) | (_, 1) => (j.tr_mul(j), j.tr_mul(r)),
+            (n, p) if p <= GEMV_SIZE || n <= GEMV_SIZE => row_order_products(j, r),
             _ => (transposed_view(j) * j, row_order_gradient(j, r)),
         };
         let diag: Vec<f64> = (0..a.nrows())
@@ -57,43 +57,53 @@ fn columns(j: &DMatrix<f64>) -> Vec<&[f64]> {
         .collect()
 }
 
-/// The sum over the rows in order, from the first row's term, as nalgebra's `gemv` sums it.
-fn accumulate(sum: &mut f64, k: usize, term: f64) {
-    *sum = if k == 0 { term } else { term + *sum };
-}
-
-/// Jᵀr, each entry summed over the rows in order.
+/// Jᵀr, each entry summed over the rows in order from the first row's term, as nalgebra's
+/// `gemv` sums it.
 fn row_order_gradient(j: &DMatrix<f64>, r: &DVector<f64>) -> DVector<f64> {
     let columns = columns(j);
-    let mut g = vec![0.0; columns.len()];
-    for (k, &rk) in r.iter().enumerate() {
+    let mut g: Vec<f64> = columns.iter().map(|column| column[0] * r[0]).collect();
+    for (k, &rk) in r.iter().enumerate().skip(1) {
         for (gc, column) in g.iter_mut().zip(&columns) {
-            accumulate(gc, k, column[k] * rk);
+            *gc += column[k] * rk;
         }
     }
     DVector::from_vec(g)
 }
 
-/// JᵀJ and Jᵀr, each entry summed over the rows in order (one pass over the rows).
+/// JᵀJ and Jᵀr, each entry summed over the rows in order from the first row's term (one pass
+/// over the rows), with fixed-size accumulators up to [`GEMV_SIZE`] columns.
 fn row_order_products(j: &DMatrix<f64>, r: &DVector<f64>) -> (DMatrix<f64>, DVector<f64>) {
+    match j.ncols() {
+        2 => fixed_row_order_products::<2>(j, r),
+        3 => fixed_row_order_products::<3>(j, r),
+        4 => fixed_row_order_products::<4>(j, r),
+        5 => fixed_row_order_products::<5>(j, r),
+        _ => (j.transpose() * j, row_order_gradient(j, r)),
+    }
+}
+
+/// [`row_order_products`] for `P` columns and at least one row.
+fn fixed_row_order_products<const P: usize>(
+    j: &DMatrix<f64>,
+    r: &DVector<f64>,
+) -> (DMatrix<f64>, DVector<f64>) {
     let columns = columns(j);
-    let p = columns.len();
-    let mut a = vec![0.0; p * p];
-    let mut g = vec![0.0; p];
-    let mut row = vec![0.0; p];
-    for (k, &rk) in r.iter().enumerate() {
-        for (x, column) in row.iter_mut().zip(&columns) {
-            *x = column[k];
-        }
-        for c in 0..p {
-            for d in c..p {
-                accumulate(&mut a[c * p + d], k, row[c] * row[d]);
+    let row_at = |k: usize| -> [f64; P] { std::array::from_fn(|c| columns[c][k]) };
+    let first = row_at(0);
+    let mut a: [[f64; P]; P] =
+        std::array::from_fn(|c| std::array::from_fn(|d| first[c] * first[d]));
+    let mut g: [f64; P] = std::array::from_fn(|c| first[c] * r[0]);
+    for (k, &rk) in r.iter().enumerate().skip(1) {
+        let row = row_at(k);
+        for c in 0..P {
+            for d in c..P {
+                a[c][d] += row[c] * row[d];
             }
-            accumulate(&mut g[c], k, row[c] * rk);
+            g[c] += row[c] * rk;
         }
     }
-    let jtj = DMatrix::from_fn(p, p, |c, d| a[c.min(d) * p + c.max(d)]);
-    (jtj, DVector::from_vec(g))
+    let jtj = DMatrix::from_fn(P, P, |c, d| a[c.min(d)][c.max(d)]);
+    (jtj, DVector::from_fn(P, |c, _| g[c]))
 }
 
 #[cfg(test)]
@@ -112,11 +122,11 @@ mod tests {
     #[test]
     fn the_products_are_those_of_the_transposed_copy_to_the_bit() {
         for cols in 1..=9 {
-            for rows in [1, 2, 17, 1000] {
+            for rows in [0, 1, 2, 5, 6, 17, 1000] {
                 let (j, r) = jacobian(rows, cols);
                 let jt = j.transpose();
                 let normal = NormalEquations::new(&j, &r);
-                if cols == 1 {
+                if cols == 1 || rows == 0 {
                     assert_eq!(normal.a, j.tr_mul(&j));
                     continue;
                 }
