@@ -112,6 +112,10 @@ pub struct LevenbergMarquardt {
     /// (absolute; `None`: never). For a run whose cost is wanted only to a given precision
     /// (a profile step, judged against a rise of the cost).
     pub cost_resolution: Option<f64>,
+    /// Stop when the Gauss-Newton step would move the parameters by less than this many
+    /// standard errors (their joint Mahalanobis distance, estimated from the residuals' variance
+    /// at the current point; `None`: never).
+    pub standard_error_resolution: Option<f64>,
     history: Vec<f64>,
     /// Largest change of any parameter in one step (a trust-region cap: a step that would
     /// move further is shortened along its direction).
@@ -124,6 +128,9 @@ pub struct LevenbergMarquardt {
     nu: f64,
     residuals: DVector<f64>,
     jacobian: DMatrix<f64>,
+    /// The normal equations of `jacobian` and `residuals`, kept across rejected steps (which
+    /// change neither).
+    normal: Option<Arc<NormalEquations>>,
     cost: f64,
     converged: Option<TerminationReason>,
     /// Whether the last trial point could not be evaluated (non-finite residuals: a
@@ -149,11 +156,13 @@ impl LevenbergMarquardt {
             stall_tol: 1e-6,
             stall_window: 10,
             cost_resolution: None,
+            standard_error_resolution: None,
             history: Vec::new(),
             mu: 0.0,
             nu: 2.0,
             residuals: DVector::zeros(0),
             jacobian: DMatrix::zeros(0, 0),
+            normal: None,
             cost: f64::INFINITY,
             converged: None,
             trial_failed: false,
@@ -226,6 +235,7 @@ where
         self.nu = 2.0;
         self.residuals = r;
         self.jacobian = j;
+        self.normal = None;
         self.cost = cost;
         self.converged = None;
         self.trial_failed = false;
@@ -255,9 +265,13 @@ where
             });
             return Ok((state.param(p).cost(self.cost), None));
         }
-        let normal = NormalEquations::new(&self.jacobian, &self.residuals);
+        let normal = self.normal_equations();
         if self.scaled_gradient_norm(&p, &normal.g, &normal.diag) < self.gtol {
             self.converged = Some(TerminationReason::GradientBelowTolerance);
+            return Ok((state.param(p).cost(self.cost), None));
+        }
+        if let Some(fraction) = self.within_standard_errors(&p, &normal) {
+            self.converged = Some(TerminationReason::WithinStandardErrors { fraction });
             return Ok((state.param(p).cost(self.cost), None));
         }
         if let Some(resolution) = self.resolved(&p, &normal) {
@@ -292,6 +306,7 @@ where
         if cost_new.is_finite() && rho > 0.0 {
             self.accept(r_new, cost_new, actual, rho);
             self.jacobian = problem.jacobian(&trial)?;
+            self.normal = None;
             Ok((state.param(trial).cost(cost_new), None))
         } else {
             self.raise_damping();
@@ -311,6 +326,14 @@ where
 }
 
 impl LevenbergMarquardt {
+    /// The normal equations at the current point, formed once per Jacobian.
+    fn normal_equations(&mut self) -> Arc<NormalEquations> {
+        let (jacobian, residuals) = (&self.jacobian, &self.residuals);
+        self.normal
+            .get_or_insert_with(|| Arc::new(NormalEquations::new(jacobian, residuals)))
+            .clone()
+    }
+
     /// The Jacobian and residuals at the current (best) point: the solver only moves to a
     /// point of lower cost, and linearises there before it decides to stop.
     pub fn linearisation(&self) -> (&DMatrix<f64>, &DVector<f64>) {
@@ -380,6 +403,21 @@ impl LevenbergMarquardt {
         let resolution = self.cost_resolution?;
         let gain = self.gauss_newton_gain(p, normal)?;
         (gain < resolution).then_some(resolution)
+    }
+
+    /// The resolution in standard errors, when the Gauss-Newton step at `p` moves the
+    /// parameters by less: its predicted decrease of the cost, delta' JᵀJ delta / 2, is half
+    /// the step's squared Mahalanobis distance times the residual variance 2 cost / (m - n).
+    fn within_standard_errors(&self, p: &DVector<f64>, normal: &NormalEquations) -> Option<f64> {
+        let fraction = self.standard_error_resolution?;
+        let dof = self
+            .residuals
+            .len()
+            .checked_sub(p.len())
+            .filter(|&d| d > 0)?;
+        let variance = 2.0 * self.cost / dof as f64;
+        let gain = self.gauss_newton_gain(p, normal)?;
+        (gain >= 0.0 && gain < 0.5 * fraction * fraction * variance).then_some(fraction)
     }
 
     /// The decrease of the cost the linear model predicts for the Gauss-Newton step (damping
@@ -779,6 +817,88 @@ mod tests {
         assert!(
             (p[0] - 3.0).abs() < 1e-9 && (p[1] - 0.7).abs() < 1e-9,
             "{p}"
+        );
+    }
+
+    /// An exponential decay with noise: residuals y_i - a exp(-b t_i).
+    struct NoisyDecay;
+    impl NoisyDecay {
+        fn samples() -> impl Iterator<Item = (f64, f64)> {
+            (0..200).map(|i| {
+                let t = i as f64 * 0.02;
+                let noise = 0.05 * ((i * 7919) as f64 * 0.618_033_988_75).sin();
+                (t, 2.0 * (-1.3 * t).exp() + noise)
+            })
+        }
+    }
+    impl Operator for NoisyDecay {
+        type Param = DVector<f64>;
+        type Output = DVector<f64>;
+        fn apply(&self, p: &DVector<f64>) -> Result<DVector<f64>, Error> {
+            Ok(DVector::from_iterator(
+                200,
+                Self::samples().map(|(t, y)| y - p[0] * (-p[1] * t).exp()),
+            ))
+        }
+    }
+    impl Jacobian for NoisyDecay {
+        type Param = DVector<f64>;
+        type Jacobian = DMatrix<f64>;
+        fn jacobian(&self, p: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+            let rows: Vec<f64> = Self::samples()
+                .flat_map(|(t, _)| {
+                    let e = (-p[1] * t).exp();
+                    [-e, p[0] * t * e]
+                })
+                .collect();
+            Ok(DMatrix::from_row_slice(200, 2, &rows))
+        }
+    }
+
+    /// A run stopped by the standard-error resolution ends within that many standard errors
+    /// of the optimum the same solver reaches at tolerances near machine precision, measured
+    /// in the covariance s² (JᵀJ)⁻¹ there, and needs no more iterations to get there.
+    #[test]
+    fn a_run_within_the_standard_error_resolution_stops_that_close_to_the_optimum() {
+        let inf = f64::INFINITY;
+        let solve = |resolution: Option<f64>| {
+            let mut solver = LevenbergMarquardt::new(
+                DVector::from_vec(vec![-inf; 2]),
+                DVector::from_vec(vec![inf; 2]),
+            );
+            solver.standard_error_resolution = resolution;
+            if resolution.is_none() {
+                (solver.xtol, solver.ftol, solver.gtol) = (1e-15, 1e-16, 1e-16);
+            }
+            let res = Executor::new(NoisyDecay, solver)
+                .configure(|s| s.param(DVector::from_vec(vec![0.5, 5.0])).max_iters(200))
+                .run()
+                .unwrap();
+            let reason = termination_reason(&res.solver, &res.state().termination_status, 200);
+            (best(res.state()).unwrap().0, res.state().get_iter(), reason)
+        };
+        let (optimum, exact_iterations, _) = solve(None);
+        let (p, iterations, reason) = solve(Some(0.01));
+        assert_eq!(
+            reason,
+            TerminationReason::WithinStandardErrors { fraction: 0.01 }
+        );
+        assert!(
+            iterations <= exact_iterations,
+            "{iterations} > {exact_iterations}"
+        );
+        let j = NoisyDecay.jacobian(&optimum).unwrap();
+        let r = NoisyDecay.apply(&optimum).unwrap();
+        let variance = r.norm_squared() / (200.0 - 2.0);
+        let d = &p - &optimum;
+        let distance = ((d.transpose() * (j.transpose() * &j) * &d)[(0, 0)] / variance).sqrt();
+        assert!(
+            distance < 0.01,
+            "{distance} standard errors from the optimum"
+        );
+        assert!(
+            distance > 0.0,
+            "stopped at the optimum itself: the test judges nothing"
         );
     }
 }

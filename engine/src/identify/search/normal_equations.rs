@@ -16,6 +16,7 @@ use nalgebra::{DMatrix, DMatrixView, DVector, Dyn};
 const GEMV_SIZE: usize = 5;
 
 /// JᵀJ, Jᵀr and the scaling diagonal at the current point.
+#[derive(Debug)]
 pub(super) struct NormalEquations {
     pub(super) a: DMatrix<f64>,
     pub(super) g: DVector<f64>,

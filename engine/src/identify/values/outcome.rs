@@ -33,6 +33,12 @@ pub enum TerminationReason {
         /// The absolute cost resolution.
         resolution: f64,
     },
+    /// The Gauss-Newton step would move the parameters by less than `fraction` of their
+    /// standard errors: iterating on would not change the estimates within their precision.
+    WithinStandardErrors {
+        /// The resolution, in standard errors.
+        fraction: f64,
+    },
     /// The damping grew past its limit without a decrease of the cost.
     DampingLimit,
     /// The iteration limit was reached before any convergence criterion.
@@ -88,6 +94,10 @@ impl fmt::Display for TerminationReason {
             Self::WithinResolution { resolution } => write!(
                 f,
                 "converged: the linear model promises less than {resolution:e} further decrease of the cost"
+            ),
+            Self::WithinStandardErrors { fraction } => write!(
+                f,
+                "converged: the linear model puts the optimum within {fraction} standard errors"
             ),
             Self::DampingLimit => {
                 f.write_str("converged: no further decrease possible (damping limit)")
