@@ -1,5 +1,6 @@
 //! A loading GMS element's exact step at any sharpness m, with its sensitivities (used by
-//! `gms_steps.rs`, which keeps the closed forms of m = 1 and 2). The regular part R below
+//! `gms_steps.rs`, which keeps the closed forms of m = 1 and 2, and their slopes in m in
+//! `gms_sharpness.rs`). The regular part R below
 //! comes from the table of `gms_table.rs` at the step's sharpness where it holds the loads,
 //! else from the series and panels of `gms_quadrature.rs`.
 //!
@@ -132,37 +133,6 @@ impl Step<'_> {
         self.table
             .filter(|t| t.sharpness() == self.m && t.holds(from.w) && t.holds(to.w))
     }
-}
-
-/// dy1/dm of a step of the load from `y0` >= 0 by `change` (staying on its side of 1), from
-/// the loads alone (the closed forms' steps), with R's slope from `table` where it holds them.
-pub(super) fn sharpness_slope_of_loads(
-    m: f64,
-    y0: f64,
-    change: f64,
-    table: Option<&RegularTable>,
-) -> f64 {
-    let d0 = y0 - 1.0;
-    let delta1 = d0 + change;
-    let rate1 = rate(m, delta1);
-    // At 1 to rounding (or past it by a rounding): no slope left.
-    if d0 == 0.0 || rate1 == 0.0 || delta1 * d0 <= 0.0 {
-        return 0.0;
-    }
-    let advance = (-change / delta1).ln_1p();
-    let span = if y0 > 0.0 {
-        (change / y0).ln_1p()
-    } else {
-        f64::INFINITY
-    };
-    let y1 = 1.0 + delta1;
-    let from = Load { y: y0, w: y0.ln() };
-    let to = Load {
-        y: y1,
-        w: delta1.ln_1p(),
-    };
-    let step = Step { m, table, advance };
-    sharpness_slope(&step, from, to, span, rate1)
 }
 
 /// r / (r^m - 1) at r = e^x (x > 0), the travel per unit of ln y of an overloaded element,

@@ -22,7 +22,8 @@
 //! Phi(y1) - Phi(y0) = sigma, `gms_relaxation.rs`).
 
 use super::gms::{Gms, GmsElement};
-use super::gms_relaxation::{relax, sharpness_slope_of_loads};
+use super::gms_relaxation::relax;
+use super::gms_sharpness::closed_sharpness_slope;
 use super::gms_table::{table_for, RegularTable};
 use crate::interval::Interval;
 use crate::model::{sgn, ParamGradients, Propagator};
@@ -111,7 +112,7 @@ fn loading_step(
             }
         };
         if with_m {
-            step.sharpness = sharpness_slope_of_loads(m, y0, step.change, table);
+            step.sharpness = closed_sharpness_slope(m == 2.0, y0, step.change);
         }
         return step;
     }
@@ -164,12 +165,11 @@ impl Gms {
     }
 
     /// The table of the element law's regular part at this sharpness, where a step needs it:
-    /// every sharpness without a closed form, and the closed forms' slopes in m.
-    fn relaxation_table(&self, with_m: bool) -> Option<Rc<RegularTable>> {
+    /// every sharpness without a closed form (the closed forms' slopes in m have theirs,
+    /// `gms_sharpness.rs`).
+    fn relaxation_table(&self) -> Option<Rc<RegularTable>> {
         let m = self.sharpness;
-        (with_m || (m != 1.0 && m != 2.0))
-            .then(|| table_for(m))
-            .flatten()
+        (m != 1.0 && m != 2.0).then(|| table_for(m)).flatten()
     }
 
     /// Steps the element `e` of deflection `z` over `interval` at the Stribeck level `s`
@@ -244,7 +244,7 @@ impl Propagator for Gms {
 
     fn propagate(&self, interval: Interval, z: &mut [f64]) {
         let s = self.s(interval.v, interval.normal);
-        let table = self.relaxation_table(false);
+        let table = self.relaxation_table();
         for (e, zi) in self.elements.iter().zip(z.iter_mut()) {
             self.step_element(e, interval, s, zi, false, table.as_deref());
         }
@@ -256,7 +256,7 @@ impl Propagator for Gms {
         let np = 3 * self.elements.len() + 6;
         let sharpness = 3 * self.elements.len() + 4;
         let u = sgn(interval.v);
-        let table = self.relaxation_table(true);
+        let table = self.relaxation_table();
         for (i, (e, zi)) in self.elements.iter().zip(z.iter_mut()).enumerate() {
             let Some(row) = sens.get_mut(i * np..(i + 1) * np) else {
                 return;
