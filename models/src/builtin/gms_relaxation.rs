@@ -225,7 +225,12 @@ fn relax_far(
         if !step.is_finite() {
             break;
         }
-        span = (span + step).clamp(0.0, most);
+        let next = (span + step).clamp(0.0, most);
+        // Held by a bound: every further iteration would repeat this one.
+        if next == span {
+            break;
+        }
+        span = next;
         let small = step.abs() <= 1e-8 * span;
         if step.abs() <= 1e-14 * span || (small && step.abs() > 0.5 * last) {
             break;
@@ -318,7 +323,13 @@ fn relax_near(m: f64, y0: f64, sigma: f64, with_m: bool, table: Option<&RegularT
         if !step.is_finite() {
             break;
         }
-        advance = (advance + step).min(most);
+        let next = (advance + step).min(most);
+        // Held by the bound (a load at 1 to rounding): every further iteration would repeat
+        // this one.
+        if next == advance {
+            break;
+        }
+        advance = next;
         // Converged, or down to the residual's rounding (the steps stop shrinking).
         let small = step.abs() <= 1e-8 * advance.abs();
         if step.abs() <= 1e-14 * advance.abs() || (small && step.abs() > 0.5 * last) {

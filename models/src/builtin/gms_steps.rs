@@ -208,8 +208,7 @@ impl Gms {
     /// s(v) and its derivatives with respect to mu_c, mu_s, v_s and delta (s computed as
     /// [`Gms::s`] computes it, to the bit).
     fn s_and_param_slopes(&self, v: f64, normal: f64) -> (f64, [f64; 4]) {
-        let power = (v / self.v_s).abs().powf(self.delta);
-        let e = crate::model::decay(power);
+        let (power, e) = self.stribeck_decay(v);
         let s = normal * (self.mu_c + (self.mu_s - self.mu_c) * e);
         let dip = normal * (self.mu_s - self.mu_c) * e;
         let (d_vs, d_delta) = if power > 0.0 {
@@ -295,13 +294,8 @@ impl ParamGradients for Gms {
         let mut d_sharpness = 0.0;
         for (i, e) in self.elements.iter().enumerate() {
             let zi = z.get(i).copied().unwrap_or(0.0);
-            let rate = self.z_dot(e, v, zi, s);
             // The rate's slopes act through the damping only.
-            let (d_load, d_m) = if e.damping == 0.0 {
-                (0.0, 0.0)
-            } else {
-                self.rate_slopes(e, v, zi, s)
-            };
+            let (rate, d_load, d_m) = self.rate_and_slopes(e, v, zi, s, e.damping != 0.0);
             let (d_k, d_w) = if d_load == 0.0 || e.damping == 0.0 {
                 (0.0, 0.0)
             } else {
@@ -333,19 +327,33 @@ impl ParamGradients for Gms {
 }
 
 impl Gms {
-    /// A loading element's d(rate)/d(ln load) = -v m load^m and d(rate)/dm = -v load^m
-    /// ln(load); (0, 0) unloading or frozen.
-    fn rate_slopes(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> (f64, f64) {
+    /// An element's rate v (1 - max(0, load)^m) (as [`Gms::z_dot`] computes it, to the bit)
+    /// and, when `with_slopes`, a loading element's d(rate)/d(ln load) = -v m load^m and
+    /// d(rate)/dm = -v load^m ln(load), from one power; (0, 0) unloading or frozen.
+    fn rate_and_slopes(
+        &self,
+        e: &GmsElement,
+        v: f64,
+        z: f64,
+        s: f64,
+        with_slopes: bool,
+    ) -> (f64, f64, f64) {
         match Gms::element_load(e, v, z, s) {
+            None => (0.0, 0.0, 0.0),
             Some((_, load)) if load > 0.0 => {
                 let p = if self.sharpness == 1.0 {
                     load
                 } else {
                     load.powf(self.sharpness)
                 };
-                (-v * self.sharpness * p, -v * p * load.ln())
+                let rate = v * (1.0 - p);
+                if with_slopes {
+                    (rate, -v * self.sharpness * p, -v * p * load.ln())
+                } else {
+                    (rate, 0.0, 0.0)
+                }
             }
-            _ => (0.0, 0.0),
+            Some(_) => (v, 0.0, 0.0),
         }
     }
 }
