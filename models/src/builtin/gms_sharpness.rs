@@ -179,14 +179,13 @@ pub(super) fn regular_slope(two: bool, y: f64, d: f64) -> f64 {
 }
 
 /// dy1/dm of a closed-form step (m = 1, or 2 when `two`) of the load from `y0` >= 0 by
-/// `change` (staying on its side of 1): by the implicit function theorem on
-/// Phi(y1) - Phi(y0) = sigma, -(1 - y1^m) (dPhi/dm(y1) - dPhi/dm(y0)) with
-/// dPhi/dm = -u / m^2 + dR/dm and u = -ln|1 - y| (`gms_relaxation.rs`).
-pub(super) fn closed_sharpness_slope(two: bool, y0: f64, change: f64) -> f64 {
+/// `change` (staying on its side of 1) to the rate `rate1` = 1 - y1^m: by the implicit
+/// function theorem on Phi(y1) - Phi(y0) = sigma, -(1 - y1^m) (dPhi/dm(y1) - dPhi/dm(y0))
+/// with dPhi/dm = -u / m^2 + dR/dm and u = -ln|1 - y| (`gms_relaxation.rs`).
+pub(super) fn closed_sharpness_slope(two: bool, y0: f64, change: f64, rate1: f64) -> f64 {
     let m = if two { 2.0 } else { 1.0 };
     let d0 = y0 - 1.0;
     let d1 = d0 + change;
-    let rate1 = -(m * d1.ln_1p()).exp_m1();
     // At 1 to rounding (or past it by a rounding): no slope left.
     if d0 == 0.0 || rate1 == 0.0 || d1 * d0 <= 0.0 {
         return 0.0;
@@ -399,7 +398,7 @@ mod tests {
         for (two, m) in [(false, 1.0), (true, 2.0)] {
             for (y0, sigma) in cases {
                 let exact = relax(m, y0, sigma, true, None);
-                let got = closed_sharpness_slope(two, y0, exact.change);
+                let got = closed_sharpness_slope(two, y0, exact.change, exact.slope);
                 let want = exact.sharpness;
                 assert!(
                     (got - want).abs() <= 1e-11 * want.abs().max(1.0),

@@ -43,31 +43,44 @@ struct LoadStep {
     stuck: bool,
 }
 
-/// tanh(x) and 1 - tanh(x)^2 for x >= 0, from exp(-2x) (no cancellation near 1).
-fn tanh_and_rate(x: f64) -> (f64, f64) {
-    let e2 = (-2.0 * x).exp();
-    let t = -(-2.0 * x).exp_m1() / (1.0 + e2);
-    (t, 4.0 * e2 / ((1.0 + e2) * (1.0 + e2)))
+/// exp(-x) and exp(-x) - 1 for x >= 0 from one exponential: the second from `exp_m1` while
+/// the first is above 1/2 (1 plus it is then exact to rounding), else the first from `exp`
+/// (less 1 it then loses nothing either).
+fn decay_and_change(x: f64) -> (f64, f64) {
+    if x < std::f64::consts::LN_2 {
+        let change = (-x).exp_m1();
+        (1.0 + change, change)
+    } else {
+        let kept = (-x).exp();
+        (kept, kept - 1.0)
+    }
+}
+
+/// tanh(x), 1 - tanh(x)^2 and exp(-2x) for x >= 0, from exp(-2x) (no cancellation near 1).
+fn tanh_parts(x: f64) -> (f64, f64, f64) {
+    let (e2, change) = decay_and_change(2.0 * x);
+    let t = -change / (1.0 + e2);
+    (t, 4.0 * e2 / ((1.0 + e2) * (1.0 + e2)), e2)
 }
 
 /// The load after the travel `rest` from y = 0 and the rate there: (y, 1 - y^m).
 fn loaded_from_zero(two: bool, rest: f64) -> (f64, f64) {
     if two {
-        tanh_and_rate(rest)
+        let (t, rate, _) = tanh_parts(rest);
+        (t, rate)
     } else {
-        let kept = (-rest).exp();
-        (-(-rest).exp_m1(), kept)
+        let (kept, change) = decay_and_change(rest);
+        (-change, kept)
     }
 }
 
 /// The step of a loaded element (y0 > 0) over the travel `sigma`.
 fn loaded_step(two: bool, y0: f64, sigma: f64) -> LoadStep {
     if two {
-        let (t, rate) = tanh_and_rate(sigma);
+        let (t, rate, e2) = tanh_parts(sigma);
         let den = 1.0 + y0 * t;
         let change = t * (1.0 - y0) * (1.0 + y0) / den;
         // 1 - y1 = (1 - y0)(1 - tanh sigma) / den, with 1 - tanh sigma from exp(-2 sigma).
-        let e2 = (-2.0 * sigma).exp();
         let unloaded = (1.0 - y0) * (2.0 * e2 / (1.0 + e2)) / den;
         LoadStep {
             change,
@@ -77,9 +90,9 @@ fn loaded_step(two: bool, y0: f64, sigma: f64) -> LoadStep {
             stuck: false,
         }
     } else {
-        let kept = (-sigma).exp();
+        let (kept, kept_change) = decay_and_change(sigma);
         LoadStep {
-            change: -(1.0 - y0) * (-sigma).exp_m1(),
+            change: -(1.0 - y0) * kept_change,
             gain: kept,
             slope: (1.0 - y0) * kept,
             sharpness: 0.0,
@@ -112,7 +125,7 @@ fn loading_step(
             }
         };
         if with_m {
-            step.sharpness = closed_sharpness_slope(m == 2.0, y0, step.change);
+            step.sharpness = closed_sharpness_slope(m == 2.0, y0, step.change, step.slope);
         }
         return step;
     }
@@ -219,17 +232,30 @@ impl Gms {
         };
         (s, [normal * (1.0 - e), normal * e, d_vs, d_delta])
     }
+}
 
-    /// d ln(rho_i)/dp_j for element `i` (see the module docs), `n` elements.
-    fn log_rho_slope(&self, i: usize, j: usize, s: f64, s_slopes: &[f64; 4]) -> f64 {
-        let n = self.elements.len();
-        let e = &self.elements[i];
+/// d ln(rho_i)/dp_j (see the module docs) of one element in one interval: 1/k_i for its
+/// stiffness, -1/w_i for its weight, -(ds/dp)/s for the Stribeck parameters, 0 otherwise.
+struct LogRhoSlopes {
+    /// The element's index i and the element count n.
+    i: usize,
+    n: usize,
+    stiffness: f64,
+    weight: f64,
+    /// -(ds/dp)/s for mu_c, mu_s, v_s and delta (the same for every element).
+    stribeck: [f64; 4],
+}
+
+impl LogRhoSlopes {
+    /// d ln(rho_i)/dp_j.
+    fn of(&self, j: usize) -> f64 {
+        let (i, n) = (self.i, self.n);
         if j == i {
-            1.0 / e.stiffness
+            self.stiffness
         } else if j == n + i {
-            -1.0 / e.weight
+            self.weight
         } else if (3 * n..3 * n + 4).contains(&j) {
-            -s_slopes[j - 3 * n] / s
+            self.stribeck[j - 3 * n]
         } else {
             0.0
         }
@@ -252,10 +278,12 @@ impl Propagator for Gms {
     fn propagate_with_sensitivities(&self, interval: Interval, z: &mut [f64], sens: &mut [f64]) {
         let (s, s_slopes) = self.s_and_param_slopes(interval.v, interval.normal);
         // The parameter vector: three per element, then six shared ones.
-        let np = 3 * self.elements.len() + 6;
-        let sharpness = 3 * self.elements.len() + 4;
+        let n = self.elements.len();
+        let np = 3 * n + 6;
+        let sharpness = 3 * n + 4;
         let u = sgn(interval.v);
         let table = self.relaxation_table();
+        let stribeck = s_slopes.map(|d| -d / s);
         for (i, (e, zi)) in self.elements.iter().zip(z.iter_mut()).enumerate() {
             let Some(row) = sens.get_mut(i * np..(i + 1) * np) else {
                 return;
@@ -266,9 +294,18 @@ impl Propagator for Gms {
             if frame.step.stuck {
                 continue;
             }
+            let slopes = LogRhoSlopes {
+                i,
+                n,
+                stiffness: 1.0 / e.stiffness,
+                weight: -1.0 / e.weight,
+                stribeck,
+            };
             let y1 = frame.y0 + frame.step.change;
+            // sgn(v) / rho, one division for the row.
+            let back = u / frame.rho;
             for (j, sj) in row.iter_mut().enumerate() {
-                let g = self.log_rho_slope(i, j, s, &s_slopes);
+                let g = slopes.of(j);
                 let dy0 = frame.y0 * g + u * frame.rho * *sj;
                 let direct = if j == sharpness {
                     frame.step.sharpness
@@ -276,7 +313,7 @@ impl Propagator for Gms {
                     frame.step.slope * frame.sigma * g
                 };
                 let dy1 = frame.step.gain * dy0 + direct;
-                *sj = u * (dy1 - y1 * g) / frame.rho;
+                *sj = (dy1 - y1 * g) * back;
             }
         }
     }
@@ -354,6 +391,27 @@ impl Gms {
                 }
             }
             Some(_) => (v, 0.0, 0.0),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_exponential_gives_the_decay_and_its_change_to_rounding() {
+        for x in [0.0, 1e-300, 1e-9, 0.3, 0.693, 0.694, 2.0, 40.0, 800.0] {
+            let (kept, change) = decay_and_change(x);
+            let (want_kept, want_change) = ((-x).exp(), (-x).exp_m1());
+            assert!(
+                (kept - want_kept).abs() <= 2.3e-16 * want_kept,
+                "exp(-{x}): {kept} against {want_kept}"
+            );
+            assert!(
+                (change - want_change).abs() <= 2.3e-16 * want_change.abs(),
+                "exp(-{x}) - 1: {change} against {want_change}"
+            );
         }
     }
 }
