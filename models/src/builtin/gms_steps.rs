@@ -22,7 +22,7 @@
 //! Phi(y1) - Phi(y0) = sigma, `gms_relaxation.rs`).
 
 use super::gms::{Gms, GmsElement};
-use super::gms_relaxation::relax;
+use super::gms_relaxation::{decay_and_change, relax};
 use super::gms_sharpness::closed_sharpness_slope;
 use super::gms_table::{table_for, RegularTable};
 use crate::interval::Interval;
@@ -41,19 +41,6 @@ struct LoadStep {
     sharpness: f64,
     /// The element stuck throughout (dz = v dt, whatever its parameters).
     stuck: bool,
-}
-
-/// exp(-x) and exp(-x) - 1 for x >= 0 from one exponential: the second from `exp_m1` while
-/// the first is above 1/2 (1 plus it is then exact to rounding), else the first from `exp`
-/// (less 1 it then loses nothing either).
-fn decay_and_change(x: f64) -> (f64, f64) {
-    if x < std::f64::consts::LN_2 {
-        let change = (-x).exp_m1();
-        (1.0 + change, change)
-    } else {
-        let kept = (-x).exp();
-        (kept, kept - 1.0)
-    }
 }
 
 /// tanh(x), 1 - tanh(x)^2 and exp(-2x) for x >= 0, from exp(-2x) (no cancellation near 1).
@@ -391,27 +378,6 @@ impl Gms {
                 }
             }
             Some(_) => (v, 0.0, 0.0),
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn one_exponential_gives_the_decay_and_its_change_to_rounding() {
-        for x in [0.0, 1e-300, 1e-9, 0.3, 0.693, 0.694, 2.0, 40.0, 800.0] {
-            let (kept, change) = decay_and_change(x);
-            let (want_kept, want_change) = ((-x).exp(), (-x).exp_m1());
-            assert!(
-                (kept - want_kept).abs() <= 2.3e-16 * want_kept,
-                "exp(-{x}): {kept} against {want_kept}"
-            );
-            assert!(
-                (change - want_change).abs() <= 2.3e-16 * want_change.abs(),
-                "exp(-{x}) - 1: {change} against {want_change}"
-            );
         }
     }
 }
