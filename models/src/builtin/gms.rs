@@ -104,6 +104,7 @@ use crate::params::ParamSpec;
 use crate::start::{StartContext, StribeckLevels, TYPICAL_PRESLIDING_DISPLACEMENT};
 use serde::de::{self, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
+use std::cell::Cell;
 
 const MODEL: &str = "gms";
 /// Most elements accepted (each is an internal state of the ODE).
@@ -190,6 +191,12 @@ pub struct Gms {
     pub sharpness: f64,
 }
 
+thread_local! {
+    /// [`Gms::stribeck_decay`]'s last result: the bits of |v / v_s| and delta it was computed
+    /// at, the power and the decay.
+    static LAST_DECAY: Cell<Option<(u64, u64, f64, f64)>> = const { Cell::new(None) };
+}
+
 /// Default stiffness of element `i` (0-based): 1e5 N/m, each next one a third of the previous,
 /// so the elements break away at well-spread displacements.
 fn default_stiffness(i: usize) -> f64 {
@@ -239,11 +246,28 @@ impl Gms {
         self.s_and_slope(v, normal).0
     }
 
+    /// The Stribeck power |v / v_s|^delta and its decay exp(-|v / v_s|^delta), to the bit as
+    /// computed afresh: the last pair this thread computed is kept, since a replay asks for
+    /// them at one velocity from several places (the force, its gradient in v and z, its
+    /// gradient in the parameters) and the power is the costliest part of each.
+    pub(super) fn stribeck_decay(&self, v: f64) -> (f64, f64) {
+        let ratio = (v / self.v_s).abs();
+        let key = (ratio.to_bits(), self.delta.to_bits());
+        if let Some((r, d, power, e)) = LAST_DECAY.get() {
+            if (r, d) == key {
+                return (power, e);
+            }
+        }
+        let power = ratio.powf(self.delta);
+        let e = decay(power);
+        LAST_DECAY.set(Some((key.0, key.1, power, e)));
+        (power, e)
+    }
+
     /// The Stribeck curve s(v) and its slope ds/dv from one power: with u = |v / v_s|,
     /// d(u^delta)/dv = delta u^delta / v (0 at v = 0).
     fn s_and_slope(&self, v: f64, normal: f64) -> (f64, f64) {
-        let power = (v / self.v_s).abs().powf(self.delta);
-        let e = decay(power);
+        let (power, e) = self.stribeck_decay(v);
         let s = normal * (self.mu_c + (self.mu_s - self.mu_c) * e);
         let slope = if v == 0.0 {
             0.0
@@ -810,5 +834,31 @@ impl Staging for Gms {
         }
         self.scale_stiffness(ctx.stiffness_for(levels.mu_c * ctx.normal_force));
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_kept_stribeck_decay_is_the_one_computed_afresh() {
+        // Two laws that share a velocity ratio, or a velocity, but not both their inputs,
+        // asked in turn: each gets its own curve, as the formula gives it.
+        let a = Gms {
+            delta: 1.7,
+            ..Gms::default()
+        };
+        let mut b = a.clone();
+        b.v_s = 2.0 * a.v_s;
+        let mut c = a.clone();
+        c.delta = 2.3;
+        for v in [0.004, -0.004, 0.008, 0.0, 0.004] {
+            for law in [&a, &b, &c, &a] {
+                let power = (v / law.v_s).abs().powf(law.delta);
+                let want = 14.5 * (law.mu_c + (law.mu_s - law.mu_c) * (-power).exp());
+                assert_eq!(law.s(v, 14.5), want, "v = {v}, v_s = {}", law.v_s);
+            }
+        }
     }
 }

@@ -1,5 +1,6 @@
 //! A loading GMS element's exact step at any sharpness m, with its sensitivities (used by
-//! `gms_steps.rs`, which keeps the closed forms of m = 1 and 2). The regular part R below
+//! `gms_steps.rs`, which keeps the closed forms of m = 1 and 2, and their slopes in m in
+//! `gms_sharpness.rs`). The regular part R below
 //! comes from the table of `gms_table.rs` at the step's sharpness where it holds the loads,
 //! else from the series and panels of `gms_quadrature.rs`.
 //!
@@ -84,13 +85,27 @@ fn rate(m: f64, delta: f64) -> f64 {
     -(m * delta.ln_1p()).exp_m1()
 }
 
+/// exp(-x) and exp(-x) - 1 for x >= 0 from one exponential: the second from `exp_m1` while
+/// the first is above 1/2 (1 plus it is then exact to rounding), else the first from `exp`
+/// (less 1 it then loses nothing either).
+pub(super) fn decay_and_change(x: f64) -> (f64, f64) {
+    if x < std::f64::consts::LN_2 {
+        let change = (-x).exp_m1();
+        (1.0 + change, change)
+    } else {
+        let kept = (-x).exp();
+        (kept, kept - 1.0)
+    }
+}
+
 /// The end of a step from `y0` (not 1) that moved u = -ln|1 - y| by `advance`: the load, its
-/// distance y1 - 1 and the span w1 - w0 (from the change, so that a short step keeps its
-/// precision).
-fn end_of(y0: f64, w0: f64, advance: f64) -> (Load, f64, f64) {
+/// distance y1 - 1, the span w1 - w0 (from the change, so that a short step keeps its
+/// precision) and the change y1 - y0.
+fn end_of(y0: f64, w0: f64, advance: f64) -> (Load, f64, f64, f64) {
     let d0 = y0 - 1.0;
-    let delta = d0 * (-advance).exp();
-    let change = d0 * (-advance).exp_m1();
+    let (kept, kept_change) = decay_and_change(advance);
+    let delta = d0 * kept;
+    let change = d0 * kept_change;
     let span = if y0 > 0.0 {
         (change / y0).ln_1p()
     } else {
@@ -101,7 +116,7 @@ fn end_of(y0: f64, w0: f64, advance: f64) -> (Load, f64, f64) {
     } else {
         w0 + span
     };
-    (Load { y: 1.0 + delta, w }, delta, span)
+    (Load { y: 1.0 + delta, w }, delta, span, change)
 }
 
 /// dy1/dm of a step from `from` to `to` that moved u = -ln|1 - y| by `advance` over the
@@ -132,37 +147,6 @@ impl Step<'_> {
         self.table
             .filter(|t| t.sharpness() == self.m && t.holds(from.w) && t.holds(to.w))
     }
-}
-
-/// dy1/dm of a step of the load from `y0` >= 0 by `change` (staying on its side of 1), from
-/// the loads alone (the closed forms' steps), with R's slope from `table` where it holds them.
-pub(super) fn sharpness_slope_of_loads(
-    m: f64,
-    y0: f64,
-    change: f64,
-    table: Option<&RegularTable>,
-) -> f64 {
-    let d0 = y0 - 1.0;
-    let delta1 = d0 + change;
-    let rate1 = rate(m, delta1);
-    // At 1 to rounding (or past it by a rounding): no slope left.
-    if d0 == 0.0 || rate1 == 0.0 || delta1 * d0 <= 0.0 {
-        return 0.0;
-    }
-    let advance = (-change / delta1).ln_1p();
-    let span = if y0 > 0.0 {
-        (change / y0).ln_1p()
-    } else {
-        f64::INFINITY
-    };
-    let y1 = 1.0 + delta1;
-    let from = Load { y: y0, w: y0.ln() };
-    let to = Load {
-        y: y1,
-        w: delta1.ln_1p(),
-    };
-    let step = Step { m, table, advance };
-    sharpness_slope(&step, from, to, span, rate1)
 }
 
 /// r / (r^m - 1) at r = e^x (x > 0), the travel per unit of ln y of an overloaded element,
@@ -255,7 +239,12 @@ fn relax_far(
         if !step.is_finite() {
             break;
         }
-        span = (span + step).clamp(0.0, most);
+        let next = (span + step).clamp(0.0, most);
+        // Held by a bound: every further iteration would repeat this one.
+        if next == span {
+            break;
+        }
+        span = next;
         let small = step.abs() <= 1e-8 * span;
         if step.abs() <= 1e-14 * span || (small && step.abs() > 0.5 * last) {
             break;
@@ -327,7 +316,7 @@ fn relax_near(m: f64, y0: f64, sigma: f64, with_m: bool, table: Option<&RegularT
         (at_start, series(m, wq.exp(), false).0 - at_start)
     });
     let residual = |advance: f64| -> (f64, f64) {
-        let (to, delta, span) = end_of(y0, from.w, advance);
+        let (to, delta, span, _) = end_of(y0, from.w, advance);
         let regular = match (tabled, series_start) {
             (Some((t, at_start)), _) => t.regular(to.y, to.w, false).0 - at_start,
             (None, None) => panels(m, from.w, span, false).0,
@@ -348,7 +337,13 @@ fn relax_near(m: f64, y0: f64, sigma: f64, with_m: bool, table: Option<&RegularT
         if !step.is_finite() {
             break;
         }
-        advance = (advance + step).min(most);
+        let next = (advance + step).min(most);
+        // Held by the bound (a load at 1 to rounding): every further iteration would repeat
+        // this one.
+        if next == advance {
+            break;
+        }
+        advance = next;
         // Converged, or down to the residual's rounding (the steps stop shrinking).
         let small = step.abs() <= 1e-8 * advance.abs();
         if step.abs() <= 1e-14 * advance.abs() || (small && step.abs() > 0.5 * last) {
@@ -356,7 +351,7 @@ fn relax_near(m: f64, y0: f64, sigma: f64, with_m: bool, table: Option<&RegularT
         }
         last = step.abs();
     }
-    let (to, delta1, span) = end_of(y0, from.w, advance);
+    let (to, delta1, span, change) = end_of(y0, from.w, advance);
     let rate1 = rate(m, delta1);
     let sharpness = if with_m {
         let step = Step { m, table, advance };
@@ -365,7 +360,7 @@ fn relax_near(m: f64, y0: f64, sigma: f64, with_m: bool, table: Option<&RegularT
         0.0
     };
     Relaxed {
-        change: d0 * (-advance).exp_m1(),
+        change,
         gain: rate1 / rate0,
         slope: rate1,
         sharpness,
@@ -495,6 +490,22 @@ mod tests {
                     "m = {m}, y0 = {y0}, sigma = {sigma}: {y1} against {reference}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn one_exponential_gives_the_decay_and_its_change_to_rounding() {
+        for x in [0.0, 1e-300, 1e-9, 0.3, 0.693, 0.694, 2.0, 40.0, 800.0] {
+            let (kept, change) = decay_and_change(x);
+            let (want_kept, want_change) = ((-x).exp(), (-x).exp_m1());
+            assert!(
+                (kept - want_kept).abs() <= 2.3e-16 * want_kept,
+                "exp(-{x}): {kept} against {want_kept}"
+            );
+            assert!(
+                (change - want_change).abs() <= 2.3e-16 * want_change.abs(),
+                "exp(-{x}) - 1: {change} against {want_change}"
+            );
         }
     }
 }

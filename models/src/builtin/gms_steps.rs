@@ -22,7 +22,8 @@
 //! Phi(y1) - Phi(y0) = sigma, `gms_relaxation.rs`).
 
 use super::gms::{Gms, GmsElement};
-use super::gms_relaxation::{relax, sharpness_slope_of_loads};
+use super::gms_relaxation::{decay_and_change, relax};
+use super::gms_sharpness::closed_sharpness_slope;
 use super::gms_table::{table_for, RegularTable};
 use crate::interval::Interval;
 use crate::model::{sgn, ParamGradients, Propagator};
@@ -42,31 +43,31 @@ struct LoadStep {
     stuck: bool,
 }
 
-/// tanh(x) and 1 - tanh(x)^2 for x >= 0, from exp(-2x) (no cancellation near 1).
-fn tanh_and_rate(x: f64) -> (f64, f64) {
-    let e2 = (-2.0 * x).exp();
-    let t = -(-2.0 * x).exp_m1() / (1.0 + e2);
-    (t, 4.0 * e2 / ((1.0 + e2) * (1.0 + e2)))
+/// tanh(x), 1 - tanh(x)^2 and exp(-2x) for x >= 0, from exp(-2x) (no cancellation near 1).
+fn tanh_parts(x: f64) -> (f64, f64, f64) {
+    let (e2, change) = decay_and_change(2.0 * x);
+    let t = -change / (1.0 + e2);
+    (t, 4.0 * e2 / ((1.0 + e2) * (1.0 + e2)), e2)
 }
 
 /// The load after the travel `rest` from y = 0 and the rate there: (y, 1 - y^m).
 fn loaded_from_zero(two: bool, rest: f64) -> (f64, f64) {
     if two {
-        tanh_and_rate(rest)
+        let (t, rate, _) = tanh_parts(rest);
+        (t, rate)
     } else {
-        let kept = (-rest).exp();
-        (-(-rest).exp_m1(), kept)
+        let (kept, change) = decay_and_change(rest);
+        (-change, kept)
     }
 }
 
 /// The step of a loaded element (y0 > 0) over the travel `sigma`.
 fn loaded_step(two: bool, y0: f64, sigma: f64) -> LoadStep {
     if two {
-        let (t, rate) = tanh_and_rate(sigma);
+        let (t, rate, e2) = tanh_parts(sigma);
         let den = 1.0 + y0 * t;
         let change = t * (1.0 - y0) * (1.0 + y0) / den;
         // 1 - y1 = (1 - y0)(1 - tanh sigma) / den, with 1 - tanh sigma from exp(-2 sigma).
-        let e2 = (-2.0 * sigma).exp();
         let unloaded = (1.0 - y0) * (2.0 * e2 / (1.0 + e2)) / den;
         LoadStep {
             change,
@@ -76,9 +77,9 @@ fn loaded_step(two: bool, y0: f64, sigma: f64) -> LoadStep {
             stuck: false,
         }
     } else {
-        let kept = (-sigma).exp();
+        let (kept, kept_change) = decay_and_change(sigma);
         LoadStep {
-            change: -(1.0 - y0) * (-sigma).exp_m1(),
+            change: -(1.0 - y0) * kept_change,
             gain: kept,
             slope: (1.0 - y0) * kept,
             sharpness: 0.0,
@@ -111,7 +112,7 @@ fn loading_step(
             }
         };
         if with_m {
-            step.sharpness = sharpness_slope_of_loads(m, y0, step.change, table);
+            step.sharpness = closed_sharpness_slope(m == 2.0, y0, step.change, step.slope);
         }
         return step;
     }
@@ -164,12 +165,11 @@ impl Gms {
     }
 
     /// The table of the element law's regular part at this sharpness, where a step needs it:
-    /// every sharpness without a closed form, and the closed forms' slopes in m.
-    fn relaxation_table(&self, with_m: bool) -> Option<Rc<RegularTable>> {
+    /// every sharpness without a closed form (the closed forms' slopes in m have theirs,
+    /// `gms_sharpness.rs`).
+    fn relaxation_table(&self) -> Option<Rc<RegularTable>> {
         let m = self.sharpness;
-        (with_m || (m != 1.0 && m != 2.0))
-            .then(|| table_for(m))
-            .flatten()
+        (m != 1.0 && m != 2.0).then(|| table_for(m)).flatten()
     }
 
     /// Steps the element `e` of deflection `z` over `interval` at the Stribeck level `s`
@@ -208,8 +208,7 @@ impl Gms {
     /// s(v) and its derivatives with respect to mu_c, mu_s, v_s and delta (s computed as
     /// [`Gms::s`] computes it, to the bit).
     fn s_and_param_slopes(&self, v: f64, normal: f64) -> (f64, [f64; 4]) {
-        let power = (v / self.v_s).abs().powf(self.delta);
-        let e = crate::model::decay(power);
+        let (power, e) = self.stribeck_decay(v);
         let s = normal * (self.mu_c + (self.mu_s - self.mu_c) * e);
         let dip = normal * (self.mu_s - self.mu_c) * e;
         let (d_vs, d_delta) = if power > 0.0 {
@@ -220,17 +219,30 @@ impl Gms {
         };
         (s, [normal * (1.0 - e), normal * e, d_vs, d_delta])
     }
+}
 
-    /// d ln(rho_i)/dp_j for element `i` (see the module docs), `n` elements.
-    fn log_rho_slope(&self, i: usize, j: usize, s: f64, s_slopes: &[f64; 4]) -> f64 {
-        let n = self.elements.len();
-        let e = &self.elements[i];
+/// d ln(rho_i)/dp_j (see the module docs) of one element in one interval: 1/k_i for its
+/// stiffness, -1/w_i for its weight, -(ds/dp)/s for the Stribeck parameters, 0 otherwise.
+struct LogRhoSlopes {
+    /// The element's index i and the element count n.
+    i: usize,
+    n: usize,
+    stiffness: f64,
+    weight: f64,
+    /// -(ds/dp)/s for mu_c, mu_s, v_s and delta (the same for every element).
+    stribeck: [f64; 4],
+}
+
+impl LogRhoSlopes {
+    /// d ln(rho_i)/dp_j.
+    fn of(&self, j: usize) -> f64 {
+        let (i, n) = (self.i, self.n);
         if j == i {
-            1.0 / e.stiffness
+            self.stiffness
         } else if j == n + i {
-            -1.0 / e.weight
+            self.weight
         } else if (3 * n..3 * n + 4).contains(&j) {
-            -s_slopes[j - 3 * n] / s
+            self.stribeck[j - 3 * n]
         } else {
             0.0
         }
@@ -244,7 +256,7 @@ impl Propagator for Gms {
 
     fn propagate(&self, interval: Interval, z: &mut [f64]) {
         let s = self.s(interval.v, interval.normal);
-        let table = self.relaxation_table(false);
+        let table = self.relaxation_table();
         for (e, zi) in self.elements.iter().zip(z.iter_mut()) {
             self.step_element(e, interval, s, zi, false, table.as_deref());
         }
@@ -253,10 +265,12 @@ impl Propagator for Gms {
     fn propagate_with_sensitivities(&self, interval: Interval, z: &mut [f64], sens: &mut [f64]) {
         let (s, s_slopes) = self.s_and_param_slopes(interval.v, interval.normal);
         // The parameter vector: three per element, then six shared ones.
-        let np = 3 * self.elements.len() + 6;
-        let sharpness = 3 * self.elements.len() + 4;
+        let n = self.elements.len();
+        let np = 3 * n + 6;
+        let sharpness = 3 * n + 4;
         let u = sgn(interval.v);
-        let table = self.relaxation_table(true);
+        let table = self.relaxation_table();
+        let stribeck = s_slopes.map(|d| -d / s);
         for (i, (e, zi)) in self.elements.iter().zip(z.iter_mut()).enumerate() {
             let Some(row) = sens.get_mut(i * np..(i + 1) * np) else {
                 return;
@@ -267,9 +281,18 @@ impl Propagator for Gms {
             if frame.step.stuck {
                 continue;
             }
+            let slopes = LogRhoSlopes {
+                i,
+                n,
+                stiffness: 1.0 / e.stiffness,
+                weight: -1.0 / e.weight,
+                stribeck,
+            };
             let y1 = frame.y0 + frame.step.change;
+            // sgn(v) / rho, one division for the row.
+            let back = u / frame.rho;
             for (j, sj) in row.iter_mut().enumerate() {
-                let g = self.log_rho_slope(i, j, s, &s_slopes);
+                let g = slopes.of(j);
                 let dy0 = frame.y0 * g + u * frame.rho * *sj;
                 let direct = if j == sharpness {
                     frame.step.sharpness
@@ -277,7 +300,7 @@ impl Propagator for Gms {
                     frame.step.slope * frame.sigma * g
                 };
                 let dy1 = frame.step.gain * dy0 + direct;
-                *sj = u * (dy1 - y1 * g) / frame.rho;
+                *sj = (dy1 - y1 * g) * back;
             }
         }
     }
@@ -295,13 +318,8 @@ impl ParamGradients for Gms {
         let mut d_sharpness = 0.0;
         for (i, e) in self.elements.iter().enumerate() {
             let zi = z.get(i).copied().unwrap_or(0.0);
-            let rate = self.z_dot(e, v, zi, s);
             // The rate's slopes act through the damping only.
-            let (d_load, d_m) = if e.damping == 0.0 {
-                (0.0, 0.0)
-            } else {
-                self.rate_slopes(e, v, zi, s)
-            };
+            let (rate, d_load, d_m) = self.rate_and_slopes(e, v, zi, s, e.damping != 0.0);
             let (d_k, d_w) = if d_load == 0.0 || e.damping == 0.0 {
                 (0.0, 0.0)
             } else {
@@ -333,19 +351,33 @@ impl ParamGradients for Gms {
 }
 
 impl Gms {
-    /// A loading element's d(rate)/d(ln load) = -v m load^m and d(rate)/dm = -v load^m
-    /// ln(load); (0, 0) unloading or frozen.
-    fn rate_slopes(&self, e: &GmsElement, v: f64, z: f64, s: f64) -> (f64, f64) {
+    /// An element's rate v (1 - max(0, load)^m) (as [`Gms::z_dot`] computes it, to the bit)
+    /// and, when `with_slopes`, a loading element's d(rate)/d(ln load) = -v m load^m and
+    /// d(rate)/dm = -v load^m ln(load), from one power; (0, 0) unloading or frozen.
+    fn rate_and_slopes(
+        &self,
+        e: &GmsElement,
+        v: f64,
+        z: f64,
+        s: f64,
+        with_slopes: bool,
+    ) -> (f64, f64, f64) {
         match Gms::element_load(e, v, z, s) {
+            None => (0.0, 0.0, 0.0),
             Some((_, load)) if load > 0.0 => {
                 let p = if self.sharpness == 1.0 {
                     load
                 } else {
                     load.powf(self.sharpness)
                 };
-                (-v * self.sharpness * p, -v * p * load.ln())
+                let rate = v * (1.0 - p);
+                if with_slopes {
+                    (rate, -v * self.sharpness * p, -v * p * load.ln())
+                } else {
+                    (rate, 0.0, 0.0)
+                }
             }
-            _ => (0.0, 0.0),
+            Some(_) => (v, 0.0, 0.0),
         }
     }
 }

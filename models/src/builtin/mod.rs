@@ -8,6 +8,7 @@ mod expression;
 mod gms;
 mod gms_quadrature;
 mod gms_relaxation;
+mod gms_sharpness;
 mod gms_steps;
 mod gms_table;
 mod lugre;
