@@ -348,6 +348,33 @@ impl ParamGradients for Gms {
             *o = v;
         }
     }
+
+    /// Row i: a loading element's rate v (1 - load^m) moves with ln(load) (d/dk_i = 1/k_i,
+    /// d/dw_i = -1/w_i, d/dp = -(ds/dp)/s for the Stribeck parameters) and with the sharpness;
+    /// an unloading (stuck) or frozen element's rate, v or 0, with no parameter.
+    fn state_param_gradient(&self, v: f64, z: &[f64], normal: f64, out: &mut [f64]) -> bool {
+        let n = self.elements.len();
+        let np = 3 * n + 6;
+        out.iter_mut().for_each(|o| *o = 0.0);
+        let (s, s_slopes) = self.s_and_param_slopes(v, normal);
+        for (i, e) in self.elements.iter().enumerate() {
+            let zi = z.get(i).copied().unwrap_or(0.0);
+            let (_, d_load, d_m) = self.rate_and_slopes(e, v, zi, s, true);
+            let Some(row) = out.get_mut(i * np..(i + 1) * np) else {
+                break;
+            };
+            if d_load == 0.0 && d_m == 0.0 {
+                continue;
+            }
+            row[i] = d_load / e.stiffness;
+            row[n + i] = -d_load / e.weight;
+            for (k, slope) in s_slopes.iter().enumerate() {
+                row[3 * n + k] = -d_load * slope / s;
+            }
+            row[3 * n + 4] = d_m;
+        }
+        true
+    }
 }
 
 impl Gms {

@@ -1,6 +1,6 @@
 //! The sensitivities against independent differences of plain simulations: central
 //! differences away from turning points for smooth responses (LuGre, Stribeck with an
-//! oscillator property free), and a brute-force perturbation p +- h over a whole record that
+//! oscillator property free, GMS), and a brute-force perturbation p +- h over a whole record that
 //! sticks and slips (Coulomb), where the jumps at the events carry the sensitivities across.
 
 use super::*;
@@ -125,6 +125,17 @@ fn worst(got: &[f64], expected: &[f64], excluded: impl Fn(usize) -> bool) -> f64
 /// Checks every parameter's sampled sensitivities against central differences, away from
 /// the turning points (a sample on each side), to `tol` of each column's scale.
 fn check_against_differences(world: &World, time: &[f64], params: &[SensitivityParam], tol: f64) {
+    check_against_differences_by(world, time, params, 1e-5, tol);
+}
+
+/// The same with central differences at the relative step `rel`.
+fn check_against_differences_by(
+    world: &World,
+    time: &[f64],
+    params: &[SensitivityParam],
+    rel: f64,
+    tol: f64,
+) {
     let sens = world.sensitivities(time, params);
     let plain = world.plain(time);
     let events: Vec<f64> = plain.events.iter().map(|e| e.time).collect();
@@ -133,7 +144,7 @@ fn check_against_differences(world: &World, time: &[f64], params: &[SensitivityP
         assert!((got - expected).abs() < 1e-7, "v[{i}] {got} vs {expected}");
     }
     for (j, &p) in params.iter().enumerate() {
-        let (dx, dv) = world.differences(time, p, 1e-5);
+        let (dx, dv) = world.differences(time, p, rel);
         let away = |i: usize| near_event(time, &events, i, 1.0);
         let ex = worst(&sens.dx[j], &dx, away);
         let ev = worst(&sens.dv[j], &dv, away);
@@ -178,6 +189,29 @@ fn stribeck_sensitivities_with_a_free_damping_match_central_differences() {
         SensitivityParam::Property(OscillatorProperty::Mass),
     ];
     check_against_differences(&world, &times(0.6), &params, 1e-4);
+}
+
+/// GMS (three elements soft enough for the augmented Dopri5 run, damped, at a sharpness
+/// without a closed form) on the FMM stage: every
+/// element's stiffness, weight and damping, the Stribeck parameters, the sharpness and the
+/// viscous term against central differences.
+#[test]
+fn gms_sensitivities_match_central_differences() {
+    let built = frictionid_models::build_json(&serde_json::json!({
+        "type": "gms", "stiffness": [3.0e4, 1.0e4, 3.0e3], "damping": 2.0, "sharpness": 1.6
+    }))
+    .unwrap();
+    let world = World {
+        osc: Oscillator::fmm(),
+        model: built.model,
+        x0: 0.022,
+    };
+    assert!(world.model.params().len() == 15, "three elements");
+    let params = [0, 2, 4, 6, 8, 9, 10, 11, 13, 14].map(SensitivityParam::Model);
+    // The elements' compliance leaves the plain runs' integration error 1e-3 times the
+    // LuGre case's relative to some columns (the dampings'): a step of 1e-3, whose truncation
+    // error is about 1e-6, keeps it out of the differences.
+    check_against_differences_by(&world, &times(0.6), &params, 1e-3, 1e-3);
 }
 
 /// Coulomb on the FMM stage from 10 mm reverses a few times and sticks for good: over the
