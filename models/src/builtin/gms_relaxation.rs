@@ -368,7 +368,7 @@ fn relax_near(m: f64, y0: f64, sigma: f64, with_m: bool, table: Option<&RegularT
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     /// dy/dsigma = 1 - y^m by classical RK4 with `steps` steps (y > 0 throughout).
@@ -388,7 +388,7 @@ mod tests {
 
     /// Loads and travels of the tabled-step checks: from 0, below 1, near 1, overloaded near
     /// and far (y^m > 2 at the larger sharpnesses), short and long travels.
-    const TABLED_CASES: [(f64, f64); 12] = [
+    pub(in crate::builtin) const TABLED_CASES: [(f64, f64); 12] = [
         (0.0, 1e-7),
         (0.0, 0.05),
         (0.0, 3.0),

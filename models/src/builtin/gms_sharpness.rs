@@ -381,20 +381,7 @@ mod tests {
     #[test]
     fn closed_step_slopes_match_the_quadrature_steps() {
         // The loads of `gms_relaxation`'s checks: from 0, below 1, near 1, overloaded.
-        let cases = [
-            (0.0, 1e-7),
-            (0.0, 0.05),
-            (0.0, 3.0),
-            (0.3, 1e-9),
-            (0.3, 0.4),
-            (0.97, 0.02),
-            (0.999_999, 5.0),
-            (1.000_001, 0.3),
-            (1.02, 1e-6),
-            (1.3, 0.1),
-            (1.2, 4.0),
-            (8.0, 0.01),
-        ];
+        let cases = crate::builtin::gms_relaxation::tests::TABLED_CASES;
         for (two, m) in [(false, 1.0), (true, 2.0)] {
             for (y0, sigma) in cases {
                 let exact = relax(m, y0, sigma, true, None);
