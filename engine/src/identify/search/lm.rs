@@ -270,12 +270,8 @@ where
             self.converged = Some(TerminationReason::GradientBelowTolerance);
             return Ok((state.param(p).cost(self.cost), None));
         }
-        if let Some(fraction) = self.within_standard_errors(&p, &normal) {
-            self.converged = Some(TerminationReason::WithinStandardErrors { fraction });
-            return Ok((state.param(p).cost(self.cost), None));
-        }
-        if let Some(resolution) = self.resolved(&p, &normal) {
-            self.converged = Some(TerminationReason::WithinResolution { resolution });
+        if let Some(reason) = self.resolved(&p, &normal) {
+            self.converged = Some(reason);
             return Ok((state.param(p).cost(self.cost), None));
         }
         let Some(delta) = self.damped_step(&p, &normal) else {
@@ -398,26 +394,34 @@ impl LevenbergMarquardt {
         Some(delta)
     }
 
-    /// The cost resolution, when the Gauss-Newton step at `p` promises less decrease.
-    fn resolved(&self, p: &DVector<f64>, normal: &NormalEquations) -> Option<f64> {
-        let resolution = self.cost_resolution?;
+    /// Why the run stops on what the Gauss-Newton step at `p` promises (its gain computed
+    /// once): it moves the parameters by less than the standard-error resolution, or it
+    /// decreases the cost by less than the cost resolution.
+    fn resolved(&self, p: &DVector<f64>, normal: &NormalEquations) -> Option<TerminationReason> {
+        let by_errors = self
+            .standard_error_resolution
+            .and_then(|fraction| Some((fraction, self.standard_error_gain(p.len(), fraction)?)));
+        if by_errors.is_none() && self.cost_resolution.is_none() {
+            return None;
+        }
         let gain = self.gauss_newton_gain(p, normal)?;
-        (gain < resolution).then_some(resolution)
+        if let Some((fraction, limit)) = by_errors {
+            if gain >= 0.0 && gain < limit {
+                return Some(TerminationReason::WithinStandardErrors { fraction });
+            }
+        }
+        let resolution = self.cost_resolution?;
+        (gain < resolution).then_some(TerminationReason::WithinResolution { resolution })
     }
 
-    /// The resolution in standard errors, when the Gauss-Newton step at `p` moves the
-    /// parameters by less: its predicted decrease of the cost, delta' JᵀJ delta / 2, is half
-    /// the step's squared Mahalanobis distance times the residual variance 2 cost / (m - n).
-    fn within_standard_errors(&self, p: &DVector<f64>, normal: &NormalEquations) -> Option<f64> {
-        let fraction = self.standard_error_resolution?;
-        let dof = self
-            .residuals
-            .len()
-            .checked_sub(p.len())
-            .filter(|&d| d > 0)?;
+    /// The Gauss-Newton gain below which the step moves `n` parameters by less than
+    /// `fraction` standard errors: the gain delta' JᵀJ delta / 2 is half the step's squared
+    /// Mahalanobis distance times the residual variance 2 cost / (m - n). `None` without
+    /// degrees of freedom.
+    fn standard_error_gain(&self, n: usize, fraction: f64) -> Option<f64> {
+        let dof = self.residuals.len().checked_sub(n).filter(|&d| d > 0)?;
         let variance = 2.0 * self.cost / dof as f64;
-        let gain = self.gauss_newton_gain(p, normal)?;
-        (gain >= 0.0 && gain < 0.5 * fraction * fraction * variance).then_some(fraction)
+        Some(0.5 * fraction * fraction * variance)
     }
 
     /// The decrease of the cost the linear model predicts for the Gauss-Newton step (damping
