@@ -16,7 +16,7 @@ mod common;
 
 use common::{
     force_route_options, inverse_dynamics_options, lugre_truth, no_oscillator_force_options,
-    records, stiff_lugre_truth, stribeck_truth, NOISE,
+    records, stiff_lugre_truth, stribeck_truth, three_tone_drive, NOISE,
 };
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use frictionid_engine::data::RecordSource;
@@ -243,18 +243,7 @@ fn lugre_force_along(v: &[f64]) -> Vec<f64> {
 /// LuGre friction force measured with 0.3 N noise.
 fn drive_friction_record() -> Record {
     use frictionid_engine::synthetic::add_gaussian_noise;
-    use std::f64::consts::TAU;
-    const TONES: [(f64, f64, f64); 3] = [(0.05, 0.3, 0.0), (0.03, 1.1, 1.0), (0.01, 2.9, 2.0)];
-    let time: Vec<f64> = (0..25_000).map(|i| i as f64 * 1e-3).collect();
-    let v: Vec<f64> = time
-        .iter()
-        .map(|&t| {
-            TONES
-                .iter()
-                .map(|&(a, f, p)| a * (TAU * f * t + p).sin())
-                .sum()
-        })
-        .collect();
+    let (time, v) = three_tone_drive(25_000);
     let mut force = lugre_force_along(&v);
     add_gaussian_noise(&mut force, 0.3, 25);
     let mut measured_v = v;

@@ -3,6 +3,7 @@
 //! otherwise run these laws too.
 
 mod energy;
+mod integrated_sensitivities;
 mod simulate_custom;
 mod starts;
 mod util;

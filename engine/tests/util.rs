@@ -634,3 +634,20 @@ impl<'a> SlideReference<'a> {
         (xs, vs)
     }
 }
+
+/// `samples` at 1 kHz of a driven axis's three-tone velocity that reverses (0.05, 0.03 and
+/// 0.01 m/s at 0.3, 1.1 and 2.9 Hz): the times and the velocities.
+pub fn three_tone_drive(samples: usize) -> (Vec<f64>, Vec<f64>) {
+    const TONES: [(f64, f64, f64); 3] = [(0.05, 0.3, 0.0), (0.03, 1.1, 1.0), (0.01, 2.9, 2.0)];
+    let time: Vec<f64> = (0..samples).map(|i| i as f64 * 1e-3).collect();
+    let v = time
+        .iter()
+        .map(|&t| {
+            TONES
+                .iter()
+                .map(|&(a, f, p)| a * (std::f64::consts::TAU * f * t + p).sin())
+                .sum()
+        })
+        .collect();
+    (time, v)
+}

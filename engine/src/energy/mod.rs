@@ -67,7 +67,9 @@
 //! a few times stiffer, and the quartic keeps the fit error at 4e-6 of the acceleration.
 
 pub(crate) mod differentiate;
+mod force_derivatives;
 pub(crate) mod halfcycle;
+mod integrated_sensitivities;
 pub(crate) mod model_force;
 mod numerical_replay;
 

@@ -58,16 +58,21 @@
 //! around it; a law that needs more (a chattering or runaway law) fails with
 //! [`IntegrationFailure::StepBudgetExceeded`]. The replay needs nothing of the model beyond
 //! `state_derivative` (and the state Jacobian, by finite differences where the law has none),
-//! so every registered model works unchanged.
+//! so every registered model works unchanged. A law that also gives its states' rate's
+//! parameter gradient has its force's derivatives from one replay too: its sensitivities are
+//! integrated with its states (`integrated_sensitivities.rs`).
 //!
 //! [`IntegrationFailure::StepBudgetExceeded`]: crate::error::IntegrationFailure::StepBudgetExceeded
 
+pub use super::force_derivatives::ForceDerivatives;
+use super::force_derivatives::{walk_rows, ReplayedSamples, SensitivityReplay};
+use super::integrated_sensitivities::{integrated_force_derivatives, SampledMotion};
 use super::numerical_replay::numerical_replay;
 use super::EnergyAnalysis;
 use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use crate::record::{ConditionColumns, NormalForce};
-use frictionid_models::{Derivatives, FrictionModel, Interval, ParamGradients, Propagator};
+use frictionid_models::{Derivatives, FrictionModel, Interval, Propagator};
 use serde::Serialize;
 
 pub use super::numerical_replay::{SETTLED_RELAXATIONS, STEPS_PER_INTERVAL};
@@ -314,27 +319,6 @@ fn check_samples(samples: &[usize], len: usize) -> Result<(), EngineError> {
     }
 }
 
-/// The model's force at some samples of a replayed motion and its derivatives with respect to
-/// every model parameter there ([`force_derivatives_along`]).
-#[derive(Debug, Clone, PartialEq)]
-pub struct ForceDerivatives {
-    /// The force at each requested sample \[N\].
-    pub force: Vec<f64>,
-    /// dF/dp at each requested sample, one row of `n_params` entries per sample (parameters in
-    /// `FrictionModel::params` order).
-    pub gradient: Vec<f64>,
-    /// For each parameter, whether its entries are given (the others' are NaN: the law has no
-    /// closed form of its sensitivity).
-    pub given: Vec<bool>,
-}
-
-impl ForceDerivatives {
-    /// The derivative of the force at requested sample `k` with respect to parameter `j`.
-    pub fn at(&self, k: usize, j: usize) -> f64 {
-        self.gradient[k * self.given.len() + j]
-    }
-}
-
 /// The force of `model` at the samples `samples` (ascending) of the motion and its
 /// derivatives with respect to the model's parameters, from one replay of the states with
 /// their sensitivities (module docs); `None` when the law has no parameter gradient, or has
@@ -358,13 +342,9 @@ pub(crate) fn force_derivatives_checked(
 ) -> Option<ForceDerivatives> {
     let gradients = model.param_gradients()?;
     let np = model.params().len();
-    let mut out = ForceDerivatives {
-        force: Vec::with_capacity(samples.len()),
-        gradient: vec![0.0; samples.len() * np],
-        given: vec![true; np],
-    };
-    let mut at = vec![0.0; conditions.len()];
+    let mut out = ForceDerivatives::for_samples(samples.len(), np);
     let Some(law) = model.states() else {
+        let mut at = vec![0.0; conditions.len()];
         for (k, &i) in samples.iter().enumerate() {
             let (v, normal) = (motion.v[i], motion.normal.at(i));
             conditions.fill(i, &mut at);
@@ -374,80 +354,32 @@ pub(crate) fn force_derivatives_checked(
         }
         return Some(out);
     };
-    let propagator = exact_propagator(model)?;
+    let Some(propagator) = exact_propagator(model) else {
+        let replay = |i: usize| motion.interval(i);
+        let motion = SampledMotion::new(motion.time, motion.v, motion.normal, &replay);
+        return integrated_force_derivatives(model, motion, samples, conditions);
+    };
     out.given = propagator.exact_sensitivities();
     if out.given.len() != np {
         return None;
     }
     let mut replay = SensitivityReplay::new(model, gradients, Derivatives::of(law), np);
-    let mut next = samples.iter().enumerate().peekable();
-    for i in 0..motion.len() {
-        if i > 0 {
-            propagator.propagate_with_sensitivities(
-                motion.interval(i),
-                &mut replay.z,
-                &mut replay.sens,
-            );
-        }
-        while let Some((k, _)) = next.next_if(|(_, &s)| s == i) {
-            let row = &mut out.gradient[k * np..(k + 1) * np];
-            conditions.fill(i, &mut at);
-            out.force
-                .push(replay.derivatives_at(motion.v[i], motion.normal.at(i), &at, row));
-        }
-    }
+    let at = ReplayedSamples {
+        v: motion.v,
+        normal: motion.normal,
+        conditions,
+    };
+    walk_rows(&mut replay, at, samples, &mut out, |i, replay| {
+        let (z, sens) = (&mut replay.z, &mut replay.sens);
+        propagator.propagate_with_sensitivities(motion.interval(i), z, sens);
+        Some(())
+    })?;
     for (j, given) in out.given.iter().enumerate() {
         if !given {
             (0..samples.len()).for_each(|k| out.gradient[k * np + j] = f64::NAN);
         }
     }
     Some(out)
-}
-
-/// The states and their sensitivities along a replay, and the force's derivatives from them.
-struct SensitivityReplay<'a> {
-    model: &'a dyn FrictionModel,
-    gradients: &'a dyn ParamGradients,
-    derivatives: Derivatives<'a>,
-    z: Vec<f64>,
-    /// dz/dp, n_states x n_params row-major.
-    sens: Vec<f64>,
-    df_dz: Vec<f64>,
-}
-
-impl<'a> SensitivityReplay<'a> {
-    fn new(
-        model: &'a dyn FrictionModel,
-        gradients: &'a dyn ParamGradients,
-        derivatives: Derivatives<'a>,
-        np: usize,
-    ) -> Self {
-        let ns = model.n_states();
-        Self {
-            model,
-            gradients,
-            derivatives,
-            z: vec![0.0; ns],
-            sens: vec![0.0; ns * np],
-            df_dz: vec![0.0; ns],
-        }
-    }
-
-    /// The force at velocity `v`, normal force `normal` and conditions `at` with the current
-    /// states, its total derivatives dF/dp + dF/dz dz/dp written into `row`.
-    fn derivatives_at(&mut self, v: f64, normal: f64, at: &[f64], row: &mut [f64]) -> f64 {
-        self.gradients
-            .force_param_gradient_in(v, &self.z, normal, at, row);
-        self.derivatives
-            .force_gradient(v, &self.z, normal, &mut self.df_dz);
-        let np = row.len();
-        for (s, &d) in self.df_dz.iter().enumerate() {
-            for (r, &dz) in row.iter_mut().zip(&self.sens[s * np..(s + 1) * np]) {
-                *r += d * dz;
-            }
-        }
-        self.model.force_in(v, &self.z, normal, at)
-    }
 }
 
 /// The model's force at every sample from its states there ([`states_along`]).

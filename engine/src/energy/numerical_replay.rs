@@ -39,31 +39,69 @@ pub(crate) fn numerical_replay(
     interval: impl Fn(usize) -> Interval,
 ) -> Result<Vec<f64>, IntegrationFailure> {
     let ns = law.n_states();
-    let intervals: Vec<Interval> = (1..time.len()).map(interval).collect();
-    let per_travel = relaxation_rate(law, &intervals);
-    let relaxations = |iv: &Interval| {
-        let r = per_travel * iv.travel();
-        if r.is_nan() {
-            f64::INFINITY
-        } else {
-            r
-        }
-    };
-    let budget: f64 = intervals
-        .iter()
-        .map(|iv| STEPS_PER_INTERVAL as f64 + relaxations(iv).min(SETTLED_RELAXATIONS))
-        .sum();
-    let mut replay = Replay::new(law, budget);
+    let plan = ReplayPlan::new(law, time, interval);
+    let mut replay = Replay::new(ns, ns, plan.budget);
+    let derivatives = Derivatives::of(law);
     let mut z = vec![0.0; ns];
     let mut out = Vec::with_capacity(time.len() * ns);
     if !time.is_empty() {
         out.extend_from_slice(&z);
     }
-    for (iv, &t0) in intervals.iter().zip(time) {
-        replay.interval(t0, *iv, relaxations(iv), &mut z)?;
+    for (iv, &t0) in plan.intervals.iter().zip(time) {
+        let system = ConstantMotion {
+            derivatives,
+            law,
+            v: iv.v,
+            normal: iv.normal,
+        };
+        replay.interval(&system, (t0, iv.dt), plan.relaxations(iv), &mut z)?;
         out.extend_from_slice(&z);
     }
     Ok(out)
+}
+
+/// The intervals of a replay, the relaxations of the law's states in each and the work the
+/// record allows: [`STEPS_PER_INTERVAL`] steps per interval plus one per relaxation (up to
+/// [`SETTLED_RELAXATIONS`]).
+pub(crate) struct ReplayPlan {
+    /// The intervals between samples i - 1 and i.
+    pub intervals: Vec<Interval>,
+    /// The law's relaxations per unit of travel ([`relaxation_rate`]).
+    per_travel: f64,
+    /// Steps the whole replay may take (accepted and rejected, both steppers).
+    pub budget: f64,
+}
+
+impl ReplayPlan {
+    /// The plan of `law`'s replay over the intervals `interval(i)` of the samples `time`.
+    pub(crate) fn new(
+        law: &dyn InternalStates,
+        time: &[f64],
+        interval: impl Fn(usize) -> Interval,
+    ) -> Self {
+        let intervals: Vec<Interval> = (1..time.len()).map(interval).collect();
+        let mut plan = Self {
+            per_travel: relaxation_rate(law, &intervals),
+            intervals,
+            budget: 0.0,
+        };
+        plan.budget = plan
+            .intervals
+            .iter()
+            .map(|iv| STEPS_PER_INTERVAL as f64 + plan.relaxations(iv).min(SETTLED_RELAXATIONS))
+            .sum();
+        plan
+    }
+
+    /// The relaxations of the states over `iv` (infinite where they cannot be told).
+    pub(crate) fn relaxations(&self, iv: &Interval) -> f64 {
+        let r = self.per_travel * iv.travel();
+        if r.is_nan() {
+            f64::INFINITY
+        } else {
+            r
+        }
+    }
 }
 
 /// How many times the law's states relax per unit of travel: the largest absolute row sum of
@@ -112,9 +150,7 @@ impl OdeSystem for ConstantMotion<'_> {
 }
 
 /// The replay's steppers and the work it may still do.
-struct Replay<'a> {
-    law: &'a dyn InternalStates,
-    derivatives: Derivatives<'a>,
+pub(crate) struct Replay {
     dopri: Dopri5,
     rodas: Rodas4,
     /// Steps the budget still allows (accepted and rejected, both steppers).
@@ -123,57 +159,50 @@ struct Replay<'a> {
     budget: f64,
 }
 
-impl<'a> Replay<'a> {
-    fn new(law: &'a dyn InternalStates, budget: f64) -> Self {
-        let n = law.n_states();
+impl Replay {
+    /// Steppers for `dim` equations whose first `controlled` are under error control (the
+    /// states; sensitivities beside them follow their steps), within `budget` steps.
+    pub(crate) fn new(dim: usize, controlled: usize, budget: f64) -> Self {
         Self {
-            law,
-            derivatives: Derivatives::of(law),
-            dopri: Dopri5::new(n, RTOL, ATOL, f64::INFINITY),
-            rodas: Rodas4::new(n, RTOL, ATOL, f64::INFINITY),
+            dopri: Dopri5::new(dim, RTOL, ATOL, f64::INFINITY).controlling_first(controlled),
+            rodas: Rodas4::new(dim, RTOL, ATOL, f64::INFINITY).controlling_first(controlled),
             left: budget,
             budget,
         }
     }
 
-    /// Integrates `z` over `interval`, which starts at time `t0` and holds `relaxations` of the
-    /// states: by Dopri5 unless that makes it stiff or Dopri5 needs more than
-    /// [`EXPLICIT_CAP`] steps, else by Rodas4.
-    fn interval(
+    /// Integrates `y` by `system` over the interval of duration `dt` starting at `t0`, which
+    /// holds `relaxations` of the states: by Dopri5 unless that makes it stiff or Dopri5 needs
+    /// more than [`EXPLICIT_CAP`] steps, else by Rodas4.
+    pub(crate) fn interval<S: OdeSystem>(
         &mut self,
-        t0: f64,
-        interval: Interval,
+        system: &S,
+        (t0, dt): (f64, f64),
         relaxations: f64,
-        z: &mut [f64],
+        y: &mut [f64],
     ) -> Result<(), IntegrationFailure> {
-        let system = ConstantMotion {
-            derivatives: self.derivatives,
-            law: self.law,
-            v: interval.v,
-            normal: interval.normal,
-        };
-        let span = (t0, t0 + interval.dt);
+        let span = (t0, t0 + dt);
         if relaxations <= STIFF_RELAXATIONS {
             match run(
                 &mut self.dopri,
-                &system,
+                system,
                 span,
-                z,
+                y,
                 self.left.min(EXPLICIT_CAP),
             ) {
                 Ok(steps) => {
                     self.left -= steps;
-                    z.copy_from_slice(self.dopri.state());
+                    y.copy_from_slice(self.dopri.state());
                     return Ok(());
                 }
                 Err(RunFailure::OverAllowance(steps)) => self.left -= steps,
                 Err(RunFailure::Failed(failure)) => return Err(failure),
             }
         }
-        match run(&mut self.rodas, &system, span, z, self.left) {
+        match run(&mut self.rodas, system, span, y, self.left) {
             Ok(steps) => {
                 self.left -= steps;
-                z.copy_from_slice(self.rodas.state());
+                y.copy_from_slice(self.rodas.state());
                 Ok(())
             }
             Err(RunFailure::OverAllowance(_)) => Err(IntegrationFailure::StepBudgetExceeded {
@@ -195,9 +224,9 @@ enum RunFailure {
 
 /// Runs `stepper` from `z` over `(t0, t1)` within `limit` steps (accepted and rejected),
 /// refusing non-finite states; the steps taken.
-fn run<S: Stepper>(
-    stepper: &mut S,
-    system: &ConstantMotion<'_>,
+fn run<T: Stepper, S: OdeSystem>(
+    stepper: &mut T,
+    system: &S,
     (t0, t1): (f64, f64),
     z: &[f64],
     limit: f64,

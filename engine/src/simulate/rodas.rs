@@ -169,6 +169,14 @@ impl Rodas4 {
         self
     }
 
+    /// The same stepper with the error control over the first `controlled` components only
+    /// (see [`Tolerance::control_first`](super::Tolerance::control_first)): forward
+    /// sensitivities integrated beside the states take the states' steps.
+    pub fn controlling_first(mut self, controlled: usize) -> Self {
+        self.ctrl.tol.control_first(controlled);
+        self
+    }
+
     /// Evaluates f and J at the current point.
     fn refresh<S: OdeSystem>(&mut self, system: &S) {
         system.rhs(self.ctrl.t, &self.y, &mut self.fx);
@@ -195,11 +203,12 @@ impl Rodas4 {
     /// The row-sum norm of D^-1 J D with D = diag(atol): the Jacobian with every component
     /// measured in units of its absolute tolerance, so that a state declared in other units
     /// than the displacement (a force, through the model's tolerance scales) does not inflate
-    /// it. Equal to ||J||_inf when all components share one absolute tolerance.
+    /// it. Equal to ||J||_inf when all components share one absolute tolerance. Over the
+    /// controlled components only (see [`Rodas4::controlling_first`]).
     fn scaled_jacobian_norm(&self) -> f64 {
         let atol = &self.ctrl.tol.atol;
         self.jac
-            .chunks(atol.len().max(1))
+            .chunks(self.y.len().max(1))
             .zip(atol)
             .map(|(row, &ai)| {
                 row.iter()
