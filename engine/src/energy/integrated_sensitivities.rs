@@ -7,14 +7,18 @@
 //!
 //!   S' = (dh/dz) S + dh/dp,
 //!
-//! from S = 0 (the replay starts from relaxed states whatever the parameters). The states'
-//! Jacobian dh/dz is the law's (or its finite differences, `Derivatives`), dh/dp its
-//! `ParamGradients::state_param_gradient`. The error control covers the states alone, so the
-//! augmented replay takes the plain replay's steps: Dopri5's exactly, and Rodas4's up to the
-//! rounding of its larger linear systems. Rodas4 needs the augmented system's Jacobian: the
-//! state Jacobian on the diagonal blocks, and below them the derivative of S' in z, taken by
-//! forward differences of S' (one state Jacobian and rate gradient per state) at steps scaled
-//! by the states' sliding values.
+//! from S = 0 (the replay starts from relaxed states whatever the parameters), integrated as
+//! y = [z, s_1, ..., s_P] with s_j = dz/dp_j. The states' Jacobian dh/dz is the law's (or its
+//! finite differences, `Derivatives`), dh/dp its `ParamGradients::state_param_gradient`. The
+//! error control covers the states alone, so the augmented replay takes the plain replay's
+//! steps: Dopri5's exactly, and Rodas4's up to the rounding of its linear systems, which it
+//! solves block by block with the factors of the states' block ([`Rodas4::block_triangular`]).
+//! Rodas4 needs the augmented system's Jacobian: the state Jacobian on the diagonal blocks,
+//! and below them the derivative of s_j' in z, taken by forward differences of the
+//! sensitivities' rates (one state Jacobian and rate gradient per state) at steps scaled by
+//! the states' sliding values.
+//!
+//! [`Rodas4::block_triangular`]: crate::simulate::Rodas4::block_triangular
 //!
 //! The force's derivatives at the samples are then dF/dp + (dF/dz) S, as the exact steps'
 //! replay gives them ([`SensitivityReplay`]): a fit's Jacobian costs one augmented replay in
@@ -87,7 +91,12 @@ pub(crate) fn integrated_force_derivatives(
             .interval(&system.at(iv), span, plan.relaxations(&iv), &mut y)
             .ok()?;
         rows.z.copy_from_slice(&y[..ns]);
-        rows.sens.copy_from_slice(&y[ns..]);
+        // Parameter by parameter in y, state by state in the rows' S.
+        for (j, s) in y[ns..].chunks_exact(ns).enumerate() {
+            for (r, &x) in s.iter().enumerate() {
+                rows.sens[r * np + j] = x;
+            }
+        }
         Some(())
     })?;
     Some(out)
@@ -185,7 +194,8 @@ struct AtInterval<'m, 'a> {
 }
 
 impl AtInterval<'_, '_> {
-    /// S' = (dh/dz) S + dh/dp at states `z` into `ds`, with `jac` and `grad` as buffers.
+    /// s_j' = (dh/dz) s_j + dh/dp_j for every parameter j at states `z` into `ds` (one block
+    /// of n_states per parameter, as `s`), with `scratch`'s buffers.
     fn sensitivity_rates(&self, z: &[f64], s: &[f64], ds: &mut [f64], scratch: &mut Scratch) {
         let m = self.motion;
         let (ns, np) = (z.len(), m.n_params);
@@ -193,13 +203,10 @@ impl AtInterval<'_, '_> {
             .state_jacobian(self.v, z, self.normal, &mut scratch.jac);
         m.gradients
             .state_param_gradient(self.v, z, self.normal, &mut scratch.grad);
-        for r in 0..ns {
-            let out = &mut ds[r * np..(r + 1) * np];
-            out.copy_from_slice(&scratch.grad[r * np..(r + 1) * np]);
-            for (c, &j) in scratch.jac[r * ns..(r + 1) * ns].iter().enumerate() {
-                for (o, &sv) in out.iter_mut().zip(&s[c * np..(c + 1) * np]) {
-                    *o += j * sv;
-                }
+        for (j, (out, sj)) in ds.chunks_exact_mut(ns).zip(s.chunks_exact(ns)).enumerate() {
+            for (r, o) in out.iter_mut().enumerate() {
+                let row = &scratch.jac[r * ns..(r + 1) * ns];
+                *o = scratch.grad[r * np + j] + row.iter().zip(sj).map(|(a, b)| a * b).sum::<f64>();
             }
         }
     }
@@ -229,13 +236,10 @@ impl OdeSystem for AtInterval<'_, '_> {
         let mut base = std::mem::take(&mut scratch.base);
         self.sensitivity_rates(z, s, &mut base, scratch);
         // dh/dz (left by the call above) on every diagonal block.
-        for r in 0..ns {
-            for c in 0..ns {
-                let d = scratch.jac[r * ns + c];
-                jac[r * dim + c] = d;
-                for p in 0..np {
-                    jac[(ns + r * np + p) * dim + ns + c * np + p] = d;
-                }
+        for block in 0..=np {
+            for r in 0..ns {
+                let row = (block * ns + r) * dim + block * ns;
+                jac[row..row + ns].copy_from_slice(&scratch.jac[r * ns..(r + 1) * ns]);
             }
         }
         for c in 0..ns {

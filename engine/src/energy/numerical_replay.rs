@@ -160,12 +160,19 @@ pub(crate) struct Replay {
 }
 
 impl Replay {
-    /// Steppers for `dim` equations whose first `controlled` are under error control (the
-    /// states; sensitivities beside them follow their steps), within `budget` steps.
-    pub(crate) fn new(dim: usize, controlled: usize, budget: f64) -> Self {
+    /// Steppers for `dim` equations, within `budget` steps: the `states` first under error
+    /// control, and after them (when `dim` is larger) their sensitivities, one block of
+    /// `states` per parameter, which follow the states' steps (Rodas4 solving their block
+    /// lower triangular systems block by block, [`Rodas4::block_triangular`]).
+    pub(crate) fn new(dim: usize, states: usize, budget: f64) -> Self {
+        let rodas = Rodas4::new(dim, RTOL, ATOL, f64::INFINITY).controlling_first(states);
         Self {
-            dopri: Dopri5::new(dim, RTOL, ATOL, f64::INFINITY).controlling_first(controlled),
-            rodas: Rodas4::new(dim, RTOL, ATOL, f64::INFINITY).controlling_first(controlled),
+            dopri: Dopri5::new(dim, RTOL, ATOL, f64::INFINITY).controlling_first(states),
+            rodas: if dim > states {
+                rodas.block_triangular(states)
+            } else {
+                rodas
+            },
             left: budget,
             budget,
         }
