@@ -452,6 +452,12 @@ impl Residuals for ForceAlongMotion {
         false
     }
 
+    fn measures_friction(&self, index: usize) -> bool {
+        self.tracks
+            .get(index)
+            .is_some_and(|t| t.source == TargetSource::Measured && t.sliding.is_none())
+    }
+
     fn sliding_samples(&self, index: usize) -> Option<SlidingSamples> {
         self.tracks.get(index).and_then(|t| t.sliding)
     }
