@@ -425,11 +425,20 @@ fn has_several_elements(model: &dyn FrictionModel) -> bool {
 }
 
 /// The normal force the records' levels are fitted under: [`UNIT_NORMAL_FORCE`] when they are
-/// read as forces (no normal force given), else the oscillator's.
+/// read as forces (no normal force given), else the mean over the records of each one's own
+/// (its constant or its channel's mean) or, without one, the oscillator's.
 fn fitted_normal_force<R: Residuals>(plan: &StartPlan<'_, R>) -> f64 {
     let unknown = &plan.opts.target.unknown_oscillator;
     if FrictionLevels::read_as_forces(unknown, plan.records) {
-        UNIT_NORMAL_FORCE
+        return UNIT_NORMAL_FORCE;
+    }
+    let each = plan
+        .records
+        .iter()
+        .map(|r| r.normal_force_with(plan.osc).mean());
+    let mean = each.sum::<f64>() / plan.records.len().max(1) as f64;
+    if mean.is_finite() && mean > 0.0 {
+        mean
     } else {
         plan.osc.normal_force
     }
@@ -671,8 +680,28 @@ mod tests {
     /// cell's.
     #[test]
     fn a_measured_stroke_stages_dahl_at_the_presliding_it_shows() {
+        staged_dahl_at_the_presliding_it_shows(None);
+    }
+
+    /// The same stroke with its own normal force (a channel of 5 N): the levels are
+    /// coefficients of it, and the staged start's stiffness is its level times the records'
+    /// normal force over the presliding displacement (the oscillator's normal force, not
+    /// given, played no part).
+    #[test]
+    fn a_stroke_with_its_own_normal_force_stages_dahl_under_its_mean() {
+        staged_dahl_at_the_presliding_it_shows(Some(5.0));
+    }
+
+    /// The staged Dahl start along [`offset_stroke`] (with a normal-force channel of mean
+    /// `normal` when given), checked against the closed form ln 3 F_c / sigma0.
+    fn staged_dahl_at_the_presliding_it_shows(normal: Option<f64>) {
         use crate::identify::problem::force_along_motion::ForceAlongMotion;
-        let (record, osc, opts) = offset_stroke(3.0);
+        use crate::record::Channel;
+        let (mut record, osc, opts) = offset_stroke(3.0);
+        if let Some(n) = normal {
+            let samples = record.len();
+            record = record.with_channel(Channel::NormalForce, vec![n; samples]);
+        }
         let records = [record];
         let residuals = Arc::new(ForceAlongMotion::new(&records, &osc, &opts).unwrap());
         let model = frictionid_models::Dahl::default();
@@ -704,7 +733,8 @@ mod tests {
             let at = layout.params.iter().position(|f| f.name == name).unwrap();
             staged[0].point[at]
         };
-        let presliding = value("mu_c") / value("sigma0");
+        let level = value("mu_c") * normal.unwrap_or(1.0);
+        let presliding = level / value("sigma0");
         let exact = 3f64.ln() * 50.0 / 4e5;
         assert!(
             (presliding / exact - 1.0).abs() < 0.03,
