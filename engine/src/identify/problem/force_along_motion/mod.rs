@@ -96,6 +96,9 @@ pub struct ForceTrack {
     balance: Option<Balance>,
     /// What a law's conditions read along the record (x, a, u, named channels).
     conditions: ConditionSource,
+    /// The replay's intervals along the motion (`CheckedMotion::intervals`): every
+    /// evaluation of a fit replays the same motion.
+    intervals: Vec<frictionid_models::Interval>,
 }
 
 /// The force-domain residual producer.
