@@ -146,28 +146,42 @@ impl<'a> MeasuredMotion<'a> {
             v,
             normal,
             displacement: None,
+            intervals: None,
         })
     }
 }
 
 /// A motion already checked by [`check_motion`]: its sample times, velocities and normal
-/// force, and the displacement whose increments it travels (`None`: it follows the velocity).
+/// force, the displacement whose increments it travels (`None`: it follows the velocity), and
+/// its replay intervals when they were computed once for every evaluation of a fit
+/// ([`CheckedMotion::intervals`]; `None`: each replay computes them).
 #[derive(Clone, Copy)]
 pub(crate) struct CheckedMotion<'a> {
     pub time: &'a [f64],
     pub v: &'a [f64],
     pub normal: &'a NormalForce,
     pub displacement: Option<&'a [f64]>,
+    pub intervals: Option<&'a [Interval]>,
 }
 
 impl<'a> CheckedMotion<'a> {
     /// The replay's interval ending at sample `i` (>= 1): [`path_interval`] along the
     /// displacement where the motion follows one, else [`replay_interval`].
     pub(crate) fn interval(&self, i: usize) -> Interval {
+        if let Some(&kept) = self.intervals.and_then(|all| all.get(i.wrapping_sub(1))) {
+            return kept;
+        }
         match self.displacement {
             Some(x) => path_interval(self.time, self.v, x, self.normal, i),
             None => replay_interval(self.time, self.v, self.normal, i),
         }
+    }
+
+    /// Every interval of the replay, in order (the one ending at sample `i` at `i - 1`): they
+    /// depend on the motion alone, so a fit, which replays the same motion at every
+    /// evaluation, computes them once and hands them back in [`CheckedMotion::intervals`].
+    pub(crate) fn intervals(&self) -> Vec<Interval> {
+        (1..self.len()).map(|i| self.interval(i)).collect()
     }
 
     /// The motion travelling the increments of `displacement`, once it has a finite value per
@@ -595,6 +609,7 @@ mod tests {
             v: &v,
             normal: &normal,
             displacement: None,
+            intervals: None,
         }
         .along(&x)
         .expect("a valid displacement");

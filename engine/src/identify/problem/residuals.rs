@@ -207,6 +207,15 @@ pub trait Residuals: Send + Sync {
         true
     }
 
+    /// Whether record `index`'s measured series ([`Residuals::measured`]) is a measured
+    /// friction force at every sample along the displacement of [`Residuals::sample_axes`],
+    /// so that a start can read the contact's presliding travel from it (default: `false`; a
+    /// velocity, an inverse-dynamics input force, Eq. 7's force or the sliding samples alone
+    /// are not).
+    fn measures_friction(&self, _index: usize) -> bool {
+        false
+    }
+
     /// Where the compared samples of record `index` lie: their times, and the displacement
     /// and velocity of the motion there when the producer knows them.
     fn sample_axes(&self, _index: usize, record: &Record) -> SampleAxes {

@@ -2,7 +2,7 @@
 //! for ([`free_params`]), the bounded Levenberg-Marquardt solver ([`lm`], its
 //! normal equations in `normal_equations`), the multi-start
 //! runs ([`starts`]), where the starts come from ([`strategy`]: local, staged from simpler
-//! laws, global), the further starts of a free decay that sticks ([`further`]) and the
+//! laws, global; the presliding travel the records show, [`presliding`]), the further starts of a free decay that sticks ([`further`]) and the
 //! force-domain prefit's options and finding ([`prefit`]).
 //! Imports the values and the problem; knows nothing of statistics or findings of a fit.
 
@@ -11,6 +11,7 @@ pub(crate) mod further;
 pub mod lm;
 mod normal_equations;
 pub(crate) mod prefit;
+mod presliding;
 pub mod starts;
 pub(crate) mod strategy;
 

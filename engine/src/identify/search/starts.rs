@@ -7,6 +7,7 @@ use crate::identify::problem::least_squares::{FitProblem, Realised};
 use crate::identify::problem::residuals::{RecordCase, Residuals};
 use crate::identify::values::fit_options::Hooks;
 use crate::identify::values::layout::{FreeParam, ParamKind};
+use crate::identify::values::nuisance::NuisanceKind;
 use crate::identify::values::options::{Progress, ProgressFn};
 use crate::identify::values::outcome::{StartOutcome, TerminationReason};
 use crate::identify::values::param_options::ParamOptions;
@@ -459,7 +460,8 @@ fn classify(runs: Vec<Result<StartRun, EngineError>>) -> Screened {
     screened
 }
 
-/// Runs every start from `points` (phase 1: each for a few iterations when there are several,
+/// Runs every start from `points`, each with its force offsets centred
+/// ([`centred_offsets`]; phase 1: each for a few iterations when there are several,
 /// abandoning those left far behind a `reachable` cost after [`SCREEN_GRACE`] iterations;
 /// phase 2: the `promote` most promising to the iteration limit) and picks the best.
 /// `make_problem` builds a fresh problem per run; `reference` explains a total failure.
@@ -476,6 +478,12 @@ where
     R: Residuals + 'static,
     F: Fn() -> FitProblem<R> + Sync,
 {
+    let centring = make_problem();
+    let centred: Vec<Vec<f64>> = points
+        .iter()
+        .map(|p| centred_offsets(&centring, p))
+        .collect();
+    let points = &centred[..];
     let n_starts = points.len();
     let screen = if n_starts > 1 {
         SCREEN_ITERATIONS.min(search.max_iterations)
@@ -526,7 +534,86 @@ where
         );
     }
     let first_error = screened.first_error.take();
-    pick_best(screened).ok_or_else(|| total_failure(first_error, reference, points))
+    let mut runs =
+        pick_best(screened).ok_or_else(|| total_failure(first_error, reference, points))?;
+    runs.simulations += centring.simulations();
+    Ok(runs)
+}
+
+/// `point` with each record's force offset (a load cell's zero,
+/// [`crate::identify::values::nuisance::NuisanceKind::ForceOffset`]) at its least-squares
+/// value given every other parameter: the offset adds to the predicted force, so the
+/// residuals are affine in it and one Gauss-Newton step on the offsets alone, its slope
+/// taken from a second evaluation with every offset moved by its scale, lands at that value
+/// exactly. Left at a blind start (0), an offset of a few newtons takes the solver's first
+/// iterations: its step cap, scaled to the offset's typical size, lets it grow threefold per
+/// iteration. `point` as it is when there is no force offset or an evaluation fails.
+fn centred_offsets<R: Residuals>(problem: &FitProblem<R>, point: &[f64]) -> Vec<f64> {
+    let slots: Vec<(usize, usize)> = problem
+        .layout
+        .iter()
+        .enumerate()
+        .filter_map(|(j, f)| match f.kind {
+            ParamKind::Nuisance {
+                kind: NuisanceKind::ForceOffset,
+                record,
+            } => Some((j, record)),
+            _ => None,
+        })
+        .collect();
+    if slots.is_empty() {
+        return point.to_vec();
+    }
+    let mut moved = point.to_vec();
+    for &(j, _) in &slots {
+        moved[j] += problem.layout[j].scale;
+    }
+    let (Ok(r0), Ok(r1)) = (problem.residuals_at(point), problem.residuals_at(&moved)) else {
+        return point.to_vec();
+    };
+    let ranges = record_ranges(problem);
+    let mut out = point.to_vec();
+    for (j, record) in slots {
+        let Some(range) = ranges.get(record).cloned() else {
+            continue;
+        };
+        let step = offset_step(&r0.as_slice()[range.clone()], &r1.as_slice()[range]);
+        let f = &problem.layout[j];
+        if let Some(step) = step {
+            out[j] = f.clip(point[j] + step * f.scale);
+        }
+    }
+    out
+}
+
+/// Each record's span in the concatenated residuals.
+fn record_ranges<R: Residuals>(problem: &FitProblem<R>) -> Vec<std::ops::Range<usize>> {
+    let mut at = 0;
+    problem
+        .records
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let n = problem.residuals.residual_count(i, r);
+            at += n;
+            at - n..at
+        })
+        .collect()
+}
+
+/// The move t (in units of the trial move) of a parameter the residuals are affine in that
+/// minimises |r0 + t (r1 - r0)|^2, given the residuals `r0` at the point and `r1` after the
+/// trial move: t = -(r0 . d) / (d . d) with d = r1 - r0. `None` when the move does not
+/// change the residuals or the result is not finite.
+fn offset_step(r0: &[f64], r1: &[f64]) -> Option<f64> {
+    let (mut rd, mut dd) = (0.0, 0.0);
+    for (a, b) in r0.iter().zip(r1) {
+        let d = b - a;
+        rd += a * d;
+        dd += d * d;
+    }
+    let t = -rd / dd;
+    (dd > 0.0 && t.is_finite()).then_some(t)
 }
 
 /// The screening's iterations, the number of starts and how many are continued.
@@ -687,4 +774,79 @@ fn pick_best(screened: Screened) -> Option<MultiStart> {
         starts_at_best,
         outcomes: outcomes.into_iter().map(|(_, o)| o).collect(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identify::problem::force_along_motion::ForceAlongMotion;
+    use crate::identify::problem::least_squares::ProblemParts;
+    use crate::identify::search::free_params::build_layout;
+    use crate::identify::search::strategy::offset_stroke;
+    use crate::record::Channel;
+
+    /// The least-squares offset of a residual affine in it: minus the mean residual per unit
+    /// move, whatever the weight, and nothing when the move changes nothing.
+    #[test]
+    fn the_offset_step_is_the_mean_residual_over_the_slope() {
+        let r0 = [1.0, -2.0, 4.0, 5.0];
+        let r1: Vec<f64> = r0.iter().map(|r| r + 0.5).collect();
+        let t = offset_step(&r0, &r1).unwrap();
+        assert!((t - (-2.0 / 0.5)).abs() < 1e-12, "{t}");
+        assert!(offset_step(&r0, &r0).is_none());
+    }
+
+    /// Dahl at its true values along a stroke whose load cell reads 3 N high, the offset
+    /// started at 0: the centred start takes the offset the record gives against Dahl's
+    /// closed-form force, the mean of the measured force less the law's; from there it does
+    /// not move, and a point without a force offset is left as it is.
+    #[test]
+    fn a_start_takes_the_offset_the_record_gives_at_its_other_values() {
+        let (record, osc, opts) = offset_stroke(3.0);
+        let records: Arc<[Record]> = vec![record].into();
+        let residuals = Arc::new(ForceAlongMotion::new(&records, &osc, &opts).unwrap());
+        let truth = frictionid_models::Dahl {
+            sigma0: 4e5,
+            mu_c: 50.0,
+            alpha: 1.0,
+        };
+        let layout = build_layout(
+            &osc,
+            &truth,
+            &records,
+            residuals.as_ref(),
+            &opts.params,
+            &opts.energy,
+        )
+        .unwrap();
+        let problem = FitProblem::new(
+            residuals,
+            ProblemParts {
+                oscillator: osc,
+                model: layout.start_model.clone(),
+                records: records.clone(),
+                layout: layout.params.clone(),
+                sim: opts.sim,
+                parallel: false,
+            },
+        );
+        let names: Vec<&str> = layout.params.iter().map(|f| f.name.as_str()).collect();
+        assert_eq!(names, ["sigma0", "mu_c", "force_offset[stroke]"]);
+        let start = [4e5, 50.0, 0.0];
+        let centred = centred_offsets(&problem, &start);
+        let x = records[0].channel(Channel::Displacement).unwrap();
+        let measured = records[0].channel(Channel::Force).unwrap();
+        let law = crate::testing::dahl_force_along(x, 4e5, 50.0);
+        let n = measured.len() as f64;
+        let oracle = measured.iter().zip(&law).map(|(m, f)| m - f).sum::<f64>() / n;
+        assert_eq!(centred[..2], start[..2]);
+        assert!(
+            (centred[2] - oracle).abs() < 1e-6,
+            "{} {oracle}",
+            centred[2]
+        );
+        assert!((centred[2] - 3.0).abs() < 0.02, "{}", centred[2]);
+        let again = centred_offsets(&problem, &centred);
+        assert!((again[2] - centred[2]).abs() < 1e-9, "{again:?}");
+    }
 }

@@ -4,9 +4,11 @@
 //! - `local`: the data-driven guess and points spread around it ([`super::starts`]).
 //! - `staged`: first the static laws along the model hierarchy (coulomb, then stribeck when
 //!   the target has Stribeck levels), each one start, one run; their optima are mapped onto
-//!   the target through `Staging::start_from` (presliding stiffness from the typical
-//!   presliding displacement and a tenth of it) and start the target alongside the local
-//!   starts.
+//!   the target through `Staging::start_from` under the normal force the records' levels are
+//!   fitted under (presliding stiffness from the presliding displacement the records show
+//!   when they measure the friction force along the motion, [`super::presliding`], else from
+//!   the typical one and a tenth of it), the stage's other fitted values (a force offset)
+//!   carried over, and start the target alongside the local starts.
 //! - `global`: the staged starts, plus a seeded Latin hypercube over the physical box in the
 //!   solver's (log) coordinates; all are screened and the best few refined.
 //!
@@ -15,6 +17,7 @@
 
 use super::free_params::{build_layout, Layout};
 use super::prefit::PREFIT_ORIGIN;
+use super::presliding::{presliding_displacement, record_travels};
 use super::starts::{fit_starting_points, run_starts};
 use crate::identify::problem::least_squares::{FitProblem, ProblemParts};
 use crate::identify::problem::residuals::Residuals;
@@ -39,7 +42,8 @@ pub(crate) const GLOBAL_SPAN: f64 = 100.0;
 pub(crate) const GLOBAL_SEED: u64 = 0x5eed_0014;
 
 /// Presliding displacements (multiples of the typical one) that map the last stage onto
-/// the target: the typical one and a stiffer contact.
+/// the target when the records do not show their own ([`super::presliding`]): the typical
+/// one and a stiffer contact.
 pub(crate) const STAGED_PRESLIDING: [f64; 2] = [1.0, 0.1];
 
 /// The presliding displacement (a multiple of the typical one) of the compliant start a law
@@ -243,6 +247,8 @@ pub(crate) struct SimplerFit {
     pub free: usize,
     /// Their names, in the layout's order.
     pub free_names: Vec<String>,
+    /// Their fitted values (physical), in the same order.
+    pub values: Vec<f64>,
 }
 
 impl SimplerFit {
@@ -255,6 +261,30 @@ impl SimplerFit {
                 .iter()
                 .zip(&layout.params)
                 .all(|(n, f)| *n == f.name)
+    }
+
+    /// `point` (of the free parameters `params`) with every parameter that is not the
+    /// model's and that this fit also fitted (a record's force or velocity offset, release
+    /// shift or x0, an oscillator property) at its fitted value, clipped to its bounds. The
+    /// stage fitted them to the same records through the same residuals, and the target
+    /// nests the stage (its rigid limit, or a law whose levels it maps): the target starts
+    /// where the records put them, not at their blind start (an offset at 0, which a step
+    /// cap scaled to its typical size lets grow only threefold per iteration).
+    fn carried(&self, params: &[FreeParam], point: Vec<f64>) -> Vec<f64> {
+        params
+            .iter()
+            .zip(point)
+            .map(|(f, x)| match f.kind {
+                ParamKind::Model(_) => x,
+                _ => self
+                    .free_names
+                    .iter()
+                    .position(|n| *n == f.name)
+                    .and_then(|i| self.values.get(i))
+                    .filter(|v| v.is_finite())
+                    .map_or(x, |&v| f.clip(v)),
+            })
+            .collect()
     }
 }
 
@@ -296,7 +326,10 @@ pub(crate) fn fit_simpler<R: Residuals + 'static>(
         .with_loss(opts.search.robust_loss())
     };
     let first = match fitted.filter(|f| f.fits_the_same(law, &layout)) {
-        Some(f) => layout.projected(&seeded_point(&layout, f.model.as_ref())),
+        Some(f) => {
+            let seeded = seeded_point(&layout, f.model.as_ref());
+            layout.projected(&f.carried(&layout.params, seeded))
+        }
         None => layout.start.clone(),
     };
     let mut points = vec![first];
@@ -315,22 +348,32 @@ pub(crate) fn fit_simpler<R: Residuals + 'static>(
         cost: runs.best.cost,
         free: layout.params.len(),
         free_names: layout.params.iter().map(|f| f.name.clone()).collect(),
+        values: p,
     })
 }
 
-/// The staged starting points: each stage mapped onto the target (the last, most refined
-/// stage at every presliding scale of [`STAGED_PRESLIDING`], and a law with several elements
-/// at [`COMPLIANT_PRESLIDING`] too).
+/// The staged starting points: each stage mapped onto the target under the normal force the
+/// records' levels are fitted under (the last, most refined stage at the presliding
+/// displacement the records show when they measure the friction force along the motion,
+/// else at every presliding scale of [`STAGED_PRESLIDING`]; a law with several elements at
+/// [`COMPLIANT_PRESLIDING`] too), with the parameters the stage fitted besides its law's
+/// (a force offset) at the stage's values ([`SimplerFit::carried`]).
 fn staged_points<R: Residuals + 'static>(
     plan: &StartPlan<'_, R>,
     fitted: &[SimplerFit],
 ) -> Vec<Seeded> {
-    let base = StartContext::new(plan.osc.normal_force, plan.osc.mass);
+    let base = StartContext::new(fitted_normal_force(plan), plan.osc.mass);
     let at = |scale: f64| StartContext {
         presliding_displacement: scale * TYPICAL_PRESLIDING_DISPLACEMENT,
         ..base
     };
-    let mut last: Vec<StartContext> = STAGED_PRESLIDING.iter().map(|&s| at(s)).collect();
+    let mut last: Vec<StartContext> = match measured_presliding(plan) {
+        Some(d) => vec![StartContext {
+            presliding_displacement: d,
+            ..base
+        }],
+        None => STAGED_PRESLIDING.iter().map(|&s| at(s)).collect(),
+    };
     if has_several_elements(plan.model) {
         last.push(StartContext {
             normal_force: fitted_normal_force(plan),
@@ -349,13 +392,28 @@ fn staged_points<R: Residuals + 'static>(
                 mapped_point(plan.layout, stage.model.as_ref(), ctx, &plan.opts.params)
             {
                 out.push(Seeded {
-                    point,
+                    point: stage.carried(&plan.layout.params, point),
                     origin: format!("staged from {}", stage.model.name()),
                 });
             }
         }
     }
     out
+}
+
+/// The presliding displacement the records show ([`super::presliding`]) when the fit compares
+/// a measured friction force along their displacement; `None` otherwise, or when they show
+/// none.
+fn measured_presliding<R: Residuals>(plan: &StartPlan<'_, R>) -> Option<f64> {
+    let mut travels = Vec::new();
+    for (i, record) in plan.records.iter().enumerate() {
+        if plan.residuals.measures_friction(i) {
+            let axes = plan.residuals.sample_axes(i, record);
+            let force = plan.residuals.measured(i, record);
+            travels.extend(record_travels(&axes.displacement, force));
+        }
+    }
+    presliding_displacement(travels)
 }
 
 /// Whether `model` has several elements (several stiffnesses that run to its rigid limit).
@@ -367,11 +425,20 @@ fn has_several_elements(model: &dyn FrictionModel) -> bool {
 }
 
 /// The normal force the records' levels are fitted under: [`UNIT_NORMAL_FORCE`] when they are
-/// read as forces (no normal force given), else the oscillator's.
+/// read as forces (no normal force given), else the mean over the records of each one's own
+/// (its constant or its channel's mean) or, without one, the oscillator's.
 fn fitted_normal_force<R: Residuals>(plan: &StartPlan<'_, R>) -> f64 {
     let unknown = &plan.opts.target.unknown_oscillator;
     if FrictionLevels::read_as_forces(unknown, plan.records) {
-        UNIT_NORMAL_FORCE
+        return UNIT_NORMAL_FORCE;
+    }
+    let each = plan
+        .records
+        .iter()
+        .map(|r| r.normal_force_with(plan.osc).mean());
+    let mean = each.sum::<f64>() / plan.records.len().max(1) as f64;
+    if mean.is_finite() && mean > 0.0 {
+        mean
     } else {
         plan.osc.normal_force
     }
@@ -524,6 +591,38 @@ fn global_points(layout: &Layout, n: usize, seed: u64) -> Vec<Seeded> {
 }
 
 #[cfg(test)]
+/// A damper's stroke (Dahl, alpha 1, sigma0 4e5 N/m, level 50 N, 0.2 N noise) read by a
+/// load cell whose zero is off by `offset` N, and the force-domain options of a Dahl fit
+/// with that offset free, the levels read as forces (no normal force given).
+pub(crate) fn offset_stroke(offset: f64) -> (Record, Oscillator, FitOptions) {
+    use crate::identify::values::target_options::{FitDomain, TargetOptions};
+    use crate::record::Channel;
+    let stroke = crate::testing::DamperStroke {
+        amplitude: 0.003,
+        frequency: 2.0,
+        sigma0: 4e5,
+        level: 50.0,
+        noise: 0.2,
+        seed: 17,
+    }
+    .record(4000);
+    let force: Vec<f64> = stroke.channel(Channel::Force).unwrap().to_vec();
+    let record = stroke.with_channel(Channel::Force, force.iter().map(|f| f + offset).collect());
+    let (osc, unknown) = crate::oscillator::PartialOscillator::default().resolve();
+    let mut opts = FitOptions {
+        target: TargetOptions {
+            domain: FitDomain::Force,
+            force_offset: true,
+            unknown_oscillator: unknown,
+            ..TargetOptions::default()
+        },
+        ..FitOptions::default()
+    };
+    opts.params.free = Some(vec!["sigma0".into(), "mu_c".into()]);
+    (record, osc, opts)
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use frictionid_models::LuGre;
@@ -551,6 +650,7 @@ mod tests {
             cost: 1.0,
             free: names.len(),
             free_names: names.iter().map(|n| n.to_string()).collect(),
+            values: vec![1.0; names.len()],
         }
     }
 
@@ -570,6 +670,78 @@ mod tests {
             &["mu_c", "mu_s", "v_s", "delta"],
         );
         assert!(!other.fits_the_same(&Stribeck::default(), &layout));
+    }
+
+    /// The staged start of Dahl along a measured stroke: the Coulomb stage mapped at the
+    /// presliding displacement the stroke shows, ln 3 F_c / sigma0 for Dahl's closed form
+    /// (one start in place of the typical displacement and a tenth of it), under the unit
+    /// normal force of levels read as forces, with the stage's offset. Against the truth:
+    /// the start's level over its stiffness is that displacement, and its offset the load
+    /// cell's.
+    #[test]
+    fn a_measured_stroke_stages_dahl_at_the_presliding_it_shows() {
+        staged_dahl_at_the_presliding_it_shows(None);
+    }
+
+    /// The same stroke with its own normal force (a channel of 5 N): the levels are
+    /// coefficients of it, and the staged start's stiffness is its level times the records'
+    /// normal force over the presliding displacement (the oscillator's normal force, not
+    /// given, played no part).
+    #[test]
+    fn a_stroke_with_its_own_normal_force_stages_dahl_under_its_mean() {
+        staged_dahl_at_the_presliding_it_shows(Some(5.0));
+    }
+
+    /// The staged Dahl start along [`offset_stroke`] (with a normal-force channel of mean
+    /// `normal` when given), checked against the closed form ln 3 F_c / sigma0.
+    fn staged_dahl_at_the_presliding_it_shows(normal: Option<f64>) {
+        use crate::identify::problem::force_along_motion::ForceAlongMotion;
+        use crate::record::Channel;
+        let (mut record, osc, opts) = offset_stroke(3.0);
+        if let Some(n) = normal {
+            let samples = record.len();
+            record = record.with_channel(Channel::NormalForce, vec![n; samples]);
+        }
+        let records = [record];
+        let residuals = Arc::new(ForceAlongMotion::new(&records, &osc, &opts).unwrap());
+        let model = frictionid_models::Dahl::default();
+        let layout = build_layout(
+            &osc,
+            &model,
+            &records,
+            residuals.as_ref(),
+            &opts.params,
+            &opts.energy,
+        )
+        .unwrap();
+        let plan = StartPlan {
+            residuals: &residuals,
+            osc: &osc,
+            model: &model,
+            records: &records,
+            layout: &layout,
+            opts: &opts,
+        };
+        let planned = plan_starts(&plan, Search::Staged, 1);
+        let staged: Vec<&Seeded> = planned
+            .seeded
+            .iter()
+            .filter(|s| s.origin == "staged from coulomb")
+            .collect();
+        assert_eq!(staged.len(), 1, "{:?}", planned.seeded);
+        let value = |name: &str| {
+            let at = layout.params.iter().position(|f| f.name == name).unwrap();
+            staged[0].point[at]
+        };
+        let level = value("mu_c") * normal.unwrap_or(1.0);
+        let presliding = level / value("sigma0");
+        let exact = 3f64.ln() * 50.0 / 4e5;
+        assert!(
+            (presliding / exact - 1.0).abs() < 0.03,
+            "{presliding} {exact}"
+        );
+        let offset = value("force_offset[stroke]");
+        assert!((offset - 3.0).abs() < 0.1, "offset {offset}");
     }
 
     #[test]

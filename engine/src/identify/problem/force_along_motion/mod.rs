@@ -96,6 +96,9 @@ pub struct ForceTrack {
     balance: Option<Balance>,
     /// What a law's conditions read along the record (x, a, u, named channels).
     conditions: ConditionSource,
+    /// The replay's intervals along the motion (`CheckedMotion::intervals`): every
+    /// evaluation of a fit replays the same motion.
+    intervals: Vec<frictionid_models::Interval>,
 }
 
 /// The force-domain residual producer.
@@ -450,6 +453,12 @@ impl Residuals for ForceAlongMotion {
 
     fn simulates_response(&self) -> bool {
         false
+    }
+
+    fn measures_friction(&self, index: usize) -> bool {
+        self.tracks
+            .get(index)
+            .is_some_and(|t| t.source == TargetSource::Measured && t.sliding.is_none())
     }
 
     fn sliding_samples(&self, index: usize) -> Option<SlidingSamples> {

@@ -93,7 +93,7 @@ impl ForceTrack {
             TargetSource::EnergyBased => None,
         };
         let conditions = track_conditions(record, &motion.v, &motion.x, balance.as_ref());
-        Ok(Self {
+        let mut track = Self {
             source,
             conditions,
             time: record.time().to_vec(),
@@ -109,12 +109,23 @@ impl ForceTrack {
             balance,
             sliding,
             unreliable,
-        })
+            intervals: Vec::new(),
+        };
+        track.intervals = track.unkept_motion().intervals();
+        Ok(track)
     }
 
-    /// The record's motion and normal force, checked when the track was prepared, and the
-    /// displacement it travels where it follows one.
+    /// The record's motion and normal force, checked when the track was prepared, the
+    /// displacement it travels where it follows one, and its replay intervals, computed then.
     pub(super) fn motion(&self) -> CheckedMotion<'_> {
+        CheckedMotion {
+            intervals: Some(&self.intervals),
+            ..self.unkept_motion()
+        }
+    }
+
+    /// [`ForceTrack::motion`] without its kept intervals.
+    fn unkept_motion(&self) -> CheckedMotion<'_> {
         CheckedMotion {
             time: &self.time,
             v: &self.velocity,
@@ -122,6 +133,7 @@ impl ForceTrack {
             displacement: self
                 .follows_displacement
                 .then_some(self.displacement.as_slice()),
+            intervals: None,
         }
     }
 
