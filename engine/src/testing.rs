@@ -108,6 +108,18 @@ pub struct DamperStroke {
 }
 
 impl DamperStroke {
+    /// A short stroke: 3 mm at 2 Hz, Dahl at sigma0 4e5 N/m and 50 N, 0.2 N of noise (seed 17).
+    pub fn short() -> Self {
+        Self {
+            amplitude: 0.003,
+            frequency: 2.0,
+            sigma0: 4e5,
+            level: 50.0,
+            noise: 0.2,
+            seed: 17,
+        }
+    }
+
     /// `samples` samples from t = 0 of x = amplitude sin(2 pi frequency t), as a record
     /// `stroke` with a displacement and a force channel.
     ///

@@ -35,15 +35,7 @@ fn a_start_below_the_domain_is_projected_and_the_fit_succeeds() {
 /// A friction damper's stroke: 3 mm at 2 Hz, 4 000 samples at 1 kHz, Dahl's force (alpha 1,
 /// sigma0 4e5 N/m, level 50 N) in closed form along the sampled path, with 0.2 N noise.
 fn damper_stroke() -> Record {
-    DamperStroke {
-        amplitude: 0.003,
-        frequency: 2.0,
-        sigma0: 4e5,
-        level: 50.0,
-        noise: 0.2,
-        seed: 17,
-    }
-    .record(4000)
+    DamperStroke::short().record(4000)
 }
 
 /// Dahl along a damper's stroke, started at a negative rest stiffness (no value near it is

@@ -863,6 +863,16 @@ mod tests {
     /// / 1e6 = 19.001, where the gradient 1000 - 999 * 0.999 > 0 holds p0 at its bound.
     #[test]
     fn a_parameter_stopped_by_its_bound_does_not_shorten_the_capped_step() {
+        let (p, reason, iterations) = run_coupled_at_bound(15.0, 500);
+        assert!(reason.is_converged(), "{reason:?}");
+        assert!(iterations <= 10, "{iterations} iterations");
+        assert_eq!(p[0], 0.0, "{p}");
+        assert!((p[1] - 19.001).abs() < 1e-9, "{p}");
+    }
+
+    /// [`CoupledAtBound`] from (0, `p1`) with p0 >= 0, a step cap of 2 and tight tolerances,
+    /// for at most `iterations`: the best point, why it stopped and the iterations run.
+    fn run_coupled_at_bound(p1: f64, iterations: u64) -> (DVector<f64>, TerminationReason, u64) {
         let mut solver = LevenbergMarquardt::new(
             DVector::from_vec(vec![0.0, f64::NEG_INFINITY]),
             DVector::from_vec(vec![f64::INFINITY; 2]),
@@ -870,19 +880,14 @@ mod tests {
         solver.max_step = 2.0;
         (solver.xtol, solver.ftol) = (1e-13, 1e-15);
         let res = Executor::new(CoupledAtBound, solver)
-            .configure(|s| s.param(DVector::from_vec(vec![0.0, 15.0])).max_iters(500))
+            .configure(|s| {
+                s.param(DVector::from_vec(vec![0.0, p1]))
+                    .max_iters(iterations)
+            })
             .run()
             .unwrap();
-        let reason = termination_reason(&res.solver, &res.state().termination_status, 500);
-        let (p, _) = best(res.state()).unwrap();
-        assert!(reason.is_converged(), "{reason:?}");
-        assert!(
-            res.state().get_iter() <= 10,
-            "{} iterations",
-            res.state().get_iter()
-        );
-        assert_eq!(p[0], 0.0, "{p}");
-        assert!((p[1] - 19.001).abs() < 1e-9, "{p}");
+        let reason = termination_reason(&res.solver, &res.state().termination_status, iterations);
+        (best(res.state()).unwrap().0, reason, res.state().get_iter())
     }
 
     /// From (0, 18.5) p0's gradient still points into the box (1000 - 999 * 1.5 < 0) and its
@@ -894,22 +899,8 @@ mod tests {
     #[test]
     fn a_projected_step_that_promises_no_decrease_is_solved_again_without_the_bound_parameter() {
         let run = |iterations: u64| {
-            let mut solver = LevenbergMarquardt::new(
-                DVector::from_vec(vec![0.0, f64::NEG_INFINITY]),
-                DVector::from_vec(vec![f64::INFINITY; 2]),
-            );
-            solver.max_step = 2.0;
-            (solver.xtol, solver.ftol) = (1e-13, 1e-15);
-            let res = Executor::new(CoupledAtBound, solver)
-                .configure(|s| {
-                    s.param(DVector::from_vec(vec![0.0, 18.5]))
-                        .max_iters(iterations)
-                })
-                .run()
-                .unwrap();
-            let reason =
-                termination_reason(&res.solver, &res.state().termination_status, iterations);
-            (best(res.state()).unwrap().0, reason)
+            let (p, reason, _) = run_coupled_at_bound(18.5, iterations);
+            (p, reason)
         };
         let (first, _) = run(1);
         assert_eq!(first[0], 0.0, "{first}");

@@ -597,15 +597,7 @@ fn global_points(layout: &Layout, n: usize, seed: u64) -> Vec<Seeded> {
 pub(crate) fn offset_stroke(offset: f64) -> (Record, Oscillator, FitOptions) {
     use crate::identify::values::target_options::{FitDomain, TargetOptions};
     use crate::record::Channel;
-    let stroke = crate::testing::DamperStroke {
-        amplitude: 0.003,
-        frequency: 2.0,
-        sigma0: 4e5,
-        level: 50.0,
-        noise: 0.2,
-        seed: 17,
-    }
-    .record(4000);
+    let stroke = crate::testing::DamperStroke::short().record(4000);
     let force: Vec<f64> = stroke.channel(Channel::Force).unwrap().to_vec();
     let record = stroke.with_channel(Channel::Force, force.iter().map(|f| f + offset).collect());
     let (osc, unknown) = crate::oscillator::PartialOscillator::default().resolve();
