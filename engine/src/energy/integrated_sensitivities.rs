@@ -73,6 +73,10 @@ pub(crate) fn integrated_force_derivatives(
     let gradients = model.param_gradients()?;
     let law = model.states()?;
     let (ns, np) = (law.n_states(), model.params().len());
+    if ns == 0 {
+        // No states to carry sensitivities (the caller differences the columns).
+        return None;
+    }
     let plan = ReplayPlan::new(law, motion.time, motion.interval);
     let system = SensitiveMotion::new(law, gradients, np, &plan.intervals)?;
     let mut replay = Replay::new(ns * (1 + np), ns, plan.budget);
