@@ -82,12 +82,7 @@ fn statistics<R: Residuals>(
     let shared = identifiability::shared_columns(&jac, standings, &unprofiled);
     let standings = identifiability::with_shared(standings, &shared);
     let mut cov = covariance_of_determined(&jac, ssr, &standings);
-    let segments: Vec<usize> = reference
-        .records
-        .iter()
-        .enumerate()
-        .map(|(i, rec)| reference.residuals.residual_count(i, rec))
-        .collect();
+    let segments = reference.residual_counts();
     let widening = widen_for_autocorrelation(&mut cov, &jac, r.as_slice(), &segments);
     let t_quantile = t_quantile_975(cov.dof);
     let world = reference.realise(&p_best)?;

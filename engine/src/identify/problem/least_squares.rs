@@ -144,11 +144,28 @@ impl<R: Residuals> FitProblem<R> {
 
     /// Number of residuals (over all records).
     pub fn n_residuals(&self) -> usize {
+        self.residual_counts().iter().sum()
+    }
+
+    /// Each record's number of residuals, in record order.
+    pub fn residual_counts(&self) -> Vec<usize> {
         self.records
             .iter()
             .enumerate()
             .map(|(i, r)| self.residuals.residual_count(i, r))
-            .sum()
+            .collect()
+    }
+
+    /// Each record's span in the concatenated residuals.
+    pub fn record_ranges(&self) -> Vec<std::ops::Range<usize>> {
+        let mut at = 0;
+        self.residual_counts()
+            .into_iter()
+            .map(|n| {
+                at += n;
+                at - n..at
+            })
+            .collect()
     }
 
     /// Simulations run so far.

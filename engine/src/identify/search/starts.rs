@@ -571,7 +571,7 @@ fn centred_offsets<R: Residuals>(problem: &FitProblem<R>, point: &[f64]) -> Vec<
     let (Ok(r0), Ok(r1)) = (problem.residuals_at(point), problem.residuals_at(&moved)) else {
         return point.to_vec();
     };
-    let ranges = record_ranges(problem);
+    let ranges = problem.record_ranges();
     let mut out = point.to_vec();
     for (j, record) in slots {
         let Some(range) = ranges.get(record).cloned() else {
@@ -584,21 +584,6 @@ fn centred_offsets<R: Residuals>(problem: &FitProblem<R>, point: &[f64]) -> Vec<
         }
     }
     out
-}
-
-/// Each record's span in the concatenated residuals.
-fn record_ranges<R: Residuals>(problem: &FitProblem<R>) -> Vec<std::ops::Range<usize>> {
-    let mut at = 0;
-    problem
-        .records
-        .iter()
-        .enumerate()
-        .map(|(i, r)| {
-            let n = problem.residuals.residual_count(i, r);
-            at += n;
-            at - n..at
-        })
-        .collect()
 }
 
 /// The move t (in units of the trial move) of a parameter the residuals are affine in that

@@ -23,7 +23,7 @@ use crate::identify::problem::least_squares::{FitProblem, ProblemParts};
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::{FreeParam, ParamKind};
-use crate::identify::values::levels::{FrictionLevels, UNIT_NORMAL_FORCE};
+use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::param_options::ParamOptions;
 use crate::identify::values::search::Search;
 use crate::oscillator::Oscillator;
@@ -424,24 +424,14 @@ fn has_several_elements(model: &dyn FrictionModel) -> bool {
         .is_some_and(|limit| limit.stiffnesses.len() > 1)
 }
 
-/// The normal force the records' levels are fitted under: [`UNIT_NORMAL_FORCE`] when they are
-/// read as forces (no normal force given), else the mean over the records of each one's own
-/// (its constant or its channel's mean) or, without one, the oscillator's.
+/// The normal force the records' levels are fitted under, their mean
+/// ([`FrictionLevels::mean_normal_force`]: 1 N when the levels are read as forces, else each
+/// record's own or the oscillator's), or the oscillator's where that gives none.
 fn fitted_normal_force<R: Residuals>(plan: &StartPlan<'_, R>) -> f64 {
     let unknown = &plan.opts.target.unknown_oscillator;
-    if FrictionLevels::read_as_forces(unknown, plan.records) {
-        return UNIT_NORMAL_FORCE;
-    }
-    let each = plan
-        .records
-        .iter()
-        .map(|r| r.normal_force_with(plan.osc).mean());
-    let mean = each.sum::<f64>() / plan.records.len().max(1) as f64;
-    if mean.is_finite() && mean > 0.0 {
-        mean
-    } else {
-        plan.osc.normal_force
-    }
+    FrictionLevels::mean_normal_force(plan.records, plan.osc, unknown)
+        .filter(|mean| mean.is_finite() && *mean > 0.0)
+        .unwrap_or(plan.osc.normal_force)
 }
 
 /// The target started from a fitted simpler model (`start_from`), as a point of the layout:

@@ -74,6 +74,24 @@ impl FrictionLevels {
         }
     }
 
+    /// The mean over `records` of the normal force each is fitted under
+    /// ([`FrictionLevels::record_normal_force`], its mean over its samples); `None` when a
+    /// record has none or there are no records.
+    pub fn mean_normal_force(
+        records: &[Record],
+        osc: &Oscillator,
+        unknown: &[OscillatorProperty],
+    ) -> Option<f64> {
+        let as_forces = Self::read_as_forces(unknown, records);
+        let each: Option<Vec<f64>> = records
+            .iter()
+            .map(|r| Self::record_normal_force(r, osc, unknown, as_forces).ok())
+            .map(|n| n.map(|n| n.mean()))
+            .collect();
+        let each = each.filter(|e| !e.is_empty())?;
+        Some(each.iter().sum::<f64>() / each.len() as f64)
+    }
+
     /// Whether `info` declares a friction level: dimensionless, named `mu` or `mu_*`, except
     /// the ratios of forces a law does not multiply by N ([`NOT_LEVELS`]).
     pub fn is_level(info: &ParamInfo) -> bool {
