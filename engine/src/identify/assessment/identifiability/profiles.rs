@@ -1,7 +1,7 @@
 //! The profile of the cost along one parameter: stepped outward on each side with the others
 //! re-optimised, and where it crosses the rise that excludes a value at 95 %.
 
-use super::pinned::{merged, pinned_fit, without};
+use super::pinned::{merged, pinned_fit, pinned_problem, without};
 use super::rigid_limit::Limit;
 use super::Standing;
 use crate::identify::problem::least_squares::FitProblem;
@@ -9,6 +9,7 @@ use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::StartRun;
 use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::result::Identifiability;
+use argmin::core::Operator;
 use nalgebra::DVector;
 
 /// chi²(1 dof, 95 %) / 2 = 3.8415 / 2: the rise of the cost (half the sum of squares), in
@@ -35,12 +36,21 @@ pub const PROFILE_RESOLUTION: f64 = 0.05;
 /// their optimum overstates the lower bound.
 pub const LIMIT_PROFILE_ITERATIONS: u64 = 40;
 
-/// One profile step: the parameter's internal value, the re-optimised cost, and the whole
-/// point (internal coordinates).
+/// A step whose cost, with the others where the previous step left them, lies below the best
+/// by more than this fraction of the rise is re-optimised even when it is within the rise: the
+/// re-optimisation may reach a full rise below, a point the fit restarts from.
+const DESCENT_FRACTION: f64 = 0.5;
+
+/// One profile step: the parameter's internal value, its cost, and the whole point (internal
+/// coordinates).
 struct ProfilePoint {
     u: f64,
+    /// The re-optimised cost, or, for a step only `bounded`, the cost as the previous step
+    /// left the others (at least the re-optimised one).
     cost: f64,
     at: DVector<f64>,
+    /// The others were not re-optimised: the cost lay within the rise as they stood.
+    bounded: bool,
 }
 
 /// A profile of the cost along one parameter at the best run.
@@ -87,6 +97,15 @@ impl<R: Residuals + 'static> Profile<'_, R> {
                 break;
             }
             let pins = [(j, u)];
+            if let Some(cost) = self.within_as_left(&pins, &others, limit) {
+                out.push(ProfilePoint {
+                    u,
+                    cost,
+                    at: merged(&others, &pins, self.best.u.len()),
+                    bounded: true,
+                });
+                continue;
+            }
             match self.step_fit(&pins, &others) {
                 None if out.is_empty() && halvings < PROFILE_HALVINGS => {
                     step /= 2.0;
@@ -94,11 +113,15 @@ impl<R: Residuals + 'static> Profile<'_, R> {
                 }
                 None => break,
                 Some(run) => {
+                    if run.cost > limit {
+                        self.reoptimise_last(j, &mut out);
+                    }
                     others = run.u;
                     out.push(ProfilePoint {
                         u,
                         cost: run.cost,
                         at: merged(&others, &pins, self.best.u.len()),
+                        bounded: false,
                     });
                     let above = out.iter().rev().take_while(|p| p.cost > limit).count();
                     if above >= confirmations {
@@ -108,6 +131,43 @@ impl<R: Residuals + 'static> Profile<'_, R> {
             }
         }
         out
+    }
+
+    /// The cost at the step `pins` with the others as the previous step left them
+    /// (`others`), when it already lies within `limit` and less than [`DESCENT_FRACTION`] of
+    /// the rise below the best. The profile is the least cost over the others, so such a
+    /// step lies inside the interval whatever a re-optimisation would find, and one
+    /// evaluation replaces it; the step before a crossing is re-optimised later
+    /// ([`Self::reoptimise_last`]), where the crossing is interpolated from its cost.
+    fn within_as_left(
+        &self,
+        pins: &[(usize, f64)],
+        others: &DVector<f64>,
+        limit: f64,
+    ) -> Option<f64> {
+        let rise = limit - self.best.cost;
+        let problem = pinned_problem(self.reference, pins)?;
+        let r = problem.apply(others).ok()?;
+        let cost = 0.5 * r.norm_squared();
+        let within = cost <= limit && cost >= self.best.cost - DESCENT_FRACTION * rise;
+        within.then_some(cost)
+    }
+
+    /// Re-optimises the last point of `out` when it was only bounded (a profile that rises
+    /// past the limit next interpolates its crossing from that point's least cost); a
+    /// re-optimisation that fails leaves the bound.
+    fn reoptimise_last(&self, j: usize, out: &mut [ProfilePoint]) {
+        let Some(last) = out.last_mut().filter(|p| p.bounded) else {
+            return;
+        };
+        let pins = [(j, last.u)];
+        if let Some(run) = self.step_fit(&pins, &without(&last.at, &pins)) {
+            if run.cost < last.cost {
+                last.cost = run.cost;
+                last.at = merged(&run.u, &pins, last.at.len());
+            }
+            last.bounded = false;
+        }
     }
 
     /// The others re-optimised at a profile step `pins` from where the previous step left
@@ -237,7 +297,125 @@ fn crossing(centre: (f64, f64), points: &[(f64, f64)], limit: f64) -> Option<f64
 
 #[cfg(test)]
 mod tests {
+    use super::super::flat::flat_and_delta;
     use super::*;
+    use crate::identify::problem::force_along_motion::ForceAlongMotion;
+    use crate::identify::problem::least_squares::ProblemParts;
+    use crate::identify::search::free_params::build_layout;
+    use crate::identify::search::starts::{run_start, RunSlot};
+    use crate::identify::search::strategy::offset_stroke;
+    use crate::record::{Channel, Record};
+    use std::sync::Arc;
+
+    /// Dahl's law along a damper stroke whose force is Dahl's at sigma0 1e13 N/m (rigid even
+    /// over the nanometre steps at the reversals: a Coulomb force with 0.2 N of noise), fitted
+    /// from there: its stiffness is bounded below only, and the profile upward stays flat.
+    fn rigid_dahl_fit() -> (FitProblem<ForceAlongMotion>, StartRun, FitOptions) {
+        let (stroke, osc, opts) = offset_stroke(0.0);
+        let x = stroke.channel(Channel::Displacement).unwrap().to_vec();
+        let force = crate::testing::dahl_force_along(&x, 1e13, 50.0);
+        let noisy: Vec<f64> = stroke
+            .channel(Channel::Force)
+            .unwrap()
+            .iter()
+            .zip(crate::testing::dahl_force_along(&x, 4e5, 50.0))
+            .zip(&force)
+            .map(|((measured, clean), rigid)| rigid + (measured - clean))
+            .collect();
+        let records: Arc<[Record]> = vec![stroke.with_channel(Channel::Force, noisy)].into();
+        let residuals = Arc::new(ForceAlongMotion::new(&records, &osc, &opts).unwrap());
+        let truth = frictionid_models::Dahl {
+            sigma0: 1e13,
+            mu_c: 50.0,
+            alpha: 1.0,
+        };
+        let layout = build_layout(
+            &osc,
+            &truth,
+            &records,
+            residuals.as_ref(),
+            &opts.params,
+            &opts.energy,
+        )
+        .unwrap();
+        let problem = || {
+            FitProblem::new(
+                residuals.clone(),
+                ProblemParts {
+                    oscillator: osc,
+                    model: layout.start_model.clone(),
+                    records: records.clone(),
+                    layout: layout.params.clone(),
+                    sim: opts.sim,
+                    parallel: false,
+                },
+            )
+        };
+        let slot = RunSlot {
+            start: 0,
+            starts: 1,
+            max_iterations: 100,
+            pace: None,
+            cost_resolution: None,
+            explain: false,
+        };
+        let reference = problem();
+        let u0 = reference.internal(&layout.start);
+        let best = run_start(problem(), u0, &opts.search, &opts.hooks, slot).unwrap();
+        (reference, best, opts)
+    }
+
+    /// A step within the rise as the previous step left the others costs one evaluation
+    /// instead of a re-optimisation, and that cost bounds the profile: the others
+    /// re-optimised there (the oracle: a pinned fit of its own, to convergence) end no
+    /// higher, so the step lies inside the interval either way. The steps downward, where the
+    /// cost rises past the limit, are re-optimised, the last one within included, so the
+    /// crossing is interpolated from least costs.
+    #[test]
+    fn a_step_within_the_rise_as_left_is_bounded_by_one_evaluation() {
+        let (reference, best, opts) = rigid_dahl_fit();
+        let j = 0;
+        assert_eq!(reference.layout[j].name, "sigma0");
+        let (flat, delta) = flat_and_delta(&reference, &best).unwrap().unwrap();
+        assert!(flat.contains(&j), "{flat:?}");
+        let profile = Profile {
+            reference: &reference,
+            best: &best,
+            opts: &opts,
+            limit: None,
+            resolution: PROFILE_RESOLUTION * delta,
+        };
+        let limit = best.cost + delta;
+        let upward = profile.side(j, 1.0, limit);
+        let bounded: Vec<&ProfilePoint> = upward.iter().filter(|p| p.bounded).collect();
+        assert!(!bounded.is_empty(), "no step was bounded");
+        for p in bounded {
+            assert!(p.cost <= limit, "{} > {limit}", p.cost);
+            let pins = [(j, p.u)];
+            let full = pinned_fit(
+                &reference,
+                &pins,
+                &without(&best.u, &pins),
+                &opts,
+                (100, None),
+            )
+            .expect("a pinned fit");
+            assert!(
+                full.cost <= p.cost * (1.0 + 1e-12),
+                "{} > {}",
+                full.cost,
+                p.cost
+            );
+        }
+        let downward = profile.side(j, -1.0, limit);
+        let crossing = downward.iter().position(|p| p.cost > limit);
+        let crossing = crossing.expect("the stiffness is bounded below");
+        assert!(downward[..=crossing]
+            .iter()
+            .rev()
+            .take(2)
+            .all(|p| !p.bounded));
+    }
 
     #[test]
     fn the_crossing_interpolates_between_profile_points() {
