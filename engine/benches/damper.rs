@@ -5,14 +5,14 @@
 //! (`identify::compare`), the records in parallel as the campaign's groups are.
 //! `benches/scipy_damper.py` is SciPy's counterpart on the same files.
 
-/// mimalloc, as the `frictionid` binary and the Python module use.
-#[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+/// The allocator of the `frictionid` binary and the Python module.
+#[path = "../../cli/src/allocator.rs"]
+mod allocator;
 
 #[path = "data/damper.rs"]
 mod damper;
 
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::{criterion_group, Criterion};
 use frictionid_engine::data::{RecordSource, RecordUse};
 use frictionid_engine::identify::{
     compare, Comparison, FitDomain, FitOptions, ParamOptions, TargetOptions,
@@ -91,4 +91,9 @@ fn damper_fits(c: &mut Criterion) {
 }
 
 criterion_group!(benches, damper_fits);
-criterion_main!(benches);
+/// criterion's main with the binary's allocator settings first.
+fn main() {
+    allocator::keep_freed_memory();
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -6,10 +6,9 @@
 //! models compared in the force domain along a driven axis's measured motion and friction
 //! force (25 000 samples), and GMS fitted along 20 000 of those samples.
 
-/// mimalloc, as the `frictionid` binary and the Python module use (glibc's malloc returned
-/// and refaulted the fits' buffers, a sixth of a Coulomb fit's time).
-#[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+/// The allocator of the `frictionid` binary and the Python module.
+#[path = "../../cli/src/allocator.rs"]
+mod allocator;
 
 #[path = "../tests/util.rs"]
 mod common;
@@ -18,7 +17,7 @@ use common::{
     force_route_options, inverse_dynamics_options, lugre_truth, no_oscillator_force_options,
     records, stiff_lugre_truth, stribeck_truth, three_tone_drive, NOISE,
 };
-use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use criterion::{criterion_group, BatchSize, Criterion};
 use frictionid_engine::data::RecordSource;
 use frictionid_engine::identify::Search;
 use frictionid_engine::identify::{compare, fit, FitOptions, ParamOptions, SearchOptions};
@@ -306,4 +305,9 @@ criterion_group!(
     drive_compare,
     gms_force_fit
 );
-criterion_main!(benches);
+/// criterion's main with the binary's allocator settings first.
+fn main() {
+    allocator::keep_freed_memory();
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -14,10 +14,8 @@
 //! - [`campaign`]: campaigns, one group a task for any executor.
 //! - [`export`]: a fitted law as C, Rust or Python source, or a compensation table.
 
-/// mimalloc, as the `frictionid` binary uses: glibc's malloc gave the fits' buffers back to
-/// the system and faulted them in again at every evaluation (a sixth of a Coulomb fit).
-#[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+#[path = "../../cli/src/allocator.rs"]
+mod allocator;
 
 pub mod api;
 pub mod campaign;
@@ -33,6 +31,7 @@ use pyo3::prelude::*;
 /// The native module `frictionid._native`; the Python package `frictionid` re-exports it.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    allocator::keep_freed_memory();
     m.add("FitError", m.py().get_type::<errors::FitError>())?;
     m.add_function(wrap_pyfunction!(api::models, m)?)?;
     m.add_function(wrap_pyfunction!(api::simulate, m)?)?;
