@@ -27,7 +27,6 @@ use crate::identify::values::target_options::FitDomain;
 use crate::oscillator::OscillatorProperty;
 use crate::record::Record;
 use frictionid_models::{clone_model, FrictionModel};
-use rayon::prelude::*;
 use serde::Serialize;
 
 /// The most folds a comparison scores (each costs one local refit and one evaluation per law).
@@ -202,8 +201,9 @@ pub(crate) fn validate(
     parallel: bool,
 ) -> Option<(ValidationScheme, Vec<LawValidation>)> {
     let (scheme, folds) = plan(records, opts)?;
-    let score = |f: &FitResult| score_law(f, &folds, opts, parallel);
+    let score = |f: &FitResult| score_law(f, &folds, opts);
     let scores = if parallel {
+        use rayon::prelude::*;
         fits.par_iter().map(score).collect()
     } else {
         fits.iter().map(score).collect()
@@ -211,15 +211,8 @@ pub(crate) fn validate(
     Some((scheme, scores))
 }
 
-/// One law's score over `folds`, its folds' refits side by side when `parallel` (the laws
-/// are scored in parallel too, but the slowest law's folds would otherwise run one after
-/// the other once the others are done).
-fn score_law(
-    fitted: &FitResult,
-    folds: &[Fold],
-    opts: &FitOptions,
-    parallel: bool,
-) -> LawValidation {
+/// One law's score over `folds`.
+fn score_law(fitted: &FitResult, folds: &[Fold], opts: &FitOptions) -> LawValidation {
     let mut out = LawValidation {
         model: fitted.model.clone(),
         validation_rms: None,
@@ -227,16 +220,10 @@ fn score_law(
         folds: Vec::new(),
         error: None,
     };
-    let held = |fold: &Fold| held_out(fitted, fold, opts);
-    let scored: Vec<_> = if parallel {
-        folds.par_iter().map(held).collect()
-    } else {
-        folds.iter().map(held).collect()
-    };
     let mut sum_sq = 0.0;
     let mut count = 0usize;
-    for fold_score in scored {
-        match fold_score {
+    for fold in folds {
+        match held_out(fitted, fold, opts) {
             Ok((ss, n)) if n > 0 => {
                 sum_sq += ss;
                 count += n;
