@@ -764,10 +764,7 @@ fn pick_best(screened: Screened) -> Option<MultiStart> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::identify::problem::force_along_motion::ForceAlongMotion;
-    use crate::identify::problem::least_squares::ProblemParts;
-    use crate::identify::search::free_params::build_layout;
-    use crate::identify::search::strategy::offset_stroke;
+    use crate::identify::search::strategy::{dahl_force_problem, offset_stroke};
     use crate::record::Channel;
 
     /// The least-squares offset of a residual affine in it: minus the mean residual per unit
@@ -789,33 +786,13 @@ mod tests {
     fn a_start_takes_the_offset_the_record_gives_at_its_other_values() {
         let (record, osc, opts) = offset_stroke(3.0);
         let records: Arc<[Record]> = vec![record].into();
-        let residuals = Arc::new(ForceAlongMotion::new(&records, &osc, &opts).unwrap());
         let truth = frictionid_models::Dahl {
             sigma0: 4e5,
             mu_c: 50.0,
             alpha: 1.0,
         };
-        let layout = build_layout(
-            &osc,
-            &truth,
-            &records,
-            residuals.as_ref(),
-            &opts.params,
-            &opts.energy,
-        )
-        .unwrap();
-        let problem = FitProblem::new(
-            residuals,
-            ProblemParts {
-                oscillator: osc,
-                model: layout.start_model.clone(),
-                records: records.clone(),
-                layout: layout.params.clone(),
-                sim: opts.sim,
-                parallel: false,
-            },
-        );
-        let names: Vec<&str> = layout.params.iter().map(|f| f.name.as_str()).collect();
+        let (problem, _) = dahl_force_problem(&records, osc, &opts, &truth);
+        let names: Vec<&str> = problem.layout.iter().map(|f| f.name.as_str()).collect();
         assert_eq!(names, ["sigma0", "mu_c", "force_offset[stroke]"]);
         let start = [4e5, 50.0, 0.0];
         let centred = centred_offsets(&problem, &start);

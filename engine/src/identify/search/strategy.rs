@@ -605,6 +605,44 @@ pub(crate) fn offset_stroke(offset: f64) -> (Record, Oscillator, FitOptions) {
 }
 
 #[cfg(test)]
+/// The force-domain problem of Dahl's law along `records` under `opts` (a fresh one per
+/// call: a solver run takes its problem), with the layout started at `truth`: the problem
+/// and the start (physical values).
+pub(crate) fn dahl_force_problem(
+    records: &Arc<[Record]>,
+    osc: Oscillator,
+    opts: &FitOptions,
+    truth: &frictionid_models::Dahl,
+) -> (
+    FitProblem<crate::identify::problem::force_along_motion::ForceAlongMotion>,
+    Vec<f64>,
+) {
+    use crate::identify::problem::force_along_motion::ForceAlongMotion;
+    let residuals = Arc::new(ForceAlongMotion::new(records, &osc, opts).unwrap());
+    let layout = build_layout(
+        &osc,
+        truth,
+        records,
+        residuals.as_ref(),
+        &opts.params,
+        &opts.energy,
+    )
+    .unwrap();
+    let problem = FitProblem::new(
+        residuals,
+        ProblemParts {
+            oscillator: osc,
+            model: layout.start_model.clone(),
+            records: records.clone(),
+            layout: layout.params.clone(),
+            sim: opts.sim,
+            parallel: false,
+        },
+    );
+    (problem, layout.start)
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use frictionid_models::LuGre;

@@ -300,10 +300,8 @@ mod tests {
     use super::super::flat::flat_and_delta;
     use super::*;
     use crate::identify::problem::force_along_motion::ForceAlongMotion;
-    use crate::identify::problem::least_squares::ProblemParts;
-    use crate::identify::search::free_params::build_layout;
     use crate::identify::search::starts::{run_start, RunSlot};
-    use crate::identify::search::strategy::offset_stroke;
+    use crate::identify::search::strategy::{dahl_force_problem, offset_stroke};
     use crate::record::{Channel, Record};
     use std::sync::Arc;
 
@@ -323,34 +321,13 @@ mod tests {
             .map(|((measured, clean), rigid)| rigid + (measured - clean))
             .collect();
         let records: Arc<[Record]> = vec![stroke.with_channel(Channel::Force, noisy)].into();
-        let residuals = Arc::new(ForceAlongMotion::new(&records, &osc, &opts).unwrap());
         let truth = frictionid_models::Dahl {
             sigma0: 1e13,
             mu_c: 50.0,
             alpha: 1.0,
         };
-        let layout = build_layout(
-            &osc,
-            &truth,
-            &records,
-            residuals.as_ref(),
-            &opts.params,
-            &opts.energy,
-        )
-        .unwrap();
-        let problem = || {
-            FitProblem::new(
-                residuals.clone(),
-                ProblemParts {
-                    oscillator: osc,
-                    model: layout.start_model.clone(),
-                    records: records.clone(),
-                    layout: layout.params.clone(),
-                    sim: opts.sim,
-                    parallel: false,
-                },
-            )
-        };
+        let (reference, start) = dahl_force_problem(&records, osc, &opts, &truth);
+        let (problem, _) = dahl_force_problem(&records, osc, &opts, &truth);
         let slot = RunSlot {
             start: 0,
             starts: 1,
@@ -359,9 +336,8 @@ mod tests {
             cost_resolution: None,
             explain: false,
         };
-        let reference = problem();
-        let u0 = reference.internal(&layout.start);
-        let best = run_start(problem(), u0, &opts.search, &opts.hooks, slot).unwrap();
+        let u0 = reference.internal(&start);
+        let best = run_start(problem, u0, &opts.search, &opts.hooks, slot).unwrap();
         (reference, best, opts)
     }
 
