@@ -56,7 +56,7 @@ pub struct FitProblem<R: Residuals = SimulatedResponse> {
     /// The step allowance of the simulations, per record ([`StepAllowance`]).
     allowance: StepAllowance,
     /// The last point `apply` evaluated, reused by `jacobian` at the same point.
-    cache: Mutex<Option<(DVector<f64>, DVector<f64>)>>,
+    cache: Mutex<Option<Evaluated>>,
     /// The last physical Jacobian and residuals, by point: the identifiability check and the
     /// statistics both ask for them at the optimum.
     physical_cache: Mutex<Option<PhysicalJacobian>>,
@@ -64,6 +64,23 @@ pub struct FitProblem<R: Residuals = SimulatedResponse> {
 
 /// A physical point with the Jacobian and residuals there.
 type PhysicalJacobian = (Vec<f64>, DMatrix<f64>, DVector<f64>);
+
+/// The Jacobian's columns in internal coordinates that a producer gave in closed form, one
+/// per free parameter (`None`: a difference quotient's).
+type ClosedFormColumns = Vec<Option<DVector<f64>>>;
+
+/// What `apply` evaluated at its last point, for `jacobian` there.
+struct Evaluated {
+    /// The point, in internal coordinates.
+    u: DVector<f64>,
+    /// The producer's residuals there (before the loss's transform).
+    residuals: DVector<f64>,
+    /// The closed-form columns evaluated with the residuals, where the producer gave both
+    /// from one evaluation.
+    columns: Option<ClosedFormColumns>,
+    /// Whether the solver asked for the Jacobian at the point: it took the step there.
+    linearised: bool,
+}
 
 /// The state of the world for one parameter vector.
 pub struct Realised {
@@ -308,11 +325,22 @@ impl<R: Residuals> FitProblem<R> {
     /// columns where it gives them, forward differences (stepping inwards at an upper bound)
     /// for the others.
     pub fn jacobian_internal(&self, u: &DVector<f64>, r0: &DVector<f64>) -> DMatrix<f64> {
+        self.completed_jacobian(u, r0, self.analytic_columns(u, r0))
+    }
+
+    /// The Jacobian at `u` from the producer's closed-form columns `analytic`, forward
+    /// differences from the residuals `r0` there (stepping inwards at an upper bound) for the
+    /// columns it did not give.
+    fn completed_jacobian(
+        &self,
+        u: &DVector<f64>,
+        r0: &DVector<f64>,
+        analytic: ClosedFormColumns,
+    ) -> DMatrix<f64> {
         let n = self.layout.len();
         if n == 0 {
             return DMatrix::zeros(r0.len(), 0);
         }
-        let analytic = self.analytic_columns(u, r0);
         let column = |j: usize| -> DVector<f64> {
             if let Some(c) = &analytic[j] {
                 return c.clone();
@@ -332,7 +360,7 @@ impl<R: Residuals> FitProblem<R> {
     /// The columns the producer gives in closed form at `u` (internal coordinates), `None` for
     /// the others: all `None` when it gives none, when the residuals `r0` there are not finite
     /// (a failed evaluation, whose columns the differences make NaN) or when it fails.
-    fn analytic_columns(&self, u: &DVector<f64>, r0: &DVector<f64>) -> Vec<Option<DVector<f64>>> {
+    fn analytic_columns(&self, u: &DVector<f64>, r0: &DVector<f64>) -> ClosedFormColumns {
         let n = self.layout.len();
         if !self.residuals.has_jacobian() || r0.iter().any(|r| !r.is_finite()) {
             return vec![None; n];
@@ -368,10 +396,21 @@ impl<R: Residuals> FitProblem<R> {
         let Some(parts) = parts.into_iter().collect::<Option<Vec<_>>>() else {
             return vec![None; n];
         };
-        (0..n)
+        self.internal_columns(&parts, &p, r0.len())
+    }
+
+    /// The records' closed-form columns `parts` (physical, in record order) at physical `p`
+    /// concatenated into columns of `len` residuals in internal coordinates.
+    fn internal_columns(
+        &self,
+        parts: &[JacobianColumns],
+        p: &[f64],
+        len: usize,
+    ) -> ClosedFormColumns {
+        (0..self.layout.len())
             .map(|j| {
-                let mut column = Vec::with_capacity(r0.len());
-                for part in &parts {
+                let mut column = Vec::with_capacity(len);
+                for part in parts {
                     column.extend_from_slice(part[j].as_ref()?);
                 }
                 // d r / d u = d r / d p * d p / d u, with d u / d p = internal_derivative.
@@ -379,6 +418,69 @@ impl<R: Residuals> FitProblem<R> {
                 Some(DVector::from_vec(column) * dp_du)
             })
             .collect()
+    }
+
+    /// The residuals at physical `p` (internal `u`) with the closed-form Jacobian columns
+    /// there, from one evaluation per record, where the producer gives them together
+    /// ([`Residuals::residuals_with_columns`]) and every record's residuals are finite; `None`
+    /// otherwise (the caller evaluates them apart, and reports any failure).
+    fn evaluated_together(&self, p: &[f64]) -> Option<(DVector<f64>, ClosedFormColumns)> {
+        if !self.residuals.has_jacobian() {
+            return None;
+        }
+        let world = self.realise(p).ok()?;
+        let at = self.evaluation(&world);
+        let n = self.layout.len();
+        let record = |r: usize| -> Option<(Vec<f64>, JacobianColumns)> {
+            let case = RecordCase {
+                index: r,
+                record: &self.records[r],
+                nuisance: &world.nuisance[r],
+            };
+            let (residuals, columns) = self
+                .residuals
+                .residuals_with_columns(&at, case, &self.layout)
+                .ok()??;
+            let len = residuals.len();
+            let fits = |c: &Option<Vec<f64>>| c.as_ref().is_none_or(|c| c.len() == len);
+            let sound = len == self.residuals.residual_count(r, &self.records[r])
+                && residuals.iter().all(|x| x.is_finite())
+                && columns.len() == n
+                && columns.iter().all(fits);
+            sound.then_some((residuals, columns))
+        };
+        let parts: Vec<Option<(Vec<f64>, JacobianColumns)>> =
+            if self.worth_threads() && self.records.len() > 1 {
+                (0..self.records.len())
+                    .into_par_iter()
+                    .map(record)
+                    .collect()
+            } else {
+                (0..self.records.len()).map(record).collect()
+            };
+        let (residuals, columns): (Vec<Vec<f64>>, Vec<JacobianColumns>) = parts
+            .into_iter()
+            .collect::<Option<Vec<_>>>()?
+            .into_iter()
+            .unzip();
+        let residuals = DVector::from_vec(residuals.concat());
+        let columns = self.internal_columns(&columns, p, residuals.len());
+        Some((residuals, columns))
+    }
+
+    /// The residuals at `u` (NaN where the evaluation failed) and, when `together`, the
+    /// closed-form columns evaluated with them where the producer gives both at once.
+    fn evaluate(
+        &self,
+        u: &DVector<f64>,
+        together: bool,
+    ) -> (DVector<f64>, Option<ClosedFormColumns>) {
+        if together {
+            if let Some((r, columns)) = self.evaluated_together(&self.physical(u)) {
+                return (r, Some(columns));
+            }
+        }
+        (self.residuals_or_nan(u), None)
     }
 
     /// Whether simulations should go to other threads: allowed, and the records are not so
@@ -469,22 +571,46 @@ impl<R: Residuals> FitProblem<R> {
         &self,
         p: &[f64],
     ) -> Result<(DMatrix<f64>, DVector<f64>), EngineError> {
-        let r0 = self.residuals_at(p)?;
         let u = self.internal(p);
-        let j = self.robust_rows(self.jacobian_internal(&u, &r0), &r0);
+        let (r0, analytic) = match self.evaluated_together(p) {
+            Some(both) => both,
+            None => {
+                let r0 = self.residuals_at(p)?;
+                let analytic = self.analytic_columns(&u, &r0);
+                (r0, analytic)
+            }
+        };
+        let j = self.robust_rows(self.completed_jacobian(&u, &r0, analytic), &r0);
         Ok((self.to_physical_columns(j, p), self.robust(r0)))
     }
 }
 
+/// The Operator and Jacobian a solver drives. Where the producer gives the residuals and the
+/// closed-form columns from one evaluation, `apply` evaluates both whenever the solver took its
+/// last step (asked for the Jacobian at `apply`'s previous point): a solver that takes its
+/// step asks for the Jacobian there next, and one evaluation with sensitivities costs less
+/// than a plain one followed by another with sensitivities. After a rejected step, `apply`
+/// evaluates the residuals alone.
 impl<R: Residuals> Operator for FitProblem<R> {
     type Param = DVector<f64>;
     type Output = DVector<f64>;
     fn apply(&self, u: &DVector<f64>) -> Result<DVector<f64>, Error> {
-        let r = self.residuals_or_nan(u);
+        let took_last_step = self
+            .cache
+            .lock()
+            .ok()
+            .is_none_or(|c| c.as_ref().is_none_or(|e| e.linearised));
+        let (r, columns) = self.evaluate(u, took_last_step);
+        let out = self.robust(r.clone());
         if let Ok(mut c) = self.cache.lock() {
-            *c = Some((u.clone(), r.clone()));
+            *c = Some(Evaluated {
+                u: u.clone(),
+                residuals: r,
+                columns,
+                linearised: false,
+            });
         }
-        Ok(self.robust(r))
+        Ok(out)
     }
 }
 
@@ -492,13 +618,17 @@ impl<R: Residuals> Jacobian for FitProblem<R> {
     type Param = DVector<f64>;
     type Jacobian = DMatrix<f64>;
     fn jacobian(&self, u: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
-        let cached = self
-            .cache
-            .lock()
-            .ok()
-            .and_then(|c| c.as_ref().filter(|(cu, _)| cu == u).map(|(_, r)| r.clone()));
-        let r0 = cached.unwrap_or_else(|| self.residuals_or_nan(u));
-        Ok(self.robust_rows(self.jacobian_internal(u, &r0), &r0))
+        let cached = self.cache.lock().ok().and_then(|mut c| {
+            let e = c.as_mut().filter(|e| &e.u == u)?;
+            e.linearised = true;
+            Some((e.residuals.clone(), e.columns.take()))
+        });
+        let (r0, columns) = match cached {
+            Some(hit) => hit,
+            None => (self.residuals_or_nan(u), None),
+        };
+        let analytic = columns.unwrap_or_else(|| self.analytic_columns(u, &r0));
+        Ok(self.robust_rows(self.completed_jacobian(u, &r0, analytic), &r0))
     }
 }
 
@@ -565,6 +695,65 @@ mod tests {
                 parallel: false,
             },
         )
+    }
+
+    /// A damper stroke's Dahl problem (sigma0, the level and the load cell's offset free) and
+    /// a point off its truth, in internal coordinates.
+    fn dahl_stroke_problem() -> (
+        FitProblem<crate::identify::problem::force_along_motion::ForceAlongMotion>,
+        DVector<f64>,
+    ) {
+        use crate::identify::search::strategy::{dahl_force_problem, offset_stroke};
+        let (stroke, osc, opts) = offset_stroke(3.0);
+        let records: Arc<[Record]> = vec![stroke].into();
+        let truth = frictionid_models::Dahl {
+            sigma0: 4e5,
+            mu_c: 50.0,
+            alpha: 1.0,
+        };
+        let (problem, start) = dahl_force_problem(&records, osc, &opts, &truth);
+        let away: Vec<f64> = start.iter().map(|x| 0.8 * x + 0.5).collect();
+        let u = problem.internal(&away);
+        (problem, u)
+    }
+
+    /// A trial the solver takes costs one replay: the replay with sensitivities that gives the
+    /// Jacobian gives the residuals as well, and they are the plain replay's. The Jacobian
+    /// agrees with central differences of the plain residuals.
+    #[test]
+    fn a_taken_step_costs_one_replay_with_sensitivities() {
+        let (problem, u) = dahl_stroke_problem();
+        let r = problem.apply(&u).unwrap();
+        let j = problem.jacobian(&u).unwrap();
+        assert_eq!(problem.simulations(), 1);
+        let (plain, _) = dahl_stroke_problem();
+        let expected = plain.residuals_at(&plain.physical(&u)).unwrap();
+        assert!((&r - &expected).norm() <= 1e-12 * expected.norm());
+        for c in 0..u.len() {
+            let h = 1e-5 * u[c].abs().max(1.0);
+            let at = |step: f64| {
+                let mut moved = u.clone();
+                moved[c] += step;
+                plain.residuals_at(&plain.physical(&moved)).unwrap()
+            };
+            let central = (at(h) - at(-h)) / (2.0 * h);
+            let error = (j.column(c) - &central).norm();
+            assert!(error <= 1e-5 * central.norm(), "column {c}: {error}");
+        }
+    }
+
+    /// After a trial the solver did not take (it asked for no Jacobian there), the next trial
+    /// is evaluated without sensitivities; its Jacobian, asked for, then costs its own replay.
+    #[test]
+    fn after_a_rejected_trial_the_next_is_evaluated_alone() {
+        let (problem, u) = dahl_stroke_problem();
+        problem.apply(&u).unwrap();
+        assert_eq!(problem.simulations(), 1);
+        let next = u.map(|x| x * 1.01);
+        problem.apply(&next).unwrap();
+        assert_eq!(problem.simulations(), 2);
+        problem.jacobian(&next).unwrap();
+        assert_eq!(problem.simulations(), 3);
     }
 
     /// Once a record's simulation fails, the records after it in the same evaluation are not

@@ -280,6 +280,19 @@ pub trait Residuals: Send + Sync {
         Ok(vec![None; layout.len()])
     }
 
+    /// Record `index`'s weighted residuals ([`Residuals::residuals`]) and its Jacobian columns
+    /// ([`Residuals::jacobian_columns`]) from one evaluation, where the producer has both for
+    /// less than apart (a replay with sensitivities yields the prediction as well); `None`
+    /// where it has not, and the fit asks for them apart. Default: `None`.
+    fn residuals_with_columns(
+        &self,
+        _at: &Evaluation<'_>,
+        _case: RecordCase<'_>,
+        _layout: &[FreeParam],
+    ) -> Result<Option<(Vec<f64>, JacobianColumns)>, EngineError> {
+        Ok(None)
+    }
+
     /// Weighted residuals `sqrt(weight) scale (predicted - measured)` of record `index`, with
     /// the scale of each of its [`Residuals::segments`].
     fn residuals(
@@ -287,8 +300,18 @@ pub trait Residuals: Send + Sync {
         at: &Evaluation<'_>,
         case: RecordCase<'_>,
     ) -> Result<Vec<f64>, EngineError> {
-        let (index, record) = (case.index, case.record);
-        let mut out = self.predict(at, case)?;
+        let predicted = self.predict(at, case)?;
+        self.weighted(case.index, case.record, predicted)
+    }
+
+    /// The prediction `out` of record `index`'s measured series turned into its weighted
+    /// residuals ([`Residuals::residuals`]).
+    fn weighted(
+        &self,
+        index: usize,
+        record: &Record,
+        mut out: Vec<f64>,
+    ) -> Result<Vec<f64>, EngineError> {
         let measured = self.measured(index, record);
         if out.len() != measured.len() {
             return Err(EngineError::InvalidInput(format!(

@@ -42,9 +42,9 @@ use track::target_source;
 use super::inverse_dynamics::{linear_start, Balance, BalanceSamples, LinearStart};
 use super::residuals::{Evaluation, JacobianColumns, RecordCase, Residuals, Segment};
 use super::state_cache::StateCache;
-use crate::energy::forces_in;
 use crate::energy::model_force::{force_derivatives_checked, states_along_checked};
 use crate::energy::EnergyOptions;
+use crate::energy::{forces_in, ForceDerivatives};
 use crate::error::EngineError;
 use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::{FreeParam, ParamKind};
@@ -287,6 +287,43 @@ impl ForceAlongMotion {
             &conditions,
         ))
     }
+
+    /// The law's force and its parameter derivatives at the compared samples of `track`, from
+    /// one replay with sensitivities (`None`: the law has no gradient, or the replay failed).
+    fn law_derivatives(
+        &self,
+        at: &Evaluation<'_>,
+        track: &ForceTrack,
+    ) -> Result<Option<ForceDerivatives>, EngineError> {
+        let conditions = track.conditions.bind(&at.model.conditions())?;
+        let law = force_derivatives_checked(at.model, track.motion(), &track.used, &conditions);
+        if law.is_some() && at.model.n_states() > 0 {
+            at.count_simulation();
+        }
+        Ok(law)
+    }
+
+    /// The prediction of record `case` from the law's `force` at its compared samples: plus
+    /// the offset and, for inverse dynamics, J a + c v + R(q) at the evaluated oscillator.
+    fn completed(
+        &self,
+        at: &Evaluation<'_>,
+        case: RecordCase<'_>,
+        mut force: Vec<f64>,
+    ) -> Result<Vec<f64>, EngineError> {
+        let nuisance = case.nuisance;
+        let track = self.track_of(case.index, case.record)?;
+        if let Some(balance) = &track.balance {
+            for (f, &i) in force.iter_mut().zip(&track.used) {
+                *f +=
+                    balance.axis_force(at.oscillator, i, track.velocity[i], track.displacement[i]);
+            }
+        }
+        if nuisance.force_offset != 0.0 {
+            force.iter_mut().for_each(|f| *f += nuisance.force_offset);
+        }
+        Ok(force)
+    }
 }
 
 impl Residuals for ForceAlongMotion {
@@ -322,19 +359,8 @@ impl Residuals for ForceAlongMotion {
     /// The law's force plus the offset; for inverse dynamics plus J a + c v + R(q) at the
     /// evaluated oscillator, so that the oscillator properties' columns are the balance's.
     fn predict(&self, at: &Evaluation<'_>, case: RecordCase<'_>) -> Result<Vec<f64>, EngineError> {
-        let (index, record, nuisance) = (case.index, case.record, case.nuisance);
-        let mut force = self.friction_at(at, index, record)?;
-        let track = self.track_of(index, record)?;
-        if let Some(balance) = &track.balance {
-            for (f, &i) in force.iter_mut().zip(&track.used) {
-                *f +=
-                    balance.axis_force(at.oscillator, i, track.velocity[i], track.displacement[i]);
-            }
-        }
-        if nuisance.force_offset != 0.0 {
-            force.iter_mut().for_each(|f| *f += nuisance.force_offset);
-        }
-        Ok(force)
+        let friction = self.friction_at(at, case.index, case.record)?;
+        self.completed(at, case, friction)
     }
 
     fn friction_levels(&self) -> FrictionLevels {
@@ -396,26 +422,33 @@ impl Residuals for ForceAlongMotion {
         layout: &[FreeParam],
     ) -> Result<JacobianColumns, EngineError> {
         let track = self.track_of(case.index, case.record)?;
-        let weight = case.record.weight.sqrt() / track.noise;
-        let wanted = layout.iter().any(|f| matches!(f.kind, ParamKind::Model(_)));
-        let conditions = track.conditions.bind(&at.model.conditions())?;
-        let law = wanted
-            .then(|| force_derivatives_checked(at.model, track.motion(), &track.used, &conditions))
-            .flatten();
-        if law.is_some() && at.model.n_states() > 0 {
-            at.count_simulation();
+        let law = if asks_for_the_law(layout) {
+            self.law_derivatives(at, track)?
+        } else {
+            None
+        };
+        Ok(track.columns(at, case, layout, law.as_ref()))
+    }
+
+    /// For a law with states, the residuals and the columns from the one replay with
+    /// sensitivities the columns need: the replay's forces are the prediction's friction.
+    fn residuals_with_columns(
+        &self,
+        at: &Evaluation<'_>,
+        case: RecordCase<'_>,
+        layout: &[FreeParam],
+    ) -> Result<Option<(Vec<f64>, JacobianColumns)>, EngineError> {
+        if at.model.n_states() == 0 || !asks_for_the_law(layout) {
+            return Ok(None);
         }
-        let columns = layout.iter().map(|f| {
-            let column = match (f.kind, &law) {
-                (ParamKind::Model(j), Some(d)) if d.given.get(j).copied().unwrap_or(false) => {
-                    Some((0..track.used.len()).map(|k| d.at(k, j)).collect())
-                }
-                (ParamKind::Model(_), _) => None,
-                (kind, _) => track.balance_column(kind, case.index, at.oscillator),
-            };
-            column.map(|c: Vec<f64>| c.into_iter().map(|x| weight * x).collect())
-        });
-        Ok(columns.collect())
+        let track = self.track_of(case.index, case.record)?;
+        let Some(law) = self.law_derivatives(at, track)? else {
+            return Ok(None);
+        };
+        let columns = track.columns(at, case, layout, Some(&law));
+        let predicted = self.completed(at, case, law.force)?;
+        let residuals = self.weighted(case.index, case.record, predicted)?;
+        Ok(Some((residuals, columns)))
     }
 
     /// The friction level from the target (mean |F| over the compared samples over the mean
@@ -483,6 +516,11 @@ impl Residuals for ForceAlongMotion {
             velocity: pick(&t.velocity),
         }
     }
+}
+
+/// Whether any of the free parameters `layout` is the law's (its columns need the replay).
+fn asks_for_the_law(layout: &[FreeParam]) -> bool {
+    layout.iter().any(|f| matches!(f.kind, ParamKind::Model(_)))
 }
 
 #[cfg(test)]

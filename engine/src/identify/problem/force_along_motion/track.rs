@@ -2,15 +2,17 @@
 //! compared, and the inverse-dynamics balance where the target is the input.
 
 use super::super::inverse_dynamics::{sliding_samples, Balance};
+use super::super::residuals::{Evaluation, JacobianColumns, RecordCase};
 use super::guards::require_mechanics;
 use super::{ForceTrack, TargetSource};
 use crate::energy::model_force::{check_displacement, check_motion, CheckedMotion};
 use crate::energy::{
-    analyze_record, central_difference, record_motion, EnergyOptions, SeriesSource,
+    analyze_record, central_difference, record_motion, EnergyOptions, ForceDerivatives,
+    SeriesSource,
 };
 use crate::error::EngineError;
 use crate::identify::values::fit_options::FitOptions;
-use crate::identify::values::layout::ParamKind;
+use crate::identify::values::layout::{FreeParam, ParamKind};
 use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::nuisance::NuisanceKind;
 use crate::identify::values::result::SlidingSamples;
@@ -140,6 +142,28 @@ impl ForceTrack {
     /// Whether the replay travels the measured displacement's increments.
     pub fn follows_displacement(&self) -> bool {
         self.follows_displacement
+    }
+
+    /// Record `case`'s Jacobian columns, one per free parameter of `layout`, weighted as its
+    /// residuals are: the law's from its derivatives `law` where they are given, the offset's
+    /// and the balance's linear terms; `None` for the fit's difference quotients.
+    pub(super) fn columns(
+        &self,
+        at: &Evaluation<'_>,
+        case: RecordCase<'_>,
+        layout: &[FreeParam],
+        law: Option<&ForceDerivatives>,
+    ) -> JacobianColumns {
+        let weight = case.record.weight.sqrt() / self.noise;
+        let column = |f: &FreeParam| match (f.kind, law) {
+            (ParamKind::Model(j), Some(d)) if d.given.get(j).copied().unwrap_or(false) => {
+                Some((0..self.used.len()).map(|k| d.at(k, j)).collect())
+            }
+            (ParamKind::Model(_), _) => None,
+            (kind, _) => self.balance_column(kind, case.index, at.oscillator),
+        };
+        let weighted = |c: Vec<f64>| c.into_iter().map(|x| weight * x).collect();
+        layout.iter().map(|f| column(f).map(weighted)).collect()
     }
 
     /// The derivative of the prediction at the compared samples with respect to the
