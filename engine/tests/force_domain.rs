@@ -6,12 +6,13 @@
 use crate::util::{
     force_route_options, measured_force_options, records, rel, stribeck_truth, NOISE,
 };
+use frictionid_engine::energy::model_force_along;
 use frictionid_engine::exact::coulomb_free_vibration;
-use frictionid_engine::identify::{fit, FitOptions, ForceTarget, TargetOptions};
+use frictionid_engine::identify::{fit, FitOptions, ForceTarget, Identifiability, TargetOptions};
 use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::synthetic::add_gaussian_noise;
 use frictionid_engine::{Oscillator, Record};
-use frictionid_models::{Coulomb, FrictionModel, LuGre, Stribeck};
+use frictionid_models::{Coulomb, FrictionModel, Gms, LuGre, Stribeck};
 use std::f64::consts::PI;
 
 /// The prescribed motion: x = A sin(w t), 5 mm at 2 Hz.
@@ -356,5 +357,95 @@ fn min_speed_is_a_force_domain_option_and_a_speed() {
         .unwrap_err()
         .to_string();
         assert!(e.contains(says), "{e}");
+    }
+}
+
+/// GMS's two elements (weights 0.6 and 0.4, stiffnesses 1.5e5 and 2e4 N/m) along the
+/// prescribed motion under a constant 10 N, replayed exactly (its Jacobian is the replay's
+/// sensitivities), with 0.01 N of noise.
+fn gms_force_record() -> (Gms, Record) {
+    let mut truth = Gms::with_elements(2);
+    truth.elements[0].stiffness = 1.5e5;
+    truth.elements[0].weight = 0.6;
+    truth.elements[1].stiffness = 2e4;
+    truth.elements[1].weight = 0.4;
+    truth.mu_c = 0.2;
+    truth.mu_s = 0.3;
+    truth.v_s = 0.01;
+    let time: Vec<f64> = (0..2000).map(|i| i as f64 * 1e-3).collect();
+    let x: Vec<f64> = time.iter().map(|&t| x_of(t)).collect();
+    let v: Vec<f64> = time.iter().map(|&t| v_of(t)).collect();
+    let osc = Oscillator {
+        normal_force: 10.0,
+        ..Oscillator::fmm()
+    };
+    let mut force = model_force_along(&truth, &osc, &time, &v).unwrap();
+    add_gaussian_noise(&mut force, 0.01, 17);
+    let record = Record::from_time_base("gms", TimeBase::new(time).unwrap())
+        .with_channel(Channel::Displacement, x)
+        .with_channel(Channel::Velocity, v)
+        .with_channel(Channel::Force, force);
+    (truth, record)
+}
+
+/// The sliding force is each weight times the levels: scaling the weights up and the levels
+/// down by one factor changes nothing, so with both free the records fix only their
+/// products. Each weight and level is reported not identifiable, no standard error, named by
+/// one identifiability warning; the stiffnesses stay determined. With the weights fixed at
+/// the truth the levels are determined and within 3 standard errors of it.
+#[test]
+fn gms_weights_and_levels_free_together_are_reported_redundant() {
+    let (truth, record) = gms_force_record();
+    let osc = Oscillator {
+        normal_force: 10.0,
+        ..Oscillator::fmm()
+    };
+    let records = [record];
+    let every = fit(
+        &osc,
+        &Gms::with_elements(2),
+        &records,
+        &measured_force_options(),
+    )
+    .unwrap();
+    for name in ["w_1", "w_2", "mu_c", "mu_s"] {
+        let p = every.param(name).unwrap();
+        assert_eq!(
+            p.identifiability,
+            Some(Identifiability::NotIdentifiable),
+            "{p:?}"
+        );
+        assert!(p.std_error.is_none(), "{p:?}");
+    }
+    for name in ["k_1", "k_2"] {
+        let p = every.param(name).unwrap();
+        assert_eq!(
+            p.identifiability,
+            Some(Identifiability::Determined),
+            "{p:?}"
+        );
+    }
+    let named = every
+        .diagnostics
+        .iter()
+        .filter(|f| f.message.contains("not identifiable one by one"))
+        .count();
+    assert_eq!(named, 1, "{:?}", every.diagnostics);
+    let mut weights_fixed = measured_force_options();
+    weights_fixed.params.free = Some(
+        ["k_1", "k_2", "mu_c", "mu_s", "v_s"]
+            .map(String::from)
+            .to_vec(),
+    );
+    let levels = fit(&osc, &truth, &records, &weights_fixed).unwrap();
+    for (name, t) in [("mu_c", truth.mu_c), ("mu_s", truth.mu_s)] {
+        let p = levels.param(name).unwrap();
+        assert_eq!(
+            p.identifiability,
+            Some(Identifiability::Determined),
+            "{p:?}"
+        );
+        let se = p.std_error.unwrap();
+        assert!((p.value - t).abs() <= 3.0 * se, "{p:?}");
     }
 }

@@ -62,6 +62,8 @@ struct Statistics {
     standings: Vec<Standing>,
     /// The parameters that share an undetermined one's column.
     shared: Vec<identifiability::SharedColumn>,
+    /// The slots whose column is a combination of the other determined ones'.
+    redundant: Vec<usize>,
 }
 
 fn statistics<R: Residuals>(
@@ -81,6 +83,8 @@ fn statistics<R: Residuals>(
         .collect();
     let shared = identifiability::shared_columns(&jac, standings, &unprofiled);
     let standings = identifiability::with_shared(standings, &shared);
+    let redundant = identifiability::redundant_columns(&jac, &standings);
+    let standings = identifiability::not_identifiable(&standings, &redundant);
     let mut cov = covariance_of_determined(&jac, ssr, &standings);
     let segments = reference.residual_counts();
     let widening = widen_for_autocorrelation(&mut cov, &jac, r.as_slice(), &segments);
@@ -96,6 +100,7 @@ fn statistics<R: Residuals>(
         without_effect,
         standings,
         shared,
+        redundant,
     })
 }
 
@@ -361,6 +366,10 @@ fn diagnose<R: Residuals>(
     findings.extend(identifiability::findings(&names, ctx.standings));
     let slot_names: Vec<String> = names.iter().map(|(n, _)| n.clone()).collect();
     findings.extend(identifiability::shared_findings(&slot_names, &stats.shared));
+    findings.extend(identifiability::redundant_findings(
+        &slot_names,
+        &stats.redundant,
+    ));
     findings.extend(identifiability::consistency_findings(
         stats.world.model.as_ref(),
         ctx.reference.residuals.friction_levels(),

@@ -42,7 +42,10 @@ pub use profiles::{
 pub use rigid_limit::LIMIT_APPROACH_DECADES;
 pub(crate) use settle::settle;
 pub use settle::PROFILE_RESTARTS;
-pub use shared::{shared_columns, shared_findings, with_shared, SharedColumn, SHARED_CORRELATION};
+pub use shared::{
+    not_identifiable, redundant_columns, redundant_findings, shared_columns, shared_findings,
+    with_shared, SharedColumn, REDUNDANT_REMAINDER, SHARED_CORRELATION,
+};
 
 use crate::identify::values::result::Identifiability;
 

@@ -3,6 +3,14 @@
 //! as that of a parameter the records do not determine takes the same verdict. On a one-way
 //! stroke the Coulomb level's column sgn(v) is the offset's column 1: the records fix their
 //! sum, neither one, so neither is reported as determined.
+//!
+//! A parameter the records determine or bound on one side whose column is a combination of
+//! the columns of the others they determine or bound (nothing of it is left apart from them)
+//! is redundant with them: the records fix only a combination, whatever each one's profile
+//! says (a profile re-optimises the others, and moving along the combination they all follow
+//! is where its refits stop short and report a rise, or where a box bound such as a weight's
+//! 1 ends it). GMS's element weights and its levels scale the sliding force together: with
+//! both free, every one of them is redundant.
 
 use super::Standing;
 use crate::identify::values::outcome::{Check, Finding};
@@ -55,11 +63,64 @@ pub fn shared_columns(
     out
 }
 
-/// `standings` with every shared slot not identifiable.
-pub fn with_shared(standings: &[Standing], shared: &[SharedColumn]) -> Vec<Standing> {
+/// The part of a determined column left apart from the other determined ones, relative to
+/// its norm, at or below which it is their combination. Exact sensitivities of an exactly
+/// redundant parameterisation leave about 1e-8 (the integration's error); two parameters
+/// that merely trade closely (correlation 0.999 999) leave 1.4e-3.
+pub const REDUNDANT_REMAINDER: f64 = 1e-6;
+
+/// Each slot that `standings` calls determined or bounded on one side whose column in `jac`
+/// is a combination of the other such slots' columns: less than [`REDUNDANT_REMAINDER`] of
+/// it is left apart from them.
+pub fn redundant_columns(jac: &DMatrix<f64>, standings: &[Standing]) -> Vec<usize> {
+    let p = jac.ncols();
+    let bounded = |j: usize| {
+        standings
+            .get(j)
+            .is_none_or(|s| s.class != Identifiability::NotIdentifiable)
+    };
+    (0..p)
+        .filter(|&slot| bounded(slot))
+        .filter(|&slot| {
+            let others: Vec<usize> = (0..p).filter(|&j| j != slot && bounded(j)).collect();
+            let basis = orthonormal_basis(&jac.select_columns(&others));
+            let own = jac.column(slot).into_owned();
+            let scale = own.norm();
+            scale > 0.0
+                && scale.is_finite()
+                && apart_from(&basis, own).norm() <= REDUNDANT_REMAINDER * scale
+        })
+        .collect()
+}
+
+/// One warning naming the redundant slots `redundant` (`names`: each slot's name); none when
+/// there are none.
+pub fn redundant_findings(names: &[String], redundant: &[usize]) -> Option<Finding> {
+    if redundant.is_empty() {
+        return None;
+    }
+    let listed: Vec<String> = redundant
+        .iter()
+        .map(|&slot| format!("`{}`", names.get(slot).map_or("?", String::as_str)))
+        .collect();
+    Some(Finding::warn(
+        Check::Identifiability,
+        None,
+        format!(
+            "{} are not identifiable one by one: each one's column is a combination of the \
+             others' on these records, so the records fix only a combination of them (GMS's \
+             weights and levels scale the sliding force together: fix the weights or a level); \
+             no standard errors",
+            listed.join(", ")
+        ),
+    ))
+}
+
+/// `standings` with every slot in `slots` not identifiable.
+pub fn not_identifiable(standings: &[Standing], slots: &[usize]) -> Vec<Standing> {
     let mut out = standings.to_vec();
-    for s in shared {
-        if let Some(st) = out.get_mut(s.slot) {
+    for &slot in slots {
+        if let Some(st) = out.get_mut(slot) {
             *st = Standing {
                 class: Identifiability::NotIdentifiable,
                 bound: None,
@@ -67,6 +128,12 @@ pub fn with_shared(standings: &[Standing], shared: &[SharedColumn]) -> Vec<Stand
         }
     }
     out
+}
+
+/// `standings` with every shared slot not identifiable.
+pub fn with_shared(standings: &[Standing], shared: &[SharedColumn]) -> Vec<Standing> {
+    let slots: Vec<usize> = shared.iter().map(|s| s.slot).collect();
+    not_identifiable(standings, &slots)
 }
 
 /// A warning per shared slot, naming the parameter it shares its column with (`names`:
@@ -171,5 +238,57 @@ mod tests {
         assert!(shared_columns(&jac, &[DETERMINED; 4], &[true; 4]).is_empty());
         let distinct = [DETERMINED, DETERMINED, DETERMINED, FLAT];
         assert!(shared_columns(&jac, &distinct, &[true; 4]).is_empty());
+    }
+
+    /// GMS's weights and level as a Jacobian: the force w1 s f1(t) + w2 s f2(t) + v g(t) in
+    /// (w1, w2, s, v). Scaling w1 and w2 up and s down by one factor leaves it unchanged, so
+    /// the columns obey w1 J_w1 + w2 J_w2 - s J_s = 0: each of the three is a combination of
+    /// the others and is redundant, w1 too when its profile bounded it on one side; v's
+    /// column is its own. A column the others nearly, but not exactly, repeat (a correlation
+    /// of 0.999 999) is not redundant.
+    #[test]
+    fn columns_that_are_a_combination_of_the_others_are_redundant_and_no_others() {
+        let n = 200;
+        let (w1, w2, s) = (0.6, 0.4, 20.0);
+        let f1 = |t: f64| (t * 0.05).tanh();
+        let f2 = |t: f64| (t * 0.01).tanh();
+        let g = |t: f64| (t * 0.07).sin();
+        let jac = DMatrix::from_fn(n, 4, |i, c| {
+            let t = i as f64;
+            match c {
+                0 => s * f1(t),
+                1 => s * f2(t),
+                2 => w1 * f1(t) + w2 * f2(t),
+                _ => g(t),
+            }
+        });
+        let redundant = redundant_columns(&jac, &[DETERMINED; 4]);
+        assert_eq!(redundant, vec![0, 1, 2]);
+        let one_sided = Standing {
+            class: Identifiability::LowerBound,
+            bound: Some(0.5),
+        };
+        let with_bound = [one_sided, DETERMINED, DETERMINED, DETERMINED];
+        assert_eq!(redundant_columns(&jac, &with_bound), vec![0, 1, 2]);
+        let after = not_identifiable(&[DETERMINED; 4], &redundant);
+        assert!(after[..3].iter().all(|s| !s.determined()) && after[3].determined());
+        let names = ["w_1", "w_2", "mu_c", "viscous"].map(String::from);
+        let finding = redundant_findings(&names, &redundant).unwrap();
+        assert!(finding
+            .message
+            .starts_with("`w_1`, `w_2`, `mu_c` are not identifiable"));
+        // A parameter the records leave unbounded is not among the others: with w2 so, w1 and
+        // s are each their own again.
+        assert!(redundant_columns(&jac, &[DETERMINED, FLAT, DETERMINED, DETERMINED]).is_empty());
+        // Nearly repeated: the second column leaves about 1e-3 of itself apart from the first.
+        let near = DMatrix::from_fn(n, 2, |i, c| {
+            let t = i as f64;
+            match c {
+                0 => f1(t),
+                _ => f1(t) + 1.4e-3 * g(t) * f1(t).abs().max(0.1),
+            }
+        });
+        assert!(redundant_columns(&near, &[DETERMINED; 2]).is_empty());
+        assert!(redundant_findings(&names, &[]).is_none());
     }
 }
