@@ -391,7 +391,8 @@ fn gms_force_record() -> (Gms, Record) {
 /// The sliding force is each weight times the levels: scaling the weights up and the levels
 /// down by one factor changes nothing, so with both free the records fix only their
 /// products. Each weight and level is reported not identifiable, no standard error, named by
-/// one identifiability warning; the stiffnesses stay determined. With the weights fixed at
+/// one identifiability warning (their profiles' verdicts overruled, not beside it); the
+/// stiffnesses stay determined. With the weights fixed at
 /// the truth the levels are determined and within 3 standard errors of it.
 #[test]
 fn gms_weights_and_levels_free_together_are_reported_redundant() {
@@ -431,6 +432,15 @@ fn gms_weights_and_levels_free_together_are_reported_redundant() {
         .filter(|f| f.message.contains("not identifiable one by one"))
         .count();
     assert_eq!(named, 1, "{:?}", every.diagnostics);
+    // Their profiles' own verdicts are overruled, not reported beside it.
+    let profile_verdicts = every.diagnostics.iter().filter(|f| {
+        ["w_1", "w_2", "mu_c", "mu_s"].iter().any(|n| {
+            f.message.starts_with(&format!("{n} "))
+                || f.message
+                    .starts_with(&format!("`{n}` is not identifiable from"))
+        })
+    });
+    assert_eq!(profile_verdicts.count(), 0, "{:?}", every.diagnostics);
     let mut weights_fixed = measured_force_options();
     weights_fixed.params.free = Some(
         ["k_1", "k_2", "mu_c", "mu_s", "v_s"]

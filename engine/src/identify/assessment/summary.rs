@@ -363,7 +363,15 @@ fn diagnose<R: Residuals>(
         .iter()
         .map(|f| (f.name.clone(), f.unit.clone()))
         .collect();
-    findings.extend(identifiability::findings(&names, ctx.standings));
+    // A redundant parameter's profile verdict is overruled; the redundancy's finding names it.
+    let (profiled_names, profiled): (Vec<(String, String)>, Vec<Standing>) = names
+        .iter()
+        .zip(ctx.standings)
+        .enumerate()
+        .filter(|(j, _)| !stats.redundant.contains(j))
+        .map(|(_, (name, standing))| (name.clone(), *standing))
+        .unzip();
+    findings.extend(identifiability::findings(&profiled_names, &profiled));
     let slot_names: Vec<String> = names.iter().map(|(n, _)| n.clone()).collect();
     findings.extend(identifiability::shared_findings(&slot_names, &stats.shared));
     findings.extend(identifiability::redundant_findings(
