@@ -2,7 +2,7 @@
 //! noise, the oracle): the
 //! default configuration names only the model; the truths are independent of the fit.
 
-use crate::util::{lugre_truth, records, rel, stiff_lugre_truth, NOISE};
+use crate::util::{lugre_truth, records, rel, stiff_lugre_truth, two_element_gms, NOISE};
 use frictionid_engine::identify::{
     fit, FitOptions, FitResult, Identifiability, Search, SearchOptions,
 };
@@ -224,15 +224,10 @@ fn dahl_is_recovered_from_its_own_records() {
 #[test]
 fn gms_with_two_elements_is_recovered_from_its_own_records() {
     let osc = Oscillator::fmm();
-    let mut truth = Gms::with_elements(2);
-    truth.elements[0].stiffness = 1.5e5;
-    truth.elements[0].weight = 0.6;
-    truth.elements[1].stiffness = 2e4;
-    truth.elements[1].weight = 0.4;
-    truth.mu_c = 0.2;
-    truth.mu_s = 0.27;
-    truth.v_s = 0.01;
-    truth.viscous = 1.0;
+    let truth = Gms {
+        viscous: 1.0,
+        ..two_element_gms()
+    };
     let recs = records(&osc, &truth, NOISE, 71);
     let r = fit(&osc, &Gms::with_elements(2), &recs, &FitOptions::default()).unwrap();
     let table = assert_recovered(&r, &truth);

@@ -4,7 +4,8 @@
 //! (Eq. 7, no force sensor) on the exact Coulomb free vibration and on Stribeck records.
 
 use crate::util::{
-    force_route_options, measured_force_options, records, rel, stribeck_truth, NOISE,
+    force_route_options, measured_force_options, records, rel, stribeck_truth, two_element_gms,
+    NOISE,
 };
 use frictionid_engine::energy::model_force_along;
 use frictionid_engine::exact::coulomb_free_vibration;
@@ -360,18 +361,10 @@ fn min_speed_is_a_force_domain_option_and_a_speed() {
     }
 }
 
-/// GMS's two elements (weights 0.6 and 0.4, stiffnesses 1.5e5 and 2e4 N/m) along the
-/// prescribed motion under a constant 10 N, replayed exactly (its Jacobian is the replay's
-/// sensitivities), with 0.01 N of noise.
+/// GMS's two elements ([`two_element_gms`]) along the prescribed motion under a constant
+/// 10 N, replayed exactly (its Jacobian is the replay's sensitivities), with 0.01 N of noise.
 fn gms_force_record() -> (Gms, Record) {
-    let mut truth = Gms::with_elements(2);
-    truth.elements[0].stiffness = 1.5e5;
-    truth.elements[0].weight = 0.6;
-    truth.elements[1].stiffness = 2e4;
-    truth.elements[1].weight = 0.4;
-    truth.mu_c = 0.2;
-    truth.mu_s = 0.3;
-    truth.v_s = 0.01;
+    let truth = two_element_gms();
     let time: Vec<f64> = (0..2000).map(|i| i as f64 * 1e-3).collect();
     let x: Vec<f64> = time.iter().map(|&t| x_of(t)).collect();
     let v: Vec<f64> = time.iter().map(|&t| v_of(t)).collect();

@@ -11,7 +11,7 @@ use frictionid_engine::record::{Channel, TimeBase};
 use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid, Trajectory};
 use frictionid_engine::synthetic::release_records;
 use frictionid_engine::{Initial, Oscillator, Record, SimOptions};
-use frictionid_models::{Coulomb, FrictionModel, LuGre, Stribeck};
+use frictionid_models::{Coulomb, FrictionModel, Gms, LuGre, Stribeck};
 use std::f64::consts::PI;
 
 /// A tone of a multisine: amplitude, frequency [Hz] and phase [rad].
@@ -120,6 +120,20 @@ pub const NOISE: f64 = 2e-4;
 pub fn records(osc: &Oscillator, model: &dyn FrictionModel, noise: f64, seed: u64) -> Vec<Record> {
     release_records(osc, model, &RELEASES, 2.0, 1000.0, noise, seed)
         .expect("simulation of the truth")
+}
+
+/// GMS with two elements (stiffnesses 1.5e5 and 2e4 N/m, weights 0.6 and 0.4, undamped) over
+/// a Stribeck curve mu_c 0.20, mu_s 0.27, v_s 0.01 m/s.
+pub fn two_element_gms() -> Gms {
+    let mut truth = Gms::with_elements(2);
+    truth.elements[0].stiffness = 1.5e5;
+    truth.elements[0].weight = 0.6;
+    truth.elements[1].stiffness = 2e4;
+    truth.elements[1].weight = 0.4;
+    truth.mu_c = 0.2;
+    truth.mu_s = 0.27;
+    truth.v_s = 0.01;
+    truth
 }
 
 /// The LuGre truth of the dynamic-model recovery tests: sigma0 1e5 N/m, sigma1

@@ -291,12 +291,7 @@ impl<R: Residuals> FitProblem<R> {
             }
             residuals
         };
-        let parts: Vec<Result<Vec<f64>, EngineError>> =
-            if self.worth_threads() && self.records.len() > 1 {
-                (0..self.records.len()).into_par_iter().map(run).collect()
-            } else {
-                (0..self.records.len()).map(run).collect()
-            };
+        let parts: Vec<Result<Vec<f64>, EngineError>> = self.per_record(run);
         if parts.len() == 1 {
             // One record: its residuals as they are (a long record's are not copied).
             let only = parts.into_iter().next().unwrap_or_else(|| Ok(Vec::new()))?;
@@ -384,15 +379,7 @@ impl<R: Residuals> FitProblem<R> {
             let fits = |c: &Option<Vec<f64>>| c.as_ref().is_none_or(|c| c.len() == len);
             (columns.len() == n && columns.iter().all(fits)).then_some(columns)
         };
-        let parts: Vec<Option<JacobianColumns>> = if self.worth_threads() && self.records.len() > 1
-        {
-            (0..self.records.len())
-                .into_par_iter()
-                .map(record)
-                .collect()
-        } else {
-            (0..self.records.len()).map(record).collect()
-        };
+        let parts: Vec<Option<JacobianColumns>> = self.per_record(record);
         let Some(parts) = parts.into_iter().collect::<Option<Vec<_>>>() else {
             return vec![None; n];
         };
@@ -449,15 +436,7 @@ impl<R: Residuals> FitProblem<R> {
                 && columns.iter().all(fits);
             sound.then_some((residuals, columns))
         };
-        let parts: Vec<Option<(Vec<f64>, JacobianColumns)>> =
-            if self.worth_threads() && self.records.len() > 1 {
-                (0..self.records.len())
-                    .into_par_iter()
-                    .map(record)
-                    .collect()
-            } else {
-                (0..self.records.len()).map(record).collect()
-            };
+        let parts: Vec<Option<(Vec<f64>, JacobianColumns)>> = self.per_record(record);
         let (residuals, columns): (Vec<Vec<f64>>, Vec<JacobianColumns>) = parts
             .into_iter()
             .collect::<Option<Vec<_>>>()?
@@ -481,6 +460,16 @@ impl<R: Residuals> FitProblem<R> {
             }
         }
         (self.residuals_or_nan(u), None)
+    }
+
+    /// `f` of every record index, in record order: on rayon's pool where simulations should
+    /// go to other threads and there is more than one record.
+    fn per_record<T: Send>(&self, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+        if self.worth_threads() && self.records.len() > 1 {
+            (0..self.records.len()).into_par_iter().map(f).collect()
+        } else {
+            (0..self.records.len()).map(f).collect()
+        }
     }
 
     /// Whether simulations should go to other threads: allowed, and the records are not so
