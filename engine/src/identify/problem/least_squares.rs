@@ -255,16 +255,11 @@ impl<R: Residuals> FitProblem<R> {
 
     /// The prediction of record `r`'s measured series at `world`.
     pub fn predict_record(&self, world: &Realised, r: usize) -> Result<Vec<f64>, EngineError> {
-        let rec = self
-            .records
-            .get(r)
-            .ok_or_else(|| EngineError::InvalidInput(format!("no record {r}")))?;
-        let case = RecordCase {
-            index: r,
-            record: rec,
-            nuisance: &world.nuisance[r],
-        };
-        self.residuals.predict(&self.evaluation(world), case)
+        if r >= self.records.len() {
+            return Err(EngineError::InvalidInput(format!("no record {r}")));
+        }
+        self.residuals
+            .predict(&self.evaluation(world), self.case(world, r))
     }
 
     /// Weighted residuals of every record at physical parameters `p`, concatenated.
@@ -280,12 +275,7 @@ impl<R: Residuals> FitProblem<R> {
             if at.superseded(r) {
                 return Err(IntegrationFailure::Halted { time: 0.0 }.into());
             }
-            let case = RecordCase {
-                index: r,
-                record: &self.records[r],
-                nuisance: &world.nuisance[r],
-            };
-            let residuals = self.residuals.residuals(&at, case);
+            let residuals = self.residuals.residuals(&at, self.case(&world, r));
             if residuals.is_err() {
                 failed.fetch_min(r, Ordering::Relaxed);
             }
@@ -366,18 +356,11 @@ impl<R: Residuals> FitProblem<R> {
         };
         let at = self.evaluation(&world);
         let record = |r: usize| -> Option<JacobianColumns> {
-            let case = RecordCase {
-                index: r,
-                record: &self.records[r],
-                nuisance: &world.nuisance[r],
-            };
             let columns = self
                 .residuals
-                .jacobian_columns(&at, case, &self.layout)
+                .jacobian_columns(&at, self.case(&world, r), &self.layout)
                 .ok()?;
-            let len = self.residuals.residual_count(r, &self.records[r]);
-            let fits = |c: &Option<Vec<f64>>| c.as_ref().is_none_or(|c| c.len() == len);
-            (columns.len() == n && columns.iter().all(fits)).then_some(columns)
+            self.fits_record(r, &columns).then_some(columns)
         };
         let parts: Vec<Option<JacobianColumns>> = self.per_record(record);
         let Some(parts) = parts.into_iter().collect::<Option<Vec<_>>>() else {
@@ -417,23 +400,14 @@ impl<R: Residuals> FitProblem<R> {
         }
         let world = self.realise(p).ok()?;
         let at = self.evaluation(&world);
-        let n = self.layout.len();
         let record = |r: usize| -> Option<(Vec<f64>, JacobianColumns)> {
-            let case = RecordCase {
-                index: r,
-                record: &self.records[r],
-                nuisance: &world.nuisance[r],
-            };
             let (residuals, columns) = self
                 .residuals
-                .residuals_with_columns(&at, case, &self.layout)
+                .residuals_with_columns(&at, self.case(&world, r), &self.layout)
                 .ok()??;
-            let len = residuals.len();
-            let fits = |c: &Option<Vec<f64>>| c.as_ref().is_none_or(|c| c.len() == len);
-            let sound = len == self.residuals.residual_count(r, &self.records[r])
+            let sound = residuals.len() == self.residuals.residual_count(r, &self.records[r])
                 && residuals.iter().all(|x| x.is_finite())
-                && columns.len() == n
-                && columns.iter().all(fits);
+                && self.fits_record(r, &columns);
             sound.then_some((residuals, columns))
         };
         let parts: Vec<Option<(Vec<f64>, JacobianColumns)>> = self.per_record(record);
@@ -460,6 +434,23 @@ impl<R: Residuals> FitProblem<R> {
             }
         }
         (self.residuals_or_nan(u), None)
+    }
+
+    /// Record `r` as the producer evaluates it at `world`.
+    fn case<'a>(&'a self, world: &'a Realised, r: usize) -> RecordCase<'a> {
+        RecordCase {
+            index: r,
+            record: &self.records[r],
+            nuisance: &world.nuisance[r],
+        }
+    }
+
+    /// Whether a producer's `columns` for record `r` are whole: one per free parameter, each
+    /// as long as the record's residuals.
+    fn fits_record(&self, r: usize, columns: &JacobianColumns) -> bool {
+        let len = self.residuals.residual_count(r, &self.records[r]);
+        let fits = |c: &Option<Vec<f64>>| c.as_ref().is_none_or(|c| c.len() == len);
+        columns.len() == self.layout.len() && columns.iter().all(fits)
     }
 
     /// `f` of every record index, in record order: on rayon's pool where simulations should
