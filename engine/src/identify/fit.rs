@@ -137,7 +137,7 @@ fn fit_seeded<R: Residuals + 'static>(
     let clock = Instant::now();
     let seed_model = seed.and_then(|s| s.as_ref().ok()).map(|p| p.model.as_ref());
     let (layout, found) = laid_out_optimum(&residuals, osc, model, records, opts, seed_model)?;
-    let (runs, standings) = identifiability::settle(
+    let settled = identifiability::settle(
         &found.reference,
         found.runs,
         opts,
@@ -151,9 +151,10 @@ fn fit_seeded<R: Residuals + 'static>(
         n_starts: found.origins.len(),
         search: found.search,
         origins: &found.origins,
-        standings: &standings,
+        standings: &settled.standings,
+        redundant: &settled.redundant,
     };
-    let mut result = summarise(&context, runs, clock)?;
+    let mut result = summarise(&context, settled.runs, clock)?;
     result.diagnostics.extend(found.further);
     if opts.uncertainty.any() {
         add_property_uncertainty(&mut result, osc, opts, |shifted, fitted, refit_opts| {

@@ -44,6 +44,8 @@ pub(crate) struct FinishContext<'a, R: Residuals> {
     pub origins: &'a [String],
     /// What the records say about each free parameter.
     pub standings: &'a [Standing],
+    /// The slots found redundant before profiling (not identifiable in `standings`).
+    pub redundant: &'a [usize],
 }
 
 /// The statistics at the best parameters.
@@ -69,7 +71,7 @@ struct Statistics {
 fn statistics<R: Residuals>(
     reference: &FitProblem<R>,
     best: &StartRun,
-    standings: &[Standing],
+    (standings, redundant_before): (&[Standing], &[usize]),
 ) -> Result<Statistics, EngineError> {
     // Statistics in physical coordinates at the optimum, of the determined parameters.
     let p_best = reference.physical(&best.u);
@@ -83,7 +85,10 @@ fn statistics<R: Residuals>(
         .collect();
     let shared = identifiability::shared_columns(&jac, standings, &unprofiled);
     let standings = identifiability::with_shared(standings, &shared);
-    let redundant = identifiability::redundant_columns(&jac, &standings);
+    let mut redundant = identifiability::redundant_columns(&jac, &standings);
+    redundant.extend(redundant_before);
+    redundant.sort_unstable();
+    redundant.dedup();
     let standings = identifiability::not_identifiable(&standings, &redundant);
     let mut cov = covariance_of_determined(&jac, ssr, &standings);
     let segments = reference.residual_counts();
@@ -232,7 +237,7 @@ pub(crate) fn summarise<R: Residuals>(
     clock: Instant,
 ) -> Result<FitResult, EngineError> {
     let params = &ctx.layout.params;
-    let stats = statistics(ctx.reference, &runs.best, ctx.standings)?;
+    let stats = statistics(ctx.reference, &runs.best, (ctx.standings, ctx.redundant))?;
     let mut simulations = runs.simulations + ctx.reference.simulations();
     let fits = record_fits(
         ctx.reference,

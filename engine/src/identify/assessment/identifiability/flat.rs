@@ -1,6 +1,7 @@
 //! Which free parameters to profile: those the curvature at the optimum does not pin down.
 
 use super::profiles::PROFILE_DELTA;
+use super::shared::redundant_columns;
 use crate::error::EngineError;
 use crate::identify::assessment::stats::covariance;
 use crate::identify::problem::least_squares::FitProblem;
@@ -12,11 +13,23 @@ use nalgebra::{DMatrix, DVector};
 /// Standard error in the solver's coordinates above which a parameter is profiled.
 pub const FLAT_INTERNAL_SE: f64 = 1.0;
 
-/// The flat slots at `best` and the profile's cost rise; `None` without a residual variance.
+/// What the curvature at a best run says before any profile.
+pub(super) struct Flat {
+    /// The slots to profile.
+    pub slots: Vec<usize>,
+    /// The profile's cost rise.
+    pub delta: f64,
+    /// The slots whose column is a combination of the other free parameters' columns
+    /// ([`redundant_columns`]): not identifiable one by one, whatever a profile would find.
+    pub redundant: Vec<usize>,
+}
+
+/// The flat and the redundant slots at `best` and the profile's cost rise; `None` without
+/// a residual variance.
 pub(super) fn flat_and_delta<R: Residuals>(
     reference: &FitProblem<R>,
     best: &StartRun,
-) -> Result<Option<(Vec<usize>, f64)>, EngineError> {
+) -> Result<Option<Flat>, EngineError> {
     if reference.layout.is_empty() {
         return Ok(None);
     }
@@ -27,8 +40,16 @@ pub(super) fn flat_and_delta<R: Residuals>(
     if !(variance.is_finite() && variance > 0.0) {
         return Ok(None);
     }
-    let slots = flat_slots(reference, &jac, ssr, &p, &r);
-    Ok(Some((slots, PROFILE_DELTA * variance)))
+    let redundant = redundant_columns(&jac, &[]);
+    let slots = flat_slots(reference, &jac, ssr, &p, &r)
+        .into_iter()
+        .filter(|j| !redundant.contains(j))
+        .collect();
+    Ok(Some(Flat {
+        slots,
+        delta: PROFILE_DELTA * variance,
+        redundant,
+    }))
 }
 
 /// Free model parameters the records may not determine: every one when the Jacobian is

@@ -352,8 +352,9 @@ mod tests {
         let (reference, best, opts) = rigid_dahl_fit();
         let j = 0;
         assert_eq!(reference.layout[j].name, "sigma0");
-        let (flat, delta) = flat_and_delta(&reference, &best).unwrap().unwrap();
-        assert!(flat.contains(&j), "{flat:?}");
+        let flat = flat_and_delta(&reference, &best).unwrap().unwrap();
+        assert!(flat.slots.contains(&j), "{:?}", flat.slots);
+        let delta = flat.delta;
         let profile = Profile {
             reference: &reference,
             best: &best,

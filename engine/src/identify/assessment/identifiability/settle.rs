@@ -1,10 +1,11 @@
 //! Settling a best run: the profiles of its flat parameters (restarting the fit from a profile
 //! point clearly below it), and an iteration limit caused only by unbounded parameters.
 
-use super::flat::flat_and_delta;
+use super::flat::{flat_and_delta, Flat};
 use super::pinned::{merged, pinned_fit, pinned_problem, without};
 use super::profiles::{Profile, PROFILE_RESOLUTION};
 use super::rigid_limit::{rigid_limit, Limit};
+use super::shared::not_identifiable;
 use super::Standing;
 use crate::error::EngineError;
 use crate::identify::problem::least_squares::FitProblem;
@@ -19,8 +20,19 @@ use rayon::prelude::*;
 /// Times a profile that found a clearly lower cost restarts the fit from there.
 pub const PROFILE_RESTARTS: usize = 2;
 
+/// A best run settled: the runs, one standing per free parameter, and the slots found
+/// redundant before profiling (not identifiable; the redundancy's finding names them).
+pub(crate) struct Settled {
+    pub runs: MultiStart,
+    pub standings: Vec<Standing>,
+    pub redundant: Vec<usize>,
+}
+
 /// Profiles the flat parameters at the best run, settles an iteration limit caused only by
-/// unbounded ones, and returns the runs with one standing per free parameter. A profile
+/// unbounded ones, and returns the runs with one standing per free parameter. A parameter
+/// whose column is a combination of the others' is not profiled: the records fix only the
+/// combination, and its profile (re-optimised along the combination until a box bound
+/// stops it) would say no more than that. A profile
 /// point whose cost lies a [`PROFILE_DELTA`](super::PROFILE_DELTA) rise below the best (the
 /// fit stopped in a local minimum or on a plateau the profile stepped off) restarts the
 /// solver there, and the profiles are taken again at the better optimum. `limit_stage`: the
@@ -30,7 +42,7 @@ pub(crate) fn settle<R: Residuals + 'static>(
     mut runs: MultiStart,
     opts: &FitOptions,
     limit_stage: Option<&SimplerFit>,
-) -> Result<(MultiStart, Vec<Standing>), EngineError> {
+) -> Result<Settled, EngineError> {
     let quiet = FitOptions {
         hooks: opts.hooks.quiet(),
         ..opts.clone()
@@ -39,8 +51,16 @@ pub(crate) fn settle<R: Residuals + 'static>(
     let mut restarts = PROFILE_RESTARTS;
     loop {
         match profile_all(reference, &runs.best, &quiet, limit.as_ref(), restarts > 0)? {
-            Profiled::Standings(standings) => {
-                return Ok(finish(reference, runs, standings, &quiet))
+            Profiled::Standings {
+                standings,
+                redundant,
+            } => {
+                let runs = finish(reference, runs, &standings, &quiet);
+                return Ok(Settled {
+                    runs,
+                    standings,
+                    redundant,
+                });
             }
             Profiled::Lower(u) => {
                 restarts = if restart_from(reference, &mut runs, u, &quiet) {
@@ -56,17 +76,20 @@ pub(crate) fn settle<R: Residuals + 'static>(
 fn finish<R: Residuals + 'static>(
     reference: &FitProblem<R>,
     mut runs: MultiStart,
-    standings: Vec<Standing>,
+    standings: &[Standing],
     opts: &FitOptions,
-) -> (MultiStart, Vec<Standing>) {
-    settle_convergence(reference, &mut runs, &standings, opts);
-    (runs, standings)
+) -> MultiStart {
+    settle_convergence(reference, &mut runs, standings, opts);
+    runs
 }
 
 /// What the profiles of a best run found.
 enum Profiled {
-    /// One standing per free parameter.
-    Standings(Vec<Standing>),
+    /// One standing per free parameter, and the slots not profiled for being redundant.
+    Standings {
+        standings: Vec<Standing>,
+        redundant: Vec<usize>,
+    },
     /// A point (internal coordinates) clearly below the best cost.
     Lower(DVector<f64>),
 }
@@ -83,8 +106,16 @@ fn profile_all<R: Residuals + 'static>(
     restart: bool,
 ) -> Result<Profiled, EngineError> {
     let mut standings = vec![Standing::DETERMINED; reference.layout.len()];
-    let Some((mut slots, delta)) = flat_and_delta(reference, best)? else {
-        return Ok(Profiled::Standings(standings));
+    let Some(Flat {
+        mut slots,
+        delta,
+        redundant,
+    }) = flat_and_delta(reference, best)?
+    else {
+        return Ok(Profiled::Standings {
+            standings,
+            redundant: Vec::new(),
+        });
     };
     let open_limit = limit.filter(|l| l.cost <= best.cost + delta * l.rise_factor());
     if let Some(l) = open_limit {
@@ -94,7 +125,9 @@ fn profile_all<R: Residuals + 'static>(
             }
         }
         l.plan_profiles(best.cost + delta, &mut slots, &mut standings);
+        slots.retain(|j| !redundant.contains(j));
     }
+    standings = not_identifiable(&standings, &redundant);
     let profile = Profile {
         reference,
         best,
@@ -119,7 +152,10 @@ fn profile_all<R: Residuals + 'static>(
         }
         standings[j] = standing;
     }
-    Ok(Profiled::Standings(standings))
+    Ok(Profiled::Standings {
+        standings,
+        redundant,
+    })
 }
 
 /// Runs the solver from `u` and makes it the best run when it ends lower; whether it did.

@@ -69,9 +69,9 @@ pub fn shared_columns(
 /// that merely trade closely (correlation 0.999 999) leave 1.4e-3.
 pub const REDUNDANT_REMAINDER: f64 = 1e-6;
 
-/// Each slot that `standings` calls determined or bounded on one side whose column in `jac`
-/// is a combination of the other such slots' columns: less than [`REDUNDANT_REMAINDER`] of
-/// it is left apart from them.
+/// Each slot that `standings` calls determined or bounded on one side (a slot it does not
+/// cover counts: every one with none) whose column in `jac` is a combination of the other
+/// such slots' columns: less than [`REDUNDANT_REMAINDER`] of it is left apart from them.
 pub fn redundant_columns(jac: &DMatrix<f64>, standings: &[Standing]) -> Vec<usize> {
     let p = jac.ncols();
     let bounded = |j: usize| {
