@@ -306,7 +306,7 @@ where
             Ok((state.param(trial).cost(cost_new), None))
         } else {
             let shrink = rejected_step_shrink(normal.g.dot(&step), cost_new - self.cost);
-            self.damp_until_shorter(&p, &normal, &step, shrink);
+            self.damp_until_shorter(&p, &normal, shrink);
             if self.mu > MAX_DAMPING {
                 self.converged = Some(TerminationReason::DampingLimit);
             }
@@ -562,9 +562,10 @@ impl LevenbergMarquardt {
         self.nu *= 2.0;
     }
 
-    /// After the step `rejected` from `p` was rejected: raises the damping (Nielsen's
-    /// doublings) until the next step is at most `shrink` times as long in the damping's
-    /// scaling, sqrt(diag(JᵀJ)), or the damping reaches [`MAX_DAMPING`].
+    /// After a step from `p` was rejected: raises the damping (Nielsen's doublings) until
+    /// the damped step, before its length cap, is at most `shrink` times as long as the
+    /// rejected one's in the damping's scaling sqrt(diag(JᵀJ)), or the damping reaches
+    /// [`MAX_DAMPING`].
     ///
     /// Each doubling alone is one more trial, one more simulation: where the damping is
     /// small beside JᵀJ's spread of curvatures (a nearly redundant parameter, a long run of
@@ -573,33 +574,29 @@ impl LevenbergMarquardt {
     /// damped system is a few microseconds; the simulation it saves, milliseconds. The next
     /// trial is then the step a trust region cut by `shrink` would take (Moré's Levenberg-
     /// Marquardt, "The Levenberg-Marquardt algorithm: implementation and theory", Lecture
-    /// Notes in Mathematics 630, 1978, as in MINPACK's lmder).
-    fn damp_until_shorter(
-        &mut self,
-        p: &DVector<f64>,
-        normal: &NormalEquations,
-        rejected: &DVector<f64>,
-        shrink: f64,
-    ) {
-        let length = |step: &DVector<f64>| {
-            step.iter()
-                .zip(normal.diag.iter())
-                .map(|(s, d)| s * s * d)
-                .sum::<f64>()
-                .sqrt()
+    /// Notes in Mathematics 630, 1978, as in MINPACK's lmder). The step before its cap is
+    /// measured: a capped step keeps its length while more damping turns it towards the
+    /// gradient, and cutting the capped length too would raise the damping by decades that
+    /// the accepted steps after it then lower by a third each.
+    fn damp_until_shorter(&mut self, p: &DVector<f64>, normal: &NormalEquations, shrink: f64) {
+        let length = |solver: &Self| {
+            let delta = solver.step_with_damping(p, normal, solver.mu)?;
+            let squares = delta.iter().zip(normal.diag.iter()).map(|(s, d)| s * s * d);
+            Some(squares.sum::<f64>().sqrt())
         };
-        let target = shrink * length(rejected);
+        let Some(rejected) = length(self) else {
+            self.raise_damping();
+            return;
+        };
+        let target = shrink * rejected;
         loop {
             self.raise_damping();
             if self.mu > MAX_DAMPING {
                 return;
             }
-            let Some(delta) = self.damped_step(p, normal) else {
-                continue;
-            };
-            let shorter = length(&(self.project(&(p + delta)) - p));
-            if shorter <= target || shorter.is_nan() {
-                return;
+            match length(self) {
+                Some(shorter) if shorter <= target || shorter.is_nan() => return,
+                _ => continue,
             }
         }
     }
@@ -1013,7 +1010,7 @@ mod tests {
     }
 
     /// After a rejected trial the next one is at most half as far from the current point
-    /// (one dimension: the damping's scaling is the same for both), where a doubling of a
+    /// (one dimension, no length cap: the damping's scaling is the same for both), where a doubling of a
     /// small damping alone would try nearly the same overshooting point again; the run
     /// still converges to the root.
     #[test]
