@@ -502,15 +502,9 @@ pub(crate) fn parameters_without_effect(
     values: &[f64],
     jac: &nalgebra::DMatrix<f64>,
 ) -> Option<Finding> {
-    let dead: Vec<String> = layout
-        .iter()
-        .zip(values)
-        .enumerate()
-        .filter(|&(j, (f, &p))| {
-            let step = if p != 0.0 { p.abs() } else { f.scale.abs() };
-            j < jac.ncols() && jac.column(j).iter().all(|d| (d * step).abs() <= NO_EFFECT)
-        })
-        .map(|(_, (f, p))| format!("`{}` = {p:e} {}", f.name, f.unit))
+    let dead: Vec<String> = slots_without_effect(layout, values, jac)
+        .into_iter()
+        .map(|j| format!("`{}` = {:e} {}", layout[j].name, values[j], layout[j].unit))
         .collect();
     (!dead.is_empty()).then(|| {
         Finding::new(
@@ -523,6 +517,26 @@ pub(crate) fn parameters_without_effect(
             ),
         )
     })
+}
+
+/// The free parameters (slots of `layout`, at `values`) whose column of `jac` moves no
+/// residual by [`NO_EFFECT`] of its noise over a change the size of their value (their
+/// scale, when zero).
+pub(crate) fn slots_without_effect(
+    layout: &[FreeParam],
+    values: &[f64],
+    jac: &nalgebra::DMatrix<f64>,
+) -> Vec<usize> {
+    layout
+        .iter()
+        .zip(values)
+        .enumerate()
+        .filter(|&(j, (f, &p))| {
+            let step = if p != 0.0 { p.abs() } else { f.scale.abs() };
+            j < jac.ncols() && jac.column(j).iter().all(|d| (d * step).abs() <= NO_EFFECT)
+        })
+        .map(|(j, _)| j)
+        .collect()
 }
 
 /// What to do about a parameter at its bound.

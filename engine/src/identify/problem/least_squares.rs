@@ -683,7 +683,7 @@ mod tests {
         FitProblem<crate::identify::problem::force_along_motion::ForceAlongMotion>,
         DVector<f64>,
     ) {
-        use crate::identify::search::strategy::{dahl_force_problem, offset_stroke};
+        use crate::identify::search::strategy::{law_force_problem, offset_stroke};
         let (stroke, osc, opts) = offset_stroke(3.0);
         let records: Arc<[Record]> = vec![stroke].into();
         let truth = frictionid_models::Dahl {
@@ -691,7 +691,7 @@ mod tests {
             mu_c: 50.0,
             alpha: 1.0,
         };
-        let (problem, start) = dahl_force_problem(&records, osc, &opts, &truth);
+        let (problem, start) = law_force_problem(&records, osc, &opts, &truth);
         let away: Vec<f64> = start.iter().map(|x| 0.8 * x + 0.5).collect();
         let u = problem.internal(&away);
         (problem, u)

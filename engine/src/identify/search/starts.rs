@@ -764,7 +764,7 @@ fn pick_best(screened: Screened) -> Option<MultiStart> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::identify::search::strategy::{dahl_force_problem, offset_stroke};
+    use crate::identify::search::strategy::{law_force_problem, offset_stroke};
     use crate::record::Channel;
 
     /// The least-squares offset of a residual affine in it: minus the mean residual per unit
@@ -791,7 +791,7 @@ mod tests {
             mu_c: 50.0,
             alpha: 1.0,
         };
-        let (problem, _) = dahl_force_problem(&records, osc, &opts, &truth);
+        let (problem, _) = law_force_problem(&records, osc, &opts, &truth);
         let names: Vec<&str> = problem.layout.iter().map(|f| f.name.as_str()).collect();
         assert_eq!(names, ["sigma0", "mu_c", "force_offset[stroke]"]);
         let start = [4e5, 50.0, 0.0];

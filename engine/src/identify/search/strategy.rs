@@ -605,14 +605,14 @@ pub(crate) fn offset_stroke(offset: f64) -> (Record, Oscillator, FitOptions) {
 }
 
 #[cfg(test)]
-/// The force-domain problem of Dahl's law along `records` under `opts` (a fresh one per
-/// call: a solver run takes its problem), with the layout started at `truth`: the problem
-/// and the start (physical values).
-pub(crate) fn dahl_force_problem(
+/// The force-domain problem of the law `truth` along `records` under `opts` (a fresh one
+/// per call: a solver run takes its problem), with the layout started at `truth`: the
+/// problem and the start (physical values).
+pub(crate) fn law_force_problem(
     records: &Arc<[Record]>,
     osc: Oscillator,
     opts: &FitOptions,
-    truth: &frictionid_models::Dahl,
+    truth: &(dyn FrictionModel + 'static),
 ) -> (
     FitProblem<crate::identify::problem::force_along_motion::ForceAlongMotion>,
     Vec<f64>,

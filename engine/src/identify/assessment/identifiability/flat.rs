@@ -1,13 +1,17 @@
 //! Which free parameters to profile: those the curvature at the optimum does not pin down.
 
+use super::covariance::covariance_of_determined;
 use super::profiles::PROFILE_DELTA;
 use super::shared::redundant_columns;
+use super::Standing;
 use crate::error::EngineError;
+use crate::identify::assessment::diagnostics::slots_without_effect;
 use crate::identify::assessment::stats::covariance;
 use crate::identify::problem::least_squares::FitProblem;
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::StartRun;
 use crate::identify::values::layout::ParamKind;
+use crate::identify::values::result::Identifiability;
 use nalgebra::{DMatrix, DVector};
 
 /// Standard error in the solver's coordinates above which a parameter is profiled.
@@ -41,7 +45,7 @@ pub(super) fn flat_and_delta<R: Residuals>(
         return Ok(None);
     }
     let redundant = redundant_columns(&jac, &[]);
-    let slots = flat_slots(reference, &jac, ssr, &p, &r)
+    let slots = flat_slots(reference, (&jac, ssr), &p, &r, &redundant)
         .into_iter()
         .filter(|j| !redundant.contains(j))
         .collect();
@@ -52,20 +56,42 @@ pub(super) fn flat_and_delta<R: Residuals>(
     }))
 }
 
-/// Free model parameters the records may not determine: every one when the Jacobian is
-/// rank-deficient, else those whose standard error in the solver's coordinates is missing
-/// or above [`FLAT_INTERNAL_SE`], those held at a bound (where the curvature says nothing of
-/// the side beyond it), or (a model with internal states) those whose Jacobian column is
-/// integration noise ([`noise_dominated`]).
+/// Free model parameters the records may not determine: those without effect at `p` (a
+/// zero column: [`slots_without_effect`]), those whose standard error in the solver's
+/// coordinates is missing or above [`FLAT_INTERNAL_SE`], those held at a bound (where the
+/// curvature says nothing of the side beyond it), or (a model with internal states) those
+/// whose Jacobian column is integration noise ([`noise_dominated`]); every one when the
+/// Jacobian is rank-deficient apart from the parameters without effect and the
+/// `redundant` ones.
+///
+/// The standard errors are those of the covariance the result reports
+/// ([`covariance_of_determined`]): the parameters without effect and the redundant ones
+/// set aside, a redundant one taken back where the others stay determined. A zero column
+/// is orthogonal to every other, so setting it aside leaves the others' errors as they
+/// were; a GMS element without load at the optimum made the whole Jacobian singular, and
+/// every parameter of the law was profiled.
 fn flat_slots<R: Residuals>(
     reference: &FitProblem<R>,
-    jac: &DMatrix<f64>,
-    ssr: f64,
+    (jac, ssr): (&DMatrix<f64>, f64),
     p: &[f64],
     r: &DVector<f64>,
+    redundant: &[usize],
 ) -> Vec<usize> {
     let layout = &reference.layout;
-    let cov = covariance(jac, ssr);
+    let without_effect = slots_without_effect(layout, p, jac);
+    let set_aside: Vec<Standing> = (0..layout.len())
+        .map(|j| {
+            if without_effect.contains(&j) || redundant.contains(&j) {
+                Standing {
+                    class: Identifiability::NotIdentifiable,
+                    bound: None,
+                }
+            } else {
+                Standing::DETERMINED
+            }
+        })
+        .collect();
+    let cov = covariance_of_determined(jac, ssr, &set_aside);
     let dynamic = reference.model.n_states() > 0;
     (0..layout.len())
         .filter(|&j| matches!(layout[j].kind, ParamKind::Model(_)))
@@ -106,4 +132,68 @@ fn noise_dominated<R: Residuals>(
     let backward = reference.difference_column(&u, r, j, -h);
     let scale = forward.norm().max(backward.norm());
     (forward - backward).norm() > NOISY_COLUMN * scale || !scale.is_finite()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identify::search::strategy::{law_force_problem, offset_stroke};
+    use crate::identify::values::outcome::TerminationReason;
+    use crate::record::Record;
+    use crate::testing::DamperStroke;
+    use frictionid_models::Stribeck;
+    use std::sync::Arc;
+
+    /// The flat slots' names of Stribeck's law (its Coulomb level, static level, Stribeck
+    /// speed and viscous coefficient free, the normal force 1 N) on a short damper stroke's
+    /// force, at `values` of those four and no force offset. The stroke's frequency puts no
+    /// sample on a reversal, where the speed would be zero.
+    fn flat_names(values: [f64; 4]) -> Vec<String> {
+        let (_, osc, mut opts) = offset_stroke(0.0);
+        let stroke = DamperStroke {
+            frequency: 2.0137,
+            ..DamperStroke::short()
+        }
+        .record(4000);
+        let free = ["mu_c", "mu_s", "v_s", "viscous"];
+        opts.params.free = Some(free.iter().map(|s| (*s).into()).collect());
+        let records: Arc<[Record]> = vec![stroke].into();
+        let law = Stribeck::default();
+        let (reference, _) = law_force_problem(&records, osc, &opts, &law);
+        let names: Vec<&str> = reference.layout.iter().map(|f| f.name.as_str()).collect();
+        assert_eq!(
+            names,
+            ["mu_c", "mu_s", "v_s", "viscous", "force_offset[stroke]"]
+        );
+        let p = [values[0], values[1], values[2], values[3], 0.0];
+        let best = StartRun {
+            u: reference.internal(&p),
+            cost: f64::NAN,
+            iterations: 0,
+            simulations: 0,
+            termination: TerminationReason::GradientBelowTolerance,
+            linearisation: None,
+        };
+        let flat = flat_and_delta(&reference, &best).unwrap().unwrap();
+        flat.slots
+            .iter()
+            .map(|&j| reference.layout[j].name.clone())
+            .collect()
+    }
+
+    /// Stribeck's law on a damper stroke with a Stribeck speed of 1e-12 m/s, far below
+    /// every sampled speed: its static level and its speed change no residual (zero
+    /// columns), which makes the Jacobian singular, while the Coulomb level and the viscous
+    /// term are determined. Set aside, the zero columns leave the others' standard errors
+    /// as they were: only they are profiled. At an ordinary Stribeck speed nothing is set
+    /// aside and the same rule profiles what the curvature does not pin down.
+    #[test]
+    fn parameters_without_effect_are_profiled_and_leave_the_others_to_their_errors() {
+        let mut flat = flat_names([40.0, 50.0, 1e-12, 100.0]);
+        flat.sort();
+        assert_eq!(flat, ["mu_s", "v_s"]);
+        let flat = flat_names([40.0, 50.0, 0.01, 100.0]);
+        assert!(!flat.contains(&"mu_c".to_string()), "{flat:?}");
+        assert!(!flat.contains(&"viscous".to_string()), "{flat:?}");
+    }
 }

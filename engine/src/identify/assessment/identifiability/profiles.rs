@@ -301,7 +301,7 @@ mod tests {
     use super::*;
     use crate::identify::problem::force_along_motion::ForceAlongMotion;
     use crate::identify::search::starts::{run_start, RunSlot};
-    use crate::identify::search::strategy::{dahl_force_problem, offset_stroke};
+    use crate::identify::search::strategy::{law_force_problem, offset_stroke};
     use crate::record::{Channel, Record};
     use std::sync::Arc;
 
@@ -326,8 +326,8 @@ mod tests {
             mu_c: 50.0,
             alpha: 1.0,
         };
-        let (reference, start) = dahl_force_problem(&records, osc, &opts, &truth);
-        let (problem, _) = dahl_force_problem(&records, osc, &opts, &truth);
+        let (reference, start) = law_force_problem(&records, osc, &opts, &truth);
+        let (problem, _) = law_force_problem(&records, osc, &opts, &truth);
         let slot = RunSlot {
             start: 0,
             starts: 1,
