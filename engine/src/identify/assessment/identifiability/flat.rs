@@ -6,7 +6,7 @@ use super::shared::redundant_columns;
 use super::Standing;
 use crate::error::EngineError;
 use crate::identify::assessment::diagnostics::slots_without_effect;
-use crate::identify::assessment::stats::covariance;
+use crate::identify::assessment::stats::{covariance, Covariance};
 use crate::identify::problem::least_squares::FitProblem;
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::StartRun;
@@ -40,12 +40,19 @@ pub(super) fn flat_and_delta<R: Residuals>(
     let p = reference.physical(&best.u);
     let (jac, r) = reference.jacobian_physical(&p)?;
     let ssr = r.norm_squared();
-    let variance = covariance(&jac, ssr).residual_variance;
+    let full = covariance(&jac, ssr);
+    let variance = full.residual_variance;
     if !(variance.is_finite() && variance > 0.0) {
         return Ok(None);
     }
-    let redundant = redundant_columns(&jac, &[]);
-    let slots = flat_slots(reference, (&jac, ssr), &p, &r, &redundant)
+    // A column that is a combination of the others makes JᵀJ singular: only then is one
+    // looked for (the QR factors of a long record's Jacobian are not free).
+    let redundant = if full.singular {
+        redundant_columns(&jac, &[])
+    } else {
+        Vec::new()
+    };
+    let slots = flat_slots(reference, (&jac, ssr, full), &p, &r, &redundant)
         .into_iter()
         .filter(|j| !redundant.contains(j))
         .collect();
@@ -72,7 +79,7 @@ pub(super) fn flat_and_delta<R: Residuals>(
 /// every parameter of the law was profiled.
 fn flat_slots<R: Residuals>(
     reference: &FitProblem<R>,
-    (jac, ssr): (&DMatrix<f64>, f64),
+    (jac, ssr, full): (&DMatrix<f64>, f64, Covariance),
     p: &[f64],
     r: &DVector<f64>,
     redundant: &[usize],
@@ -91,7 +98,11 @@ fn flat_slots<R: Residuals>(
             }
         })
         .collect();
-    let cov = covariance_of_determined(jac, ssr, &set_aside);
+    let cov = if without_effect.is_empty() && redundant.is_empty() {
+        full
+    } else {
+        covariance_of_determined(jac, ssr, &set_aside)
+    };
     let dynamic = reference.model.n_states() > 0;
     (0..layout.len())
         .filter(|&j| matches!(layout[j].kind, ParamKind::Model(_)))
