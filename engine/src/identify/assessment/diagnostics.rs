@@ -14,7 +14,7 @@
 //! - Parameters at a bound, standard errors that cannot be computed, starts that disagree,
 //!   non-convergence.
 
-use super::identifiability::PROFILE_DELTA;
+use super::identifiability::{slots_without_effect, PROFILE_DELTA};
 use super::stats::autocorrelation;
 use crate::axis::Axis;
 use crate::energy::cumulative_trapezoid;
@@ -489,13 +489,9 @@ fn unit_suffix(unit: &str) -> String {
     }
 }
 
-/// The largest change of any weighted residual (in units of its noise) that a change of a
-/// free parameter by its own magnitude may make for the parameter to count as without effect.
-pub(crate) const NO_EFFECT: f64 = 1e-8;
-
 /// A failure naming the free parameters whose Jacobian column `jac` (physical coordinates,
 /// weighted residuals) is zero everywhere at `values`: changed by their own magnitude (or
-/// scale, when zero), none moves a residual by [`NO_EFFECT`] of its noise. `None` when every
+/// scale, when zero), none moves a residual by `NO_EFFECT` (in `identifiability/flat.rs`) of its noise. `None` when every
 /// parameter acts on the records.
 pub(crate) fn parameters_without_effect(
     layout: &[FreeParam],
@@ -517,26 +513,6 @@ pub(crate) fn parameters_without_effect(
             ),
         )
     })
-}
-
-/// The free parameters (slots of `layout`, at `values`) whose column of `jac` moves no
-/// residual by [`NO_EFFECT`] of its noise over a change the size of their value (their
-/// scale, when zero).
-pub(crate) fn slots_without_effect(
-    layout: &[FreeParam],
-    values: &[f64],
-    jac: &nalgebra::DMatrix<f64>,
-) -> Vec<usize> {
-    layout
-        .iter()
-        .zip(values)
-        .enumerate()
-        .filter(|&(j, (f, &p))| {
-            let step = if p != 0.0 { p.abs() } else { f.scale.abs() };
-            j < jac.ncols() && jac.column(j).iter().all(|d| (d * step).abs() <= NO_EFFECT)
-        })
-        .map(|(j, _)| j)
-        .collect()
 }
 
 /// What to do about a parameter at its bound.

@@ -5,11 +5,11 @@ use super::profiles::PROFILE_DELTA;
 use super::shared::redundant_columns;
 use super::Standing;
 use crate::error::EngineError;
-use crate::identify::assessment::diagnostics::slots_without_effect;
 use crate::identify::assessment::stats::{covariance, Covariance};
 use crate::identify::problem::least_squares::FitProblem;
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::StartRun;
+use crate::identify::values::layout::FreeParam;
 use crate::identify::values::layout::ParamKind;
 use crate::identify::values::result::Identifiability;
 use nalgebra::{DMatrix, DVector};
@@ -112,6 +112,30 @@ fn flat_slots<R: Residuals>(
             let at_bound = layout[j].bound_side(p[j]).is_some();
             !fine || at_bound || (dynamic && noise_dominated(reference, jac, p, r, j))
         })
+        .collect()
+}
+
+/// The largest change of any weighted residual (in units of its noise) that a change of a
+/// free parameter by its own magnitude may make for the parameter to count as without effect.
+pub(super) const NO_EFFECT: f64 = 1e-8;
+
+/// The free parameters (slots of `layout`, at `values`) whose column of `jac` moves no
+/// residual by [`NO_EFFECT`] of its noise over a change the size of their value (their
+/// scale, when zero).
+pub(crate) fn slots_without_effect(
+    layout: &[FreeParam],
+    values: &[f64],
+    jac: &nalgebra::DMatrix<f64>,
+) -> Vec<usize> {
+    layout
+        .iter()
+        .zip(values)
+        .enumerate()
+        .filter(|&(j, (f, &p))| {
+            let step = if p != 0.0 { p.abs() } else { f.scale.abs() };
+            j < jac.ncols() && jac.column(j).iter().all(|d| (d * step).abs() <= NO_EFFECT)
+        })
+        .map(|(j, _)| j)
         .collect()
 }
 

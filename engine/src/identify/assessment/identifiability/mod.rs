@@ -34,6 +34,7 @@ mod shared;
 
 pub use covariance::covariance_of_determined;
 pub use findings::{consistency_findings, findings};
+pub(crate) use flat::slots_without_effect;
 pub use flat::{FLAT_INTERNAL_SE, NOISY_COLUMN};
 pub use profiles::{
     LIMIT_PROFILE_ITERATIONS, PROFILE_DELTA, PROFILE_HALVINGS, PROFILE_ITERATIONS,
