@@ -2,16 +2,14 @@
 
 use super::covariance::covariance_of_determined;
 use super::profiles::PROFILE_DELTA;
-use super::shared::redundant_columns;
+use super::shared::{not_identifiable, redundant_columns};
 use super::Standing;
 use crate::error::EngineError;
 use crate::identify::assessment::stats::{covariance, Covariance};
 use crate::identify::problem::least_squares::FitProblem;
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::StartRun;
-use crate::identify::values::layout::FreeParam;
-use crate::identify::values::layout::ParamKind;
-use crate::identify::values::result::Identifiability;
+use crate::identify::values::layout::{FreeParam, ParamKind};
 use nalgebra::{DMatrix, DVector};
 
 /// Standard error in the solver's coordinates above which a parameter is profiled.
@@ -86,22 +84,12 @@ fn flat_slots<R: Residuals>(
 ) -> Vec<usize> {
     let layout = &reference.layout;
     let without_effect = slots_without_effect(layout, p, jac);
-    let set_aside: Vec<Standing> = (0..layout.len())
-        .map(|j| {
-            if without_effect.contains(&j) || redundant.contains(&j) {
-                Standing {
-                    class: Identifiability::NotIdentifiable,
-                    bound: None,
-                }
-            } else {
-                Standing::DETERMINED
-            }
-        })
-        .collect();
-    let cov = if without_effect.is_empty() && redundant.is_empty() {
+    let set_aside = [without_effect.as_slice(), redundant].concat();
+    let cov = if set_aside.is_empty() {
         full
     } else {
-        covariance_of_determined(jac, ssr, &set_aside)
+        let standings = vec![Standing::DETERMINED; layout.len()];
+        covariance_of_determined(jac, ssr, &not_identifiable(&standings, &set_aside))
     };
     let dynamic = reference.model.n_states() > 0;
     (0..layout.len())
@@ -125,7 +113,7 @@ pub(super) const NO_EFFECT: f64 = 1e-8;
 pub(crate) fn slots_without_effect(
     layout: &[FreeParam],
     values: &[f64],
-    jac: &nalgebra::DMatrix<f64>,
+    jac: &DMatrix<f64>,
 ) -> Vec<usize> {
     layout
         .iter()
