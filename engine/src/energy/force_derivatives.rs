@@ -35,6 +35,23 @@ impl ForceDerivatives {
     pub fn at(&self, k: usize, j: usize) -> f64 {
         self.gradient[k * self.given.len() + j]
     }
+
+    /// Every parameter's column over the first `samples` requested samples, each entry times
+    /// `weight`: the rows read once, in the order they are stored (a column read on its own
+    /// would stride through every row of the gradient).
+    pub fn weighted_columns(&self, samples: usize, weight: f64) -> Vec<Vec<f64>> {
+        let np = self.given.len();
+        if np == 0 {
+            return Vec::new();
+        }
+        let mut columns: Vec<Vec<f64>> = (0..np).map(|_| Vec::with_capacity(samples)).collect();
+        for row in self.gradient.chunks_exact(np).take(samples) {
+            for (column, &entry) in columns.iter_mut().zip(row) {
+                column.push(weight * entry);
+            }
+        }
+        columns
+    }
 }
 
 /// The states and their sensitivities along a replay, and the force's derivatives from them.
@@ -123,4 +140,30 @@ pub(crate) fn walk_rows(
         }
     }
     Some(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The columns read in one pass over the rows hold each entry as `at` gives it, times the
+    /// weight, for the samples asked for only.
+    #[test]
+    fn weighted_columns_hold_each_entry_times_the_weight() {
+        let (samples, np) = (7, 3);
+        let mut d = ForceDerivatives::for_samples(samples, np);
+        for (i, g) in d.gradient.iter_mut().enumerate() {
+            *g = (i as f64 * 0.731).sin();
+        }
+        let weight = 2.5;
+        let columns = d.weighted_columns(5, weight);
+        assert_eq!(columns.len(), np);
+        for (j, column) in columns.iter().enumerate() {
+            let want: Vec<f64> = (0..5).map(|k| weight * d.at(k, j)).collect();
+            assert_eq!(column, &want, "column {j}");
+        }
+        assert!(ForceDerivatives::for_samples(4, 0)
+            .weighted_columns(4, 1.0)
+            .is_empty());
+    }
 }

@@ -195,7 +195,14 @@ thread_local! {
     /// [`Gms::stribeck_decay`]'s last result: the bits of |v / v_s| and delta it was computed
     /// at, the power and the decay.
     static LAST_DECAY: Cell<Option<(u64, u64, f64, f64)>> = const { Cell::new(None) };
+    /// [`Gms::load_power`]'s last results, [`KEPT_POWERS`] slots picked by the load's bits:
+    /// the bits of the load and the sharpness each was computed at, and the power.
+    static LAST_POWERS: [Cell<(u64, u64, f64)>; KEPT_POWERS] =
+        const { [const { Cell::new((u64::MAX, u64::MAX, f64::NAN)) }; KEPT_POWERS] };
 }
+
+/// Load powers kept ([`Gms::load_power`]): more than the elements of a usual GMS.
+const KEPT_POWERS: usize = 8;
 
 /// Default stiffness of element `i` (0-based): 1e5 N/m, each next one a third of the previous,
 /// so the elements break away at well-spread displacements.
@@ -264,6 +271,29 @@ impl Gms {
         (power, e)
     }
 
+    /// An element's load raised to the sharpness, load^m (the load itself at m = 1), to the
+    /// bit as computed afresh: the last few powers are kept, in a slot picked by the load's
+    /// bits, since a replay asks for each element's power at one sample from three places
+    /// (the force, its gradient in z and v, its gradient in the parameters) and the power is
+    /// the costliest part of each.
+    pub(super) fn load_power(&self, load: f64) -> f64 {
+        let m = self.sharpness;
+        if m == 1.0 {
+            return load;
+        }
+        let key = (load.to_bits(), m.to_bits());
+        let slot = ((key.0 ^ (key.0 >> 32)) % KEPT_POWERS as u64) as usize;
+        LAST_POWERS.with(|kept| {
+            let (l, k, power) = kept[slot].get();
+            if (l, k) == key {
+                return power;
+            }
+            let power = load.powf(m);
+            kept[slot].set((key.0, key.1, power));
+            power
+        })
+    }
+
     /// The Stribeck curve s(v) and its slope ds/dv from one power: with u = |v / v_s|,
     /// d(u^delta)/dv = delta u^delta / v (0 at v = 0).
     fn s_and_slope(&self, v: f64, normal: f64) -> (f64, f64) {
@@ -286,7 +316,7 @@ impl Gms {
             None => (0.0, 0.0),
             Some((limit, load)) if load > 0.0 => {
                 let m = self.sharpness;
-                let p = if m == 1.0 { load } else { load.powf(m) };
+                let p = self.load_power(load);
                 let d_dz = -v.abs() * m * (p / load) * e.stiffness / limit;
                 (d_dz, 1.0 - p + v * m * p * ds / s)
             }
@@ -339,11 +369,7 @@ impl Gms {
         match Self::element_load(e, v, z, s) {
             None => 0.0,
             Some((_, load)) if load > 0.0 => {
-                let p = if self.sharpness == 1.0 {
-                    load
-                } else {
-                    load.powf(self.sharpness)
-                };
+                let p = self.load_power(load);
                 v * (1.0 - p)
             }
             Some(_) => v,
@@ -860,5 +886,38 @@ mod tests {
                 assert_eq!(law.s(v, 14.5), want, "v = {v}, v_s = {}", law.v_s);
             }
         }
+    }
+
+    #[test]
+    fn the_kept_load_powers_are_the_ones_computed_afresh() {
+        // More loads than slots, asked in turn by laws of two sharpnesses and again: every
+        // answer is the power the formula gives, whichever slot it was kept in.
+        let a = Gms {
+            sharpness: 2.7,
+            ..Gms::default()
+        };
+        let b = Gms {
+            sharpness: 6.0,
+            ..Gms::default()
+        };
+        let loads: Vec<f64> = (1..=3 * KEPT_POWERS).map(|k| 0.037 * k as f64).collect();
+        for _ in 0..2 {
+            for &load in &loads {
+                for law in [&a, &b, &a] {
+                    let want = load.powf(law.sharpness);
+                    assert_eq!(
+                        law.load_power(load),
+                        want,
+                        "load {load}, m {}",
+                        law.sharpness
+                    );
+                }
+            }
+        }
+        let linear = Gms {
+            sharpness: 1.0,
+            ..Gms::default()
+        };
+        assert_eq!(linear.load_power(0.3), 0.3);
     }
 }

@@ -291,16 +291,34 @@ impl Propagator for Gms {
             let y1 = frame.y0 + frame.step.change;
             // sgn(v) / rho, one division for the row.
             let back = u / frame.rho;
-            for (j, sj) in row.iter_mut().enumerate() {
+            let step = |g: f64, direct: f64, sj: f64| {
+                let dy0 = frame.y0 * g + u * frame.rho * sj;
+                let dy1 = frame.step.gain * dy0 + direct;
+                (dy1 - y1 * g) * back
+            };
+            // The element's own stiffness and weight, the Stribeck parameters and the
+            // sharpness move its load or its travel; every other parameter only carries a
+            // sensitivity the element already has (none, in a replay from rest).
+            for j in [i, n + i, 3 * n, 3 * n + 1, 3 * n + 2, 3 * n + 3, sharpness] {
+                let Some(sj) = row.get_mut(j) else {
+                    continue;
+                };
                 let g = slopes.of(j);
-                let dy0 = frame.y0 * g + u * frame.rho * *sj;
                 let direct = if j == sharpness {
                     frame.step.sharpness
                 } else {
                     frame.step.slope * frame.sigma * g
                 };
-                let dy1 = frame.step.gain * dy0 + direct;
-                *sj = (dy1 - y1 * g) * back;
+                *sj = step(g, direct, *sj);
+            }
+            let unmoved = frame.step.slope * frame.sigma * 0.0;
+            for carried in [0..i, i + 1..n + i, n + i + 1..3 * n, sharpness + 1..np] {
+                let Some(part) = row.get_mut(carried) else {
+                    continue;
+                };
+                for sj in part.iter_mut().filter(|sj| **sj != 0.0) {
+                    *sj = step(0.0, unmoved, *sj);
+                }
             }
         }
     }
@@ -392,11 +410,7 @@ impl Gms {
         match Gms::element_load(e, v, z, s) {
             None => (0.0, 0.0, 0.0),
             Some((_, load)) if load > 0.0 => {
-                let p = if self.sharpness == 1.0 {
-                    load
-                } else {
-                    load.powf(self.sharpness)
-                };
+                let p = self.load_power(load);
                 let rate = v * (1.0 - p);
                 if with_slopes {
                     (rate, -v * self.sharpness * p, -v * p * load.ln())

@@ -155,15 +155,22 @@ impl ForceTrack {
         law: Option<&ForceDerivatives>,
     ) -> JacobianColumns {
         let weight = case.record.weight.sqrt() / self.noise;
-        let column = |f: &FreeParam| match (f.kind, law) {
-            (ParamKind::Model(j), Some(d)) if d.given.get(j).copied().unwrap_or(false) => {
-                Some((0..self.used.len()).map(|k| d.at(k, j)).collect())
-            }
-            (ParamKind::Model(_), _) => None,
-            (kind, _) => self.balance_column(kind, case.index, at.oscillator),
-        };
+        let mut law_columns = law.map(|d| d.weighted_columns(self.used.len(), weight));
         let weighted = |c: Vec<f64>| c.into_iter().map(|x| weight * x).collect();
-        layout.iter().map(|f| column(f).map(weighted)).collect()
+        layout
+            .iter()
+            .map(|f| match (f.kind, law, law_columns.as_mut()) {
+                (ParamKind::Model(j), Some(d), Some(columns))
+                    if d.given.get(j).copied().unwrap_or(false) =>
+                {
+                    columns.get_mut(j).map(std::mem::take)
+                }
+                (ParamKind::Model(_), _, _) => None,
+                (kind, _, _) => self
+                    .balance_column(kind, case.index, at.oscillator)
+                    .map(weighted),
+            })
+            .collect()
     }
 
     /// The derivative of the prediction at the compared samples with respect to the
