@@ -36,18 +36,24 @@ impl ForceDerivatives {
         self.gradient[k * self.given.len() + j]
     }
 
-    /// Every parameter's column over the first `samples` requested samples, each entry times
-    /// `weight`: the rows read once, in the order they are stored (a column read on its own
-    /// would stride through every row of the gradient).
-    pub fn weighted_columns(&self, samples: usize, weight: f64) -> Vec<Vec<f64>> {
+    /// Each parameter's column over the first `samples` requested samples (`None` for a
+    /// parameter whose entries are not given): the rows read once, in the order they are
+    /// stored (a column read on its own would stride through every row of the gradient).
+    pub fn columns(&self, samples: usize) -> Vec<Option<Vec<f64>>> {
         let np = self.given.len();
+        let mut columns: Vec<Option<Vec<f64>>> = self
+            .given
+            .iter()
+            .map(|&given| given.then(|| Vec::with_capacity(samples)))
+            .collect();
         if np == 0 {
-            return Vec::new();
+            return columns;
         }
-        let mut columns: Vec<Vec<f64>> = (0..np).map(|_| Vec::with_capacity(samples)).collect();
         for row in self.gradient.chunks_exact(np).take(samples) {
             for (column, &entry) in columns.iter_mut().zip(row) {
-                column.push(weight * entry);
+                if let Some(column) = column {
+                    column.push(entry);
+                }
             }
         }
         columns
@@ -146,24 +152,23 @@ pub(crate) fn walk_rows(
 mod tests {
     use super::*;
 
-    /// The columns read in one pass over the rows hold each entry as `at` gives it, times the
-    /// weight, for the samples asked for only.
+    /// The columns read in one pass over the rows hold each entry as `at` gives it, for the
+    /// samples asked for only, and none for a parameter whose entries are not given.
     #[test]
-    fn weighted_columns_hold_each_entry_times_the_weight() {
+    fn columns_hold_each_entry_as_at_gives_it() {
         let (samples, np) = (7, 3);
         let mut d = ForceDerivatives::for_samples(samples, np);
         for (i, g) in d.gradient.iter_mut().enumerate() {
             *g = (i as f64 * 0.731).sin();
         }
-        let weight = 2.5;
-        let columns = d.weighted_columns(5, weight);
+        d.given[1] = false;
+        let columns = d.columns(5);
         assert_eq!(columns.len(), np);
-        for (j, column) in columns.iter().enumerate() {
-            let want: Vec<f64> = (0..5).map(|k| weight * d.at(k, j)).collect();
-            assert_eq!(column, &want, "column {j}");
+        assert_eq!(columns[1], None);
+        for j in [0, 2] {
+            let want: Vec<f64> = (0..5).map(|k| d.at(k, j)).collect();
+            assert_eq!(columns[j].as_ref(), Some(&want), "column {j}");
         }
-        assert!(ForceDerivatives::for_samples(4, 0)
-            .weighted_columns(4, 1.0)
-            .is_empty());
+        assert!(ForceDerivatives::for_samples(4, 0).columns(4).is_empty());
     }
 }

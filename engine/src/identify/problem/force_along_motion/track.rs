@@ -155,21 +155,15 @@ impl ForceTrack {
         law: Option<&ForceDerivatives>,
     ) -> JacobianColumns {
         let weight = case.record.weight.sqrt() / self.noise;
-        let mut law_columns = law.map(|d| d.weighted_columns(self.used.len(), weight));
+        let mut law_columns = law.map_or_else(Vec::new, |d| d.columns(self.used.len()));
+        let column = |f: &FreeParam, law_columns: &mut Vec<Option<Vec<f64>>>| match f.kind {
+            ParamKind::Model(j) => law_columns.get_mut(j).and_then(Option::take),
+            kind => self.balance_column(kind, case.index, at.oscillator),
+        };
         let weighted = |c: Vec<f64>| c.into_iter().map(|x| weight * x).collect();
         layout
             .iter()
-            .map(|f| match (f.kind, law, law_columns.as_mut()) {
-                (ParamKind::Model(j), Some(d), Some(columns))
-                    if d.given.get(j).copied().unwrap_or(false) =>
-                {
-                    columns.get_mut(j).map(std::mem::take)
-                }
-                (ParamKind::Model(_), _, _) => None,
-                (kind, _, _) => self
-                    .balance_column(kind, case.index, at.oscillator)
-                    .map(weighted),
-            })
+            .map(|f| column(f, &mut law_columns).map(weighted))
             .collect()
     }
 
