@@ -1,6 +1,7 @@
 //! Identifier benchmarks: the Coulomb mu fit on the three FMM records, the
-//! five-model comparison, and LuGre fits from the default start and from the truth of stiff
-//! (sigma0 = 1e7) records. Records: the acceptance set-up of the tests (releases of 10, 14
+//! five-model comparison, and LuGre fits from the default start (the default search, and one
+//! local start as SciPy's `benches/scipy_lugre_velocity.py` runs it) and from the truth of
+//! stiff (sigma0 = 1e7) records. Records: the acceptance set-up of the tests (releases of 10, 14
 //! and 22 mm, 2 s at 1 kHz, 0.2 mm/s noise). And the inverse-dynamics fit of a driven axis
 //! (25 000 samples; `benches/scipy_inverse_dynamics.py` is SciPy's counterpart), and five
 //! models compared in the force domain along a driven axis's measured motion and friction
@@ -119,6 +120,20 @@ fn lugre(c: &mut Criterion) {
         b.iter(|| {
             let model = LuGre::default();
             fit(&osc, black_box(&model), &recs, &FitOptions::default()).expect("fit")
+        })
+    });
+    let one_local_start = FitOptions {
+        search: SearchOptions {
+            strategy: Some(Search::Local),
+            multistart: Some(1),
+            ..SearchOptions::default()
+        },
+        ..FitOptions::default()
+    };
+    group.bench_function("one local start from the default, 3 records of 2 s", |b| {
+        b.iter(|| {
+            let model = LuGre::default();
+            fit(&osc, black_box(&model), &recs, &one_local_start).expect("fit")
         })
     });
     let stiff = stiff_lugre_truth();
