@@ -25,6 +25,9 @@ pub(super) struct Setup<'a, 'b> {
     pub period: f64,
     /// The series kept at the samples.
     pub kept: SampledSeries,
+    /// The largest believable |dx/dp| and |dv/dp| of each parameter (see
+    /// [`super::believable_sizes`]): a run whose sensitivities pass one has diverged.
+    pub believable: Vec<(f64, f64)>,
 }
 
 /// A run in progress: the output and the book-keeping of turning points.
@@ -36,10 +39,14 @@ struct Run<'a, 'b> {
     last_turn: Option<f64>,
     /// The right-hand side of the states just before the last turning point.
     before_turn: Option<Vec<f64>>,
+    /// Whether a sampled sensitivity passed its believable size.
+    diverged: bool,
 }
 
-/// Runs `setup` to its end time.
-pub(super) fn run(setup: Setup<'_, '_>) -> Result<Sensitivities, EngineError> {
+/// Runs `setup` to its end time; `None` when the sensitivities diverged (the explicit
+/// stepper, its steps set by the states' error alone, can run the sensitivities of a stiff
+/// stretch at steps beyond its stability bound, where they grow without limit).
+pub(super) fn run(setup: Setup<'_, '_>) -> Result<Option<Sensitivities>, EngineError> {
     let n = setup.y0.len();
     let n_params = setup.terms.params().len();
     let mut y = vec![0.0; n * (1 + n_params)];
@@ -73,6 +80,7 @@ pub(super) fn run(setup: Setup<'_, '_>) -> Result<Sensitivities, EngineError> {
         events: 0,
         last_turn: None,
         before_turn: None,
+        diverged: false,
     };
     let result = run.segments(&mut stepper, y);
     let counts = stepper.counts();
@@ -84,7 +92,7 @@ pub(super) fn run(setup: Setup<'_, '_>) -> Result<Sensitivities, EngineError> {
         // Every right-hand side of the augmented system evaluates the Jacobian.
         jacobian_evaluations: counts.rhs_evaluations,
     };
-    result.map(|()| run.out)
+    result.map(|()| (!run.diverged).then_some(run.out))
 }
 
 impl Run<'_, '_> {
@@ -256,11 +264,17 @@ impl Run<'_, '_> {
             out.x.push(y[0]);
             out.v.push(if moving { y[1] } else { 0.0 });
         }
-        for (j, s) in y[n..].chunks_exact(n).enumerate() {
+        for ((j, s), &(dx_max, dv_max)) in y[n..]
+            .chunks_exact(n)
+            .enumerate()
+            .zip(&self.setup.believable)
+        {
             if all {
                 out.dx[j].push(s[0]);
             }
             out.dv[j].push(if moving { s[1] } else { 0.0 });
+            // Written so that NaN counts as diverged.
+            self.diverged |= !(s[0].abs() <= dx_max && s[1].abs() <= dv_max);
         }
         self.next += 1;
     }
