@@ -143,12 +143,7 @@ fn lugre(c: &mut Criterion) {
             guess: false,
             ..ParamOptions::default()
         },
-        search: SearchOptions {
-            strategy: Some(Search::Local),
-            multistart: Some(1),
-            ..SearchOptions::default()
-        },
-        ..FitOptions::default()
+        ..one_local_start.clone()
     };
     group.bench_function("from the truth, sigma0 1e7, 3 records of 2 s", |b| {
         b.iter(|| fit(&osc, black_box(&stiff), &stiff_recs, &at_truth).expect("fit"))
