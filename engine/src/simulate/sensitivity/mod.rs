@@ -18,7 +18,7 @@
 //! smooth law's right-hand side is continuous there: no jump.
 //!
 //! An explicit run's steps are set by the states' error alone: over a stretch stiff enough
-//! (Dahl at sigma0 3e5 N/m sliding at 5 cm/s) they can exceed the stability bound of the
+//! (Dahl at sigma0 3e5 N/m sliding at a few cm/s) they can exceed the stability bound of the
 //! sensitivities, which the states do not excite but the direct terms do, and the
 //! sensitivities then grow without limit while the states stay right. A run whose sampled
 //! sensitivities pass a bound no motion reaches (`believable_sizes`) is given up: `None`.
@@ -151,9 +151,9 @@ pub fn simulate_sensitivities(
 const BELIEVABLE_GAIN: f64 = 1e8;
 
 /// The largest believable |dx/dp| and |dv/dp| of each parameter of `terms` in a run from
-/// `y0`: [`BELIEVABLE_GAIN`] times the motion's scale (the release displacement, or the
-/// absolute tolerance where it is smaller, and the speed omega_n times it) over the
-/// parameter's size |p| (1 where it is zero). A diverged run grows exponentially and passes
+/// `y0`: [`BELIEVABLE_GAIN`] times the motion's scale (the release displacement, at least
+/// 1e-9 m, and the speed omega_n times it, or the starting speed where that is larger) over
+/// the parameter's size |p| (1 where it is zero or not finite). A diverged run grows exponentially and passes
 /// it within a few steps; a true sensitivity near a stick or a reversal stays orders of
 /// magnitude below it.
 fn believable_sizes(
