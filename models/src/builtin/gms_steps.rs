@@ -299,7 +299,7 @@ impl Propagator for Gms {
             // The element's own stiffness and weight, the Stribeck parameters and the
             // sharpness move its load or its travel; every other parameter only carries a
             // sensitivity the element already has (none, in a replay from rest).
-            for j in [i, n + i, 3 * n, 3 * n + 1, 3 * n + 2, 3 * n + 3, sharpness] {
+            for j in [i, n + i].into_iter().chain(3 * n..=sharpness) {
                 let Some(sj) = row.get_mut(j) else {
                     continue;
                 };
@@ -311,6 +311,9 @@ impl Propagator for Gms {
                 };
                 *sj = step(g, direct, *sj);
             }
+            // A parameter that does not move the load has slope 0, so its direct term is
+            // slope * sigma * 0: kept as that product (0, or NaN where slope * sigma is not
+            // finite) so that a carried entry is what the full step above would give it.
             let unmoved = frame.step.slope * frame.sigma * 0.0;
             for carried in [0..i, i + 1..n + i, n + i + 1..3 * n, sharpness + 1..np] {
                 let Some(part) = row.get_mut(carried) else {
