@@ -135,7 +135,7 @@ fn time_scale(osc: &Oscillator, t_end: f64) -> f64 {
 /// 1e-5 N of `simulate_custom`'s test).
 ///
 /// [`InternalStates::state_tolerance_scales`]: frictionid_models::InternalStates
-fn component_tolerance_scales(model: &dyn FrictionModel, dim: usize) -> Vec<f64> {
+pub(super) fn component_tolerance_scales(model: &dyn FrictionModel, dim: usize) -> Vec<f64> {
     let mut scales = vec![1.0, 1.0];
     if let Some(states) = model.states().filter(|s| s.n_states() > 0) {
         let usable = |s: f64| if s.is_finite() && s > 0.0 { s } else { 1.0 };

@@ -18,14 +18,14 @@
 use super::free_params::{build_layout, Layout};
 use super::prefit::PREFIT_ORIGIN;
 use super::presliding::{presliding_displacement, record_travels};
-use super::starts::{fit_starting_points, run_starts};
+use super::starts::{fit_starting_points, run_starts, start_count};
 use crate::identify::problem::least_squares::{FitProblem, ProblemParts};
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::{FreeParam, ParamKind};
 use crate::identify::values::levels::FrictionLevels;
 use crate::identify::values::param_options::ParamOptions;
-use crate::identify::values::search::Search;
+use crate::identify::values::search::{fits_directly, Search, SearchOptions};
 use crate::oscillator::Oscillator;
 use crate::record::Record;
 use frictionid_models::start::TYPICAL_PRESLIDING_DISPLACEMENT;
@@ -224,7 +224,12 @@ fn stage_fit<R: Residuals + 'static>(
         osc: plan.osc,
         records: &plan.records.into(),
     };
-    fit_simpler(&on, stage, &stage_options(plan.opts), &[], None)
+    let starts = SimplerStarts {
+        also_from: &[],
+        fitted: None,
+        spread: None,
+    };
+    fit_simpler(&on, stage, &stage_options(plan.opts), starts)
 }
 
 /// The records a simpler law is fitted to, with the fit's residuals and oscillator.
@@ -288,16 +293,27 @@ impl SimplerFit {
     }
 }
 
-/// Fits `law` with `opts` (local runs: one from its data-driven guess and one from each model
-/// of `also_from` mapped onto it by `start_from`, the best kept); `None` when it fails. An
-/// earlier fit of the same law over the same free parameters (`fitted`, e.g. a stage of the
-/// staged search, itself one run from the guess) starts at its optimum in place of the guess.
+/// Where the local runs of a simpler law's fit start.
+#[derive(Clone, Copy)]
+pub(crate) struct SimplerStarts<'a> {
+    /// Models mapped onto the law by `start_from`, each a start.
+    pub also_from: &'a [(&'a dyn FrictionModel, StartContext)],
+    /// An earlier fit of the same law over the same free parameters (e.g. a stage of the
+    /// staged search, itself one run from the guess), whose optimum starts in place of the
+    /// guess.
+    pub fitted: Option<&'a SimplerFit>,
+    /// The search whose local starts around the guess (as many as a fit of the law under
+    /// it takes) are started too; `None`: the guess (or `fitted`) alone.
+    pub spread: Option<&'a SearchOptions>,
+}
+
+/// Fits `law` with `opts` (local runs from `starts`, every one to its end, the best kept);
+/// `None` when it fails.
 pub(crate) fn fit_simpler<R: Residuals + 'static>(
     on: &FitTarget<'_, R>,
     law: &(dyn FrictionModel + 'static),
     opts: &FitOptions,
-    also_from: &[(&dyn FrictionModel, StartContext)],
-    fitted: Option<&SimplerFit>,
+    starts: SimplerStarts<'_>,
 ) -> Option<SimplerFit> {
     let layout = build_layout(
         on.osc,
@@ -325,7 +341,7 @@ pub(crate) fn fit_simpler<R: Residuals + 'static>(
         )
         .with_loss(opts.search.robust_loss())
     };
-    let first = match fitted.filter(|f| f.fits_the_same(law, &layout)) {
+    let first = match starts.fitted.filter(|f| f.fits_the_same(law, &layout)) {
         Some(f) => {
             let seeded = seeded_point(&layout, f.model.as_ref());
             layout.projected(&f.carried(&layout.params, seeded))
@@ -333,14 +349,32 @@ pub(crate) fn fit_simpler<R: Residuals + 'static>(
         None => layout.start.clone(),
     };
     let mut points = vec![first];
-    for (from, ctx) in also_from {
+    let n_spread = starts.spread.map_or(1, |search| {
+        let direct = fits_directly(law, on.residuals.simulates_response());
+        start_count(search, layout.n_model_free(), direct).unwrap_or(1)
+    });
+    if n_spread > 1 {
+        let around =
+            fit_starting_points(&layout.params, &layout.start, law, &opts.params, n_spread);
+        for point in around.into_iter().skip(1).map(|p| layout.projected(&p)) {
+            if !points.contains(&point) {
+                points.push(point);
+            }
+        }
+    }
+    for (from, ctx) in starts.also_from {
         points.extend(
             mapped_point(&layout, *from, ctx, &opts.params).filter(|p| !points.contains(p)),
         );
     }
     let reference = make();
     let (search, hooks) = (&opts.search, &opts.hooks);
-    let runs = run_starts(make, &reference, &points, search, hooks, points.len(), None).ok()?;
+    // The spread starts are screened as a staged search's are; the others all run to the end.
+    let promoted = match starts.spread {
+        Some(_) => Search::Staged.promoted(),
+        None => points.len(),
+    };
+    let runs = run_starts(make, &reference, &points, search, hooks, promoted, None).ok()?;
     let p = reference.physical(&runs.best.u);
     let model = reference.realise(&p).ok()?.model;
     Some(SimplerFit {

@@ -3,15 +3,29 @@
 
 use super::super::driver::locate;
 use super::super::dynamics::{Dynamics, Law, Start};
-use super::super::stepper::{StepOutcome, Stepper};
+use super::super::stepper::{StepCounts, StepOutcome, Stepper};
 use super::super::values::{SampleGrid, SimOptions, SimStats};
-use super::super::{Dopri5, REST_SWING_ATOLS};
+use super::super::{Dopri5, Rodas4, REST_SWING_ATOLS, RODAS_ATOL_SCALE, RODAS_TOL_SCALE};
 use super::system::{Augmented, DirectTerms};
 use super::{SampledSeries, Sensitivities, SensitivityParam};
 use crate::error::{EngineError, IntegrationFailure};
 
-/// Largest Dopri5 step as a fraction of the time scale (the plain run's).
+/// Largest step as a fraction of the time scale (the plain run's).
 const H_MAX_PERIODS: f64 = 1.0 / 8.0;
+
+/// The stepper of an augmented run.
+pub(super) enum Method {
+    /// Dopri5, its error control over the states.
+    Dopri5,
+    /// Rodas4 for a stiff contact, at the plain stiff run's tolerances (`typical`: each
+    /// state's typical size, for the differences of its Jacobian; `atol_scales`: the plain
+    /// run's multipliers of the absolute tolerance), its error control over the states and
+    /// its linear systems solved block by block ([`Rodas4::block_triangular`]).
+    Rodas4 {
+        typical: Vec<f64>,
+        atol_scales: Vec<f64>,
+    },
+}
 
 /// What an augmented run is made of.
 pub(super) struct Setup<'a, 'b> {
@@ -28,6 +42,8 @@ pub(super) struct Setup<'a, 'b> {
     /// The largest believable |dx/dp| and |dv/dp| of each parameter (see
     /// [`super::believable_sizes`]): a run whose sensitivities pass one has diverged.
     pub believable: Vec<(f64, f64)>,
+    /// The stepper.
+    pub method: Method,
 }
 
 /// A run in progress: the output and the book-keeping of turning points.
@@ -60,13 +76,8 @@ pub(super) fn run(setup: Setup<'_, '_>) -> Result<Option<Sensitivities>, EngineE
     let all = setup.kept == SampledSeries::All;
     let kept = |keep: bool| if keep { samples } else { 0 };
     let series = |keep: bool| vec![Vec::with_capacity(kept(keep)); n_params];
-    let mut stepper = Dopri5::new(
-        y.len(),
-        setup.opts.rtol,
-        setup.opts.atol,
-        setup.period * H_MAX_PERIODS,
-    )
-    .controlling_first(n);
+    let h_max = setup.period * H_MAX_PERIODS;
+    let (rtol, atol) = (setup.opts.rtol, setup.opts.atol);
     let mut run = Run {
         out: Sensitivities {
             x: Vec::with_capacity(kept(all)),
@@ -82,17 +93,53 @@ pub(super) fn run(setup: Setup<'_, '_>) -> Result<Option<Sensitivities>, EngineE
         before_turn: None,
         diverged: false,
     };
-    let result = run.segments(&mut stepper, y);
-    let counts = stepper.counts();
-    run.out.stats = SimStats {
-        rhs_evaluations: counts.rhs_evaluations,
-        steps: counts.accepted,
-        rejected_steps: counts.rejected,
-        events: run.events,
-        // Every right-hand side of the augmented system evaluates the Jacobian.
-        jacobian_evaluations: counts.rhs_evaluations,
-    };
-    result.map(|()| (!run.diverged).then_some(run.out))
+    match &run.setup.method {
+        Method::Dopri5 => {
+            let mut stepper = Dopri5::new(y.len(), rtol, atol, h_max).controlling_first(n);
+            let result = run.segments(&mut stepper, y, &[]);
+            run.finish(result, stepper.counts())
+        }
+        Method::Rodas4 {
+            typical,
+            atol_scales,
+        } => {
+            let (rtol, atol) = (RODAS_TOL_SCALE * rtol, RODAS_ATOL_SCALE * atol);
+            let mut stepper = Rodas4::new(y.len(), rtol, atol, h_max)
+                .with_atol_scales(atol_scales)
+                .controlling_first(n)
+                .block_triangular(n);
+            let typical = typical.clone();
+            let result = run.segments(&mut stepper, y, &typical);
+            run.finish(result, stepper.counts())
+        }
+    }
+}
+
+impl Run<'_, '_> {
+    /// The run's output after `result`, with the work counted in `counts`.
+    fn finish(
+        mut self,
+        result: Result<(), EngineError>,
+        counts: StepCounts,
+    ) -> Result<Option<Sensitivities>, EngineError> {
+        let explicit = matches!(self.setup.method, Method::Dopri5);
+        self.out.stats = SimStats {
+            rhs_evaluations: counts.rhs_evaluations,
+            steps: counts.accepted,
+            rejected_steps: counts.rejected,
+            events: self.events,
+            // Every right-hand side of the augmented system evaluates the states' Jacobian;
+            // the stiff stepper's Jacobian of it evaluates it once more per state.
+            jacobian_evaluations: match explicit {
+                true => counts.rhs_evaluations,
+                false => {
+                    let per_jacobian = 1 + self.setup.y0.len() as u64;
+                    counts.rhs_evaluations + per_jacobian * counts.jacobian_evaluations
+                }
+            },
+        };
+        result.map(|()| (!self.diverged).then_some(self.out))
+    }
 }
 
 impl Run<'_, '_> {
@@ -100,7 +147,12 @@ impl Run<'_, '_> {
         self.setup.y0.len()
     }
 
-    fn segments(&mut self, stepper: &mut Dopri5, mut y: Vec<f64>) -> Result<(), EngineError> {
+    fn segments<S: Stepper>(
+        &mut self,
+        stepper: &mut S,
+        mut y: Vec<f64>,
+        typical: &[f64],
+    ) -> Result<(), EngineError> {
         let t_end = self.setup.grid.t_end;
         let tiny = 1e-13 * (1.0 + t_end);
         let mut t = 0.0;
@@ -116,7 +168,7 @@ impl Run<'_, '_> {
                 self.fill(&y, Some(dir));
                 return Ok(());
             }
-            let system = Augmented::new(self.setup.dynamics, dir, self.setup.terms);
+            let system = Augmented::new(self.setup.dynamics, dir, self.setup.terms, typical);
             stepper.reset(&system, t, &y, t_end)?;
             match self.advance(stepper, &system, &mut y)? {
                 None => return Ok(()),
@@ -130,9 +182,9 @@ impl Run<'_, '_> {
 
     /// Steps through one segment; at a turning point leaves the augmented state there in `y`
     /// (v = 0) and returns its time, `None` at the end time.
-    fn advance(
+    fn advance<S: Stepper>(
         &mut self,
-        stepper: &mut Dopri5,
+        stepper: &mut S,
         system: &Augmented<'_, '_>,
         y: &mut [f64],
     ) -> Result<Option<f64>, EngineError> {
@@ -238,7 +290,7 @@ impl Run<'_, '_> {
     }
 
     /// Writes the samples with time <= `until` from the last step's dense output.
-    fn write(&mut self, stepper: &Dopri5, until: f64, buf: &mut [f64]) {
+    fn write<S: Stepper>(&mut self, stepper: &S, until: f64, buf: &mut [f64]) {
         while let Some(&ts) = self.setup.grid.sample_times.get(self.next) {
             if ts > until {
                 break;

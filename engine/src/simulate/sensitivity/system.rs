@@ -76,13 +76,16 @@ fn rate_gradient_given(
     gradients.state_param_gradient(v, z, dynamics.normal, &mut probe)
 }
 
-/// Scratch of one right-hand side.
+/// Scratch of one right-hand side, and of the Jacobian's differences.
 #[derive(Default)]
 struct Scratch {
     jac: Vec<f64>,
     force: Vec<f64>,
     rate: Vec<f64>,
     direct: Vec<f64>,
+    probe: Vec<f64>,
+    base_jac: Vec<f64>,
+    base_direct: Vec<f64>,
 }
 
 /// The augmented system of one segment (slip direction `dir`).
@@ -90,17 +93,36 @@ pub(super) struct Augmented<'a, 'b> {
     pub dynamics: Dynamics<'a>,
     pub dir: f64,
     pub terms: &'b DirectTerms<'a>,
+    /// Each state's typical size, which scales its difference step in the Jacobian's
+    /// derivatives of the sensitivities' rates ([`OdeSystem::jacobian`]); empty where only
+    /// the right-hand side is asked for (the explicit stepper).
+    typical: &'b [f64],
     scratch: RefCell<Scratch>,
 }
 
 impl<'a, 'b> Augmented<'a, 'b> {
-    pub(super) fn new(dynamics: Dynamics<'a>, dir: f64, terms: &'b DirectTerms<'a>) -> Self {
+    pub(super) fn new(
+        dynamics: Dynamics<'a>,
+        dir: f64,
+        terms: &'b DirectTerms<'a>,
+        typical: &'b [f64],
+    ) -> Self {
         Self {
             dynamics,
             dir,
             terms,
+            typical,
             scratch: RefCell::new(Scratch::default()),
         }
+    }
+
+    /// The states' Jacobian J and the direct terms df/dp_j at the states `state`, left in
+    /// the scratch.
+    fn jacobian_and_direct_terms(&self, t: f64, state: &[f64], scratch: &mut Scratch) {
+        let n = state.len();
+        scratch.jac.resize(n * n, 0.0);
+        self.dynamics.jacobian(t, state, self.dir, &mut scratch.jac);
+        self.direct_terms(t, state, scratch);
     }
 
     /// The states' dimension n of y = [x, v, z...].
@@ -165,9 +187,7 @@ impl OdeSystem for Augmented<'_, '_> {
         let (d_state, d_sens) = dy.split_at_mut(n);
         self.dynamics.rhs(t, state, d_state, self.dir);
         let mut scratch = self.scratch.borrow_mut();
-        scratch.jac.resize(n * n, 0.0);
-        self.dynamics.jacobian(t, state, self.dir, &mut scratch.jac);
-        self.direct_terms(t, state, &mut scratch);
+        self.jacobian_and_direct_terms(t, state, &mut scratch);
         let Scratch { jac, direct, .. } = &*scratch;
         match n {
             2 => sensitivity_rates::<2>(jac, sens, direct, d_sens),
@@ -177,6 +197,75 @@ impl OdeSystem for Augmented<'_, '_> {
             _ => general_sensitivity_rates(n, jac, sens, direct, d_sens),
         }
     }
+
+    /// Block lower triangular, as [`Rodas4::block_triangular`] solves it: the states'
+    /// Jacobian J on every diagonal block, and below it the derivative of each s_j' in the
+    /// states, H_j = (dJ/dy) s_j + d(df/dp_j)/dy. The derivatives of J and of the direct
+    /// terms are forward differences (one Jacobian and one set of direct terms per state)
+    /// at steps of sqrt(eps) times the state's size or its typical size, whichever is
+    /// larger, the velocity's in the segment's direction; they are taken of J and of the terms apart, not of the rates J s_j + df/dp_j,
+    /// whose large and nearly unchanged J s_j would leave rounding errors of the step's
+    /// order in the difference (entries of J that do not move give exact zeros). H_j enters
+    /// only the stiff stepper's linear systems, not the rates it integrates.
+    ///
+    /// [`Rodas4::block_triangular`]: super::super::Rodas4::block_triangular
+    fn jacobian(&self, t: f64, y: &[f64], jac: &mut [f64]) {
+        let n = self.n();
+        let dim = y.len();
+        let (state, sens) = y.split_at(n);
+        jac.fill(0.0);
+        let mut guard = self.scratch.borrow_mut();
+        let scratch = &mut *guard;
+        self.jacobian_and_direct_terms(t, state, scratch);
+        for block in 0..dim / n {
+            for r in 0..n {
+                let row = (block * n + r) * dim + block * n;
+                jac[row..row + n].copy_from_slice(&scratch.jac[r * n..(r + 1) * n]);
+            }
+        }
+        let base_jac = std::mem::take(&mut scratch.base_jac);
+        let base_direct = std::mem::take(&mut scratch.base_direct);
+        let (base_jac, base_direct) = (
+            refill(base_jac, &scratch.jac),
+            refill(base_direct, &scratch.direct),
+        );
+        let mut probe = std::mem::take(&mut scratch.probe);
+        for c in 0..n {
+            let typical = self.typical.get(c).copied().unwrap_or(0.0);
+            let size = f64::EPSILON.sqrt() * state[c].abs().max(typical).max(f64::MIN_POSITIVE);
+            // The velocity moves on in the segment's direction: from a turning point (v = 0)
+            // a step against it would cross the kink of the law in v.
+            let step = if c == 1 { self.dir * size } else { size };
+            probe.clear();
+            probe.extend_from_slice(state);
+            probe[c] += step;
+            self.jacobian_and_direct_terms(t, &probe, scratch);
+            for (j, s) in sens.chunks_exact(n).enumerate() {
+                for i in 0..n {
+                    let moved = &scratch.jac[i * n..(i + 1) * n];
+                    let held = &base_jac[i * n..(i + 1) * n];
+                    let d_jac_s: f64 = moved
+                        .iter()
+                        .zip(held)
+                        .zip(s)
+                        .map(|((a, b), sk)| (a - b) * sk)
+                        .sum();
+                    let d_direct = scratch.direct[j * n + i] - base_direct[j * n + i];
+                    jac[((j + 1) * n + i) * dim + c] = (d_jac_s + d_direct) / step;
+                }
+            }
+        }
+        scratch.probe = probe;
+        scratch.base_jac = base_jac;
+        scratch.base_direct = base_direct;
+    }
+}
+
+/// `buf` holding a copy of `from`.
+fn refill(mut buf: Vec<f64>, from: &[f64]) -> Vec<f64> {
+    buf.clear();
+    buf.extend_from_slice(from);
+    buf
 }
 
 /// s_j' = df/dp_j + J s_j for every parameter j, for states of any dimension `n`.

@@ -24,12 +24,14 @@ fn times(seconds: f64) -> Vec<f64> {
         .collect()
 }
 
-/// A world: the oscillator, the law and the release displacement.
+/// A world: the oscillator, the law, the release displacement and the integrator of its
+/// plain runs (at the tight tolerances).
 #[derive(Clone)]
 struct World {
     osc: Oscillator,
     model: Box<dyn FrictionModel>,
     x0: f64,
+    plain: Integrator,
 }
 
 impl World {
@@ -40,7 +42,11 @@ impl World {
             z0: None,
         };
         let t_end = time.last().copied().unwrap_or(0.0);
-        simulate(&self.osc, self.model.as_ref(), &init, t_end, time, &tight()).unwrap()
+        let opts = SimOptions {
+            integrator: self.plain,
+            ..tight()
+        };
+        simulate(&self.osc, self.model.as_ref(), &init, t_end, time, &opts).unwrap()
     }
 
     fn sensitivities(&self, time: &[f64], params: &[SensitivityParam]) -> Sensitivities {
@@ -168,6 +174,7 @@ fn lugre_sensitivities_match_central_differences() {
         osc: Oscillator::fmm(),
         model: Box::new(LuGre::default()),
         x0: 0.022,
+        plain: Integrator::Dopri5,
     };
     let params = [
         SensitivityParam::Model(0),
@@ -186,6 +193,7 @@ fn stribeck_sensitivities_with_a_free_damping_match_central_differences() {
         osc: Oscillator::fmm(),
         model: Box::new(Stribeck::default()),
         x0: 0.022,
+        plain: Integrator::Dopri5,
     };
     let params = [
         SensitivityParam::Model(0),
@@ -212,6 +220,7 @@ fn gms_sensitivities_match_central_differences() {
         osc: Oscillator::fmm(),
         model: built.model,
         x0: 0.022,
+        plain: Integrator::Dopri5,
     };
     assert!(world.model.params().len() == 15, "three elements");
     let params = [0, 2, 4, 6, 8, 9, 10, 11, 13, 14].map(SensitivityParam::Model);
@@ -236,6 +245,7 @@ fn a_diverging_explicit_run_is_given_up() {
             alpha: 1.0,
         }),
         x0: 0.022,
+        plain: Integrator::Dopri5,
     };
     let time = times(2.0);
     let params: Vec<_> = (0..3).map(SensitivityParam::Model).collect();
@@ -252,6 +262,79 @@ fn a_diverging_explicit_run_is_given_up() {
     }
 }
 
+/// Whether the augmented run took the stiff stepper: its Jacobian evaluations include those
+/// of the stepper's linear systems, so they exceed its right-hand sides (the explicit run
+/// evaluates one Jacobian per right-hand side).
+fn took_the_stiff_stepper(sens: &Sensitivities) -> bool {
+    sens.stats.jacobian_evaluations > sens.stats.rhs_evaluations
+}
+
+/// `model` on the FMM stage released from 22 mm, its plain runs on Rodas4.
+fn stiff_world(model: Box<dyn FrictionModel>) -> World {
+    World {
+        osc: Oscillator::fmm(),
+        model,
+        x0: 0.022,
+        plain: Integrator::Rodas,
+    }
+}
+
+/// LuGre with sigma0 = 1e7 N/m is far beyond the explicit augmented run's stiffness: its
+/// sensitivities come from Rodas4, and match central differences of plain Rodas4 runs at the
+/// tight tolerances (every parameter, a property and the release).
+#[test]
+fn stiff_lugre_sensitivities_from_the_stiff_stepper_match_central_differences() {
+    let world = stiff_world(Box::new(LuGre {
+        sigma0: 1e7,
+        sigma1: 5000.0,
+        ..LuGre::default()
+    }));
+    let law: Vec<_> = (0..6).map(SensitivityParam::Model).collect();
+    let time = times(0.6);
+    assert!(took_the_stiff_stepper(&world.sensitivities(&time, &law)));
+    // The stiff plain runs' integration error would swamp differences at the default step
+    // for sigma0 and sigma1, which barely move a motion this close to the rigid limit.
+    check_against_differences_by(&world, &time, &law, 1e-3, 1e-4);
+    // The stiffness moves the turning points: at the default step the samples next to them
+    // stay on the same side in the perturbed runs.
+    let mechanics = [
+        SensitivityParam::Property(OscillatorProperty::Stiffness),
+        SensitivityParam::StartDisplacement,
+    ];
+    check_against_differences(&world, &time, &mechanics, 1e-4);
+}
+
+/// The default GMS (three elements of 1e5, 3.3e4 and 1.1e4 N/m) is stiff when its elements
+/// load: every parameter's sensitivity from the stiff stepper against central differences.
+#[test]
+fn stiff_gms_sensitivities_from_the_stiff_stepper_match_central_differences() {
+    let built = frictionid_models::build_json(&serde_json::json!({
+        "type": "gms", "damping": 2.0, "sharpness": 1.6
+    }))
+    .unwrap();
+    let world = stiff_world(built.model);
+    let params: Vec<_> = (0..15).map(SensitivityParam::Model).collect();
+    let time = times(0.6);
+    assert!(took_the_stiff_stepper(&world.sensitivities(&time, &params)));
+    // The elements' dampings move the motion by a few parts in a million of the others'
+    // columns: a step of 1e-2 keeps the plain runs' integration error out of their
+    // differences.
+    check_against_differences_by(&world, &time, &params, 1e-2, 1e-3);
+}
+
+/// The explicit augmented run is told apart from the stiff one by its counts.
+#[test]
+fn a_soft_contact_keeps_the_explicit_stepper() {
+    let world = World {
+        osc: Oscillator::fmm(),
+        model: Box::new(LuGre::default()),
+        x0: 0.022,
+        plain: Integrator::Dopri5,
+    };
+    let sens = world.sensitivities(&times(0.2), &[SensitivityParam::Model(0)]);
+    assert!(!took_the_stiff_stepper(&sens));
+}
+
 /// Coulomb on the FMM stage from 10 mm reverses a few times and sticks for good: over the
 /// whole record (rest included) the sensitivities equal the difference of two simulations at
 /// p +- h, but for the samples between the events of the two (one on each side of each
@@ -262,6 +345,7 @@ fn coulomb_sensitivities_carry_across_reversals_and_the_stick() {
         osc: Oscillator::fmm(),
         model: Box::new(Coulomb { mu: 0.24 }),
         x0: 0.010,
+        plain: Integrator::Dopri5,
     };
     let time = times(1.5);
     let params = [

@@ -40,7 +40,7 @@ pub use profiles::{
     LIMIT_PROFILE_ITERATIONS, PROFILE_DELTA, PROFILE_HALVINGS, PROFILE_ITERATIONS,
     PROFILE_RESOLUTION, PROFILE_STEPS,
 };
-pub use rigid_limit::LIMIT_APPROACH_DECADES;
+pub use rigid_limit::{LIMIT_APPROACH_DECADES, NARROW_REJECTION};
 pub(crate) use settle::settle;
 pub use settle::PROFILE_RESTARTS;
 pub use shared::{

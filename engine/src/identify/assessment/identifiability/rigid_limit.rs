@@ -1,12 +1,15 @@
 //! The rigid-contact limit's test: the model's rigid limit fitted to the same records, and
 //! whether they reject it (otherwise the contact stiffness is at most a lower bound).
 
+use super::profiles::PROFILE_DELTA;
 use super::Standing;
 use crate::identify::assessment::stats::chi_square_95;
 use crate::identify::problem::least_squares::FitProblem;
 use crate::identify::problem::residuals::Residuals;
 use crate::identify::search::starts::StartRun;
-use crate::identify::search::strategy::{fit_simpler, stage_options, FitTarget, Onto, SimplerFit};
+use crate::identify::search::strategy::{
+    fit_simpler, stage_options, FitTarget, Onto, SimplerFit, SimplerStarts,
+};
 use crate::identify::values::fit_options::FitOptions;
 use crate::identify::values::layout::ParamKind;
 use crate::identify::values::result::Identifiability;
@@ -79,7 +82,7 @@ impl Limit {
     /// The cost rise that rejects the limit, in units of the one-parameter rise
     /// [`PROFILE_DELTA`]: chi²(d) / chi²(1).
     pub(super) fn rise_factor(&self) -> f64 {
-        chi_square_95(self.removed) / chi_square_95(1)
+        rise_factor(self.removed)
     }
 
     /// The target started from the fitted limit law at the presliding displacement of `ctx`
@@ -162,10 +165,19 @@ impl Limit {
     }
 }
 
+/// How far above the rejection threshold (in units of it) a rigid limit's first fit may end
+/// and still be refitted from more starts: there, a local run stopped short of the limit
+/// law's optimum would decide the verdict.
+pub const NARROW_REJECTION: f64 = 2.0;
+
 /// The model's rigid limit fitted to the records (from its own guess, or from `stage` when
 /// the staged search fitted the same law from it, and from the fit's best mapped onto it),
 /// when the model declares one and a stiffness of it is free; `None` otherwise or when the
-/// limit cannot be fitted.
+/// limit cannot be fitted. A limit the records reject by less than [`NARROW_REJECTION`]
+/// times the threshold is fitted again from the local starts a fit of the limit law takes
+/// around its guess, the lower optimum kept: the test compares the fit with the limit law's
+/// optimum, and one local run ending in a shallow minimum would reject a limit the records
+/// allow.
 pub(super) fn rigid_limit<R: Residuals + 'static>(
     reference: &FitProblem<R>,
     best: &StartRun,
@@ -193,20 +205,51 @@ pub(super) fn rigid_limit<R: Residuals + 'static>(
     let mut limit_opts = stage_options(opts);
     limit_opts.params.oscillator = opts.params.oscillator.clone();
     limit_opts.params.free = limit_free(declared.law.as_ref(), &declared.also_free);
-    let fit = fit_simpler(
-        &on,
-        declared.law.as_ref(),
-        &limit_opts,
-        &[(fitted.as_ref(), ctx)],
-        stage,
-    )?;
+    let law = declared.law.as_ref();
+    let first = SimplerStarts {
+        also_from: &[(fitted.as_ref(), ctx)],
+        fitted: stage,
+        spread: None,
+    };
+    let mut fit = fit_simpler(&on, law, &limit_opts, first)?;
+    let removed = reference.layout.len().saturating_sub(fit.free).max(1);
+    let threshold = rejection_rise(reference, best, removed);
+    if fit.cost > best.cost + threshold && fit.cost <= best.cost + NARROW_REJECTION * threshold {
+        let again = SimplerStarts {
+            also_from: &[],
+            fitted: Some(&fit),
+            spread: Some(&opts.search),
+        };
+        if let Some(lower) = fit_simpler(&on, law, &limit_opts, again).filter(|f| f.cost < fit.cost)
+        {
+            fit = lower;
+        }
+    }
     Some(Limit {
         slots,
         presliding: slots_of(&declared.presliding),
         cost: fit.cost,
-        removed: reference.layout.len().saturating_sub(fit.free).max(1),
+        removed,
         law: fit.model,
     })
+}
+
+/// The cost rise over `best` that rejects a limit removing `removed` free parameters:
+/// chi²(removed, 95 %) / 2 residual variances, the variance the residuals at `best` leave
+/// over their degrees of freedom.
+fn rejection_rise<R: Residuals>(reference: &FitProblem<R>, best: &StartRun, removed: usize) -> f64 {
+    let dof = reference
+        .n_residuals()
+        .saturating_sub(reference.layout.len())
+        .max(1);
+    let variance = 2.0 * best.cost / dof as f64;
+    PROFILE_DELTA * variance * rise_factor(removed)
+}
+
+/// chi²(removed, 95 %) / chi²(1, 95 %): the rise that rejects a limit removing `removed`
+/// free parameters, in units of one parameter's.
+fn rise_factor(removed: usize) -> f64 {
+    chi_square_95(removed) / chi_square_95(1)
 }
 
 /// The free parameters of a limit law: its defaults and `also_free`; `None` (the defaults)
