@@ -1,7 +1,6 @@
 //! The rigid-contact limit's test: the model's rigid limit fitted to the same records, and
 //! whether they reject it (otherwise the contact stiffness is at most a lower bound).
 
-use super::profiles::PROFILE_DELTA;
 use super::Standing;
 use crate::identify::assessment::stats::chi_square_95;
 use crate::identify::problem::least_squares::FitProblem;
@@ -243,7 +242,7 @@ fn rejection_rise<R: Residuals>(reference: &FitProblem<R>, best: &StartRun, remo
         .saturating_sub(reference.layout.len())
         .max(1);
     let variance = 2.0 * best.cost / dof as f64;
-    PROFILE_DELTA * variance * rise_factor(removed)
+    0.5 * chi_square_95(removed) * variance
 }
 
 /// chi²(removed, 95 %) / chi²(1, 95 %): the rise that rejects a limit removing `removed`
