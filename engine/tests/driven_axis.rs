@@ -272,3 +272,92 @@ fn the_engine_follows_the_reference_under_the_input() {
     );
     assert!(worst < 1e-9, "{worst}");
 }
+
+/// LuGre on the FMM stage driven from rest by the input `u` (sampled at 1 kHz over 1 s)
+/// against fixed-step RK4 at 1e-5 s written here over the law's own state derivative and
+/// force, the input linear between its samples: the largest velocity error relative to the
+/// largest speed, and that speed.
+fn lugre_drive_against_rk4(u: &[f64]) -> (f64, f64) {
+    use frictionid_engine::simulate::{simulate_driven, Input, RunInputs, SampleGrid};
+    use frictionid_engine::{Initial, Oscillator, SimOptions};
+    use frictionid_models::{FrictionModel, LuGre};
+    let osc = Oscillator::fmm();
+    let law = LuGre::default();
+    let t = sample_times(1.0, RATE);
+    let input = Input::new(t.clone(), u.to_vec()).unwrap();
+    let opts = SimOptions {
+        rtol: 1e-10,
+        atol: 1e-12,
+        ..SimOptions::default()
+    };
+    let run = simulate_driven(RunInputs {
+        osc: &osc,
+        model: &law,
+        init: &Initial::at_rest(0.0),
+        input: Some(&input),
+        channels: None,
+        grid: SampleGrid {
+            t_end: 1.0,
+            sample_times: &t,
+        },
+        opts: &opts,
+    })
+    .unwrap();
+    let states = law.states().unwrap();
+    let rate = |s: f64, y: [f64; 3]| -> [f64; 3] {
+        let mut dz = [0.0];
+        let f = states.state_derivative_and_force(y[1], &y[2..], osc.normal_force, &mut dz);
+        let a = (input.at(s) - osc.damping * y[1] - osc.stiffness * y[0] - f) / osc.mass;
+        [y[1], a, dz[0]]
+    };
+    let h = 1e-5;
+    let mut y = [0.0; 3];
+    let (mut worst, mut fastest) = (0.0f64, 0.0f64);
+    for (i, &ts) in t.iter().enumerate().skip(1) {
+        let mut s = t[i - 1];
+        while s < ts - 1e-12 {
+            let k1 = rate(s, y);
+            let at = |k: [f64; 3], c: f64| [0, 1, 2].map(|j| y[j] + c * h * k[j]);
+            let k2 = rate(s + h / 2.0, at(k1, 0.5));
+            let k3 = rate(s + h / 2.0, at(k2, 0.5));
+            let k4 = rate(s + h, at(k3, 1.0));
+            y = [0, 1, 2].map(|j| y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]));
+            s += h;
+        }
+        worst = worst.max((run.v[i] - y[1]).abs());
+        fastest = fastest.max(y[1].abs());
+    }
+    (worst / fastest, fastest)
+}
+
+/// u = 8 sin(3 pi t) N starts at 0: LuGre is in balance at t = 0, and the mass must move
+/// with the input at once (it was held at rest for the whole record).
+#[test]
+fn a_drive_starting_in_balance_moves_a_law_without_a_static_limit() {
+    let u: Vec<f64> = sample_times(1.0, RATE)
+        .iter()
+        .map(|s| 8.0 * (3.0 * std::f64::consts::PI * s).sin())
+        .collect();
+    let (error, fastest) = lugre_drive_against_rk4(&u);
+    assert!(fastest > 0.05, "the reference moves: {fastest}");
+    assert!(
+        error < 1e-6,
+        "velocity off by {error:e} of the largest speed"
+    );
+}
+
+/// The same input held at 0 for its first 0.2 s: the mass rests in balance, then moves when
+/// the input leaves 0.
+#[test]
+fn a_drive_held_flat_in_balance_moves_when_the_input_leaves() {
+    let u: Vec<f64> = sample_times(1.0, RATE)
+        .iter()
+        .map(|s| 8.0 * (3.0 * std::f64::consts::PI * (s - 0.2).max(0.0)).sin())
+        .collect();
+    let (error, fastest) = lugre_drive_against_rk4(&u);
+    assert!(fastest > 0.05, "the reference moves: {fastest}");
+    assert!(
+        error < 1e-6,
+        "velocity off by {error:e} of the largest speed"
+    );
+}

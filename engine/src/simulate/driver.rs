@@ -12,11 +12,6 @@ use frictionid_models::sgn;
 /// Width of the final bracket of a turning point's time [s].
 pub(crate) const EVENT_TOL: f64 = 1e-13;
 
-/// A knot of the input closer than this (relative to 1 + |t|) after a segment's start is not
-/// stopped at: a step that short is lost in round-off, and the kink it would resolve spans
-/// nothing.
-const KNOT_GAP: f64 = 1e-9;
-
 /// The equation of motion within one segment: slip direction `dir` fixed.
 struct Segment<'a> {
     dynamics: Dynamics<'a>,
@@ -188,13 +183,7 @@ impl<R: Recorder> Driver<'_, R> {
     /// The next knot after `t` of the input or of a channel the law reads (the same kink
     /// in a condition's slope), if any.
     fn next_knot(&self, t: f64) -> Option<f64> {
-        let gap = KNOT_GAP * (1.0 + t.abs());
-        let input = self.dynamics.input.and_then(|u| u.next_knot(t, gap));
-        let channels = self.dynamics.conditions.and_then(|c| c.next_knot(t, gap));
-        match (input, channels) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        }
+        self.dynamics.next_knot(t)
     }
 
     /// The time of the zero of the event function inside the last step.
@@ -368,7 +357,7 @@ impl<R: Recorder> Driver<'_, R> {
     /// and when the stick lasts to the end.
     fn breakaway(&self, t: f64, x: f64, t_end: f64) -> Option<(f64, f64)> {
         if !matches!(self.dynamics.law, Law::Switched { .. }) {
-            return None;
+            return self.input_resumes(t, t_end);
         }
         if self.dynamics.conditions.is_some() {
             return self.breakaway_under_conditions(t, x, t_end);
@@ -386,6 +375,17 @@ impl<R: Recorder> Driver<'_, R> {
             return None;
         }
         Some((t_b, sgn(self.dynamics.held_force(t_b, x) - offset)))
+    }
+
+    /// When a law without a static limit, in balance at rest at `t` under a flat input,
+    /// starts moving: where the input leaves the value it holds, in the direction it goes.
+    /// `None` without an input, or when it stays flat to the end.
+    fn input_resumes(&self, t: f64, t_end: f64) -> Option<(f64, f64)> {
+        let input = self.dynamics.input?;
+        let t_b = input.first_exceedance(t, t_end, input.at(t), 0.0)?;
+        let next = self.next_knot(t_b).map_or(t_end, |k| k.min(t_end));
+        let rise = input.at(next) - input.at(t_b);
+        (t_b > t && rise != 0.0).then(|| (t_b, sgn(rise)))
     }
 
     /// [`Driver::breakaway`] of a law whose stick band moves with its conditions (a load, a

@@ -7,6 +7,11 @@ use crate::error::EngineError;
 use crate::oscillator::Oscillator;
 use frictionid_models::{sgn, Derivatives, FrictionModel, InternalStates, SwitchedLaw};
 
+/// A knot of the input closer than this (relative to 1 + |t|) after a segment's start is not
+/// stopped at: a step that short is lost in round-off, and the kink it would resolve spans
+/// nothing.
+const KNOT_GAP: f64 = 1e-9;
+
 /// How the friction law is treated.
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Law<'a> {
@@ -145,6 +150,27 @@ impl Dynamics<'_> {
         self.input.map_or(0.0, |u| u.at(t)) - self.osc.input_offset
     }
 
+    /// The next knot after `t` of the input or of a channel the law reads (the same kink in
+    /// a condition's slope), if any: a step of any stepper stops there.
+    pub(crate) fn next_knot(&self, t: f64) -> Option<f64> {
+        let gap = KNOT_GAP * (1.0 + t.abs());
+        let input = self.input.and_then(|u| u.next_knot(t, gap));
+        let channels = self.conditions.and_then(|c| c.next_knot(t, gap));
+        match (input, channels) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// The direction the measured input moves in just after `t` (the sign of its slope to
+    /// its next knot); `None` without an input or while it stays where it is.
+    fn input_departure(&self, t: f64) -> Option<f64> {
+        let u = self.input?;
+        let next = self.next_knot(t)?;
+        let rise = u.at(next) - u.at(t);
+        (rise != 0.0).then(|| sgn(rise))
+    }
+
     /// Whether an input or a constant force acts (else the motion is free vibration).
     #[inline]
     pub(crate) fn driven(&self) -> bool {
@@ -240,10 +266,15 @@ impl Dynamics<'_> {
             Law::Switched { .. } => Start::Rest,
             Law::Smooth | Law::Dynamic { .. } => {
                 let a = self.accel(t, x, 0.0, self.force(t, x, 0.0, z, 0.0));
-                if a == 0.0 || !a.is_finite() {
-                    Start::Rest
-                } else {
+                if a.is_finite() && a != 0.0 {
                     Start::Slip(sgn(a))
+                } else if a == 0.0 {
+                    // In balance at this instant (a drive starting from rest with u = 0):
+                    // nothing holds a law without a static limit, so the input's next move
+                    // sets the mass going.
+                    self.input_departure(t).map_or(Start::Rest, Start::Slip)
+                } else {
+                    Start::Rest
                 }
             }
         }

@@ -55,8 +55,18 @@ struct Run<'a, 'b> {
     last_turn: Option<f64>,
     /// The right-hand side of the states just before the last turning point.
     before_turn: Option<Vec<f64>>,
-    /// Whether a sampled sensitivity passed its believable size.
-    diverged: bool,
+    /// Why the run gives no sensitivities, once it knows.
+    given_up: Option<GivenUp>,
+}
+
+/// Why an augmented run gives no sensitivities.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum GivenUp {
+    /// A sampled sensitivity passed its believable size.
+    Diverged,
+    /// A run driven by a measured input came to rest: it would break away again when the
+    /// input changes, an event whose jump this run does not follow.
+    RestUnderInput,
 }
 
 /// Runs `setup` to its end time; `None` when the sensitivities diverged (the explicit
@@ -91,7 +101,7 @@ pub(super) fn run(setup: Setup<'_, '_>) -> Result<Option<Sensitivities>, EngineE
         events: 0,
         last_turn: None,
         before_turn: None,
-        diverged: false,
+        given_up: None,
     };
     match &run.setup.method {
         Method::Dopri5 => {
@@ -138,7 +148,7 @@ impl Run<'_, '_> {
                 }
             },
         };
-        result.map(|()| (!self.diverged).then_some(self.out))
+        result.map(|()| self.given_up.is_none().then_some(self.out))
     }
 }
 
@@ -157,9 +167,13 @@ impl Run<'_, '_> {
         let tiny = 1e-13 * (1.0 + t_end);
         let mut t = 0.0;
         loop {
-            let start = self.decide(&y);
-            self.jump(&mut y, start);
+            let start = self.decide(t, &y);
+            self.jump(t, &mut y, start);
             let Start::Slip(dir) = start else {
+                if self.setup.dynamics.input.is_some() {
+                    self.given_up = Some(GivenUp::RestUnderInput);
+                    return Ok(());
+                }
                 self.count_event(t)?;
                 self.fill(&y, None);
                 return Ok(());
@@ -169,7 +183,7 @@ impl Run<'_, '_> {
                 return Ok(());
             }
             let system = Augmented::new(self.setup.dynamics, dir, self.setup.terms, typical);
-            stepper.reset(&system, t, &y, t_end)?;
+            stepper.reset(&system, t, &y, self.stop_after(t))?;
             match self.advance(stepper, &system, &mut y)? {
                 None => return Ok(()),
                 Some(t_e) => {
@@ -225,8 +239,14 @@ impl Run<'_, '_> {
                 return Ok(Some(t_e));
             }
             if stepper.reached_end() {
-                self.write(stepper, self.setup.grid.t_end, y);
+                let (t_stop, t_end) = (stepper.time(), self.setup.grid.t_end);
+                self.write(stepper, t_stop, y);
                 y.copy_from_slice(stepper.state());
+                if t_stop < t_end {
+                    // A knot of the input: the next step starts afresh from it.
+                    stepper.reset(system, t_stop, y, self.stop_after(t_stop))?;
+                    continue;
+                }
                 self.fill(y, Some(dir));
                 return Ok(None);
             }
@@ -234,13 +254,21 @@ impl Run<'_, '_> {
         }
     }
 
-    /// The mode at a turning point or the start, as the plain driver decides it.
-    fn decide(&mut self, y: &[f64]) -> Start {
+    /// Where a step from `t` must stop: the input's next knot (as the plain driver stops
+    /// there), else the end time.
+    fn stop_after(&self, t: f64) -> f64 {
+        let t_end = self.setup.grid.t_end;
+        let knot = self.setup.dynamics.next_knot(t);
+        knot.map_or(t_end, |knot| knot.min(t_end))
+    }
+
+    /// The mode at a turning point or the start (time `t`), as the plain driver decides it.
+    fn decide(&mut self, t: f64, y: &[f64]) -> Start {
         let [x, v, z @ ..] = &y[..self.n()] else {
             return Start::Rest;
         };
         let dynamics = &self.setup.dynamics;
-        let mut start = dynamics.start(0.0, *x, *v, z);
+        let mut start = dynamics.start(t, *x, *v, z);
         let switched = matches!(dynamics.law, Law::Switched { .. });
         if *v == 0.0 && !dynamics.driven() && !switched {
             let swing = REST_SWING_ATOLS * self.setup.opts.atol;
@@ -254,9 +282,9 @@ impl Run<'_, '_> {
         start
     }
 
-    /// The sensitivities' jump at the turning point just reached (if any) into `start`:
-    /// s += (f- - f+) dt_e/dp with dt_e/dp = -s_v / a-.
-    fn jump(&mut self, y: &mut [f64], start: Start) {
+    /// The sensitivities' jump at the turning point just reached (if any, at time `t`) into
+    /// `start`: s += (f- - f+) dt_e/dp with dt_e/dp = -s_v / a-.
+    fn jump(&mut self, t: f64, y: &mut [f64], start: Start) {
         let Some(before) = self.before_turn.take() else {
             return;
         };
@@ -267,7 +295,7 @@ impl Run<'_, '_> {
         }
         let mut after = vec![0.0; n];
         if let Start::Slip(dir) = start {
-            self.setup.dynamics.rhs(0.0, &y[..n], &mut after, dir);
+            self.setup.dynamics.rhs(t, &y[..n], &mut after, dir);
         }
         for s in y[n..].chunks_exact_mut(n) {
             let dt_dp = -s[1] / a_before;
@@ -326,7 +354,9 @@ impl Run<'_, '_> {
             }
             out.dv[j].push(if moving { s[1] } else { 0.0 });
             // Written so that NaN counts as diverged.
-            self.diverged |= !(s[0].abs() <= dx_max && s[1].abs() <= dv_max);
+            if !(s[0].abs() <= dx_max && s[1].abs() <= dv_max) {
+                self.given_up.get_or_insert(GivenUp::Diverged);
+            }
         }
         self.next += 1;
     }

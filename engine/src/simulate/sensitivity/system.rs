@@ -203,10 +203,11 @@ impl OdeSystem for Augmented<'_, '_> {
     /// states, H_j = (dJ/dy) s_j + d(df/dp_j)/dy. The derivatives of J and of the direct
     /// terms are forward differences (one Jacobian and one set of direct terms per state)
     /// at steps of sqrt(eps) times the state's size or its typical size, whichever is
-    /// larger, the velocity's in the segment's direction; they are taken of J and of the terms apart, not of the rates J s_j + df/dp_j,
-    /// whose large and nearly unchanged J s_j would leave rounding errors of the step's
-    /// order in the difference (entries of J that do not move give exact zeros). H_j enters
-    /// only the stiff stepper's linear systems, not the rates it integrates.
+    /// larger, the velocity's in the segment's direction. They are taken of J and of the
+    /// terms apart, not of the rates J s_j + df/dp_j, whose large and nearly unchanged J s_j
+    /// would leave rounding errors of the step's order in the difference (entries of J that
+    /// do not move give exact zeros). H_j enters only the stiff stepper's linear systems,
+    /// not the rates it integrates.
     ///
     /// [`Rodas4::block_triangular`]: super::super::Rodas4::block_triangular
     fn jacobian(&self, t: f64, y: &[f64], jac: &mut [f64]) {

@@ -5,7 +5,7 @@
 
 use super::*;
 use crate::oscillator::Oscillator;
-use crate::simulate::{simulate, Initial, SampleGrid, SimOptions, Trajectory};
+use crate::simulate::{simulate_driven, Initial, Input, SampleGrid, SimOptions, Trajectory};
 use frictionid_models::{Coulomb, FrictionModel, LuGre, Stribeck};
 
 /// Tight options, so that the differences of plain runs are accurate.
@@ -24,14 +24,15 @@ fn times(seconds: f64) -> Vec<f64> {
         .collect()
 }
 
-/// A world: the oscillator, the law, the release displacement and the integrator of its
-/// plain runs (at the tight tolerances).
+/// A world: the oscillator, the law, the release displacement, the integrator of its
+/// plain runs (at the tight tolerances) and the measured input driving it, if any.
 #[derive(Clone)]
 struct World {
     osc: Oscillator,
     model: Box<dyn FrictionModel>,
     x0: f64,
     plain: Integrator,
+    input: Option<Input>,
 }
 
 impl World {
@@ -46,7 +47,19 @@ impl World {
             integrator: self.plain,
             ..tight()
         };
-        simulate(&self.osc, self.model.as_ref(), &init, t_end, time, &opts).unwrap()
+        simulate_driven(RunInputs {
+            osc: &self.osc,
+            model: self.model.as_ref(),
+            init: &init,
+            input: self.input.as_ref(),
+            channels: None,
+            grid: SampleGrid {
+                t_end,
+                sample_times: time,
+            },
+            opts: &opts,
+        })
+        .unwrap()
     }
 
     fn sensitivities(&self, time: &[f64], params: &[SensitivityParam]) -> Sensitivities {
@@ -68,7 +81,7 @@ impl World {
             osc: &self.osc,
             model: self.model.as_ref(),
             init: &init,
-            input: None,
+            input: self.input.as_ref(),
             channels: None,
             grid: SampleGrid {
                 t_end: time.last().copied().unwrap_or(0.0),
@@ -175,6 +188,7 @@ fn lugre_sensitivities_match_central_differences() {
         model: Box::new(LuGre::default()),
         x0: 0.022,
         plain: Integrator::Dopri5,
+        input: None,
     };
     let params = [
         SensitivityParam::Model(0),
@@ -194,6 +208,7 @@ fn stribeck_sensitivities_with_a_free_damping_match_central_differences() {
         model: Box::new(Stribeck::default()),
         x0: 0.022,
         plain: Integrator::Dopri5,
+        input: None,
     };
     let params = [
         SensitivityParam::Model(0),
@@ -221,6 +236,7 @@ fn gms_sensitivities_match_central_differences() {
         model: built.model,
         x0: 0.022,
         plain: Integrator::Dopri5,
+        input: None,
     };
     assert!(world.model.params().len() == 15, "three elements");
     let params = [0, 2, 4, 6, 8, 9, 10, 11, 13, 14].map(SensitivityParam::Model);
@@ -246,6 +262,7 @@ fn a_diverging_explicit_run_is_given_up() {
         }),
         x0: 0.022,
         plain: Integrator::Dopri5,
+        input: None,
     };
     let time = times(2.0);
     let params: Vec<_> = (0..3).map(SensitivityParam::Model).collect();
@@ -276,6 +293,7 @@ fn stiff_world(model: Box<dyn FrictionModel>) -> World {
         model,
         x0: 0.022,
         plain: Integrator::Rodas,
+        input: None,
     }
 }
 
@@ -330,6 +348,7 @@ fn a_soft_contact_keeps_the_explicit_stepper() {
         model: Box::new(LuGre::default()),
         x0: 0.022,
         plain: Integrator::Dopri5,
+        input: None,
     };
     let sens = world.sensitivities(&times(0.2), &[SensitivityParam::Model(0)]);
     assert!(!took_the_stiff_stepper(&sens));
@@ -346,6 +365,7 @@ fn coulomb_sensitivities_carry_across_reversals_and_the_stick() {
         model: Box::new(Coulomb { mu: 0.24 }),
         x0: 0.010,
         plain: Integrator::Dopri5,
+        input: None,
     };
     let time = times(1.5);
     let params = [
@@ -422,4 +442,53 @@ fn laws_without_gradients_and_driven_or_euler_runs_give_none() {
     };
     assert!(run(&Coulomb { mu: 0.2 }, &euler).is_none());
     assert!(run(&Coulomb { mu: 0.2 }, &tight()).is_some());
+}
+
+/// A force of 8 N at 1.5 Hz sampled at 1 kHz (the knots of a measured input), from rest:
+/// enough to slide the FMM stage against a 3 N level and reverse it every third of a second.
+fn shaker(seconds: f64) -> Input {
+    let time = times(seconds);
+    let value = time
+        .iter()
+        .map(|t| 8.0 * (2.0 * std::f64::consts::PI * 1.5 * t).sin())
+        .collect();
+    Input::new(time, value).unwrap()
+}
+
+/// `model` on the FMM stage driven by [`shaker`] from rest, its plain runs on `plain`.
+fn driven_world(model: Box<dyn FrictionModel>, plain: Integrator, seconds: f64) -> World {
+    World {
+        osc: Oscillator::fmm(),
+        model,
+        x0: 0.0,
+        plain,
+        input: Some(shaker(seconds)),
+    }
+}
+
+/// Under a measured input, LuGre's sensitivities follow the input from knot to knot and
+/// across its reversals: every parameter, the mass and the stiffness against central
+/// differences of plain driven runs.
+#[test]
+fn driven_lugre_sensitivities_match_central_differences() {
+    let world = driven_world(Box::new(LuGre::default()), Integrator::Dopri5, 1.0);
+    let time = times(1.0);
+    let mut params: Vec<_> = (0..6).map(SensitivityParam::Model).collect();
+    params.extend([
+        SensitivityParam::Property(OscillatorProperty::Mass),
+        SensitivityParam::Property(OscillatorProperty::Stiffness),
+    ]);
+    assert!(!took_the_stiff_stepper(
+        &world.sensitivities(&time, &params)
+    ));
+    check_against_differences(&world, &time, &params, 1e-4);
+}
+
+/// A switched law under a measured input sticks until the input breaks it away, an event
+/// whose jump the augmented run does not follow: no sensitivities, so the fit differences.
+#[test]
+fn a_driven_switched_law_has_no_sensitivities() {
+    let world = driven_world(Box::new(Coulomb { mu: 0.2 }), Integrator::Dopri5, 1.0);
+    let params = [SensitivityParam::Model(0)];
+    assert!(world.try_sensitivities(&times(1.0), &params).is_none());
 }
