@@ -330,6 +330,17 @@ fn lugre_drive_against_rk4(u: &[f64]) -> (f64, f64) {
     (worst / fastest, fastest)
 }
 
+/// The drive by `u` moves the mass (0.05 m/s at least) and follows RK4 within 1e-6 of its
+/// largest speed.
+fn assert_lugre_follows_rk4(u: &[f64]) {
+    let (error, fastest) = lugre_drive_against_rk4(u);
+    assert!(fastest > 0.05, "the reference moves: {fastest}");
+    assert!(
+        error < 1e-6,
+        "velocity off by {error:e} of the largest speed"
+    );
+}
+
 /// u = 8 sin(3 pi t) N starts at 0: LuGre is in balance at t = 0, and the mass must move
 /// with the input at once (it was held at rest for the whole record).
 #[test]
@@ -338,12 +349,7 @@ fn a_drive_starting_in_balance_moves_a_law_without_a_static_limit() {
         .iter()
         .map(|s| 8.0 * (3.0 * std::f64::consts::PI * s).sin())
         .collect();
-    let (error, fastest) = lugre_drive_against_rk4(&u);
-    assert!(fastest > 0.05, "the reference moves: {fastest}");
-    assert!(
-        error < 1e-6,
-        "velocity off by {error:e} of the largest speed"
-    );
+    assert_lugre_follows_rk4(&u);
 }
 
 /// The same input held at 0 for its first 0.2 s: the mass rests in balance, then moves when
@@ -354,10 +360,5 @@ fn a_drive_held_flat_in_balance_moves_when_the_input_leaves() {
         .iter()
         .map(|s| 8.0 * (3.0 * std::f64::consts::PI * (s - 0.2).max(0.0)).sin())
         .collect();
-    let (error, fastest) = lugre_drive_against_rk4(&u);
-    assert!(fastest > 0.05, "the reference moves: {fastest}");
-    assert!(
-        error < 1e-6,
-        "velocity off by {error:e} of the largest speed"
-    );
+    assert_lugre_follows_rk4(&u);
 }

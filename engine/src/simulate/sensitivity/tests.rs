@@ -42,24 +42,32 @@ impl World {
             v0: 0.0,
             z0: None,
         };
-        let t_end = time.last().copied().unwrap_or(0.0);
         let opts = SimOptions {
             integrator: self.plain,
             ..tight()
         };
-        simulate_driven(RunInputs {
+        simulate_driven(self.inputs(&init, time, &opts)).unwrap()
+    }
+
+    /// A run of this world from `init`, sampled at `time`, with `opts`.
+    fn inputs<'a>(
+        &'a self,
+        init: &'a Initial,
+        time: &'a [f64],
+        opts: &'a SimOptions,
+    ) -> RunInputs<'a> {
+        RunInputs {
             osc: &self.osc,
             model: self.model.as_ref(),
-            init: &init,
+            init,
             input: self.input.as_ref(),
             channels: None,
             grid: SampleGrid {
-                t_end,
+                t_end: time.last().copied().unwrap_or(0.0),
                 sample_times: time,
             },
-            opts: &opts,
-        })
-        .unwrap()
+            opts,
+        }
     }
 
     fn sensitivities(&self, time: &[f64], params: &[SensitivityParam]) -> Sensitivities {
@@ -77,18 +85,8 @@ impl World {
             v0: 0.0,
             z0: None,
         };
-        let inputs = RunInputs {
-            osc: &self.osc,
-            model: self.model.as_ref(),
-            init: &init,
-            input: self.input.as_ref(),
-            channels: None,
-            grid: SampleGrid {
-                t_end: time.last().copied().unwrap_or(0.0),
-                sample_times: time,
-            },
-            opts: &tight(),
-        };
+        let opts = tight();
+        let inputs = self.inputs(&init, time, &opts);
         simulate_sensitivities(inputs, params, SampledSeries::All).unwrap()
     }
 
@@ -183,13 +181,7 @@ fn check_against_differences_by(
 
 #[test]
 fn lugre_sensitivities_match_central_differences() {
-    let world = World {
-        osc: Oscillator::fmm(),
-        model: Box::new(LuGre::default()),
-        x0: 0.022,
-        plain: Integrator::Dopri5,
-        input: None,
-    };
+    let world = released(Box::new(LuGre::default()), Integrator::Dopri5);
     let params = [
         SensitivityParam::Model(0),
         SensitivityParam::Model(1),
@@ -203,13 +195,7 @@ fn lugre_sensitivities_match_central_differences() {
 
 #[test]
 fn stribeck_sensitivities_with_a_free_damping_match_central_differences() {
-    let world = World {
-        osc: Oscillator::fmm(),
-        model: Box::new(Stribeck::default()),
-        x0: 0.022,
-        plain: Integrator::Dopri5,
-        input: None,
-    };
+    let world = released(Box::new(Stribeck::default()), Integrator::Dopri5);
     let params = [
         SensitivityParam::Model(0),
         SensitivityParam::Model(1),
@@ -231,13 +217,7 @@ fn gms_sensitivities_match_central_differences() {
         "type": "gms", "stiffness": [3.0e4, 1.0e4, 3.0e3], "damping": 2.0, "sharpness": 1.6
     }))
     .unwrap();
-    let world = World {
-        osc: Oscillator::fmm(),
-        model: built.model,
-        x0: 0.022,
-        plain: Integrator::Dopri5,
-        input: None,
-    };
+    let world = released(built.model, Integrator::Dopri5);
     assert!(world.model.params().len() == 15, "three elements");
     let params = [0, 2, 4, 6, 8, 9, 10, 11, 13, 14].map(SensitivityParam::Model);
     // The elements' compliance leaves the plain runs' integration error 1e-3 times the
@@ -253,17 +233,14 @@ fn gms_sensitivities_match_central_differences() {
 /// sensitivities stay within a thousand times the motion's scale over the whole record.
 #[test]
 fn a_diverging_explicit_run_is_given_up() {
-    let world = World {
-        osc: Oscillator::fmm(),
-        model: Box::new(frictionid_models::Dahl {
+    let world = released(
+        Box::new(frictionid_models::Dahl {
             sigma0: 3e5,
             mu_c: 0.21,
             alpha: 1.0,
         }),
-        x0: 0.022,
-        plain: Integrator::Dopri5,
-        input: None,
-    };
+        Integrator::Dopri5,
+    );
     let time = times(2.0);
     let params: Vec<_> = (0..3).map(SensitivityParam::Model).collect();
     assert!(world.try_sensitivities(&time, &params).is_none());
@@ -286,13 +263,13 @@ fn took_the_stiff_stepper(sens: &Sensitivities) -> bool {
     sens.stats.jacobian_evaluations > sens.stats.rhs_evaluations
 }
 
-/// `model` on the FMM stage released from 22 mm, its plain runs on Rodas4.
-fn stiff_world(model: Box<dyn FrictionModel>) -> World {
+/// `model` on the FMM stage released from 22 mm, its plain runs on `plain`.
+fn released(model: Box<dyn FrictionModel>, plain: Integrator) -> World {
     World {
         osc: Oscillator::fmm(),
         model,
         x0: 0.022,
-        plain: Integrator::Rodas,
+        plain,
         input: None,
     }
 }
@@ -302,11 +279,12 @@ fn stiff_world(model: Box<dyn FrictionModel>) -> World {
 /// tight tolerances (every parameter, a property and the release).
 #[test]
 fn stiff_lugre_sensitivities_from_the_stiff_stepper_match_central_differences() {
-    let world = stiff_world(Box::new(LuGre {
+    let model = LuGre {
         sigma0: 1e7,
         sigma1: 5000.0,
         ..LuGre::default()
-    }));
+    };
+    let world = released(Box::new(model), Integrator::Rodas);
     let law: Vec<_> = (0..6).map(SensitivityParam::Model).collect();
     let time = times(0.6);
     assert!(took_the_stiff_stepper(&world.sensitivities(&time, &law)));
@@ -330,7 +308,7 @@ fn stiff_gms_sensitivities_from_the_stiff_stepper_match_central_differences() {
         "type": "gms", "damping": 2.0, "sharpness": 1.6
     }))
     .unwrap();
-    let world = stiff_world(built.model);
+    let world = released(built.model, Integrator::Rodas);
     let params: Vec<_> = (0..15).map(SensitivityParam::Model).collect();
     let time = times(0.6);
     assert!(took_the_stiff_stepper(&world.sensitivities(&time, &params)));
@@ -343,13 +321,7 @@ fn stiff_gms_sensitivities_from_the_stiff_stepper_match_central_differences() {
 /// The explicit augmented run is told apart from the stiff one by its counts.
 #[test]
 fn a_soft_contact_keeps_the_explicit_stepper() {
-    let world = World {
-        osc: Oscillator::fmm(),
-        model: Box::new(LuGre::default()),
-        x0: 0.022,
-        plain: Integrator::Dopri5,
-        input: None,
-    };
+    let world = released(Box::new(LuGre::default()), Integrator::Dopri5);
     let sens = world.sensitivities(&times(0.2), &[SensitivityParam::Model(0)]);
     assert!(!took_the_stiff_stepper(&sens));
 }
