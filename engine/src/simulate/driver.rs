@@ -100,7 +100,7 @@ impl<R: Recorder> Driver<'_, R> {
                 dynamics: self.dynamics,
                 dir,
             };
-            stepper.reset(&segment, t, &y, self.stop_after(t, t_end))?;
+            stepper.reset(&segment, t, &y, self.dynamics.stop_after(t, t_end))?;
             match self.advance(stepper, &segment, &mut y, t_end)? {
                 SegmentEnd::Finished => return Ok(()),
                 SegmentEnd::Turn(t_e) => {
@@ -159,7 +159,7 @@ impl<R: Recorder> Driver<'_, R> {
             }
             if stepper.reached_end() && stepper.end_time() < t_end {
                 self.write_samples(stepper, stepper.time(), dir, y);
-                stepper.continue_to(self.stop_after(stepper.time(), t_end));
+                stepper.continue_to(self.dynamics.stop_after(stepper.time(), t_end));
                 continue;
             }
             if stepper.reached_end() {
@@ -170,20 +170,6 @@ impl<R: Recorder> Driver<'_, R> {
             }
             self.write_samples(stepper, stepper.time(), dir, y);
         }
-    }
-
-    /// Where a step from `t` must stop: the input's next knot (a step across one straddles
-    /// the kink of u's slope there, which the error estimate cannot resolve: Dopri5 rejected
-    /// nine steps in ten under a multisine sampled at 1 kHz and left errors of 1e-7 m/s that
-    /// changed erratically with the parameters), else `t_end`.
-    fn stop_after(&self, t: f64, t_end: f64) -> f64 {
-        self.next_knot(t).map_or(t_end, |knot| knot.min(t_end))
-    }
-
-    /// The next knot after `t` of the input or of a channel the law reads (the same kink
-    /// in a condition's slope), if any.
-    fn next_knot(&self, t: f64) -> Option<f64> {
-        self.dynamics.next_knot(t)
     }
 
     /// The time of the zero of the event function inside the last step.
@@ -383,9 +369,8 @@ impl<R: Recorder> Driver<'_, R> {
     fn input_resumes(&self, t: f64, t_end: f64) -> Option<(f64, f64)> {
         let input = self.dynamics.input?;
         let t_b = input.first_exceedance(t, t_end, input.at(t), 0.0)?;
-        let next = self.next_knot(t_b).map_or(t_end, |k| k.min(t_end));
-        let rise = input.at(next) - input.at(t_b);
-        (t_b > t && rise != 0.0).then(|| (t_b, sgn(rise)))
+        let dir = self.dynamics.input_departure(t_b).filter(|_| t_b > t)?;
+        Some((t_b, dir))
     }
 
     /// [`Driver::breakaway`] of a law whose stick band moves with its conditions (a load, a
@@ -401,7 +386,7 @@ impl<R: Recorder> Driver<'_, R> {
         };
         let mut t0 = t;
         while t0 < t_end {
-            let t1 = self.next_knot(t0).map_or(t_end, |k| k.min(t_end));
+            let t1 = dynamics.stop_after(t0, t_end);
             let g1 = excess(t1)?;
             if g1 > 0.0 {
                 let g0 = excess(t0)?;

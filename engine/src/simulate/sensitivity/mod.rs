@@ -14,11 +14,11 @@
 //! A contact so stiff that Dopri5 would be held by stability ([`SENSITIVITY_STIFF_RATIO`])
 //! is integrated by Rodas4 instead, at the plain stiff run's tolerances, its error control
 //! over the states alone (as the explicit run's): LuGre and the default GMS match central
-//! differences within 1e-4 and 1e-3; a stiff Dahl with alpha 1.5 or 3 within 1 %. Its linear systems take the augmented system's Jacobian, block
-//! lower triangular (J on the diagonal, H_j = d(s_j')/dy below it, by differences), and are
-//! solved block by block with the factors of J's block alone
-//! ([`Rodas4::block_triangular`]): the sensitivities cost their right-hand sides, not a
-//! larger factorisation. The default GMS (stiffness ratio 286) and the bristle laws far up
+//! differences within 1e-4 and 1e-3; a stiff Dahl with alpha 1.5 or 3 within 1 %. Its
+//! linear systems take the augmented system's Jacobian, block lower triangular (J on the
+//! diagonal, H_j = d(s_j')/dy below it, by differences), and are solved block by block
+//! with the factors of J's block alone ([`Rodas4::block_triangular`]): the sensitivities
+//! cost their right-hand sides, not a larger factorisation. The default GMS (stiffness ratio 286) and the bristle laws far up
 //! their presliding stiffness take this path; LuGre fitted to the bundled Coulomb fixture
 //! went from 1 746 simulations (its columns differenced over Rodas4) to 612.
 //!
@@ -38,8 +38,9 @@
 //! Free vibration, or a drive by a measured input of a law without a static limit (whose
 //! run breaks away from no stick; the steps stop at the input's knots, as the plain run's)
 //! that is not stiff (Rodas4 steps a driven system as if autonomous), of a law that reads
-//! no conditions, every parameter with its derivative available (a law with [`ParamGradients`], and states' rate gradients
-//! for a dynamic law; the normal force is never differentiated), not the Euler integrator
+//! no conditions, every parameter with its derivative available (a law with
+//! [`ParamGradients`], and states' rate gradients for a dynamic law; the normal force is
+//! never differentiated), not the Euler integrator
 //! (whose trajectory the sensitivities of the exact motion would not describe), and a
 //! states' Jacobian finite where the run starts and slides (Dahl with alpha < 1 has an
 //! unbounded slope at its level; a stiff run whose sensitivities still leave the finite
@@ -163,7 +164,6 @@ pub fn simulate_sensitivities(
         // the sensitivities' equations are singular there.
         return Ok(None);
     }
-    let sizes = parameter_sizes(&dynamics, &terms, &y0);
     if input.is_some() && ratio > SENSITIVITY_STIFF_RATIO {
         // Rodas4 steps a driven system as if autonomous (no d f/dt term in its stages): its
         // states under a measured input are off by parts in 1e4 at tight tolerances, and its
@@ -172,11 +172,12 @@ pub fn simulate_sensitivities(
     }
     let method = match ratio > SENSITIVITY_STIFF_RATIO {
         true => run::Method::Rodas4 {
-            typical: typical_sizes(&dynamics, &y0, period),
+            typical: typical_sizes(&dynamics, scale),
             atol_scales: component_tolerance_scales(model, y0.len()),
         },
         false => run::Method::Dopri5,
     };
+    let sizes = parameter_sizes(&dynamics, &terms, &y0);
     let believable = believable_sizes(&sizes, scale);
     let outcome = run::run(run::Setup {
         dynamics,
@@ -258,11 +259,10 @@ fn motion_scale(dynamics: &Dynamics<'_>, y0: &[f64], period: f64) -> (f64, f64) 
     (x_scale, v_scale)
 }
 
-/// Each state's typical size in a run from `y0`: the motion's scale ([`motion_scale`]), and
-/// the law's steady sliding states at its speed (where the
-/// law states them; else a millionth of the state's tolerance scale).
-fn typical_sizes(dynamics: &Dynamics<'_>, y0: &[f64], period: f64) -> Vec<f64> {
-    let (x_scale, speed) = motion_scale(dynamics, y0, period);
+/// Each state's typical size in a run whose motion has the scale `(x_scale, speed)`
+/// ([`motion_scale`]): those two, and the law's steady sliding states at that speed (where
+/// the law states them; else a millionth of the state's tolerance scale).
+fn typical_sizes(dynamics: &Dynamics<'_>, (x_scale, speed): (f64, f64)) -> Vec<f64> {
     let mut typical = vec![x_scale, speed];
     let model = dynamics.model;
     if let Some(states) = model.states().filter(|s| s.n_states() > 0) {

@@ -183,7 +183,8 @@ impl Run<'_, '_> {
                 return Ok(());
             }
             let system = Augmented::new(self.setup.dynamics, dir, self.setup.terms, typical);
-            stepper.reset(&system, t, &y, self.stop_after(t))?;
+            let stop = self.setup.dynamics.stop_after(t, t_end);
+            stepper.reset(&system, t, &y, stop)?;
             match self.advance(stepper, &system, &mut y)? {
                 None => return Ok(()),
                 Some(t_e) => {
@@ -238,28 +239,21 @@ impl Run<'_, '_> {
                 self.before_turn = Some(f);
                 return Ok(Some(t_e));
             }
+            let t_end = self.setup.grid.t_end;
+            if stepper.reached_end() && stepper.end_time() < t_end {
+                // A knot of the input: on to the next, as the plain driver goes.
+                self.write(stepper, stepper.time(), y);
+                stepper.continue_to(self.setup.dynamics.stop_after(stepper.time(), t_end));
+                continue;
+            }
             if stepper.reached_end() {
-                let (t_stop, t_end) = (stepper.time(), self.setup.grid.t_end);
-                self.write(stepper, t_stop, y);
+                self.write(stepper, t_end, y);
                 y.copy_from_slice(stepper.state());
-                if t_stop < t_end {
-                    // A knot of the input: the next step starts afresh from it.
-                    stepper.reset(system, t_stop, y, self.stop_after(t_stop))?;
-                    continue;
-                }
                 self.fill(y, Some(dir));
                 return Ok(None);
             }
             self.write(stepper, stepper.time(), y);
         }
-    }
-
-    /// Where a step from `t` must stop: the input's next knot (as the plain driver stops
-    /// there), else the end time.
-    fn stop_after(&self, t: f64) -> f64 {
-        let t_end = self.setup.grid.t_end;
-        let knot = self.setup.dynamics.next_knot(t);
-        knot.map_or(t_end, |knot| knot.min(t_end))
     }
 
     /// The mode at a turning point or the start (time `t`), as the plain driver decides it.
