@@ -614,7 +614,7 @@ pub fn sgn(v: f64) -> f64 {
 }
 
 /// A boxed copy of a model behind a reference.
-pub fn clone_model(model: &(dyn FrictionModel + 'static)) -> Box<dyn FrictionModel> {
+pub fn clone_model<'a>(model: &(dyn FrictionModel + 'a)) -> Box<dyn FrictionModel + 'a> {
     dyn_clone::clone_box(model)
 }
 

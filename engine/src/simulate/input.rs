@@ -66,6 +66,18 @@ impl Input {
         self.time.get(i).copied()
     }
 
+    /// du/dt on the piece that reaches `t` from the left (the piece from the last knot
+    /// before `t` to the first at or after it): the rate at which u arrives at `t`, where a
+    /// stick's band is left. 0 at or before the first sample and beyond the last, where u
+    /// is held.
+    pub fn slope_arriving_at(&self, t: f64) -> f64 {
+        let i = self.time.partition_point(|&ti| ti < t);
+        match (i.checked_sub(1), self.time.get(i)) {
+            (Some(j), Some(&t1)) => (self.value[i] - self.value[j]) / (t1 - self.time[j]),
+            _ => 0.0,
+        }
+    }
+
     /// The first time in (`from`, `until`] at which |u(t) - `centre`| exceeds `half_width`,
     /// exact for the piecewise-linear input: the stick of an axis held by static friction
     /// `half_width` against the restoring force `centre` ends there. `None` when it holds
@@ -145,6 +157,18 @@ mod tests {
         assert_eq!(u.next_knot(0.5, 0.0), Some(1.0));
         assert_eq!(u.next_knot(1.0 - 1e-12, 1e-9), Some(2.0));
         assert_eq!(u.next_knot(3.0, 0.0), None);
+    }
+
+    #[test]
+    fn the_slope_arriving_at_a_time_is_that_of_the_piece_ending_there() {
+        let u = ramp();
+        assert_eq!(u.slope_arriving_at(0.5), 2.0);
+        // At a knot: the piece that ends there, not the one that leaves it.
+        assert_eq!(u.slope_arriving_at(1.0), 2.0);
+        assert_eq!(u.slope_arriving_at(2.0), 0.0);
+        assert_eq!(u.slope_arriving_at(2.5), -6.0);
+        assert_eq!(u.slope_arriving_at(0.0), 0.0);
+        assert_eq!(u.slope_arriving_at(4.0), 0.0);
     }
 
     #[test]

@@ -43,6 +43,7 @@
 
 mod auto;
 mod block;
+mod breakaway;
 mod closed_form;
 mod conditions;
 mod dopri;

@@ -53,6 +53,7 @@
 //! [`ParamGradients::force_param_gradient`]: frictionid_models::ParamGradients::force_param_gradient
 //! [`ParamGradients::state_param_gradient`]: frictionid_models::ParamGradients::state_param_gradient
 
+mod breakaway;
 mod run;
 mod system;
 
@@ -133,11 +134,6 @@ pub fn simulate_sensitivities(
     }
     check_system(osc, model)?;
     let dynamics = Dynamics::new(osc, model)?.driven_by(input);
-    if input.is_some() && matches!(dynamics.law, Law::Switched { .. }) {
-        // Under a measured input a stick ends when the input breaks it away: an event whose
-        // jump this run does not follow.
-        return Ok(None);
-    }
     let mut y0 = vec![init.x0, init.v0];
     match &init.z0 {
         Some(z0) if z0.len() == model.n_states() => y0.extend_from_slice(z0),

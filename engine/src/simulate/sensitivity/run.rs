@@ -6,6 +6,7 @@ use super::super::dynamics::{Dynamics, Law, Start};
 use super::super::stepper::{StepCounts, StepOutcome, Stepper};
 use super::super::values::{SampleGrid, SimOptions, SimStats};
 use super::super::{Dopri5, Rodas4, REST_SWING_ATOLS, RODAS_ATOL_SCALE, RODAS_TOL_SCALE};
+use super::breakaway::apply_breakaway_jump;
 use super::system::{Augmented, DirectTerms};
 use super::{SampledSeries, Sensitivities, SensitivityParam};
 use crate::error::{EngineError, IntegrationFailure};
@@ -64,9 +65,9 @@ struct Run<'a, 'b> {
 enum GivenUp {
     /// A sampled sensitivity passed its believable size.
     Diverged,
-    /// A run driven by a measured input came to rest: it would break away again when the
-    /// input changes, an event whose jump this run does not follow.
-    RestUnderInput,
+    /// A measured input broke a stick away arriving at the band's edge with zero slope (or
+    /// a law parameter's edge had no derivative): the breakaway time has no derivative.
+    TangentBreakaway,
 }
 
 /// Runs `setup` to its end time; `None` when the sensitivities diverged (the explicit
@@ -169,14 +170,15 @@ impl Run<'_, '_> {
         loop {
             let start = self.decide(t, &y);
             self.jump(t, &mut y, start);
-            let Start::Slip(dir) = start else {
-                if self.setup.dynamics.input.is_some() {
-                    self.given_up = Some(GivenUp::RestUnderInput);
-                    return Ok(());
-                }
-                self.count_event(t)?;
-                self.fill(&y, None);
-                return Ok(());
+            let dir = match start {
+                Start::Slip(dir) => dir,
+                Start::Rest => match self.stick(t, &mut y)? {
+                    Some((t_b, dir)) => {
+                        t = t_b;
+                        dir
+                    }
+                    None => return Ok(()),
+                },
             };
             if t_end - t <= tiny {
                 self.fill(&y, Some(dir));
@@ -256,6 +258,27 @@ impl Run<'_, '_> {
         }
     }
 
+    /// A stick from time `t` at the augmented state `y`: its samples at rest, and, where a
+    /// measured input breaks it away, the breakaway's time and direction with the
+    /// sensitivities' jump there applied to `y` (`None`: it lasts to the end, or the jump
+    /// cannot be taken and the run is given up).
+    fn stick(&mut self, t: f64, y: &mut [f64]) -> Result<Option<(f64, f64)>, EngineError> {
+        self.count_event(t)?;
+        let t_end = self.setup.grid.t_end;
+        let dynamics = self.setup.dynamics;
+        let Some((t_b, dir)) = dynamics.breakaway(t, y[0], t_end) else {
+            self.fill(y, None);
+            return Ok(None);
+        };
+        self.fill_until(y, t_b);
+        self.count_event(t_b)?;
+        if apply_breakaway_jump(&dynamics, self.setup.terms, t_b, dir, y).is_none() {
+            self.given_up = Some(GivenUp::TangentBreakaway);
+            return Ok(None);
+        }
+        Ok(Some((t_b, dir)))
+    }
+
     /// The mode at a turning point or the start (time `t`), as the plain driver decides it.
     fn decide(&mut self, t: f64, y: &[f64]) -> Start {
         let [x, v, z @ ..] = &y[..self.n()] else {
@@ -319,6 +342,19 @@ impl Run<'_, '_> {
             }
             stepper.interpolate(ts, buf);
             self.push(buf, true);
+        }
+    }
+
+    /// Writes the samples before `t` at rest with the augmented state `y`.
+    fn fill_until(&mut self, y: &[f64], t: f64) {
+        while self
+            .setup
+            .grid
+            .sample_times
+            .get(self.next)
+            .is_some_and(|&ts| ts < t)
+        {
+            self.push(y, false);
         }
     }
 

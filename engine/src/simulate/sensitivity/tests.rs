@@ -416,25 +416,31 @@ fn laws_without_gradients_and_driven_or_euler_runs_give_none() {
     assert!(run(&Coulomb { mu: 0.2 }, &tight()).is_some());
 }
 
-/// A force of 8 N at 1.5 Hz sampled at 1 kHz (the knots of a measured input), from rest:
-/// enough to slide the FMM stage against a 3 N level and reverse it every third of a second.
-fn shaker(seconds: f64) -> Input {
+/// A sine force of `amplitude` newtons at `hz` sampled at 1 kHz (the knots of a measured
+/// input) for `seconds`, from 0.
+fn sine_force(amplitude: f64, hz: f64, seconds: f64) -> Input {
     let time = times(seconds);
     let value = time
         .iter()
-        .map(|t| 8.0 * (2.0 * std::f64::consts::PI * 1.5 * t).sin())
+        .map(|t| amplitude * (2.0 * std::f64::consts::PI * hz * t).sin())
         .collect();
     Input::new(time, value).unwrap()
 }
 
-/// `model` on the FMM stage driven by [`shaker`] from rest, its plain runs on `plain`.
-fn driven_world(model: Box<dyn FrictionModel>, plain: Integrator, seconds: f64) -> World {
+/// A force of 8 N at 1.5 Hz: enough to slide the FMM stage against a 3 N level and reverse
+/// it every third of a second.
+fn shaker(seconds: f64) -> Input {
+    sine_force(8.0, 1.5, seconds)
+}
+
+/// `model` on the FMM stage driven by `input` from rest, its plain runs on `plain`.
+fn driven_world(model: Box<dyn FrictionModel>, plain: Integrator, input: Input) -> World {
     World {
         osc: Oscillator::fmm(),
         model,
         x0: 0.0,
         plain,
-        input: Some(shaker(seconds)),
+        input: Some(input),
     }
 }
 
@@ -443,7 +449,7 @@ fn driven_world(model: Box<dyn FrictionModel>, plain: Integrator, seconds: f64) 
 /// differences of plain driven runs.
 #[test]
 fn driven_lugre_sensitivities_match_central_differences() {
-    let world = driven_world(Box::new(LuGre::default()), Integrator::Dopri5, 1.0);
+    let world = driven_world(Box::new(LuGre::default()), Integrator::Dopri5, shaker(1.0));
     let time = times(1.0);
     let mut params: Vec<_> = (0..6).map(SensitivityParam::Model).collect();
     params.extend([
@@ -456,11 +462,183 @@ fn driven_lugre_sensitivities_match_central_differences() {
     check_against_differences(&world, &time, &params, 1e-4);
 }
 
-/// A switched law under a measured input sticks until the input breaks it away, an event
-/// whose jump the augmented run does not follow: no sensitivities, so the fit differences.
+/// Checks the sensitivities of a driven switched law over a record that sticks and breaks
+/// away under the input: against central differences of plain runs at p +- h, h = `rel`
+/// times the parameter (the plain driver locates each breakaway exactly on the
+/// piecewise-linear input), but for the samples next to the events, to `tol` of each
+/// column's scale.
+fn check_across_sticks(
+    world: &World,
+    time: &[f64],
+    params: &[SensitivityParam],
+    rel: f64,
+    tol: f64,
+) {
+    let plain = world.plain(time);
+    let breakaways = plain
+        .events
+        .iter()
+        .filter(|e| e.kind == crate::simulate::EventKind::Breakaway)
+        .count();
+    assert!(breakaways >= 2, "{:?}", plain.events);
+    let sens = world.sensitivities(time, params);
+    for (i, (got, expected)) in sens.v.iter().zip(&plain.v).enumerate() {
+        assert!((got - expected).abs() < 1e-9, "v[{i}] {got} vs {expected}");
+    }
+    let events: Vec<f64> = plain.events.iter().map(|e| e.time).collect();
+    let near = |i: usize| near_event(time, &events, i, 1.0);
+    for (j, &p) in params.iter().enumerate() {
+        let (dx, dv) = world.differences(time, p, rel);
+        let (ex, ev) = (worst(&sens.dx[j], &dx, near), worst(&sens.dv[j], &dv, near));
+        assert!(
+            ex < tol && ev < tol,
+            "{p:?}: dx off by {ex:e}, dv by {ev:e}"
+        );
+    }
+}
+
+/// A slow force (8 N at 0.5 Hz, well below the stage's 2.2 Hz): the stage follows it nearly
+/// in balance and sticks at each of its turns until the force has swung across the band.
+fn slow_force() -> Input {
+    sine_force(8.0, 0.5, 3.0)
+}
+
+/// Coulomb under a slow force sticks at its start and at each turn until the input breaks
+/// it away: the level, the mass, the damping, the stiffness and the input's offset carry
+/// their sensitivities across every stick and breakaway.
 #[test]
-fn a_driven_switched_law_has_no_sensitivities() {
-    let world = driven_world(Box::new(Coulomb { mu: 0.2 }), Integrator::Dopri5, 1.0);
-    let params = [SensitivityParam::Model(0)];
-    assert!(world.try_sensitivities(&times(1.0), &params).is_none());
+fn driven_coulomb_sensitivities_carry_across_sticks_and_breakaways() {
+    let world = driven_world(
+        Box::new(Coulomb { mu: 0.2 }),
+        Integrator::Dopri5,
+        slow_force(),
+    );
+    let params = [
+        SensitivityParam::Model(0),
+        SensitivityParam::Property(OscillatorProperty::Mass),
+        SensitivityParam::Property(OscillatorProperty::Damping),
+        SensitivityParam::Property(OscillatorProperty::Stiffness),
+    ];
+    check_across_sticks(&world, &times(3.0), &params, 1e-6, 1e-5);
+    // The offset is 0: its step is 1e-3 of a newton's scale (a micronewton), where the
+    // plain runs' integration error stays out of the differences.
+    let offset = [SensitivityParam::Property(OscillatorProperty::InputOffset)];
+    check_across_sticks(&world, &times(3.0), &offset, 1e-3, 1e-5);
+}
+
+/// Stribeck under a slow force breaks away at its static level mu_s N and slides on its
+/// curve: mu_s moves the breakaways, mu_c, v_s and the viscous term the slides.
+#[test]
+fn driven_stribeck_sensitivities_carry_across_sticks_and_breakaways() {
+    let world = driven_world(
+        Box::new(Stribeck::default()),
+        Integrator::Dopri5,
+        slow_force(),
+    );
+    let params: Vec<_> = (0..Stribeck::default().params().len())
+        .map(SensitivityParam::Model)
+        .chain([SensitivityParam::Property(OscillatorProperty::Stiffness)])
+        .collect();
+    check_across_sticks(&world, &times(3.0), &params, 1e-6, 1e-5);
+}
+
+/// Coulomb friction with a static level above its sliding one: held up to mu_s N, sliding
+/// at mu_k N. Its slip starts at an acceleration (mu_s - mu_k) N / m, so the sensitivities
+/// jump at every breakaway (no built-in law with gradients breaks away with a jump).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+struct BreakingCoulomb {
+    mu_s: f64,
+    mu_k: f64,
+}
+
+impl Default for BreakingCoulomb {
+    fn default() -> Self {
+        Self {
+            mu_s: 0.3,
+            mu_k: 0.2,
+        }
+    }
+}
+
+#[typetag::serde(name = "test_laws_breaking_coulomb")]
+impl FrictionModel for BreakingCoulomb {
+    fn name(&self) -> &'static str {
+        "test_laws_breaking_coulomb"
+    }
+    fn equation(&self) -> String {
+        "F = mu_k N sgn(v), held up to mu_s N".into()
+    }
+    fn param_info(&self) -> Vec<frictionid_models::ParamInfo> {
+        let level = |name: &str, value: f64| {
+            frictionid_models::ParamInfo::new(name, "1", value, (0.0, 10.0), "level")
+        };
+        vec![level("mu_s", self.mu_s), level("mu_k", self.mu_k)]
+    }
+    fn params(&self) -> Vec<f64> {
+        vec![self.mu_s, self.mu_k]
+    }
+    fn set_params(&mut self, values: &[f64]) -> Result<(), frictionid_models::ModelError> {
+        if let [mu_s, mu_k] = values {
+            (self.mu_s, self.mu_k) = (*mu_s, *mu_k);
+        }
+        Ok(())
+    }
+    fn force(&self, v: f64, _z: &[f64], normal: f64) -> f64 {
+        self.mu_k * normal * frictionid_models::sgn(v)
+    }
+    frictionid_models::law_groups!(switching, param_gradients);
+}
+
+impl frictionid_models::SwitchedLaw for BreakingCoulomb {
+    fn static_limit(&self, normal: f64) -> Option<f64> {
+        Some(self.mu_s * normal)
+    }
+    fn slip_force(&self, _v: f64, direction: f64, normal: f64) -> f64 {
+        self.mu_k * normal * direction
+    }
+}
+
+impl frictionid_models::ParamGradients for BreakingCoulomb {
+    fn force_param_gradient(&self, v: f64, _z: &[f64], normal: f64, out: &mut [f64]) {
+        out.copy_from_slice(&[0.0, normal * frictionid_models::sgn(v)]);
+    }
+}
+
+/// A law that breaks away with a jump in its acceleration: dv/dp steps by -a+ dt_b/dp at
+/// every breakaway, and both levels, the mass and the stiffness match central differences
+/// across them. Without the jump the static level's column would be off by its whole
+/// scale after the first breakaway (checked: the jump is a good part of it).
+#[test]
+fn sensitivities_jump_where_the_input_breaks_a_stick_away() {
+    let world = driven_world(
+        Box::new(BreakingCoulomb::default()),
+        Integrator::Dopri5,
+        slow_force(),
+    );
+    let params = [
+        SensitivityParam::Model(0),
+        SensitivityParam::Model(1),
+        SensitivityParam::Property(OscillatorProperty::Mass),
+        SensitivityParam::Property(OscillatorProperty::Stiffness),
+    ];
+    let time = times(3.0);
+    check_across_sticks(&world, &time, &params, 1e-6, 1e-5);
+    // The static level's column right after the first breakaway: all of it is the jump
+    // (mu_s moves nothing before, and the slip's direct terms do not hold mu_s).
+    let plain = world.plain(&time);
+    let t_b = plain
+        .events
+        .iter()
+        .find(|e| e.kind == crate::simulate::EventKind::Breakaway)
+        .map(|e| e.time)
+        .unwrap();
+    let sens = world.sensitivities(&time, &params);
+    let after = time.partition_point(|&t| t <= t_b) + 1;
+    let scale = sens.dv[0].iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    assert!(
+        sens.dv[0][after].abs() > 0.05 * scale,
+        "{:e}",
+        sens.dv[0][after]
+    );
 }
