@@ -66,6 +66,19 @@ impl Input {
         self.time.get(i).copied()
     }
 
+    /// u's slope du/dt over the stretch a step from `after` covers: the stretch between
+    /// consecutive samples just after `after`, where a sample closer than `gap` after it
+    /// is passed over as [`Input::next_knot`] passes it (a step from `after` stops at the
+    /// sample after it, not there). 0 before the first sample and from the last on, where u
+    /// is held.
+    pub fn slope_after(&self, after: f64, gap: f64) -> f64 {
+        let i = self.time.partition_point(|&ti| ti <= after + gap);
+        match (i.checked_sub(1), self.time.get(i)) {
+            (Some(j), Some(&t1)) => (self.value[i] - self.value[j]) / (t1 - self.time[j]),
+            _ => 0.0,
+        }
+    }
+
     /// The first time in (`from`, `until`] at which |u(t) - `centre`| exceeds `half_width`,
     /// exact for the piecewise-linear input: the stick of an axis held by static friction
     /// `half_width` against the restoring force `centre` ends there. `None` when it holds
@@ -145,6 +158,19 @@ mod tests {
         assert_eq!(u.next_knot(0.5, 0.0), Some(1.0));
         assert_eq!(u.next_knot(1.0 - 1e-12, 1e-9), Some(2.0));
         assert_eq!(u.next_knot(3.0, 0.0), None);
+    }
+
+    #[test]
+    fn the_slope_is_that_of_the_stretch_ahead() {
+        let u = ramp();
+        assert_eq!(u.slope_after(-1.0, 0.0), 0.0);
+        assert_eq!(u.slope_after(0.0, 0.0), 2.0);
+        assert_eq!(u.slope_after(0.5, 0.0), 2.0);
+        // At a sample, the stretch that starts there; just short of one by less than the
+        // gap, the stretch after it (where a step from there goes).
+        assert_eq!(u.slope_after(1.0, 0.0), 0.0);
+        assert_eq!(u.slope_after(2.0 - 1e-12, 1e-9), -6.0);
+        assert_eq!(u.slope_after(3.0, 0.0), 0.0);
     }
 
     #[test]
