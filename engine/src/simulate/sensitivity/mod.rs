@@ -36,9 +36,10 @@
 //!
 //! # Where it applies
 //! Free vibration, or a drive by a measured input of a law without a static limit (whose
-//! run breaks away from no stick; the steps stop at the input's knots, as the plain run's)
-//! that is not stiff (Rodas4 steps a driven system as if autonomous), of a law that reads
-//! no conditions, every parameter with its derivative available (a law with
+//! run breaks away from no stick; the steps stop at the input's knots, as the plain run's),
+//! stiff or not (Rodas4 takes the augmented system's time derivative, the input's slope in
+//! the acceleration and in the mass's direct term, [`OdeSystem::time_derivative`]), of a
+//! law that reads no conditions, every parameter with its derivative available (a law with
 //! [`ParamGradients`], and states' rate gradients for a dynamic law; the normal force is
 //! never differentiated), not the Euler integrator
 //! (whose trajectory the sensitivities of the exact motion would not describe), and a
@@ -48,6 +49,7 @@
 //! and the caller takes difference quotients.
 //!
 //! [`Rodas4::block_triangular`]: super::Rodas4::block_triangular
+//! [`OdeSystem::time_derivative`]: super::stepper::OdeSystem::time_derivative
 //! [`Tolerance::control_first`]: super::Tolerance::control_first
 //! [`ParamGradients`]: frictionid_models::ParamGradients
 //! [`ParamGradients::force_param_gradient`]: frictionid_models::ParamGradients::force_param_gradient
@@ -162,12 +164,6 @@ pub fn simulate_sensitivities(
     if !ratio.is_finite() {
         // A states' Jacobian without a finite value (Dahl with alpha < 1 at its level):
         // the sensitivities' equations are singular there.
-        return Ok(None);
-    }
-    if input.is_some() && ratio > SENSITIVITY_STIFF_RATIO {
-        // Rodas4 steps a driven system as if autonomous (no d f/dt term in its stages): its
-        // states under a measured input are off by parts in 1e4 at tight tolerances, and its
-        // sensitivities would be no better.
         return Ok(None);
     }
     let method = match ratio > SENSITIVITY_STIFF_RATIO {

@@ -492,3 +492,26 @@ fn a_driven_stiff_run_of_rodas4_matches_dopri5() {
     eprintln!("Rodas4 off Dopri5 by {off:e} of the peak speed {peak} m/s");
     assert!(off < 1e-7, "off by {off:e} of the peak {peak}");
 }
+
+/// Under a measured input, the stiff LuGre's sensitivities come from Rodas4 with the
+/// augmented system's time derivative, and match central differences of plain driven Rodas4
+/// runs: every parameter of the law, the mass (whose direct term follows the input) and
+/// the stiffness.
+#[test]
+fn driven_stiff_lugre_sensitivities_match_central_differences() {
+    let world = driven_world(stiff_lugre(), Integrator::Rodas, 1.0);
+    let time = times(1.0);
+    let law: Vec<_> = (0..6).map(SensitivityParam::Model).collect();
+    let sens = world
+        .try_sensitivities(&time, &law)
+        .expect("a driven stiff contact has sensitivities");
+    assert!(took_the_stiff_stepper(&sens));
+    // As for the released stiff LuGre: a larger step keeps the plain runs' integration
+    // error out of the differences of sigma0 and sigma1.
+    check_against_differences_by(&world, &time, &law, 1e-3, 1e-4);
+    let mechanics = [
+        SensitivityParam::Property(OscillatorProperty::Mass),
+        SensitivityParam::Property(OscillatorProperty::Stiffness),
+    ];
+    check_against_differences(&world, &time, &mechanics, 1e-4);
+}
