@@ -249,6 +249,16 @@ impl OscillatorProperty {
         }
     }
 
+    /// The derivative of [`Self::balance_column`] in the acceleration `a`: 1 for the
+    /// inertia (its column is a), 0 for every other property (whose columns do not read
+    /// it). The columns are affine in a, so this is exact at every state.
+    pub fn balance_column_acceleration_slope(self) -> f64 {
+        match self {
+            Self::Mass => 1.0,
+            _ => 0.0,
+        }
+    }
+
     /// Whether [`Self::balance_column`] is the balance's exact derivative on `osc`'s
     /// restoring law (the stiffness only on the linear and polynomial springs, the polynomial
     /// terms where the law has them; not the gravity moment,

@@ -27,6 +27,10 @@ impl OdeSystem for Segment<'_> {
         self.dynamics.jacobian(t, y, self.dir, jac);
     }
 
+    fn time_derivative(&self, t: f64, y: &[f64], dfdt: &mut [f64]) -> bool {
+        self.dynamics.time_derivative(t, y, self.dir, dfdt)
+    }
+
     fn affine_motion(&self) -> Option<AffineMotion> {
         self.dynamics.affine_motion(self.dir)
     }

@@ -223,6 +223,45 @@ impl Dynamics<'_> {
         *dv = self.accel(t, *x, *v, f);
     }
 
+    /// Writes df/dt of [`Dynamics::rhs`] at (t, y) in direction `dir` (the explicit
+    /// dependence on time at fixed y) into `dfdt` and returns true; false, `dfdt` untouched,
+    /// when nothing in it varies with time (no measured input, no channel the law reads).
+    /// Only the acceleration row moves: (u'(t) - dF/dt) / m, with u' the input's slope over
+    /// the stretch a step from `t` covers (steps stop at its knots, so that slope holds over
+    /// the whole step) and dF/dt the friction's change through the channels it reads; the
+    /// states' rates do not read the time.
+    pub(crate) fn time_derivative(&self, t: f64, y: &[f64], dir: f64, dfdt: &mut [f64]) -> bool {
+        let gap = KNOT_GAP * (1.0 + t.abs());
+        let input_rate = self.input.map(|u| u.slope_after(t, gap));
+        let friction_rate = self.friction_time_rate(t, y, dir);
+        if input_rate.is_none() && friction_rate.is_none() {
+            return false;
+        }
+        dfdt.fill(0.0);
+        if let Some(dv) = dfdt.get_mut(1) {
+            *dv = (input_rate.unwrap_or(0.0) - friction_rate.unwrap_or(0.0)) / self.osc.mass;
+        }
+        true
+    }
+
+    /// dF/dt at fixed (x, v, z) in direction `dir` when the law reads a condition that
+    /// varies with time (the input force, a channel), else `None`: a forward difference
+    /// over a step short of the next knot, within which the conditions are linear in t.
+    fn friction_time_rate(&self, t: f64, y: &[f64], dir: f64) -> Option<f64> {
+        let conditions = self.conditions?;
+        let [x, v, z @ ..] = y else {
+            return None;
+        };
+        let knot = conditions.next_knot(t, KNOT_GAP * (1.0 + t.abs()))?;
+        let dt = (f64::EPSILON.sqrt() * (1.0 + t.abs())).min(0.5 * (knot - t));
+        if dt <= 0.0 {
+            return None;
+        }
+        let later = t + dt;
+        let force = |at: f64| self.force(at, *x, *v, z, dir);
+        Some((force(later) - force(t)) / (later - t))
+    }
+
     /// The segment's linear equation when the law is affine in v in direction `dir`, on a
     /// linear spring in free vibration.
     pub(crate) fn affine_motion(&self, dir: f64) -> Option<AffineMotion> {
@@ -310,5 +349,60 @@ fn classify_law(model: &dyn FrictionModel, normal: f64) -> Result<Law<'_>, Engin
             model.name()
         ))),
         None => Ok(Law::Smooth),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::conditions::{BoundConditions, ChannelSeries};
+    use super::*;
+    use frictionid_models::default_model;
+
+    /// The acceleration row of the right-hand side at time `t`, from (x, v) = (0.01, 0.05).
+    fn accel_at(d: &Dynamics<'_>, t: f64) -> f64 {
+        let mut dy = [0.0; 2];
+        d.rhs(t, &[0.01, 0.05], &mut dy, 1.0);
+        dy[1]
+    }
+
+    /// Under an input and a load channel (a law that reads it), df/dt is the change of the
+    /// right-hand side in t over the stretch a step from t covers: a central difference
+    /// inside a stretch, a forward one from a knot (where the slope changes).
+    #[test]
+    fn the_time_derivative_is_the_rate_of_the_stretch_ahead() {
+        let model = default_model("coulomb_load").expect("registered");
+        let input = Input::new(vec![0.0, 1.0, 2.0], vec![0.0, 4.0, -2.0]).expect("an input");
+        let load = ChannelSeries::new("r")
+            .with_channel("load", vec![0.0, 0.5, 2.0], vec![1.0, 3.0, -1.5])
+            .expect("a channel");
+        let bound = BoundConditions::bind(model.as_ref(), Some(&input), Some(&load))
+            .expect("the channel is there")
+            .expect("the law reads the load");
+        let d = Dynamics::new(&Oscillator::fmm(), model.as_ref())
+            .expect("a switched law")
+            .driven_by(Some(&input))
+            .reading(Some(&bound));
+        let h = 1e-6;
+        let central = |t: f64| (accel_at(&d, t + h) - accel_at(&d, t - h)) / (2.0 * h);
+        let forward = |t: f64| (accel_at(&d, t + h) - accel_at(&d, t)) / h;
+        for (t, expected) in [
+            (0.25, central(0.25)),
+            (0.75, central(0.75)),
+            (1.0, forward(1.0)),
+        ] {
+            let mut dfdt = [f64::NAN; 2];
+            assert!(d.time_derivative(t, &[0.01, 0.05], 1.0, &mut dfdt));
+            assert_eq!(dfdt[0], 0.0);
+            assert!(
+                (dfdt[1] - expected).abs() <= 1e-6 * expected.abs().max(1.0),
+                "t {t}: {} vs {expected}",
+                dfdt[1]
+            );
+        }
+        let free = Dynamics::new(&Oscillator::fmm(), &frictionid_models::Coulomb { mu: 0.2 })
+            .expect("a switched law");
+        let mut dfdt = [f64::NAN; 2];
+        assert!(!free.time_derivative(0.25, &[0.01, 0.05], 1.0, &mut dfdt));
+        assert!(dfdt.iter().all(|d| d.is_nan()), "left as it was");
     }
 }

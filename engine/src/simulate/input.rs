@@ -66,12 +66,24 @@ impl Input {
         self.time.get(i).copied()
     }
 
-    /// du/dt on the piece that reaches `t` from the left (the piece from the last knot
-    /// before `t` to the first at or after it): the rate at which u arrives at `t`, where a
-    /// stick's band is left. 0 at or before the first sample and beyond the last, where u
+    /// u's slope du/dt over the stretch a step from `after` covers: the stretch between
+    /// consecutive samples just after `after`, where a sample closer than `gap` after it
+    /// is passed over as [`Input::next_knot`] passes it (a step from `after` stops at the
+    /// sample after it, not there). 0 before the first sample and from the last on, where u
     /// is held.
+    pub fn slope_after(&self, after: f64, gap: f64) -> f64 {
+        self.slope_of_stretch_ending_at(self.time.partition_point(|&ti| ti <= after + gap))
+    }
+
+    /// du/dt on the stretch that reaches `t` from the left (from the last sample before `t`
+    /// to the first at or after it): the rate at which u arrives at `t`, where a stick's
+    /// band is left. 0 at or before the first sample and beyond the last, where u is held.
     pub fn slope_arriving_at(&self, t: f64) -> f64 {
-        let i = self.time.partition_point(|&ti| ti < t);
+        self.slope_of_stretch_ending_at(self.time.partition_point(|&ti| ti < t))
+    }
+
+    /// The slope between samples i - 1 and i; 0 where one of them does not exist.
+    fn slope_of_stretch_ending_at(&self, i: usize) -> f64 {
         match (i.checked_sub(1), self.time.get(i)) {
             (Some(j), Some(&t1)) => (self.value[i] - self.value[j]) / (t1 - self.time[j]),
             _ => 0.0,
@@ -157,6 +169,19 @@ mod tests {
         assert_eq!(u.next_knot(0.5, 0.0), Some(1.0));
         assert_eq!(u.next_knot(1.0 - 1e-12, 1e-9), Some(2.0));
         assert_eq!(u.next_knot(3.0, 0.0), None);
+    }
+
+    #[test]
+    fn the_slope_is_that_of_the_stretch_ahead() {
+        let u = ramp();
+        assert_eq!(u.slope_after(-1.0, 0.0), 0.0);
+        assert_eq!(u.slope_after(0.0, 0.0), 2.0);
+        assert_eq!(u.slope_after(0.5, 0.0), 2.0);
+        // At a sample, the stretch that starts there; just short of one by less than the
+        // gap, the stretch after it (where a step from there goes).
+        assert_eq!(u.slope_after(1.0, 0.0), 0.0);
+        assert_eq!(u.slope_after(2.0 - 1e-12, 1e-9), -6.0);
+        assert_eq!(u.slope_after(3.0, 0.0), 0.0);
     }
 
     #[test]

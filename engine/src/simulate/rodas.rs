@@ -21,9 +21,16 @@
 //! was a guess; the error it measured is the first information on the scale of the motion).
 //! On Dahl with sigma0 = 1e7 N/m, whose elastic tail restarts 72 times in the last 0.4 s,
 //! these took 17 394 RHS evaluations to 8 885 together with the force state's tolerance
-//! scale (see `InternalStates::state_tolerance_scales`). The system is autonomous (the
-//! driver's right-hand side does not depend on t), so no time derivative enters the
-//! stages.
+//! scale (see `InternalStates::state_tolerance_scales`).
+//!
+//! A system whose right-hand side depends on t explicitly (an axis driven by a measured
+//! input) is stepped as a non-autonomous Rosenbrock method (Hairer & Wanner, IV.7, eq.
+//! (7.4')): stage i evaluates f at t + alpha_i h and adds gamma_i h df/dt, with df/dt at the
+//! step's start from [`OdeSystem::time_derivative`]. Stepped as if autonomous (every stage
+//! at the step's start time, no df/dt), a stiff LuGre (sigma0 = 1e7 N/m) driven by an 8 N
+//! input ended 3.3e-4 m/s off a tight Dopri5 run at tight tolerances, against a peak of
+//! 0.09 m/s; with the stages' times and no df/dt, 6.6e-8 m/s; with both, 5e-12 m/s. An
+//! autonomous system (no time derivative) pays nothing: none is evaluated or added.
 //!
 //! Stability is not bounded by the stiffness: bristle models with sigma0 = 1e7..1e9 N/m take
 //! steps set by the accuracy of the motion, not by 3.3 / (sigma0 |v| / g).
@@ -86,6 +93,13 @@ const C: [[f64; 5]; 5] = [
         -6.058_818_238_834_054,
     ],
 ];
+/// The stages' times alpha_i (fractions of the step), stage 1 first: the row sums of the
+/// untransformed a_ij. Stages 5 and 6 lie at the step's end (stiffly accurate).
+const ALPHA: [f64; 6] = [0.0, 0.386, 0.21, 0.63, 1.0, 1.0];
+/// The weights gamma_i of h df/dt in the stages, stage 1 first: the row sums of the
+/// untransformed gamma_ij (with the diagonal gamma), which vanish for the stages at the
+/// step's end.
+const GAMMA_SUM: [f64; 6] = [0.25, -0.1043, 0.1035, -0.0362, 0.0, 0.0];
 /// Dense-output coefficients d_2j and d_3j over k_1..k_5.
 const D: [[f64; 5]; 2] = [
     [
@@ -127,6 +141,11 @@ pub struct Rodas4 {
     y: Vec<f64>,
     y_new: Vec<f64>,
     fx: Vec<f64>,
+    /// df/dt at the current point, when `timed`.
+    dfdt: Vec<f64>,
+    /// Whether the system depends on t explicitly at the current point (its
+    /// [`OdeSystem::time_derivative`] gave `dfdt`).
+    timed: bool,
     dy: Vec<f64>,
     k: [Vec<f64>; 6],
     jac: Vec<f64>,
@@ -157,6 +176,8 @@ impl Rodas4 {
             y: zeros(),
             y_new: zeros(),
             fx: zeros(),
+            dfdt: zeros(),
+            timed: false,
             dy: zeros(),
             k: std::array::from_fn(|_| zeros()),
             jac: vec![0.0; dim * dim],
@@ -200,10 +221,12 @@ impl Rodas4 {
         self
     }
 
-    /// Evaluates f and J at the current point.
+    /// Evaluates f, J and (for a system that depends on t explicitly) df/dt at the current
+    /// point.
     fn refresh<S: OdeSystem>(&mut self, system: &S) {
         system.rhs(self.ctrl.t, &self.y, &mut self.fx);
         system.jacobian(self.ctrl.t, &self.y, &mut self.jac);
+        self.timed = system.time_derivative(self.ctrl.t, &self.y, &mut self.dfdt);
         self.counts.rhs_evaluations += 1;
         self.counts.jacobian_evaluations += 1;
         self.stale = false;
@@ -263,12 +286,14 @@ impl Rodas4 {
         self.lu.factor_shifted(diag, &self.corner)
     }
 
-    /// Solves E k = f(arg) + sum_j (c_sj / h) k_j for stage `s` (1-based, 2..=6) into
-    /// k[s-1], where `arg` is in `y_new` (f at the step's start time: the system is
-    /// autonomous). `n` is the dimension (see [`Rodas4::step`]).
+    /// Solves E k = f(t + alpha_s h, arg) + sum_j (c_sj / h) k_j + gamma_s h df/dt for stage
+    /// `s` (1-based, 2..=6) of a step of size `h` into k[s-1], where `arg` is in `y_new` (the
+    /// last term only for a system that depends on t explicitly). `n` is the dimension (see
+    /// [`Rodas4::step`]).
     #[inline(always)]
-    fn stage<S: OdeSystem>(&mut self, system: &S, s: usize, n: usize) {
-        system.rhs(self.ctrl.t, &self.y_new[..n], &mut self.dy[..n]);
+    fn stage<S: OdeSystem>(&mut self, system: &S, s: usize, h: f64, n: usize) {
+        let t = self.ctrl.t + ALPHA[s - 1] * h;
+        system.rhs(t, &self.y_new[..n], &mut self.dy[..n]);
         self.counts.rhs_evaluations += 1;
         let coupling = &self.c_h[s - 2][..s - 1];
         let (done, todo) = self.k.split_at_mut(s - 1);
@@ -278,6 +303,9 @@ impl Rodas4 {
             for (o, &kv) in out.iter_mut().zip(&kj[..n]) {
                 *o += c * kv;
             }
+        }
+        if self.timed {
+            add_time_term(out, &self.dfdt[..n], GAMMA_SUM[s - 1] * h);
         }
         solve(&self.lu, self.block, &self.jac, out);
     }
@@ -303,16 +331,19 @@ impl Rodas4 {
         }
         let k0 = &mut self.k[0][..n];
         k0.copy_from_slice(&self.fx[..n]);
+        if self.timed {
+            add_time_term(k0, &self.dfdt[..n], GAMMA_SUM[0] * h);
+        }
         solve(&self.lu, self.block, &self.jac, k0);
         for s in 2..=5 {
             self.stage_argument(s - 2, n);
-            self.stage(system, s, n);
+            self.stage(system, s, h, n);
         }
         // Stiffly accurate: stage 6 is evaluated at the 5th stage's solution.
         for (yn, &k5) in self.y_new[..n].iter_mut().zip(&self.k[4][..n]) {
             *yn += k5;
         }
-        self.stage(system, 6, n);
+        self.stage(system, 6, h, n);
         for (yn, &k6) in self.y_new[..n].iter_mut().zip(&self.k[5][..n]) {
             *yn += k6;
         }
@@ -410,6 +441,14 @@ impl Rodas4 {
         self.ctrl.last = false;
         self.counts.rejected += 1;
         StepOutcome::Rejected
+    }
+}
+
+/// Adds `weight` times df/dt (`dfdt`) to a stage's right-hand side `out`.
+#[inline(always)]
+fn add_time_term(out: &mut [f64], dfdt: &[f64], weight: f64) {
+    for (o, &d) in out.iter_mut().zip(dfdt) {
+        *o += weight * d;
     }
 }
 
@@ -565,6 +604,65 @@ mod tests {
                 jac[3 * n + 1] = -2.0 * mu * u0 * s0 + (1.0 - u0 * u0);
             }
         }
+    }
+
+    /// Prothero and Robinson's stiff non-autonomous test y' = lambda (y - sin t) + cos t,
+    /// whose solution from y(0) = 0 is sin t for every lambda; with `timed`, df/dt =
+    /// -lambda cos t - sin t is given to the stepper.
+    struct ProtheroRobinson {
+        lambda: f64,
+        timed: bool,
+    }
+
+    impl OdeSystem for ProtheroRobinson {
+        fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+            dy[0] = self.lambda * (y[0] - t.sin()) + t.cos();
+        }
+
+        fn jacobian(&self, _t: f64, _y: &[f64], jac: &mut [f64]) {
+            jac[0] = self.lambda;
+        }
+
+        fn time_derivative(&self, t: f64, _y: &[f64], dfdt: &mut [f64]) -> bool {
+            dfdt[0] = -self.lambda * t.cos() - t.sin();
+            self.timed
+        }
+    }
+
+    /// The largest |y - sin t| at the accepted steps' ends over [0, 2] at lambda = -1e6,
+    /// and the accepted steps; `None` when the run takes more than `attempts` attempts.
+    fn prothero_robinson_error(timed: bool, attempts: u64) -> Option<(f64, u64)> {
+        let system = ProtheroRobinson {
+            lambda: -1e6,
+            timed,
+        };
+        let mut stepper = Rodas4::new(1, 1e-8, 1e-10, 1.0);
+        stepper.reset(&system, 0.0, &[0.0], 2.0).expect("a start");
+        let mut worst = 0.0f64;
+        while !stepper.reached_end() {
+            if stepper.counts().attempts() >= attempts {
+                return None;
+            }
+            if stepper.step(&system).expect("a step") == StepOutcome::Accepted {
+                worst = worst.max((stepper.state()[0] - stepper.time().sin()).abs());
+            }
+        }
+        Some((worst, stepper.counts().accepted))
+    }
+
+    /// With the time derivative in its stages the stiff stepper follows the exact solution
+    /// sin t to the tolerances in a few dozen steps (32 measured). Without it (f's
+    /// dependence on t held still within a step but for the stages' times) the error
+    /// estimate only falls with tiny steps: the run took 16.7 million steps to the same
+    /// accuracy, here more than 10 000 attempts.
+    #[test]
+    fn a_stiff_non_autonomous_system_follows_its_exact_solution() {
+        let (error, steps) = prothero_robinson_error(true, 10_000).expect("a cheap run");
+        assert!(
+            error < 1e-7 && steps < 100,
+            "off by {error:e} in {steps} steps"
+        );
+        assert!(prothero_robinson_error(false, 10_000).is_none());
     }
 
     /// The state at t = 2 from u = (2, 0) (and s = 0).

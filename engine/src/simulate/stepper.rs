@@ -37,6 +37,17 @@ pub trait OdeSystem {
         }
     }
 
+    /// Writes df/dt at (t, y), the explicit dependence of f on time at fixed y, into `dfdt`
+    /// (same length as `y`) and returns true; returns false, leaving `dfdt` as it is, when
+    /// f does not depend on t (an autonomous system: the default). A Rosenbrock stepper
+    /// (Rodas4) needs it in its stages, since its linearisation about the step's start
+    /// would otherwise hold the time fixed there. It describes the system over a step
+    /// starting at `t` and moving forward: where f's time dependence has a kink (a knot of a
+    /// measured input), the rate of the stretch after `t`.
+    fn time_derivative(&self, _t: f64, _y: &[f64], _dfdt: &mut [f64]) -> bool {
+        false
+    }
+
     /// When y = [x, v] obeys a linear oscillator equation (see [`AffineMotion`]): its
     /// coefficients, for closed-form propagation. `None` (the default) otherwise.
     fn affine_motion(&self) -> Option<AffineMotion> {

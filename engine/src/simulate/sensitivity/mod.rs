@@ -26,7 +26,10 @@
 //! (f- - f+) dt_e/dp with dt_e/dp = -s_v / a- (the event function is v; f- and f+ are the
 //! right-hand sides before and after, a- = x'' before): at a reversal of a switched law
 //! the force flips, at a stick the motion stops (f+ = 0, so dv/dp is 0 from there on). A
-//! smooth law's right-hand side is continuous there: no jump.
+//! smooth law's right-hand side is continuous there: no jump. Under a measured input a
+//! stick lasts until the input breaks it away, where the plain driver puts it
+//! ([`Dynamics::breakaway`]); the sensitivities jump there by -(0, a+) dt_b/dp, dt_b/dp
+//! from the band the input leaves (`breakaway.rs`).
 //!
 //! An explicit run's steps are set by the states' error alone: over a stretch stiff enough
 //! (Dahl at sigma0 3e5 N/m sliding at a few cm/s) they can exceed the stability bound of the
@@ -35,10 +38,10 @@
 //! sensitivities pass a bound no motion reaches (`believable_sizes`) is given up: `None`.
 //!
 //! # Where it applies
-//! Free vibration, or a drive by a measured input of a law without a static limit (whose
-//! run breaks away from no stick; the steps stop at the input's knots, as the plain run's)
-//! that is not stiff (Rodas4 steps a driven system as if autonomous), of a law that reads
-//! no conditions, every parameter with its derivative available (a law with
+//! Free vibration, or a drive by a measured input (the steps stop at the input's knots, as
+//! the plain run's; a switched law's sticks end at the breakaways it forces), stiff or not (Rodas4 takes the augmented system's time derivative, the input's slope in
+//! the acceleration and in the mass's direct term, [`OdeSystem::time_derivative`]), of a
+//! law that reads no conditions, every parameter with its derivative available (a law with
 //! [`ParamGradients`], and states' rate gradients for a dynamic law; the normal force is
 //! never differentiated), not the Euler integrator
 //! (whose trajectory the sensitivities of the exact motion would not describe), and a
@@ -48,6 +51,8 @@
 //! and the caller takes difference quotients.
 //!
 //! [`Rodas4::block_triangular`]: super::Rodas4::block_triangular
+//! [`Dynamics::breakaway`]: super::Dynamics::breakaway
+//! [`OdeSystem::time_derivative`]: super::stepper::OdeSystem::time_derivative
 //! [`Tolerance::control_first`]: super::Tolerance::control_first
 //! [`ParamGradients`]: frictionid_models::ParamGradients
 //! [`ParamGradients::force_param_gradient`]: frictionid_models::ParamGradients::force_param_gradient
@@ -158,12 +163,6 @@ pub fn simulate_sensitivities(
     if !ratio.is_finite() {
         // A states' Jacobian without a finite value (Dahl with alpha < 1 at its level):
         // the sensitivities' equations are singular there.
-        return Ok(None);
-    }
-    if input.is_some() && ratio > SENSITIVITY_STIFF_RATIO {
-        // Rodas4 steps a driven system as if autonomous (no d f/dt term in its stages): its
-        // states under a measured input are off by parts in 1e4 at tight tolerances, and its
-        // sensitivities would be no better.
         return Ok(None);
     }
     let method = match ratio > SENSITIVITY_STIFF_RATIO {

@@ -180,7 +180,40 @@ impl<'a, 'b> Augmented<'a, 'b> {
     }
 }
 
+impl Augmented<'_, '_> {
+    /// Writes d(df/dp_j)/dt at fixed states into each parameter's block of `d_sens` (n
+    /// components per parameter), given the acceleration's explicit rate `accel_rate`
+    /// (d(x'')/dt at fixed y). Only an oscillator property's balance column can read the
+    /// time, through the acceleration: the mass's d(x'')/dm = -x''/m moves by
+    /// -accel_rate / m. The law's force and states' rate gradients do not read it (a law
+    /// that reads conditions has no augmented run).
+    fn direct_terms_time_rates(&self, accel_rate: f64, d_sens: &mut [f64]) {
+        let n = self.n();
+        let mass = self.dynamics.osc.mass;
+        for (col, p) in d_sens.chunks_exact_mut(n).zip(&self.terms.params) {
+            col.fill(0.0);
+            if let SensitivityParam::Property(q) = *p {
+                col[1] = -q.balance_column_acceleration_slope() * accel_rate / mass;
+            }
+        }
+    }
+}
+
 impl OdeSystem for Augmented<'_, '_> {
+    /// The states' df/dt ([`Dynamics::time_derivative`]) and, for each s_j' = J s_j +
+    /// df/dp_j, the rate of its direct terms: J does not read the time (the input enters
+    /// the acceleration additively), the mass's direct term does through x''.
+    fn time_derivative(&self, t: f64, y: &[f64], dfdt: &mut [f64]) -> bool {
+        let n = self.n();
+        let (state, d_state) = (&y[..n], &mut dfdt[..n]);
+        if !self.dynamics.time_derivative(t, state, self.dir, d_state) {
+            return false;
+        }
+        let accel_rate = d_state[1];
+        self.direct_terms_time_rates(accel_rate, &mut dfdt[n..]);
+        true
+    }
+
     fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
         let n = self.n();
         let (state, sens) = y.split_at(n);

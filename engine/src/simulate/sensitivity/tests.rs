@@ -642,3 +642,54 @@ fn sensitivities_jump_where_the_input_breaks_a_stick_away() {
         sens.dv[0][after]
     );
 }
+
+/// LuGre with sigma0 = 1e7 N/m on the FMM stage: far beyond the explicit augmented run's
+/// stiffness, so plain and augmented runs alike take Rodas4.
+fn stiff_lugre() -> Box<dyn FrictionModel> {
+    Box::new(LuGre {
+        sigma0: 1e7,
+        sigma1: 5000.0,
+        ..LuGre::default()
+    })
+}
+
+/// Driven by [`shaker`], the stiff LuGre's plain Rodas4 run follows the input's change
+/// within each step (each stage reads f at its own time and carries gamma_i h df/dt): its
+/// velocity matches a Dopri5 run, whose explicit stages read the input at their own times,
+/// within 1e-7 of the peak speed at the tight tolerances (6e-11 measured). Stepped as if
+/// autonomous (every stage at the step's start time, no df/dt) it was 3.7e-3 of the peak
+/// off; with the stages' times but without df/dt, 7.3e-7.
+#[test]
+fn a_driven_stiff_run_of_rodas4_matches_dopri5() {
+    let time = times(1.0);
+    let stiff = driven_world(stiff_lugre(), Integrator::Rodas, shaker(1.0)).plain(&time);
+    let explicit = driven_world(stiff_lugre(), Integrator::Dopri5, shaker(1.0)).plain(&time);
+    let peak = explicit.v.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(peak > 0.05, "the input drives the stage: peak {peak}");
+    let off = worst(&stiff.v, &explicit.v, |_| false);
+    eprintln!("Rodas4 off Dopri5 by {off:e} of the peak speed {peak} m/s");
+    assert!(off < 1e-7, "off by {off:e} of the peak {peak}");
+}
+
+/// Under a measured input, the stiff LuGre's sensitivities come from Rodas4 with the
+/// augmented system's time derivative, and match central differences of plain driven Rodas4
+/// runs: every parameter of the law, the mass (whose direct term follows the input) and
+/// the stiffness.
+#[test]
+fn driven_stiff_lugre_sensitivities_match_central_differences() {
+    let world = driven_world(stiff_lugre(), Integrator::Rodas, shaker(1.0));
+    let time = times(1.0);
+    let law: Vec<_> = (0..6).map(SensitivityParam::Model).collect();
+    let sens = world
+        .try_sensitivities(&time, &law)
+        .expect("a driven stiff contact has sensitivities");
+    assert!(took_the_stiff_stepper(&sens));
+    // As for the released stiff LuGre: a larger step keeps the plain runs' integration
+    // error out of the differences of sigma0 and sigma1.
+    check_against_differences_by(&world, &time, &law, 1e-3, 1e-4);
+    let mechanics = [
+        SensitivityParam::Property(OscillatorProperty::Mass),
+        SensitivityParam::Property(OscillatorProperty::Stiffness),
+    ];
+    check_against_differences(&world, &time, &mechanics, 1e-4);
+}
