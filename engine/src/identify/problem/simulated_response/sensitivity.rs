@@ -3,10 +3,10 @@
 //! ([`simulate_sensitivities`]) weighted as the residuals are, the velocity offset's column
 //! in closed form, and zeros for another record's nuisance values.
 //!
-//! Where the sensitivities are not available (a law without parameter gradients such as a
-//! formula or a plugin, a measured input, the Euler integrator, a contact stiff enough that
-//! the explicit augmented run would cost more than differences over the stiff integrator,
-//! levels simulated scaled, an acceleration channel) or for a release shift, the column is
+//! A record driven by a measured input has its sensitivities under that input, across the
+//! sticks and breakaways it forces. Where they are not available (a law without parameter
+//! gradients such as a formula or a plugin, a law that reads channels, the Euler
+//! integrator, levels simulated scaled, an acceleration channel) or for a release shift, the column is
 //! left to the fit's difference quotients: the choice is automatic.
 
 use super::{ReleaseClock, SimulatedResponse};
@@ -70,7 +70,6 @@ impl SimulatedResponse {
         let (index, record) = (case.index, case.record);
         let channels = self.channels_of(index);
         let unsupported = channels.contains(&Channel::Acceleration)
-            || record.channel(Channel::InputForce).is_some()
             || self.levels.scaled_for_simulation(at.model).is_some();
         if unsupported {
             return Ok(vec![None; layout.len()]);
@@ -116,8 +115,9 @@ impl SimulatedResponse {
     }
 
     /// The augmented run of `case`'s record from its release to `t_end`, sampled at
-    /// `clock`'s times, under the same oscillator, law, release state and step limit as its
-    /// simulation ([`super::simulated_from_release`]); counted as a simulation.
+    /// `clock`'s times, under the same oscillator, law, release state, measured input and
+    /// step limit as its simulation ([`super::simulated_from_release`]); counted as a
+    /// simulation. A law that reads channels has none (`simulate_sensitivities` refuses it).
     fn sensitivities(
         &self,
         at: &Evaluation<'_>,
@@ -139,12 +139,13 @@ impl SimulatedResponse {
         let init = super::initial(record, case.nuisance);
         let opts = super::within_allowance(at, case.index, record, clock.times.len());
         let osc = record.oscillator_for(at.oscillator);
+        let input = clock.input(record)?;
         simulate_sensitivities(
             RunInputs {
                 osc: &osc,
                 model: at.model,
                 init: &init,
-                input: None,
+                input: input.as_ref(),
                 channels: None,
                 grid: SampleGrid {
                     t_end,
@@ -263,5 +264,77 @@ mod tests {
             .take(600)
             .all(|&d| (d - 1.0).abs() < 1e-12));
         assert!(jac.column(3).iter().skip(600).all(|&d| d == 0.0));
+    }
+
+    /// A record driven by a slow 8 N force (0.5 Hz) that sticks Stribeck's law at its start
+    /// and at each turn until the force breaks it away: the Jacobian (every law parameter,
+    /// the mass and the stiffness) from one augmented run under the record's input, against
+    /// central differences of the residuals.
+    #[test]
+    fn a_driven_record_takes_its_columns_from_one_run_under_its_input() {
+        let osc = Oscillator::fmm();
+        let model = frictionid_models::Stribeck::default();
+        let time: Vec<f64> = (0..3000).map(|i| i as f64 * 1e-3).collect();
+        let u: Vec<f64> = time
+            .iter()
+            .map(|t| 8.0 * (std::f64::consts::PI * t).sin())
+            .collect();
+        let record = Record::new("driven", time.clone(), vec![0.0; time.len()], 0.0)
+            .with_channel(Channel::InputForce, u);
+        let records: Arc<[Record]> = vec![record].into();
+        let layout = vec![
+            param("mu_c", ParamKind::Model(0), 0.2, false),
+            param("mu_s", ParamKind::Model(1), 0.3, false),
+            param("v_s", ParamKind::Model(2), 0.01, true),
+            param("viscous", ParamKind::Model(4), 0.5, false),
+            param(
+                "m",
+                ParamKind::Property(OscillatorProperty::Mass),
+                osc.mass,
+                false,
+            ),
+            param(
+                "k",
+                ParamKind::Property(OscillatorProperty::Stiffness),
+                osc.stiffness,
+                false,
+            ),
+        ];
+        let residuals =
+            Arc::new(SimulatedResponse::for_records(&records, true, false, false).unwrap());
+        let problem = FitProblem::new(
+            residuals,
+            ProblemParts {
+                oscillator: osc,
+                model: Box::new(model),
+                records,
+                layout,
+                sim: SimOptions {
+                    integrator: Integrator::Dopri5,
+                    rtol: 1e-12,
+                    atol: 1e-14,
+                    ..SimOptions::default()
+                },
+                parallel: false,
+            },
+        );
+        let p = [0.2, 0.3, 0.01, 0.5, osc.mass, osc.stiffness];
+        let u = problem.internal(&p);
+        let r0 = problem.residuals_at(&p).unwrap();
+        let before = problem.simulations();
+        let jac = problem.jacobian_internal(&u, &r0);
+        assert_eq!(problem.simulations() - before, 1, "one augmented run");
+        for j in 0..p.len() {
+            let h = 1e-6 * u[j].abs().max(1e-3);
+            let mut moved = u.clone();
+            moved[j] += h;
+            let plus = problem.residuals_at(&problem.physical(&moved)).unwrap();
+            moved[j] -= 2.0 * h;
+            let minus = problem.residuals_at(&problem.physical(&moved)).unwrap();
+            let expected: DVector<f64> = (plus - minus) / (2.0 * h);
+            let scale = expected.amax().max(1e-12);
+            let off = (jac.column(j) - &expected).amax() / scale;
+            assert!(off < 1e-3, "column {j}: off by {off:e} of {scale:e}");
+        }
     }
 }
