@@ -194,6 +194,29 @@ mod tests {
         }
     }
 
+    /// The first `columns` columns of `jac` (at internal point `u`) against central
+    /// differences of the residuals at relative step `rel`, each within 1e-3 of its scale.
+    fn assert_columns_match_differences<R: Residuals + 'static>(
+        problem: &FitProblem<R>,
+        u: &DVector<f64>,
+        jac: &nalgebra::DMatrix<f64>,
+        columns: usize,
+        rel: f64,
+    ) {
+        for j in 0..columns {
+            let h = rel * u[j].abs().max(1e-3);
+            let mut moved = u.clone();
+            moved[j] += h;
+            let plus = problem.residuals_at(&problem.physical(&moved)).unwrap();
+            moved[j] -= 2.0 * h;
+            let minus = problem.residuals_at(&problem.physical(&moved)).unwrap();
+            let expected: DVector<f64> = (plus - minus) / (2.0 * h);
+            let scale = expected.amax().max(1e-12);
+            let off = (jac.column(j) - &expected).amax() / scale;
+            assert!(off < 1e-3, "column {j}: off by {off:e} of {scale:e}");
+        }
+    }
+
     /// The fit's Jacobian with the sensitivity columns (law, property, x0, offset, another
     /// record's nuisance) against central differences of the residuals in internal
     /// coordinates, column by column; the release shift's column is the fit's forward
@@ -245,18 +268,7 @@ mod tests {
         let u = problem.internal(&p);
         let r0 = problem.residuals_at(&p).unwrap();
         let jac = problem.jacobian_internal(&u, &r0);
-        for j in 0..p.len() - 1 {
-            let h = 1e-5 * u[j].abs().max(1e-3);
-            let mut moved = u.clone();
-            moved[j] += h;
-            let plus = problem.residuals_at(&problem.physical(&moved)).unwrap();
-            moved[j] -= 2.0 * h;
-            let minus = problem.residuals_at(&problem.physical(&moved)).unwrap();
-            let expected: DVector<f64> = (plus - minus) / (2.0 * h);
-            let scale = expected.amax().max(1e-12);
-            let off = (jac.column(j) - &expected).amax() / scale;
-            assert!(off < 1e-3, "column {j}: off by {off:e} of {scale:e}");
-        }
+        assert_columns_match_differences(&problem, &u, &jac, p.len() - 1, 1e-5);
         // The offset's column is 1 on record 0's samples and 0 on record 1's.
         assert!(jac
             .column(3)
@@ -324,17 +336,6 @@ mod tests {
         let before = problem.simulations();
         let jac = problem.jacobian_internal(&u, &r0);
         assert_eq!(problem.simulations() - before, 1, "one augmented run");
-        for j in 0..p.len() {
-            let h = 1e-6 * u[j].abs().max(1e-3);
-            let mut moved = u.clone();
-            moved[j] += h;
-            let plus = problem.residuals_at(&problem.physical(&moved)).unwrap();
-            moved[j] -= 2.0 * h;
-            let minus = problem.residuals_at(&problem.physical(&moved)).unwrap();
-            let expected: DVector<f64> = (plus - minus) / (2.0 * h);
-            let scale = expected.amax().max(1e-12);
-            let off = (jac.column(j) - &expected).amax() / scale;
-            assert!(off < 1e-3, "column {j}: off by {off:e} of {scale:e}");
-        }
+        assert_columns_match_differences(&problem, &u, &jac, p.len(), 1e-6);
     }
 }
