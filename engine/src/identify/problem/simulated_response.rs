@@ -553,6 +553,24 @@ mod tests {
         }
     }
 
+    /// Under a fit's simulation options a record's simulations are held per sample: a
+    /// 19 000-sample record may take the steps per sample a 2 000-sample one may (a fixed
+    /// limit of 200 000 steps held the long one to 10.5 per sample and dropped every start
+    /// of a LuGre fit to a drive record).
+    #[test]
+    fn a_long_record_may_take_the_steps_per_sample_of_a_short_one() {
+        let osc = Oscillator::fmm();
+        let sim = crate::identify::values::fit_options::fit_sim_options();
+        let simulations = AtomicU64::new(0);
+        let at = Evaluation::new(&osc, &Coulomb { mu: 0.2 }, &sim, &simulations);
+        for samples in [2_000usize, 19_000, 200_000] {
+            let time: Vec<f64> = (0..samples).map(|i| i as f64 * 1e-3).collect();
+            let record = Record::new("r", time, vec![0.0; samples], 0.01);
+            let cap = within_allowance(&at, 0, &record, samples).max_steps;
+            assert_eq!(cap, STEPS_PER_SAMPLE * samples as u64, "{samples} samples");
+        }
+    }
+
     /// A displacement + acceleration record of the exact Coulomb solution: at the true
     /// parameters the stacked prediction is the exact x then a (to the integrator's
     /// accuracy), and the acceleration part is scaled by sigma_x / sigma_a.

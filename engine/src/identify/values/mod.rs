@@ -23,7 +23,7 @@ pub use layout::{BoundSide, FreeParam, ParamKind};
 pub use levels::FrictionLevels;
 pub use nuisance::{non_model_bound_keys, NuisanceKind, NuisanceValues, X0_RELATIVE_BOUND};
 pub use option_keys::OptionKeys;
-pub use options::{OscillatorParam, Progress, ProgressFn, FIT_MAX_STEPS};
+pub use options::{OscillatorParam, Progress, ProgressFn};
 pub use outcome::{worst_status, Check, Finding, StartOutcome, Status, TerminationReason};
 pub use param_options::ParamOptions;
 pub use result::{

@@ -25,8 +25,3 @@ pub struct Progress {
 
 /// A progress callback (e.g. the CLI's progress bar). Called from worker threads.
 pub type ProgressFn = Arc<dyn Fn(&Progress) + Send + Sync>;
-
-/// The step limit of each simulation during a fit. Trial parameters that make a model so
-/// stiff that a record needs more steps are rejected quickly instead of being integrated
-/// for seconds (the engine's own default allows 2e7 steps).
-pub const FIT_MAX_STEPS: u64 = 200_000;
