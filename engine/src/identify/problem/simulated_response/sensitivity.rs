@@ -194,6 +194,39 @@ mod tests {
         }
     }
 
+    /// Tight options, so that differences of the residuals are accurate.
+    fn tight() -> SimOptions {
+        SimOptions {
+            integrator: Integrator::Dopri5,
+            rtol: 1e-12,
+            atol: 1e-14,
+            ..SimOptions::default()
+        }
+    }
+
+    /// A velocity fit's problem of `model` on `osc` over `records` with `layout` at the
+    /// tight options; `(offset, shift, x0)` say which nuisance values the residuals carry.
+    fn velocity_problem(
+        osc: Oscillator,
+        model: Box<dyn frictionid_models::FrictionModel>,
+        records: Arc<[Record]>,
+        layout: Vec<FreeParam>,
+        (offset, shift, x0): (bool, bool, bool),
+    ) -> FitProblem<SimulatedResponse> {
+        let residuals = SimulatedResponse::for_records(&records, offset, shift, x0).unwrap();
+        FitProblem::new(
+            Arc::new(residuals),
+            ProblemParts {
+                oscillator: osc,
+                model,
+                records,
+                layout,
+                sim: tight(),
+                parallel: false,
+            },
+        )
+    }
+
     /// The first `columns` columns of `jac` (at internal point `u`) against central
     /// differences of the residuals at relative step `rel`, each within 1e-3 of its scale.
     fn assert_columns_match_differences<R: Residuals + 'static>(
@@ -225,13 +258,7 @@ mod tests {
     fn sensitivity_columns_match_central_differences_of_the_residuals() {
         let osc = Oscillator::fmm();
         let model = LuGre::default();
-        let opts = SimOptions {
-            integrator: Integrator::Dopri5,
-            rtol: 1e-12,
-            atol: 1e-14,
-            ..SimOptions::default()
-        };
-        let records: Arc<[Record]> = records(&osc, &model, &opts).into();
+        let records: Arc<[Record]> = records(&osc, &model, &tight()).into();
         let nuisance = |kind, record| ParamKind::Nuisance { kind, record };
         let layout = vec![
             param("sigma0", ParamKind::Model(0), 1e5, true),
@@ -251,19 +278,8 @@ mod tests {
             ),
             param("shift", nuisance(NuisanceKind::ReleaseShift, 0), 0.0, false),
         ];
-        let residuals =
-            Arc::new(SimulatedResponse::for_records(&records, true, true, true).unwrap());
-        let problem = FitProblem::new(
-            residuals,
-            ProblemParts {
-                oscillator: osc,
-                model: Box::new(model),
-                records,
-                layout,
-                sim: opts,
-                parallel: false,
-            },
-        );
+        let nuisance = (true, true, true);
+        let problem = velocity_problem(osc, Box::new(model), records, layout, nuisance);
         let p = [1e5, 0.2, 0.275, 0.0, 0.022, 0.0];
         let u = problem.internal(&p);
         let r0 = problem.residuals_at(&p).unwrap();
@@ -312,24 +328,8 @@ mod tests {
                 false,
             ),
         ];
-        let residuals =
-            Arc::new(SimulatedResponse::for_records(&records, true, false, false).unwrap());
-        let problem = FitProblem::new(
-            residuals,
-            ProblemParts {
-                oscillator: osc,
-                model: Box::new(model),
-                records,
-                layout,
-                sim: SimOptions {
-                    integrator: Integrator::Dopri5,
-                    rtol: 1e-12,
-                    atol: 1e-14,
-                    ..SimOptions::default()
-                },
-                parallel: false,
-            },
-        );
+        let nuisance = (true, false, false);
+        let problem = velocity_problem(osc, Box::new(model), records, layout, nuisance);
         let p = [0.2, 0.3, 0.01, 0.5, osc.mass, osc.stiffness];
         let u = problem.internal(&p);
         let r0 = problem.residuals_at(&p).unwrap();
