@@ -68,6 +68,19 @@ impl Default for SimOptions {
     }
 }
 
+#[cfg(test)]
+impl SimOptions {
+    /// Dopri5 at rtol 1e-12 and atol 1e-14: simulations whose differences in a parameter
+    /// are accurate enough to hold sensitivities against.
+    pub(crate) fn tight_dopri5() -> Self {
+        Self {
+            rtol: 1e-12,
+            atol: 1e-14,
+            ..Self::default()
+        }
+    }
+}
+
 /// The initial state at t = 0.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

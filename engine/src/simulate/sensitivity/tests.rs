@@ -10,12 +10,7 @@ use frictionid_models::{Coulomb, FrictionModel, LuGre, Stribeck};
 
 /// Tight options, so that the differences of plain runs are accurate.
 fn tight() -> SimOptions {
-    SimOptions {
-        integrator: Integrator::Dopri5,
-        rtol: 1e-12,
-        atol: 1e-14,
-        ..SimOptions::default()
-    }
+    SimOptions::tight_dopri5()
 }
 
 fn times(seconds: f64) -> Vec<f64> {

@@ -165,7 +165,7 @@ mod tests {
     use crate::identify::problem::least_squares::{FitProblem, ProblemParts};
     use crate::oscillator::Oscillator;
     use crate::record::Record;
-    use crate::simulate::{simulate, Initial, Integrator, SimOptions};
+    use crate::simulate::{simulate, Initial, SimOptions};
     use frictionid_models::LuGre;
     use nalgebra::DVector;
     use std::sync::Arc;
@@ -194,16 +194,6 @@ mod tests {
         }
     }
 
-    /// Tight options, so that differences of the residuals are accurate.
-    fn tight() -> SimOptions {
-        SimOptions {
-            integrator: Integrator::Dopri5,
-            rtol: 1e-12,
-            atol: 1e-14,
-            ..SimOptions::default()
-        }
-    }
-
     /// A velocity fit's problem of `model` on `osc` over `records` with `layout` at the
     /// tight options; `(offset, shift, x0)` say which nuisance values the residuals carry.
     fn velocity_problem(
@@ -221,7 +211,7 @@ mod tests {
                 model,
                 records,
                 layout,
-                sim: tight(),
+                sim: SimOptions::tight_dopri5(),
                 parallel: false,
             },
         )
@@ -258,7 +248,7 @@ mod tests {
     fn sensitivity_columns_match_central_differences_of_the_residuals() {
         let osc = Oscillator::fmm();
         let model = LuGre::default();
-        let records: Arc<[Record]> = records(&osc, &model, &tight()).into();
+        let records: Arc<[Record]> = records(&osc, &model, &SimOptions::tight_dopri5()).into();
         let nuisance = |kind, record| ParamKind::Nuisance { kind, record };
         let layout = vec![
             param("sigma0", ParamKind::Model(0), 1e5, true),
