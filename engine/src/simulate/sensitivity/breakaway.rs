@@ -46,13 +46,17 @@ pub(super) fn apply_breakaway_jump(
     };
     let n = 2;
     let x = *y.first()?;
+    let mut after = [0.0; 2];
+    dynamics.rhs(t_b, &[x, 0.0], &mut after, dir);
+    let a_after = after[1];
+    if a_after == 0.0 {
+        // The slip starts at the band's edge force (Coulomb, Stribeck): no jump to take.
+        return Some(());
+    }
     let departure = dir * dynamics.input.map_or(0.0, |u| u.slope_arriving_at(t_b));
     if !(departure.is_finite() && departure != 0.0) {
         return None;
     }
-    let mut after = [0.0; 2];
-    dynamics.rhs(t_b, &[x, 0.0], &mut after, dir);
-    let a_after = after[1];
     let dg_dx = -dir * dynamics.restoring_stiffness(x);
     for (&p, s) in terms.params().iter().zip(y[n..].chunks_exact_mut(n)) {
         let dg_dp = band_rate(dynamics, p, x, dir)?;
