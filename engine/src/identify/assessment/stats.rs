@@ -172,23 +172,34 @@ pub fn newey_west_filtered(
     bread * meat * bread * (n as f64 / dof)
 }
 
-/// A heteroskedasticity and autocorrelation consistent covariance and how it was made.
+/// Each estimate's heteroskedasticity and autocorrelation consistent variance, and how it
+/// was made.
 #[derive(Debug, Clone)]
 pub struct Hac {
-    /// The covariance.
-    pub matrix: DMatrix<f64>,
+    /// Each parameter's variance, in the order of the Jacobian's columns.
+    pub variances: Vec<f64>,
     /// The Bartlett lags.
     pub lags: usize,
     /// Each parameter's prewhitening filter.
     pub filters: Vec<Ar2>,
 }
 
-/// The HAC covariance with every choice made from the data: each parameter's scores
-/// g_t = J_t r_t prewhitened by their own Yule-Walker AR(2) filter ([`Ar2::of_scores`]; it
-/// follows AR(1) noise and a ringing's oscillatory correlation alike, and its gain at zero
-/// frequency is positive whatever the data), then Bartlett lags by Andrews' plug-in rule on
-/// what the filters leave (the most any parameter's scores ask for, at most `cap`), then
-/// [`newey_west_filtered`].
+/// Each estimate's HAC variance with every choice made from the data. An estimate moves
+/// with its influence series h_(t,k) = sum_a B_(k,a) J_(t,a) r_t (B the bread), so its
+/// variance is that series' long-run variance: each parameter's series is prewhitened by its
+/// own Yule-Walker AR(2) filter ([`Ar2::of_scores`]; it follows AR(1) noise and a ringing's
+/// oscillatory correlation alike, and its gain at zero frequency is positive whatever the
+/// data), then Bartlett lags by Andrews' plug-in rule on what the filters leave (the most
+/// any parameter's series asks for, at most `cap`), then [`newey_west_filtered`] with the
+/// identity as bread.
+///
+/// Filtering each column's scores J_(t,a) r_t by its own filter before the bread combines
+/// them (a diagonal VAR(2) on the scores) recolours two nearly collinear columns by
+/// different gains, and their large, opposite bread entries no longer cancel: on a linear
+/// model whose two estimates correlate -0.9999 under AR(1) noise that overstated their
+/// standard errors 1.7 times, and on a three-element GMS fit to a drive's friction force
+/// 2 to 3 times (widening them up to 1 268 times the classical ones, where each estimate's
+/// own series widens them up to 405 times).
 pub fn hac_covariance(
     j: &DMatrix<f64>,
     r: &[f64],
@@ -197,13 +208,19 @@ pub fn hac_covariance(
     cap: usize,
 ) -> Hac {
     let (n, p) = j.shape();
+    let influence = j * bread.transpose();
     let filters: Vec<Ar2> = (0..p)
         .map(|c| {
-            let scores: Vec<f64> = j.column(c).iter().zip(r).map(|(a, b)| a * b).collect();
+            let scores: Vec<f64> = influence
+                .column(c)
+                .iter()
+                .zip(r)
+                .map(|(a, b)| a * b)
+                .collect();
             Ar2::of_scores(&scores, segments)
         })
         .collect();
-    let filtered = filtered_scores(j, r, segments, &filters);
+    let filtered = filtered_scores(&influence, r, segments, &filters);
     let lags = (0..p)
         .map(|c| {
             let column: Vec<f64> = filtered.column(c).iter().copied().collect();
@@ -212,8 +229,10 @@ pub fn hac_covariance(
         })
         .max()
         .unwrap_or(1);
+    let identity = DMatrix::identity(p, p);
+    let matrix = newey_west_filtered(&influence, r, segments, lags, &identity, &filters);
     Hac {
-        matrix: newey_west_filtered(j, r, segments, lags, bread, &filters),
+        variances: matrix.diagonal().iter().copied().collect(),
         lags,
         filters,
     }
@@ -709,13 +728,81 @@ mod tests {
         let bread = DMatrix::from_element(1, 1, 1.0 / n as f64);
         let truth = 1.0 / (n as f64 * truth_filter.gain_at_zero().powi(2));
         let hac = hac_covariance(&j, &r, &[n], &bread, n / 4);
-        let got = hac.matrix[(0, 0)];
+        let got = hac.variances[0];
         assert!((got / truth - 1.0).abs() < 0.15, "{got} vs {truth}");
         assert!(
             (hac.filters[0].a1 - truth_filter.a1).abs() < 0.05,
             "{:?}",
             hac.filters
         );
+    }
+
+    /// Sum_s phi^|t - s| x_s for every t, by a forward and a backward recursion.
+    fn ar1_smoothed(x: &[f64], phi: f64) -> Vec<f64> {
+        let (mut forward, mut backward) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+        let mut acc = 0.0;
+        for (t, &v) in x.iter().enumerate() {
+            acc = v + phi * acc;
+            forward[t] = acc;
+        }
+        acc = 0.0;
+        for (t, &v) in x.iter().enumerate().rev() {
+            acc = v + phi * acc;
+            backward[t] = acc;
+        }
+        (0..x.len())
+            .map(|t| forward[t] + backward[t] - x[t])
+            .collect()
+    }
+
+    /// Least squares on two nearly collinear columns (a slow sine, and the same sine plus a
+    /// hundredth of a fast one: estimates correlated -0.9999) and a third, under AR(1) noise
+    /// (phi 0.5): each HAC standard error is within 15 % of the exact one,
+    /// B Xᵀ Sigma X B with Sigma_(t,s) = phi^|t-s| / (1 - phi^2). Filtering each column's
+    /// scores by its own filter overstated the collinear pair's by 1.7 times.
+    #[test]
+    fn hac_errors_of_nearly_collinear_columns_match_the_exact_covariance() {
+        use rand::rngs::StdRng;
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, Normal};
+        let (n, phi) = (20_000, 0.5);
+        let tau = 2.0 * std::f64::consts::PI;
+        let x = DMatrix::from_fn(n, 3, |t, c| {
+            let time = t as f64 / 1000.0;
+            let slow = (tau * 0.3 * time).sin();
+            match c {
+                0 => slow,
+                1 => slow + 1e-2 * (tau * 150.0 * time).sin(),
+                _ => (tau * 1.1 * time).cos(),
+            }
+        });
+        let mut rng = StdRng::seed_from_u64(1);
+        let normal = Normal::new(0.0, 1.0).unwrap();
+        let mut e = 0.0;
+        let noise: Vec<f64> = (0..n)
+            .map(|_| {
+                e = phi * e + normal.sample(&mut rng);
+                e
+            })
+            .collect();
+        let bread = (x.transpose() * &x).try_inverse().unwrap();
+        let noise_v = DVector::from_column_slice(&noise);
+        let beta = &bread * x.transpose() * &noise_v;
+        let r: Vec<f64> = (noise_v - &x * beta).iter().copied().collect();
+        let smoothed = DMatrix::from_fn(n, 3, |_, _| 0.0);
+        let smoothed = (0..3).fold(smoothed, |mut m, c| {
+            let column: Vec<f64> = x.column(c).iter().copied().collect();
+            m.set_column(c, &DVector::from_vec(ar1_smoothed(&column, phi)));
+            m
+        });
+        let exact = &bread * x.transpose() * smoothed * &bread / (1.0 - phi * phi);
+        let hac = hac_covariance(&x, &r, &[n], &bread, n / 4);
+        let correlation = exact[(0, 1)] / (exact[(0, 0)] * exact[(1, 1)]).sqrt();
+        assert!(correlation < -0.9998, "{correlation}");
+        for c in 0..3 {
+            let ratio = (hac.variances[c] / exact[(c, c)]).sqrt();
+            assert!((ratio - 1.0).abs() < 0.15, "column {c}: {ratio}");
+        }
     }
 
     /// The textbook lag sum of the meat, pair by pair within each segment.

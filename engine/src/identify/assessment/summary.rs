@@ -118,7 +118,7 @@ pub(crate) use super::diagnostics::SMOOTH_RESIDUALS;
 
 /// Widens the covariance for autocorrelated residuals: each standard error becomes the
 /// larger of the classical and the HAC one ([`stats::hac_covariance`]: Newey-West on each
-/// parameter's scores prewhitened by their own AR(2) filter, Bartlett lags by Andrews'
+/// estimate's influence series prewhitened by its own AR(2) filter, Bartlett lags by Andrews'
 /// plug-in rule, at most a quarter of the shortest record), keeping the correlations, when
 /// some error grows by [`MIN_WIDENING`] or more. Nothing here hangs on a noise estimate
 /// that a ringing can turn negative: the filters' gains at zero frequency are positive by
@@ -144,7 +144,7 @@ fn widen_for_autocorrelation(
     let hac = stats::hac_covariance(jac, r, segments, &bread, shortest / 4 + 1);
     let p = cov.std_errors.len();
     let factors: Vec<f64> = (0..p)
-        .map(|i| (hac.matrix[(i, i)] / cov.matrix[(i, i)]).sqrt())
+        .map(|i| (hac.variances[i] / cov.matrix[(i, i)]).sqrt())
         .map(|f| if f.is_finite() { f.max(1.0) } else { 1.0 })
         .collect();
     let widest = factors.iter().copied().fold(1.0, f64::max);
@@ -190,7 +190,7 @@ struct Widening {
 impl Widening {
     fn method(&self) -> String {
         format!(
-            "Newey-West on scores prewhitened by an AR(2) filter each, {} Bartlett lags by Andrews' plug-in rule",
+            "Newey-West on each estimate's influence prewhitened by an AR(2) filter of its own, {} Bartlett lags by Andrews' plug-in rule",
             self.lags
         )
     }
