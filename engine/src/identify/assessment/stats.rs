@@ -554,23 +554,28 @@ mod tests {
         assert_eq!(andrews_lags(f64::NAN, 100, 50), 1);
     }
 
-    /// AR(1) scores: the prewhitened estimate with the true phi recovers the long-run
-    /// variance that Bartlett's kernel alone underestimates at the same lag count.
-    #[test]
-    fn prewhitening_recovers_the_long_run_variance_of_ar1_scores() {
+    /// `n` samples of AR(1) noise e_t = `phi` e_(t-1) + w_t, w_t standard normal (seeded).
+    fn ar1_noise(n: usize, phi: f64, seed: u64) -> Vec<f64> {
         use rand::rngs::StdRng;
         use rand::SeedableRng;
         use rand_distr::{Distribution, Normal};
-        let (n, phi) = (200_000, 0.9);
-        let mut rng = StdRng::seed_from_u64(7);
+        let mut rng = StdRng::seed_from_u64(seed);
         let normal = Normal::new(0.0, 1.0).unwrap();
         let mut e = 0.0;
-        let r: Vec<f64> = (0..n)
+        (0..n)
             .map(|_| {
                 e = phi * e + normal.sample(&mut rng);
                 e
             })
-            .collect();
+            .collect()
+    }
+
+    /// AR(1) scores: the prewhitened estimate with the true phi recovers the long-run
+    /// variance that Bartlett's kernel alone underestimates at the same lag count.
+    #[test]
+    fn prewhitening_recovers_the_long_run_variance_of_ar1_scores() {
+        let (n, phi) = (200_000, 0.9);
+        let r = ar1_noise(n, phi, 7);
         let j = DMatrix::from_element(n, 1, 1.0);
         let bread = DMatrix::from_element(1, 1, 1.0 / n as f64);
         // Var(mean) of AR(1) with innovation variance 1: n^-1 / (1 - phi)^2.
@@ -762,9 +767,6 @@ mod tests {
     /// scores by its own filter overstated the collinear pair's by 1.7 times.
     #[test]
     fn hac_errors_of_nearly_collinear_columns_match_the_exact_covariance() {
-        use rand::rngs::StdRng;
-        use rand::SeedableRng;
-        use rand_distr::{Distribution, Normal};
         let (n, phi) = (20_000, 0.5);
         let tau = 2.0 * std::f64::consts::PI;
         let x = DMatrix::from_fn(n, 3, |t, c| {
@@ -776,15 +778,7 @@ mod tests {
                 _ => (tau * 1.1 * time).cos(),
             }
         });
-        let mut rng = StdRng::seed_from_u64(1);
-        let normal = Normal::new(0.0, 1.0).unwrap();
-        let mut e = 0.0;
-        let noise: Vec<f64> = (0..n)
-            .map(|_| {
-                e = phi * e + normal.sample(&mut rng);
-                e
-            })
-            .collect();
+        let noise = ar1_noise(n, phi, 1);
         let bread = (x.transpose() * &x).try_inverse().unwrap();
         let noise_v = DVector::from_column_slice(&noise);
         let beta = &bread * x.transpose() * &noise_v;
