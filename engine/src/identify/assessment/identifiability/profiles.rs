@@ -256,8 +256,9 @@ impl<R: Residuals + 'static> Profile<'_, R> {
         let centre = (self.best.u[j], best);
         let f = &self.reference.layout[j];
         // A side that cannot be evaluated at all (too stiff to simulate) counts as open.
-        let low = outer_crossing(centre, &below, floor + delta).map(|u| f.to_physical(u));
-        let high = outer_crossing(centre, &above, floor + delta).map(|u| f.to_physical(u));
+        let rise = Rise { floor, delta };
+        let low = outer_crossing(centre, &below, rise).map(|u| f.to_physical(u));
+        let high = outer_crossing(centre, &above, rise).map(|u| f.to_physical(u));
         let (class, bound) = match (low, high) {
             (Some(_), Some(_)) => (Identifiability::Determined, None),
             (Some(b), None) => (Identifiability::LowerBound, Some(b)),
@@ -268,23 +269,51 @@ impl<R: Residuals + 'static> Profile<'_, R> {
     }
 }
 
-/// Where the profile rises above `limit` for good: [`crossing`] from its last point within
-/// the limit (a point above it followed by one within is a re-optimisation that stopped in a
-/// poorer local minimum, not the edge of the interval).
-fn outer_crossing(centre: (f64, f64), points: &[(f64, f64)], limit: f64) -> Option<f64> {
-    match points.iter().rposition(|&(_, c)| c <= limit) {
-        Some(k) => crossing(points[k], &points[k + 1..], limit),
-        None => crossing(centre, points, limit),
+/// The rise of a profile that excludes a value: `delta` above the profile's least cost
+/// `floor`.
+#[derive(Debug, Clone, Copy)]
+struct Rise {
+    floor: f64,
+    delta: f64,
+}
+
+impl Rise {
+    /// The cost that excludes a value.
+    fn limit(&self) -> f64 {
+        self.floor + self.delta
+    }
+
+    /// The signed root of a cost's rise above the floor, sqrt(cost - floor): linear in the
+    /// parameter on each side of the optimum where the profile is quadratic.
+    fn root(&self, cost: f64) -> f64 {
+        (cost - self.floor).max(0.0).sqrt()
     }
 }
 
-/// Where the profile first rises above `limit` (linear between its points), from `centre`.
-fn crossing(centre: (f64, f64), points: &[(f64, f64)], limit: f64) -> Option<f64> {
+/// Where the profile rises above the limit for good: [`crossing`] from its last point within
+/// the limit (a point above it followed by one within is a re-optimisation that stopped in a
+/// poorer local minimum, not the edge of the interval).
+fn outer_crossing(centre: (f64, f64), points: &[(f64, f64)], rise: Rise) -> Option<f64> {
+    match points.iter().rposition(|&(_, c)| c <= rise.limit()) {
+        Some(k) => crossing(points[k], &points[k + 1..], rise),
+        None => crossing(centre, points, rise),
+    }
+}
+
+/// Where the profile first rises above the limit, from `centre`: between the last point
+/// within it and the first beyond, linear in the root of the rise (exact for a quadratic
+/// profile, which a profile is near its optimum). Linear in the cost itself, the crossing
+/// lies too close to the point within whenever the profile curves upwards: between the
+/// optimum and a step at four times the limit's rise it stood at a quarter of the step,
+/// where the rise is a quarter of the limit's, not at half.
+fn crossing(centre: (f64, f64), points: &[(f64, f64)], rise: Rise) -> Option<f64> {
+    let limit = rise.limit();
     let mut previous = centre;
     for &(u, c) in points {
         if c > limit {
-            let t = if c > previous.1 {
-                ((limit - previous.1) / (c - previous.1)).clamp(0.0, 1.0)
+            let (from, to, target) = (rise.root(previous.1), rise.root(c), rise.delta.sqrt());
+            let t = if to > from {
+                ((target - from) / (to - from)).clamp(0.0, 1.0)
             } else {
                 1.0
             };
@@ -394,25 +423,46 @@ mod tests {
             .all(|p| !p.bounded));
     }
 
+    /// A rise above a floor of 0 by `delta`.
+    fn rise(delta: f64) -> Rise {
+        Rise { floor: 0.0, delta }
+    }
+
     #[test]
-    fn the_crossing_interpolates_between_profile_points() {
-        // From cost 0 at u = 0 to 4 at u = 2: the limit 1.92 is crossed at u = 0.96.
-        let u = crossing((0.0, 0.0), &[(2.0, 4.0)], 1.92).unwrap();
-        assert!((u - 0.96).abs() < 1e-12);
-        assert_eq!(crossing((0.0, 0.0), &[(1.0, 0.5), (2.0, 1.0)], 1.92), None);
+    fn the_crossing_of_a_quadratic_profile_is_exact_between_its_points() {
+        // The profile u^2 (the cost of a linear least-squares parameter, in its standard
+        // errors) crosses the rise 1.92 at sqrt(1.92) = 1.386, from its optimum to a step at
+        // u = 2 (cost 4) or from a point within (u = 1) to one beyond (u = 3), either side.
+        let exact = 1.92_f64.sqrt();
+        let u = crossing((0.0, 0.0), &[(2.0, 4.0)], rise(1.92)).unwrap();
+        assert!((u - exact).abs() < 1e-12, "{u}");
+        let u = crossing((0.0, 0.0), &[(-1.0, 1.0), (-3.0, 9.0)], rise(1.92)).unwrap();
+        assert!((u + exact).abs() < 1e-12, "{u}");
+        // Above a floor the profile found below the optimum's cost, the same.
+        let raised = Rise {
+            floor: 10.0,
+            delta: 1.92,
+        };
+        let u = crossing((0.0, 10.0), &[(2.0, 14.0)], raised).unwrap();
+        assert!((u - exact).abs() < 1e-12, "{u}");
+        assert_eq!(
+            crossing((0.0, 0.0), &[(1.0, 0.5), (2.0, 1.0)], rise(1.92)),
+            None
+        );
     }
 
     #[test]
     fn the_outer_crossing_skips_a_point_above_the_limit_that_a_later_one_undercuts() {
-        // -1 rose to 3 (a poor local minimum), -2 fits again at 1, -3 rises to 5: the
-        // interval ends between -2 and -3, at -2.25.
-        let points = [(-1.0, 3.0), (-2.0, 1.0), (-3.0, 5.0)];
-        let u = outer_crossing((0.0, 0.0), &points, 2.0).unwrap();
-        assert!((u + 2.25).abs() < 1e-12);
-        assert_eq!(outer_crossing((0.0, 0.0), &points[..2], 2.0), None);
+        // -1 rose to 3 (a poor local minimum), -2 fits again at 1, -3 rises to 4: the
+        // interval ends between -2 and -3, where the root of the rise, 1 at -2 and 2 at -3,
+        // reaches sqrt(2): at -2 - (sqrt(2) - 1).
+        let points = [(-1.0, 3.0), (-2.0, 1.0), (-3.0, 4.0)];
+        let u = outer_crossing((0.0, 0.0), &points, rise(2.0)).unwrap();
+        assert!((u + 1.0 + 2.0_f64.sqrt()).abs() < 1e-12, "{u}");
+        assert_eq!(outer_crossing((0.0, 0.0), &points[..2], rise(2.0)), None);
         assert_eq!(
-            outer_crossing((0.0, 0.0), &points[..1], 2.0),
-            crossing((0.0, 0.0), &points[..1], 2.0)
+            outer_crossing((0.0, 0.0), &points[..1], rise(2.0)),
+            crossing((0.0, 0.0), &points[..1], rise(2.0))
         );
     }
 }
