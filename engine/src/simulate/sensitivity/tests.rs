@@ -498,16 +498,17 @@ fn slow_force() -> Input {
     sine_force(8.0, 0.5, 3.0)
 }
 
+/// `model` on the FMM stage under [`slow_force`], its plain runs by Dopri5.
+fn slowly_driven(model: Box<dyn FrictionModel>) -> World {
+    driven_world(model, Integrator::Dopri5, slow_force())
+}
+
 /// Coulomb under a slow force sticks at its start and at each turn until the input breaks
 /// it away: the level, the mass, the damping, the stiffness and the input's offset carry
 /// their sensitivities across every stick and breakaway.
 #[test]
 fn driven_coulomb_sensitivities_carry_across_sticks_and_breakaways() {
-    let world = driven_world(
-        Box::new(Coulomb { mu: 0.2 }),
-        Integrator::Dopri5,
-        slow_force(),
-    );
+    let world = slowly_driven(Box::new(Coulomb { mu: 0.2 }));
     let params = [
         SensitivityParam::Model(0),
         SensitivityParam::Property(OscillatorProperty::Mass),
@@ -525,11 +526,7 @@ fn driven_coulomb_sensitivities_carry_across_sticks_and_breakaways() {
 /// curve: mu_s moves the breakaways, mu_c, v_s and the viscous term the slides.
 #[test]
 fn driven_stribeck_sensitivities_carry_across_sticks_and_breakaways() {
-    let world = driven_world(
-        Box::new(Stribeck::default()),
-        Integrator::Dopri5,
-        slow_force(),
-    );
+    let world = slowly_driven(Box::new(Stribeck::default()));
     let params: Vec<_> = (0..Stribeck::default().params().len())
         .map(SensitivityParam::Model)
         .chain([SensitivityParam::Property(OscillatorProperty::Stiffness)])
@@ -606,11 +603,7 @@ impl frictionid_models::ParamGradients for BreakingCoulomb {
 /// scale after the first breakaway (checked: the jump is a good part of it).
 #[test]
 fn sensitivities_jump_where_the_input_breaks_a_stick_away() {
-    let world = driven_world(
-        Box::new(BreakingCoulomb::default()),
-        Integrator::Dopri5,
-        slow_force(),
-    );
+    let world = slowly_driven(Box::new(BreakingCoulomb::default()));
     let params = [
         SensitivityParam::Model(0),
         SensitivityParam::Model(1),
